@@ -1,0 +1,45 @@
+# specc — `make demo` and `make test` set everything up from a fresh clone (Python 3.11 + pip).
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+EXAMPLES := examples/hilare examples/generic examples/atrv
+
+.PHONY: demo test test-slow goldens bench style install clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/specc check $(EXAMPLES)
+	$(BIN)/specc compile examples/hilare -o generated
+	$(BIN)/python -c "import sys; sys.path.insert(0, 'generated'); import hilare; print('robot', hilare.ROBOT, 'modules:', ', '.join(hilare.MODULES))"
+
+test: $(STAMP)
+	$(BIN)/ruff check specc tests
+	$(BIN)/mypy
+	$(BIN)/python -m pytest
+
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -m slow
+
+goldens: $(STAMP)
+	$(BIN)/specc compile examples/hilare -o generated
+	$(BIN)/specc compile examples/generic -o generated
+	$(BIN)/specc compile examples/atrv -o generated
+
+bench: $(STAMP)
+	$(BIN)/python -m pytest -m bench --benchmark-enable -p no:randomly -s
+
+style: $(STAMP)
+	$(BIN)/ruff check specc tests
+	$(BIN)/ruff format --check specc tests || true
+	$(BIN)/mypy
+
+clean:
+	rm -rf $(VENV) build dist *.egg-info .pytest_cache .mypy_cache .ruff_cache

@@ -1,0 +1,1 @@
+"""Back ends: model (+ analyses) -> files of the generated robot package."""

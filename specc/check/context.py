@@ -1,0 +1,73 @@
+"""What every check pass looks things up in: the program's items indexed by kind and name."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeVar
+
+from specc.diagnostics import Diagnostic, did_you_mean, error
+from specc.model import nodes as m
+from specc.model.span import Span
+
+T = TypeVar("T")
+
+KIND_WORDS: dict[type, str] = {
+    m.Module: "module", m.Executive: "executive", m.RuleBase: "rules", m.Procedures: "procedures",
+    m.Domain: "domain", m.Problem: "problem", m.Fragment: "fragment", m.FtPlan: "ftplan",
+    m.System: "system",
+}
+
+
+@dataclass
+class Context:
+    program: m.Program
+    base_dirs: dict[str, Path] = field(default_factory=dict)  # file (as in spans) -> its folder
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.by_kind: dict[type, dict[str, Any]] = {kind: {} for kind in KIND_WORDS}
+        for item in self.program.items:
+            self.by_kind[type(item)].setdefault(item.name, item)
+
+    # ------------------------------------------------------------ lookups
+    def items(self, kind: type[T]) -> Iterator[T]:
+        return (item for item in self.program.items if isinstance(item, kind))
+
+    def named(self, kind: type[T]) -> dict[str, T]:
+        return self.by_kind[kind]
+
+    def lookup(self, kind: type[T], ref: m.Ref | str, span: Span, code: str) -> T | None:
+        """The item of `kind` called `ref`, or a diagnostic with a suggestion."""
+        name = ref if isinstance(ref, str) else ref.text
+        table = self.by_kind[kind]
+        if name in table:
+            return table[name]  # type: ignore[no-any-return]
+        word = KIND_WORDS[kind]
+        self.report(code, f"unknown {word} '{name}'{did_you_mean(name, table)}", span)
+        return None
+
+    def base_dir(self, span: Span) -> Path:
+        return self.base_dirs.get(span.file, Path.cwd())
+
+    # ------------------------------------------------------------ reporting
+    def report(self, code: str, message: str, span: Span, *notes: tuple[Span, str]) -> None:
+        self.diagnostics.append(error(code, message, span, *notes))
+
+    def warn(self, code: str, message: str, span: Span) -> None:
+        self.diagnostics.append(Diagnostic(code, message, span, "warning"))
+
+    def unknown(self, code: str, what: str, name: str, candidates: Any, span: Span, where: str = "") -> None:
+        self.report(code, f"unknown {what} '{name}'{where}{did_you_mean(name, candidates)}", span)
+
+    def duplicates(self, nodes: Any, what: str, key: str = "name") -> None:
+        """Report every node whose `key` was already used by an earlier node of the list."""
+        first: dict[str, Any] = {}
+        for node in nodes:
+            name = getattr(node, key)
+            if name in first:
+                self.report("duplicate-definition", f"{what} '{name}' is defined twice", node.span,
+                            (first[name].span, "first defined here"))
+            else:
+                first[name] = node

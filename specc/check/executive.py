@@ -1,0 +1,117 @@
+"""The executive (seed 000 ch. 3): services run existing module requests, conflicts name
+existing services, reflexes and parameters point at real requests and posters."""
+
+from __future__ import annotations
+
+from specc.check.codels import python_functions
+from specc.check.context import Context
+from specc.diagnostics import did_you_mean
+from specc.model import nodes as m
+
+
+def resolve_request(ctx: Context, ref: m.Ref) -> m.Request | None:
+    """`module.request` -> the request, or a diagnostic saying which part is wrong."""
+    if len(ref.parts) != 2:
+        ctx.report("bad-reference", f"'{ref.text}' should be written module.request", ref.span)
+        return None
+    module = ctx.lookup(m.Module, ref.parts[0], ref.span, "undefined-module")
+    if module is None:
+        return None
+    requests = {r.name: r for r in module.requests}
+    request = requests.get(ref.parts[1])
+    if request is None:
+        ctx.unknown("undefined-request", "request", ref.parts[1], requests, ref.span,
+                    f" in module '{module.name}'")
+    return request
+
+
+def resolve_poster(ctx: Context, ref: m.Ref) -> m.Poster | None:
+    """`module.Poster[.field]` -> the poster, or a diagnostic."""
+    if len(ref.parts) < 2:
+        ctx.report("bad-reference", f"'{ref.text}' should be written module.Poster or module.Poster.field", ref.span)
+        return None
+    module = ctx.lookup(m.Module, ref.parts[0], ref.span, "undefined-module")
+    if module is None:
+        return None
+    posters = {p.name: p for p in module.posters}
+    poster = posters.get(ref.parts[1])
+    if poster is None:
+        ctx.unknown("undefined-poster", "poster", ref.parts[1], posters, ref.span, f" in module '{module.name}'")
+        return None
+    if len(ref.parts) > 2:
+        exported = {d.parts[0] for d in poster.data}
+        if ref.parts[2] not in exported:
+            ctx.unknown("undefined-field", "poster field", ref.parts[2], exported, ref.span,
+                        f" in poster '{module.name}.{poster.name}'")
+    return poster
+
+
+def check(ctx: Context) -> None:
+    for executive in ctx.items(m.Executive):
+        check_executive(ctx, executive)
+
+
+def check_executive(ctx: Context, executive: m.Executive) -> None:
+    ctx.duplicates(executive.services, "service")
+    ctx.duplicates(executive.parameters, "parameter")
+    services = {s.name: s for s in executive.services}
+    functions = python_functions(ctx, executive.codel_module) if executive.codel_module else None
+    for ref in executive.rules:
+        ctx.lookup(m.RuleBase, ref, ref.span, "undefined-rules")
+    for service in executive.services:
+        if service.request is None:
+            ctx.report("missing-property", f"service '{service.name}' needs 'request: module.request;'",
+                       service.span)
+        else:
+            resolve_request(ctx, service.request)
+        for io in (service.input, service.output):
+            if io is None:
+                continue
+            if len(io.parts) >= 2:
+                resolve_poster(ctx, io)
+            elif functions is None:
+                ctx.report("missing-property",
+                           f"'{io.text}' is a function: give the executive 'codels: \"python.module\";'", io.span)
+            elif io.text not in functions:
+                ctx.report("undefined-codel", f"function '{io.text}' is not defined in "
+                           f"{executive.codel_module.value if executive.codel_module else ''}"
+                           f"{did_you_mean(io.text, functions)}", io.span)
+        timeout = service.timeout
+        if timeout is not None:
+            for value in (timeout.start, timeout.interm, timeout.final):
+                if value is not None and value.seconds <= 0:
+                    ctx.report("bad-duration", "a timeout must be longer than zero", value.span)
+        ctx.duplicates(service.conflicts, "conflict with service", key="service")
+        for conflict in service.conflicts:
+            if conflict.service not in services:
+                ctx.unknown("undefined-service", "service", conflict.service, services, conflict.span)
+    for parameter in executive.parameters:
+        if parameter.get is None and parameter.set is None:
+            ctx.report("missing-property", f"parameter '{parameter.name}' needs 'get:' and/or 'set:'",
+                       parameter.span)
+        if parameter.get is not None:
+            resolve_poster(ctx, parameter.get)
+        if parameter.set is not None:
+            request = resolve_request(ctx, parameter.set)
+            if request is not None and request.kind != "control":
+                ctx.report("not-a-control-request",
+                           f"SET-PARAM writes through a control request; '{parameter.set.text}' is '{request.kind}'",
+                           parameter.set.span)
+    for reflex in executive.reflexes:
+        check_reflex(ctx, reflex, services)
+
+
+def check_reflex(ctx: Context, reflex: m.Reflex, services: dict[str, m.Service]) -> None:
+    source = reflex.source
+    if len(source.parts) == 1:
+        if source.text not in services:
+            ctx.unknown("undefined-service", "service", source.text, services, source.span)
+    else:
+        resolve_request(ctx, source)
+    for action in reflex.actions:
+        target = action.target
+        if action.verb == "request":
+            resolve_request(ctx, target)
+        elif target.text not in services:
+            ctx.unknown("undefined-service", "service", target.text, services, target.span,
+                        f" (reflexes '{action.verb}' executive services)")

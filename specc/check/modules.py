@@ -1,0 +1,126 @@
+"""GenoM modules (seed 000 §2.4): requests, exec tasks, posters, types and codel states."""
+
+from __future__ import annotations
+
+from specc.check.context import Context
+from specc.model import nodes as m
+
+BUILTIN_TYPES = frozenset({"double", "float", "int", "long", "bool", "string", "char"})
+STANDARD_STATES = ("start", "exec", "end", "inter")
+TERMINAL_YIELDS = frozenset({"ether", "zombie"})
+EXEC_TASK_CODELS = ("init", "permanent")
+
+
+def check(ctx: Context) -> None:
+    numbers: dict[int | float, m.Module] = {}
+    for module in ctx.items(m.Module):
+        if module.number is not None:
+            other = numbers.setdefault(module.number.value, module)
+            if other is not module:
+                ctx.report("duplicate-module-number",
+                           f"modules '{other.name}' and '{module.name}' both use number {module.number.value}",
+                           module.number.span, (other.span, f"'{other.name}' declared here"))
+        check_module(ctx, module)
+
+
+def check_module(ctx: Context, module: m.Module) -> None:
+    ctx.duplicates(module.structs + module.enums, "type")  # type: ignore[operator]
+    ctx.duplicates(module.internal_data, "internal data field")
+    ctx.duplicates(module.requests, "request")
+    ctx.duplicates(module.exec_tasks, "exec task")
+    ctx.duplicates(module.posters, "poster")
+    types = BUILTIN_TYPES | {t.name for t in module.structs} | {e.name for e in module.enums}
+
+    def check_type(t: m.TypeRef) -> None:
+        if t.name not in types:
+            ctx.unknown("undefined-type", "type", t.name, types, t.span, f" in module '{module.name}'")
+
+    for struct in module.structs:
+        ctx.duplicates(struct.fields, "field")
+        for f in struct.fields:
+            check_type(f.type)
+    for f in module.internal_data:
+        check_type(f.type)
+    requests = {r.name: r for r in module.requests}
+    tasks = {t.name: t for t in module.exec_tasks}
+    for request in module.requests:
+        check_request(ctx, module, request, requests, tasks, check_type)
+    for task in module.exec_tasks:
+        check_exec_task(ctx, task)
+    # GenoM names a poster's activity by request or by codel (`activity: odoAndAsserv::exec`).
+    activities = (set(requests) | {c.function for t in module.exec_tasks for c in t.codels}
+                  | {c.function for r in module.requests for c in r.codels})
+    fields = {f.name for f in module.internal_data}
+    for poster in module.posters:
+        for data in poster.data:
+            if data.parts[0] not in fields:
+                ctx.unknown("undefined-field", "internal data field", data.parts[0], fields, data.span,
+                            f" in poster '{poster.name}'")
+        if poster.activity is not None and poster.activity.text not in activities:
+            ctx.unknown("undefined-activity", "activity", poster.activity.text, activities, poster.activity.span,
+                        " (a request or a permanent codel of this module)")
+        if poster.update is None:
+            ctx.report("missing-property", f"poster '{poster.name}' needs 'update: auto;' or 'update: manual;'",
+                       poster.span)
+
+
+def check_request(ctx: Context, module: m.Module, request: m.Request, requests: dict[str, m.Request],
+                  tasks: dict[str, m.ExecTask], check_type: object) -> None:
+    assert callable(check_type)
+    ctx.duplicates(request.inputs, "input")
+    ctx.duplicates(request.outputs, "output")
+    ctx.duplicates(request.codels, "codel for state", key="state")
+    for typed in request.inputs + request.outputs:
+        check_type(typed.type)
+    if request.kind is None:
+        ctx.report("missing-property", f"request '{request.name}' needs 'type: control;' or 'type: exec;'",
+                   request.span)
+    for other in request.incompatible_with:
+        if other.text != "all" and other.text not in requests:
+            ctx.unknown("undefined-request", "request", other.text, requests, other.span,
+                        f" in module '{module.name}'")
+    if request.kind == "control":
+        for codel in request.codels:
+            ctx.report("codel-on-control-request",
+                       f"control request '{request.name}' runs no activity, so it takes no "
+                       f"'codel {codel.state}'; use 'validate:' or make it 'type: exec;'", codel.span)
+        if request.task is not None:
+            ctx.report("codel-on-control-request",
+                       f"control request '{request.name}' runs in the module's control task; remove 'task:'",
+                       request.task.span)
+    if request.kind == "exec":
+        if request.task is None:
+            ctx.report("missing-exec-task",
+                       f"exec request '{request.name}' needs 'task: <exec_task>;' to run its activity",
+                       request.span)
+        elif request.task.text not in tasks:
+            ctx.unknown("undefined-exec-task", "exec task", request.task.text, tasks, request.task.span,
+                        f" in module '{module.name}'")
+        if not request.codels:
+            ctx.report("missing-codel", f"exec request '{request.name}' has no codel; give at least 'codel exec: f;'",
+                       request.span)
+    states = {c.state for c in request.codels}
+    reachable = states | set(STANDARD_STATES) | TERMINAL_YIELDS
+    for codel in request.codels:
+        for state in codel.yields:
+            if state not in reachable:
+                ctx.unknown("undefined-codel-state", "codel state", state, reachable, codel.span,
+                            f" (request '{request.name}' declares codels for: {', '.join(sorted(states))})")
+
+
+def check_exec_task(ctx: Context, task: m.ExecTask) -> None:
+    ctx.duplicates(task.codels, "codel for state", key="state")
+    for codel in task.codels:
+        if codel.state not in EXEC_TASK_CODELS:
+            ctx.report("bad-codel-state",
+                       f"an exec task runs only 'codel init' and 'codel permanent', not 'codel {codel.state}'",
+                       codel.span)
+    if task.period is None:
+        ctx.report("missing-property", f"exec task '{task.name}' needs a 'period:'", task.span)
+    for duration in (task.period, task.delay):
+        if duration is not None and duration.seconds <= 0 and duration is task.period:
+            ctx.report("bad-duration", "a period must be longer than zero", duration.span)
+        if duration is not None and duration.seconds < 0:
+            ctx.report("bad-duration", "a delay cannot be negative", duration.span)
+    if task.period is not None and task.delay is not None and task.delay.seconds >= task.period.seconds > 0:
+        ctx.report("bad-duration", "the delay must be shorter than the period", task.delay.span)

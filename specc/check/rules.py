@@ -1,0 +1,148 @@
+"""Kheops rule bases (seed 000 §3.7, annex A).
+
+Attributes that are neither inputs nor outputs are intermediate, declared or not (annex A:
+`diagn` and `difP` of Fig. 3.8 are never declared). What is checked: inputs are never
+restricted, outputs are all deduced by some rule, `@x` has an `init`, values compared with a
+declared symbolic attribute belong to its domain, and `foreach` variables are in scope.
+"""
+
+from __future__ import annotations
+
+from specc.check.context import Context
+from specc.model import nodes as m
+from specc.model.visitor import Visitor
+
+
+class RuleVisitor(Visitor):
+    """Collects, for one rule base, what each attribute is used for."""
+
+    def __init__(self, ctx: Context, base: m.RuleBase):
+        self.ctx = ctx
+        self.declared = {a.name: a for a in base.attributes}
+        self.constants = {c.name for c in base.constants}
+        self.inits = {i.name for i in base.inits}
+        self.loop_vars: list[str] = []
+        self.restricted: set[str] = set()
+        self.tested: set[str] = set()
+        self.in_action = False
+
+    def visit_RuleForeach(self, node: m.RuleForeach) -> None:
+        self.loop_vars.append(node.var)
+        self.generic_visit(node)
+        self.loop_vars.pop()
+
+    def visit_KForeach(self, node: m.KForeach) -> None:
+        self.loop_vars.append(node.var)
+        self.generic_visit(node)
+        self.loop_vars.pop()
+
+    def visit_Rule(self, node: m.Rule) -> None:
+        if node.index is not None:
+            self.check_index(node.index, node.span)
+        if node.condition is not None:
+            self.in_action = False
+            self.visit(node.condition)
+        self.in_action = True
+        for action in node.actions:
+            self.visit(action)
+        self.in_action = False
+
+    def visit_DoAssign(self, node: m.DoAssign) -> None:
+        self.restricted.add(node.target)
+        self.check_not_input(node.target, node.span)
+        self.in_action = False
+        self.visit(node.value)
+        self.in_action = True
+
+    def visit_DoCall(self, node: m.DoCall) -> None:
+        self.in_action = False
+        for arg in node.args:
+            self.visit(arg)
+        self.in_action = True
+
+    def visit_KCompare(self, node: m.KCompare) -> None:
+        self.use(node.attr)
+        self.check_value(node.attr, node.value, numeric=node.op not in ("==", "!="))
+        self.in_action, was = False, self.in_action
+        self.visit(node.value)
+        self.in_action = was
+
+    def visit_KMember(self, node: m.KMember) -> None:
+        self.use(node.attr)
+        for item in node.items:
+            if isinstance(item, (m.String, m.Number)):
+                self.check_value(node.attr, item, numeric=False)
+
+    def visit_KTrue(self, node: m.KTrue) -> None:
+        self.use(node.attr)
+
+    def visit_KFalse(self, node: m.KFalse) -> None:
+        self.use(node.attr)
+
+    def visit_AttrRef(self, node: m.AttrRef) -> None:
+        if node.name in self.constants or node.name in self.loop_vars:
+            return
+        self.use(node)
+
+    def use(self, attr: m.AttrRef) -> None:
+        if attr.index is not None:
+            self.check_index(attr.index, attr.span)
+        if attr.previous:
+            if attr.name not in self.inits:
+                self.ctx.report("missing-init",
+                                f"'@{attr.name}' reads the previous cycle's value: add 'init @{attr.name} = ...;'",
+                                attr.span)
+            return
+        if self.in_action:
+            self.restricted.add(attr.name)
+            self.check_not_input(attr.name, attr.span)
+        else:
+            self.tested.add(attr.name)
+
+    def check_not_input(self, name: str, span: object) -> None:
+        declared = self.declared.get(name)
+        if declared is not None and declared.role == "inputs":
+            assert isinstance(span, m.Span)
+            self.ctx.report("restrict-input", f"'{name}' is an input: rules may test it, not deduce it", span)
+
+    def check_index(self, index: str, span: m.Span) -> None:
+        if index not in self.loop_vars:
+            self.ctx.report("undefined-loop-variable",
+                            f"'{index}' is not a foreach variable here; wrap the rule in 'foreach {index} in [...]'",
+                            span)
+
+    def check_value(self, attr: m.AttrRef, value: m.KExpr, numeric: bool) -> None:
+        declared = self.declared.get(attr.name)
+        if declared is None or declared.domain is None:
+            return
+        domain = declared.domain
+        if isinstance(domain, m.SymbolDomain):
+            if numeric:
+                self.ctx.report("type-mismatch",
+                                f"'{attr.name}' is symbolic; compare it with == != oneof noneof, not an ordering",
+                                attr.span)
+            elif isinstance(value, (m.String, m.Number)):
+                allowed = [v.value for v in domain.values if isinstance(v, (m.String, m.Number))]
+                if value.value not in allowed:
+                    self.ctx.report("value-outside-domain",
+                                    f"{value.value!r} is not a value of '{attr.name}' "
+                                    f"(domain: {', '.join(repr(a) for a in allowed)})", value.span)
+        elif isinstance(domain, m.NumericDomain) and isinstance(value, m.String):
+            self.ctx.report("type-mismatch", f"'{attr.name}' is numeric; it cannot equal the string {value.value!r}",
+                            value.span)
+
+
+def check(ctx: Context) -> None:
+    for base in ctx.items(m.RuleBase):
+        ctx.duplicates(base.attributes, "attribute")
+        ctx.duplicates(base.constants, "constant")
+        ctx.duplicates([r for r in base.rules if isinstance(r, m.Rule)], "rule")
+        visitor = RuleVisitor(ctx, base)
+        visitor.visit(base)
+        for attr in base.attributes:
+            if attr.role == "outputs" and attr.name not in visitor.restricted:
+                ctx.report("output-never-set", f"no rule deduces output '{attr.name}'", attr.span)
+        for init in base.inits:
+            declared = visitor.declared.get(init.name)
+            if declared is None:
+                ctx.warn("init-undeclared", f"'init @{init.name}' for an attribute that is not declared", init.span)

@@ -1,0 +1,134 @@
+"""The `specc` command line."""
+
+from __future__ import annotations
+
+import difflib
+import sys
+import time
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+from rich.console import Console
+
+from specc.backends import package
+from specc.backends.manifest import Output
+from specc.diagnostics import render
+from specc.pipeline import Loaded, load
+from specc.syntax.printer import format_source
+
+app = typer.Typer(
+    name="specc",
+    help="Compile robot control-architecture specs (modules, executive, rules, procedures, "
+         "planning) into a Python package.\n\nExample: specc check examples/hilare",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    rich_markup_mode=None,
+)
+err = Console(stderr=True, highlight=False, soft_wrap=True)
+out = Console(highlight=False, soft_wrap=True)
+
+PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders searched for *.spec files.",
+                                                show_default=False)]
+
+
+def report(loaded: Loaded) -> int:
+    """Print every diagnostic; the exit code is 1 when any is an error."""
+    for diagnostic in loaded.diagnostics:
+        err.print(render(diagnostic, loaded.sources), markup=False)
+    errors = len(loaded.errors)
+    warnings = len(loaded.diagnostics) - errors
+    if errors or warnings:
+        err.print(f"{errors} error(s), {warnings} warning(s)", markup=False)
+    return 1 if errors else 0
+
+
+@app.command()
+def check(paths: PathsArg,
+          quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing when all is well.")] = False
+          ) -> None:
+    """Parse and check specs; report every problem at once.
+
+    Example: specc check examples/hilare examples/atrv/model1.spec
+    """
+    started = time.perf_counter()
+    loaded = load(paths)
+    code = report(loaded)
+    if code == 0 and not quiet:
+        count = len(loaded.sources)
+        items = len(loaded.program.items) if loaded.program else 0
+        out.print(f"ok: {count} file(s), {items} block(s) checked in "
+                  f"{(time.perf_counter() - started) * 1000:.0f} ms", markup=False)
+    raise typer.Exit(code)
+
+
+@app.command()
+def compile(paths: PathsArg,
+            output: Annotated[Path, typer.Option("--output", "-o", help="Folder receiving the robot package.")]
+            = Path("generated"),
+            robot: Annotated[Optional[str], typer.Option(help="Package name (default: the system block's name).")]
+            = None) -> None:
+    """Check specs, then write the robot's Python package into OUTPUT/<robot>/.
+
+    Example: specc compile examples/hilare -o generated
+    """
+    loaded = load(paths)
+    code = report(loaded)
+    if code or loaded.program is None:
+        raise typer.Exit(code or 1)
+    fallback = paths[0].resolve().name if paths[0].is_dir() else paths[0].stem
+    name = robot or package.robot_name(loaded.program, fallback)
+    if not name.isidentifier():
+        err.print(f"error: '{name}' is not a valid Python package name; pass --robot NAME", markup=False)
+        raise typer.Exit(1)
+    result = Output()
+    package.generate(loaded.program, name, result)
+    folder = output / name
+    written = result.write(folder)
+    out.print(f"wrote {len(written)} file(s) to {folder}", markup=False)
+
+
+@app.command()
+def fmt(paths: PathsArg,
+        check_only: Annotated[bool, typer.Option("--check", help="Change nothing; exit 1 if a file would change.")]
+        = False,
+        diff: Annotated[bool, typer.Option("--diff", help="Show what would change.")] = False) -> None:
+    """Rewrite specs in canonical form, keeping comments.
+
+    Example: specc fmt --check examples/
+    """
+    loaded = load(paths, check=False)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    changed = []
+    for source in loaded.program.files:
+        text = loaded.sources[source.path]
+        formatted = format_source(source, text, loaded.comments[source.path])
+        if formatted == text:
+            continue
+        changed.append(source.path)
+        if diff or check_only:
+            sys.stdout.writelines(difflib.unified_diff(
+                text.splitlines(keepends=True), formatted.splitlines(keepends=True),
+                f"{source.path} (now)", f"{source.path} (formatted)"))
+        if not check_only:
+            loaded.paths[source.path].write_text(formatted, encoding="utf-8")
+    verb = "would reformat" if check_only else "reformatted"
+    for path in changed:
+        out.print(f"{verb} {path}", markup=False)
+    if not changed:
+        out.print(f"{len(loaded.program.files)} file(s) already formatted", markup=False)
+    raise typer.Exit(1 if check_only and changed else 0)
+
+
+def main() -> None:
+    try:
+        app()
+    except KeyboardInterrupt:
+        err.print("interrupted", markup=False)
+        sys.exit(130)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,84 @@
+"""Diagnostics: gcc-style messages with stable codes, and the one exception root.
+
+Passes collect `Diagnostic`s and return them; only the CLI decides the exit code.
+Tests assert `code`, never the wording.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from specc.model.span import Span
+
+
+class SpeccError(Exception):
+    """Root of every exception specc raises on purpose; carries its diagnostics."""
+
+    def __init__(self, diagnostics: list[Diagnostic]):
+        self.diagnostics = diagnostics
+        super().__init__("\n".join(d.headline() for d in diagnostics))
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    code: str
+    message: str
+    span: Span
+    severity: str = "error"  # error | warning | note
+    notes: tuple[tuple[Span, str], ...] = field(default=())
+
+    def headline(self) -> str:
+        return f"{self.span}: {self.severity}: {self.message} [{self.code}]"
+
+
+def error(code: str, message: str, span: Span, *notes: tuple[Span, str]) -> Diagnostic:
+    return Diagnostic(code, message, span, "error", tuple(notes))
+
+
+def warning(code: str, message: str, span: Span) -> Diagnostic:
+    return Diagnostic(code, message, span, "warning")
+
+
+def did_you_mean(name: str, candidates: Iterable[str]) -> str:
+    """' (did you mean 'X'?)' when a close candidate exists, else ''."""
+    pool = sorted(set(candidates))
+    match = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
+    if not match:
+        lowered = {c.lower(): c for c in pool}
+        if name.lower() in lowered:
+            match = [lowered[name.lower()]]
+    return f" (did you mean '{match[0]}'?)" if match else ""
+
+
+def render(diagnostic: Diagnostic, sources: dict[str, str]) -> str:
+    """The headline, the source line and a `^~~~` marker under the span."""
+    lines = [diagnostic.headline()]
+    lines += _excerpt(diagnostic.span, sources)
+    for span, note in diagnostic.notes:
+        lines.append(f"{span}: note: {note}")
+        lines += _excerpt(span, sources)
+    return "\n".join(lines)
+
+
+def _excerpt(span: Span, sources: dict[str, str]) -> list[str]:
+    text = sources.get(span.file)
+    if text is None:
+        return []
+    source_lines = text.splitlines()
+    if not 1 <= span.line <= len(source_lines):
+        return []
+    line = source_lines[span.line - 1].expandtabs(1)
+    start = max(span.column - 1, 0)
+    if span.end_line == span.line and span.end_column > span.column:
+        width = span.end_column - span.column
+    else:
+        width = max(len(line) - start, 1)
+    width = max(1, min(width, max(len(line) - start, 1)))
+    return [f"    {line}", "    " + " " * start + "^" + "~" * (width - 1)]
+
+
+def sort_key(diagnostic: Diagnostic) -> tuple[str, int, int, str]:
+    s = diagnostic.span
+    return (s.file, s.line, s.column, diagnostic.code)

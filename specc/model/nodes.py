@@ -1,0 +1,869 @@
+"""The specc model: frozen dataclasses, one per language construct, each with a span.
+
+Spans never take part in equality, so `parse(print(model)) == model` compares meaning only.
+Blocks written as GenoM-style `key: value;` properties declare those keys in field metadata
+(see `prop`): the builder fills them and the printer writes them back from the same schema.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Any, Literal, Union
+
+from specc.model.span import NO_SPAN, Span
+
+ValueKind = Literal["ref", "refs", "int", "string", "duration", "typed", "symbol"]
+
+
+def span_field() -> Any:
+    return field(default=NO_SPAN, compare=False, repr=False)
+
+
+def prop(key: str, kind: ValueKind, *, choices: tuple[str, ...] = (), doc: str = "") -> Any:
+    """A field filled from the property `key: ...;`.
+
+    kind: ref (one name), refs (a list of names), int, string, duration, typed (a list of
+    `name: type`), symbol (one name out of `choices`).
+    """
+    default: Any = () if kind in ("refs", "typed") else None
+    return field(default=default, metadata={"key": key, "kind": kind, "choices": choices, "doc": doc})
+
+
+def property_fields(node_type: type) -> list[Any]:
+    return [f for f in fields(node_type) if "key" in f.metadata]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Node:
+    span: Span = span_field()
+
+
+# ---------------------------------------------------------------- values
+
+
+@dataclass(frozen=True, kw_only=True)
+class Ref(Node):
+    """A name, possibly dotted (`pilo.execPosterTraj`)."""
+
+    parts: tuple[str, ...]
+
+    @property
+    def text(self) -> str:
+        return ".".join(self.parts)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Number(Node):
+    value: int | float
+
+
+@dataclass(frozen=True, kw_only=True)
+class Duration(Node):
+    value: int | float
+    unit: str
+
+    SCALE = {"us": 1e-6, "ms": 1e-3, "s": 1.0, "min": 60.0}
+
+    @property
+    def seconds(self) -> float:
+        return float(self.value) * self.SCALE[self.unit]
+
+
+@dataclass(frozen=True, kw_only=True)
+class String(Node):
+    value: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class TypeRef(Node):
+    name: str
+    size: int | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class TypedName(Node):
+    name: str
+    type: TypeRef
+
+
+PropValue = Union[Ref, Number, Duration, String, TypedName]
+
+
+# ---------------------------------------------------------------- module (GenoM)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Field(Node):
+    name: str
+    type: TypeRef
+
+
+@dataclass(frozen=True, kw_only=True)
+class StructDecl(Node):
+    name: str
+    fields: tuple[Field, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class EnumDecl(Node):
+    name: str
+    values: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Codel(Node):
+    """`codel <state>: <function> [-> next, states];` — the codel run in that activity state."""
+
+    state: str
+    function: str
+    yields: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Request(Node):
+    name: str
+    kind: str | None = prop("type", "symbol", choices=("control", "exec"))
+    activity: Ref | None = prop("activity", "ref", doc="activity kind, e.g. filter")
+    inputs: tuple[TypedName, ...] = prop("input", "typed")
+    outputs: tuple[TypedName, ...] = prop("output", "typed")
+    validate: Ref | None = prop("validate", "ref", doc="validation codel (control function)")
+    task: Ref | None = prop("task", "ref", doc="exec task that runs the activity")
+    fail: tuple[Ref, ...] = prop("fail", "refs", doc="the only errors a codel may report")
+    incompatible_with: tuple[Ref, ...] = prop("incompatible_with", "refs")
+    doc: String | None = prop("doc", "string")
+    codels: tuple[Codel, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class ExecTask(Node):
+    name: str
+    period: Duration | None = prop("period", "duration")
+    delay: Duration | None = prop("delay", "duration")
+    priority: Number | None = prop("priority", "int")
+    stack: Number | None = prop("stack", "int")
+    resources: tuple[Ref, ...] = prop("resources", "refs")
+    doc: String | None = prop("doc", "string")
+    codels: tuple[Codel, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Poster(Node):
+    name: str
+    update: str | None = prop("update", "symbol", choices=("auto", "manual"))
+    data: tuple[Ref, ...] = prop("data", "refs", doc="internal data fields exported")
+    activity: Ref | None = prop("activity", "ref", doc="activity whose cycle updates the poster")
+    doc: String | None = prop("doc", "string")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Module(Node):
+    name: str
+    number: Number | None = prop("number", "int")
+    codel_module: String | None = prop("codels", "string", doc="Python module holding the codels")
+    doc: String | None = prop("doc", "string")
+    structs: tuple[StructDecl, ...] = ()
+    enums: tuple[EnumDecl, ...] = ()
+    internal_data: tuple[Field, ...] = ()
+    requests: tuple[Request, ...] = ()
+    exec_tasks: tuple[ExecTask, ...] = ()
+    posters: tuple[Poster, ...] = ()
+
+
+# ---------------------------------------------------------------- executive
+
+
+@dataclass(frozen=True, kw_only=True)
+class Timeouts(Node):
+    start: Duration | None = prop("start", "duration")
+    interm: Duration | None = prop("interm", "duration")
+    final: Duration | None = prop("final", "duration")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Conflict(Node):
+    service: str
+    policy: str  # "interrupt" | "wait"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Service(Node):
+    name: str
+    request: Ref | None = prop("request", "ref", doc="module.request the service runs")
+    input: Ref | None = prop("input", "ref", doc="input function or poster giving the request's input")
+    output: Ref | None = prop("output", "ref", doc="output function receiving the final reply")
+    doc: String | None = prop("doc", "string")
+    timeout: Timeouts | None = None
+    conflicts: tuple[Conflict, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Comparison(Node):
+    op: str
+    value: PropValue
+
+
+@dataclass(frozen=True, kw_only=True)
+class ReflexAction(Node):
+    verb: str  # request | abort | start
+    target: Ref
+
+
+@dataclass(frozen=True, kw_only=True)
+class Reflex(Node):
+    name: str | None
+    trigger: str  # reply | warning | interm
+    source: Ref
+    comparison: Comparison | None = None
+    actions: tuple[ReflexAction, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Parameter(Node):
+    """A GET-PARAM / SET-PARAM parameter of the executive (seed 000 §4.2.2)."""
+
+    name: str
+    get: Ref | None = prop("get", "ref", doc="poster or poster field read by GET-PARAM")
+    set: Ref | None = prop("set", "ref", doc="control request written by SET-PARAM")
+    doc: String | None = prop("doc", "string")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Executive(Node):
+    name: str
+    rules: tuple[Ref, ...] = prop("rules", "refs", doc="rule bases added to the generated controller")
+    codel_module: String | None = prop("codels", "string", doc="Python module of input/output functions")
+    doc: String | None = prop("doc", "string")
+    services: tuple[Service, ...] = ()
+    reflexes: tuple[Reflex, ...] = ()
+    parameters: tuple[Parameter, ...] = ()
+
+
+# ---------------------------------------------------------------- rules (Kheops)
+
+
+@dataclass(frozen=True, kw_only=True)
+class AttrRef(Node):
+    name: str
+    previous: bool = False
+    index: str | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class KBinary(Node):
+    op: str
+    left: KExpr
+    right: KExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class KNegate(Node):
+    operand: KExpr
+
+
+KExpr = Union[Number, String, AttrRef, KBinary, KNegate]
+
+
+@dataclass(frozen=True, kw_only=True)
+class KRange(Node):
+    low: KItem
+    high: KItem
+
+
+KItem = Union[String, Number, Ref, KRange]
+
+
+@dataclass(frozen=True, kw_only=True)
+class SymbolDomain(Node):
+    values: tuple[KItem, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class NumericDomain(Node):
+    low: KExpr | None = None
+    high: KExpr | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class BoolDomain(Node):
+    pass
+
+
+AttrDomain = Union[SymbolDomain, NumericDomain, BoolDomain]
+
+
+@dataclass(frozen=True, kw_only=True)
+class AttrDecl(Node):
+    role: str  # inputs | outputs | intermediate
+    name: str
+    domain: AttrDomain | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class ConstDecl(Node):
+    name: str
+    value: KExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class InitDecl(Node):
+    name: str
+    value: KExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class KCompare(Node):
+    attr: AttrRef
+    op: str
+    value: KExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class KMember(Node):
+    attr: AttrRef
+    op: str  # oneof | noneof
+    items: tuple[KItem, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class KTrue(Node):
+    attr: AttrRef
+
+
+@dataclass(frozen=True, kw_only=True)
+class KFalse(Node):
+    attr: AttrRef
+
+
+@dataclass(frozen=True, kw_only=True)
+class KNot(Node):
+    operand: Cond
+
+
+@dataclass(frozen=True, kw_only=True)
+class KAnd(Node):
+    operands: tuple[Cond, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class KOr(Node):
+    operands: tuple[Cond, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class KForeach(Node):
+    var: str
+    items: tuple[KItem, ...]
+    body: Cond
+
+
+Cond = Union[KCompare, KMember, KTrue, KNot, KAnd, KOr, KForeach]
+Restriction = Union[KCompare, KMember, KTrue, KFalse]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Restrict(Node):
+    restriction: Restriction
+
+
+@dataclass(frozen=True, kw_only=True)
+class DoAssign(Node):
+    target: str
+    value: KExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class DoCall(Node):
+    function: str
+    args: tuple[KExpr, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class DoAction(Node):
+    statements: tuple[DoAssign | DoCall, ...]
+
+
+Action = Union[Restrict, DoAction]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Rule(Node):
+    name: str
+    index: str | None = None
+    kind: str = "when"  # when | impossible | else
+    condition: Cond | None = None
+    actions: tuple[Action, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class RuleForeach(Node):
+    var: str
+    items: tuple[KItem, ...]
+    rules: tuple[Rule, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class RuleBase(Node):
+    name: str
+    constants: tuple[ConstDecl, ...] = ()
+    attributes: tuple[AttrDecl, ...] = ()
+    inits: tuple[InitDecl, ...] = ()
+    rules: tuple[Rule | RuleForeach, ...] = ()
+
+
+# ---------------------------------------------------------------- procedures (PRS)
+
+
+@dataclass(frozen=True, kw_only=True)
+class SymbolSet(Node):
+    values: tuple[str, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class DomainRef(Node):
+    name: str
+
+
+PDomain = Union[SymbolSet, DomainRef]
+
+
+@dataclass(frozen=True, kw_only=True)
+class TypeDecl(Node):
+    name: str
+    domain: PDomain
+
+
+@dataclass(frozen=True, kw_only=True)
+class PParam(Node):
+    name: str
+    domain: PDomain
+
+
+@dataclass(frozen=True, kw_only=True)
+class PredicateDecl(Node):
+    name: str
+    kinds: tuple[str, ...] = ()  # closed | functional | event | evaluable
+    params: tuple[PParam, ...] = ()
+    result: PDomain | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class ActionDecl(Node):
+    name: str
+    params: tuple[PParam, ...] = ()
+    result: PDomain | None = None
+    binding: String
+
+
+@dataclass(frozen=True, kw_only=True)
+class LogicVar(Node):
+    name: str  # with its leading $
+
+
+@dataclass(frozen=True, kw_only=True)
+class ProgramVar(Node):
+    name: str  # with its leading @
+
+
+@dataclass(frozen=True, kw_only=True)
+class SExp(Node):
+    head: str
+    args: tuple[SArg, ...] = ()
+
+
+SArg = Union[LogicVar, ProgramVar, Ref, Number, String, SExp]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Goal(Node):
+    op: str  # ! ? ^ => ~> # %
+    body: SExp
+
+
+@dataclass(frozen=True, kw_only=True)
+class Block(Node):
+    statements: tuple[Stmt, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class GoalStmt(Node):
+    goal: Goal
+
+
+@dataclass(frozen=True, kw_only=True)
+class IfStmt(Node):
+    condition: Goal
+    then: Block
+    orelse: Block | IfStmt | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class WhileStmt(Node):
+    condition: Goal
+    body: Block
+
+
+@dataclass(frozen=True, kw_only=True)
+class ParallelStmt(Node):
+    branches: tuple[Block, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ChooseStmt(Node):
+    branches: tuple[Block, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class AssignStmt(Node):
+    var: str
+    value: SArg
+
+
+@dataclass(frozen=True, kw_only=True)
+class FailStmt(Node):
+    pass
+
+
+Stmt = Union[GoalStmt, IfStmt, WhileStmt, ParallelStmt, ChooseStmt, AssignStmt, FailStmt]
+
+
+@dataclass(frozen=True, kw_only=True)
+class KAAction(Node):
+    call: SExp
+    result: LogicVar | ProgramVar | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class KA(Node):
+    name: str
+    invocation: Goal | SExp | None = None
+    context: Goal | SExp | None = None
+    body: Block | None = None
+    action: KAAction | None = None
+    effects: tuple[Goal, ...] = ()
+    documentation: String | None = None
+    properties: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Procedures(Node):
+    name: str
+    types: tuple[TypeDecl, ...] = ()
+    predicates: tuple[PredicateDecl, ...] = ()
+    actions: tuple[ActionDecl, ...] = ()
+    kas: tuple[KA, ...] = ()
+
+
+# ---------------------------------------------------------------- domain / problem (IxTeT)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Infinity(Node):
+    pass
+
+
+@dataclass(frozen=True, kw_only=True)
+class IxVar(Node):
+    name: str  # with its leading ?
+
+
+@dataclass(frozen=True, kw_only=True)
+class IxName(Node):
+    name: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class IxCall(Node):
+    function: str
+    args: tuple[IxExpr, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class IxBinary(Node):
+    op: str
+    left: IxExpr
+    right: IxExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class IxUnary(Node):
+    op: str
+    operand: IxExpr
+
+
+IxExpr = Union[Number, Infinity, IxVar, IxName, IxCall, IxBinary, IxUnary]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Interval(Node):
+    low: IxExpr
+    high: IxExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class SetLiteral(Node):
+    values: tuple[str, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class SetRef(Node):
+    name: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class SetUnion(Node):
+    parts: tuple[SetLiteral | SetRef, ...]
+
+
+DomainValue = Union[Interval, SetUnion]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Transition(Node):
+    before: IxExpr
+    after: IxExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class AttrValue(Node):
+    attribute: str
+    args: tuple[IxExpr, ...] = ()
+    value: IxExpr | Transition
+
+
+@dataclass(frozen=True, kw_only=True)
+class GoalMark(Node):
+    priority: IxExpr
+    weight: IxExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class Hold(Node):
+    attr: AttrValue
+    start: IxExpr
+    end: IxExpr
+    goal: GoalMark | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Event(Node):
+    kind: str | None  # explained | contingent | None
+    attr: AttrValue
+    time: IxExpr
+    goal: GoalMark | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Window(Node):
+    start: IxExpr
+    end: IxExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class ResourceUse(Node):
+    verb: str  # use | consume | produce
+    attr: AttrValue
+    when: IxExpr | Window
+    goal: GoalMark | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class VariableDecl(Node):
+    names: tuple[IxVar, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class TimepointDecl(Node):
+    names: tuple[str, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class InConstraint(Node):
+    expr: IxExpr
+    domain: DomainValue
+    contingent: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class RelConstraint(Node):
+    left: IxExpr
+    op: str
+    right: IxExpr
+    contingent: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class Implication(Node):
+    condition: InConstraint
+    consequence: InConstraint | RelConstraint
+
+
+@dataclass(frozen=True, kw_only=True)
+class MacroCall(Node):
+    name: str
+    args: tuple[IxExpr, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Include(Node):
+    name: str
+
+
+TStmt = Union[
+    VariableDecl, TimepointDecl, Hold, Event, ResourceUse, InConstraint, RelConstraint,
+    Implication, MacroCall,
+]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Constant(Node):
+    name: str
+    value: SetUnion
+
+
+@dataclass(frozen=True, kw_only=True)
+class Attribute(Node):
+    name: str
+    params: tuple[IxVar, ...] = ()
+    body: tuple[TStmt, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Resource(Node):
+    name: str
+    params: tuple[IxVar, ...] = ()
+    body: tuple[TStmt, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Macro(Node):
+    name: str
+    params: tuple[str, ...] = ()
+    body: tuple[TStmt, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Task(Node):
+    name: str
+    params: tuple[IxVar, ...] = ()
+    start: str = "t_start"
+    end: str = "t_end"
+    body: tuple[TStmt, ...] = ()
+    preemption: str | None = None
+
+
+DomainMember = Union[Include, Constant, Attribute, Resource, Macro, Task]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Domain(Node):
+    name: str
+    members: tuple[DomainMember, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Problem(Node):
+    name: str
+    domain: Ref
+    body: tuple[TStmt | Include, ...] = ()
+    preemption: str | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Fragment(Node):
+    name: str
+    members: tuple[DomainMember | TStmt, ...] = ()
+
+
+# ---------------------------------------------------------------- ftplan
+
+
+@dataclass(frozen=True, kw_only=True)
+class Planner(Node):
+    name: str
+    domain: Ref | None = prop("domain", "ref", doc="planning domain the planner uses")
+    heuristic: Ref | None = prop("heuristic", "ref", doc="flaw/resolver ordering heuristic")
+    doc: String | None = prop("doc", "string")
+
+
+@dataclass(frozen=True, kw_only=True)
+class AnalyzerCondition(Node):
+    kind: str  # during | at_start | at_end
+    task: str
+    args: tuple[IxExpr, ...]
+    requirement: AttrValue
+
+
+@dataclass(frozen=True, kw_only=True)
+class AnalyzerNoOverlap(Node):
+    tasks: tuple[str, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class AnalyzerMaxDuration(Node):
+    task: str
+    limit: Duration
+
+
+AnalyzerRule = Union[AnalyzerCondition, AnalyzerNoOverlap, AnalyzerMaxDuration]
+
+
+@dataclass(frozen=True, kw_only=True)
+class FactUpdate(Node):
+    attribute: str
+    args: tuple[IxExpr, ...]
+    value: IxExpr
+
+
+@dataclass(frozen=True, kw_only=True)
+class StateUpdate(Node):
+    report: str  # ended | failed | report
+    task: str
+    args: tuple[IxExpr, ...]
+    updates: tuple[FactUpdate, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class FtPlan(Node):
+    name: str
+    order: tuple[Ref, ...] = prop("planners", "refs", doc="planners in the order successive planning tries them")
+    policy: str | None = prop("policy", "symbol", choices=("successive", "concurrent"))
+    watchdog: Duration | None = prop("watchdog", "duration")
+    doc: String | None = prop("doc", "string")
+    planners: tuple[Planner, ...] = ()
+    analyzer: tuple[AnalyzerRule, ...] = ()
+    state_updates: tuple[StateUpdate, ...] = ()
+
+
+# ---------------------------------------------------------------- system
+
+
+@dataclass(frozen=True, kw_only=True)
+class System(Node):
+    name: str
+    modules: tuple[Ref, ...] = prop("modules", "refs")
+    executive: Ref | None = prop("executive", "ref")
+    supervisor: Ref | None = prop("supervisor", "ref")
+    planning: Ref | None = prop("planning", "ref", doc="the ftplan block")
+    missions: tuple[Ref, ...] = prop("missions", "refs", doc="problems the robot can be given")
+    world: String | None = prop("world", "string", doc="world file, relative to the spec")
+    doc: String | None = prop("doc", "string")
+
+
+Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment, FtPlan, System]
+
+
+@dataclass(frozen=True, kw_only=True)
+class SourceFile(Node):
+    path: str
+    items: tuple[Item, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Program(Node):
+    """Every file of one robot, in the order they were given."""
+
+    files: tuple[SourceFile, ...] = ()
+
+    @property
+    def items(self) -> tuple[Item, ...]:
+        return tuple(item for f in self.files for item in f.items)

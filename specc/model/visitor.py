@@ -1,0 +1,46 @@
+"""Walking the model: `visit_<NodeClass>` methods with a `generic_visit` fallback."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import fields
+from typing import Any
+
+from specc.model.nodes import Node
+
+
+def children(node: Node) -> Iterator[Node]:
+    """The direct child nodes of `node`, in field order."""
+    for f in fields(node):
+        if f.name == "span":
+            continue
+        value = getattr(node, f.name)
+        if isinstance(value, Node):
+            yield value
+        elif isinstance(value, tuple):
+            for element in value:
+                if isinstance(element, Node):
+                    yield element
+
+
+def walk(node: Node) -> Iterator[Node]:
+    """`node` and all its descendants, depth first, in source order."""
+    stack = [node]
+    while stack:
+        current = stack.pop()
+        yield current
+        stack.extend(reversed(list(children(current))))
+
+
+class Visitor:
+    """Dispatches on the node's class name; unhandled nodes visit their children."""
+
+    def visit(self, node: Node) -> Any:
+        method = getattr(self, "visit_" + type(node).__name__, None)
+        if method is None:
+            return self.generic_visit(node)
+        return method(node)
+
+    def generic_visit(self, node: Node) -> None:
+        for child in children(node):
+            self.visit(child)

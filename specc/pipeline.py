@@ -1,0 +1,65 @@
+"""The front end in one call: find the spec files, parse them all, then run every check."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lark import Token
+
+from specc.check import check_program
+from specc.diagnostics import Diagnostic, sort_key
+from specc.model import nodes as m
+from specc.syntax.parser import display_path, parse_text, read_source, spec_files
+
+
+@dataclass
+class Loaded:
+    program: m.Program | None
+    diagnostics: list[Diagnostic]
+    sources: dict[str, str] = field(default_factory=dict)  # file as shown in spans -> its text
+    comments: dict[str, list[Token]] = field(default_factory=dict)
+    paths: dict[str, Path] = field(default_factory=dict)  # file as shown in spans -> its path
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.diagnostics if d.severity == "error"]
+
+
+def load(paths: list[Path], *, check: bool = True) -> Loaded:
+    files, diagnostics = spec_files(paths)
+    loaded = Loaded(None, diagnostics)
+    sources: list[m.SourceFile] = []
+    for path in files:
+        shown = display_path(path)
+        text, problem = read_source(path)
+        if problem is not None:
+            loaded.diagnostics.append(problem)
+            continue
+        assert text is not None
+        loaded.sources[shown] = text
+        loaded.paths[shown] = path
+        result = parse_text(text, shown)
+        loaded.diagnostics.extend(result.diagnostics)
+        loaded.comments[shown] = result.comments
+        if result.source is not None:
+            sources.append(result.source)
+    parsed_all = len(sources) == len(files)
+    if sources:
+        loaded.program = m.Program(files=tuple(sources))
+    if check and parsed_all and loaded.program is not None:
+        base_dirs = {shown: path.resolve().parent for shown, path in loaded.paths.items()}
+        found = check_program(loaded.program, base_dirs)
+        loaded.diagnostics.extend(d for d in found if not _already_reported(d, loaded.diagnostics))
+    loaded.diagnostics.sort(key=sort_key)
+    return loaded
+
+
+def _already_reported(diagnostic: Diagnostic, earlier: list[Diagnostic]) -> bool:
+    """A property the builder rejected as malformed is not reported missing again."""
+    if diagnostic.code != "missing-property":
+        return False
+    s = diagnostic.span
+    return any(d.code == "bad-property-value" and d.span.file == s.file
+               and (s.line, s.column) <= (d.span.line, d.span.column) <= (s.end_line, s.end_column)
+               for d in earlier)

@@ -1,0 +1,1 @@
+"""Text <-> model: parser, builder, friendly parse errors, printer."""

@@ -1,0 +1,667 @@
+"""Model -> canonical text (`specc fmt`). `parse(print(model)) == model` for every model.
+
+Comments are not part of the model; the formatter hands them in with the source text and
+each is written back before (or at the end of the line of) the element it preceded.
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+from lark import Token
+
+from specc.model import nodes as m
+from specc.model.nodes import property_fields
+from specc.model.span import Span
+
+INDENT = "  "
+WRAP_AT = 100
+
+
+# ---------------------------------------------------------------- expressions (pure functions)
+
+
+def number(n: m.Number | int | float) -> str:
+    value = n.value if isinstance(n, m.Number) else n
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def string(s: m.String) -> str:
+    escaped = s.value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    return f'"{escaped}"'
+
+
+def type_ref(t: m.TypeRef) -> str:
+    return t.name if t.size is None else f"{t.name}[{t.size}]"
+
+
+def prop_value(v: m.PropValue) -> str:
+    if isinstance(v, m.Ref):
+        return v.text
+    if isinstance(v, m.Number):
+        return number(v)
+    if isinstance(v, m.Duration):
+        return f"{number(v.value)} {v.unit}"
+    if isinstance(v, m.String):
+        return string(v)
+    if isinstance(v, m.TypedName):
+        return f"{v.name}: {type_ref(v.type)}"
+    raise TypeError(v)
+
+
+_K_PRECEDENCE = {"+": 1, "-": 1, "*": 2, "/": 2}
+
+
+def kexpr(e: m.KExpr) -> str:
+    if isinstance(e, m.Number):
+        return number(e)
+    if isinstance(e, m.String):
+        return string(e)
+    if isinstance(e, m.AttrRef):
+        return attr_ref(e)
+    if isinstance(e, m.KNegate):
+        inner = kexpr(e.operand)
+        return f"-({inner})" if isinstance(e.operand, m.KBinary) else f"-{inner}"
+    if isinstance(e, m.KBinary):
+        level = _K_PRECEDENCE[e.op]
+        left, right = kexpr(e.left), kexpr(e.right)
+        if isinstance(e.left, m.KBinary) and _K_PRECEDENCE[e.left.op] < level:
+            left = f"({left})"
+        if isinstance(e.right, m.KBinary) and _K_PRECEDENCE[e.right.op] <= level:
+            right = f"({right})"
+        return f"{left} {e.op} {right}"
+    raise TypeError(e)
+
+
+def attr_ref(a: m.AttrRef) -> str:
+    text = ("@" if a.previous else "") + a.name
+    return text + (f"[{a.index}]" if a.index is not None else "")
+
+
+def kitem(i: m.KItem) -> str:
+    if isinstance(i, m.KRange):
+        return f"{kitem(i.low)}..{kitem(i.high)}"
+    if isinstance(i, m.Ref):
+        return i.text
+    if isinstance(i, m.Number):
+        return number(i)
+    return string(i)
+
+
+def klist(items: Iterable[m.KItem]) -> str:
+    return "[" + ", ".join(kitem(i) for i in items) + "]"
+
+
+def cond(c: m.Cond) -> str:
+    if isinstance(c, m.KOr):
+        return " | ".join(_cond_operand(o, m.KOr) for o in c.operands)
+    if isinstance(c, m.KAnd):
+        return ", ".join(_cond_operand(o, m.KAnd) for o in c.operands)
+    if isinstance(c, m.KNot):
+        inner = cond(c.operand)
+        return f"!({inner})" if isinstance(c.operand, (m.KAnd, m.KOr, m.KNot)) else f"!{inner}"
+    if isinstance(c, m.KForeach):
+        return f"foreach {c.var} in {klist(c.items)} ({cond(c.body)})"
+    return restriction(c)
+
+
+def _cond_operand(o: m.Cond, parent: type) -> str:
+    text = cond(o)
+    # `a | b` inside `,` needs parentheses, and so does a nested group of the same kind,
+    # or it would read back flattened.
+    if isinstance(o, (m.KOr, parent)):
+        return f"({text})"
+    return text
+
+
+def restriction(r: Any) -> str:
+    if isinstance(r, m.KCompare):
+        return f"{attr_ref(r.attr)} {r.op} {kexpr(r.value)}"
+    if isinstance(r, m.KMember):
+        return f"{attr_ref(r.attr)} {r.op} {klist(r.items)}"
+    if isinstance(r, m.KTrue):
+        return attr_ref(r.attr)
+    if isinstance(r, m.KFalse):
+        return "!" + attr_ref(r.attr)
+    raise TypeError(r)
+
+
+def action(a: m.Action) -> str:
+    if isinstance(a, m.Restrict):
+        return "restrict " + restriction(a.restriction)
+    statements = []
+    for s in a.statements:
+        if isinstance(s, m.DoAssign):
+            statements.append(f"{s.target} = {kexpr(s.value)}")
+        else:
+            statements.append(f"{s.function}({', '.join(kexpr(x) for x in s.args)})")
+    return "do {" + "; ".join(statements) + "}"
+
+
+def kdomain(d: m.AttrDomain) -> str:
+    if isinstance(d, m.SymbolDomain):
+        return "{" + ", ".join(kitem(v) for v in d.values) + "}"
+    if isinstance(d, m.BoolDomain):
+        return "bool"
+    if d.low is None or d.high is None:
+        return "number"
+    return f"[{kexpr(d.low)}, {kexpr(d.high)}]"
+
+
+def sarg(a: m.SArg) -> str:
+    if isinstance(a, (m.LogicVar, m.ProgramVar)):
+        return a.name
+    if isinstance(a, m.Ref):
+        return a.text
+    if isinstance(a, m.Number):
+        return number(a)
+    if isinstance(a, m.String):
+        return string(a)
+    return sexp(a)
+
+
+def sexp(s: m.SExp) -> str:
+    return "(" + " ".join([s.head, *(sarg(a) for a in s.args)]) + ")"
+
+
+def goal(g: m.Goal | m.SExp) -> str:
+    return sexp(g) if isinstance(g, m.SExp) else f"{g.op}{sexp(g.body)}"
+
+
+def pdomain(d: m.PDomain) -> str:
+    if isinstance(d, m.SymbolSet):
+        return "{" + ", ".join(d.values) + "}"
+    return d.name
+
+
+def pparams(params: Iterable[m.PParam]) -> str:
+    return "(" + ", ".join(f"{p.name}: {pdomain(p.domain)}" for p in params) + ")"
+
+
+_IX_PRECEDENCE = {"+.": 1, "-.": 1, "+": 1, "-": 1, "*.": 2, "/.": 2, "*": 2, "/": 2}
+
+
+def ixexpr(e: m.IxExpr) -> str:
+    if isinstance(e, m.Number):
+        return number(e)
+    if isinstance(e, m.Infinity):
+        return "oo"
+    if isinstance(e, (m.IxVar, m.IxName)):
+        return e.name
+    if isinstance(e, m.IxCall):
+        return f"{e.function}({ix_args(e.args)})"
+    if isinstance(e, m.IxUnary):
+        inner = ixexpr(e.operand)
+        return f"{e.op}({inner})" if isinstance(e.operand, m.IxBinary) else f"{e.op}{inner}"
+    if isinstance(e, m.IxBinary):
+        level = _IX_PRECEDENCE[e.op]
+        left, right = ixexpr(e.left), ixexpr(e.right)
+        if isinstance(e.left, m.IxBinary) and _IX_PRECEDENCE[e.left.op] < level:
+            left = f"({left})"
+        if isinstance(e.right, m.IxBinary) and _IX_PRECEDENCE[e.right.op] <= level:
+            right = f"({right})"
+        return f"{left} {e.op} {right}"
+    raise TypeError(e)
+
+
+def ix_args(args: Iterable[m.IxExpr]) -> str:
+    return ", ".join(ixexpr(a) for a in args)
+
+
+def ix_statement_expr(e: m.IxExpr) -> str:
+    """A constraint's left side: `(t_end - t_start) in [2, 10]` reads better with parentheses."""
+    return f"({ixexpr(e)})" if isinstance(e, m.IxBinary) else ixexpr(e)
+
+
+def attr_value(a: m.AttrValue) -> str:
+    value = a.value
+    shown = (f"({ixexpr(value.before)}, {ixexpr(value.after)})" if isinstance(value, m.Transition)
+             else ixexpr(value))
+    return f"{a.attribute}({ix_args(a.args)}): {shown}"
+
+
+def domain_value(d: m.DomainValue) -> str:
+    if isinstance(d, m.Interval):
+        return f"[{ixexpr(d.low)}, {ixexpr(d.high)}]"
+    return set_union(d)
+
+
+def set_union(d: m.SetUnion) -> str:
+    return " | ".join("{" + ", ".join(p.values) + "}" if isinstance(p, m.SetLiteral) else p.name
+                      for p in d.parts)
+
+
+def in_constraint(c: m.InConstraint) -> str:
+    return f"{ix_statement_expr(c.expr)} in {domain_value(c.domain)}"
+
+
+def rel_constraint(c: m.RelConstraint) -> str:
+    return f"{ix_statement_expr(c.left)} {c.op} {ixexpr(c.right)}"
+
+
+def goal_mark(g: m.GoalMark | None) -> str:
+    return "" if g is None else f" goal({ixexpr(g.priority)}, {ixexpr(g.weight)})"
+
+
+def tstmt(s: Any) -> str:
+    if isinstance(s, m.VariableDecl):
+        return "variable " + ", ".join(v.name for v in s.names) + ";"
+    if isinstance(s, m.TimepointDecl):
+        return "timepoint " + ", ".join(s.names) + ";"
+    if isinstance(s, m.Hold):
+        return f"hold({attr_value(s.attr)}, ({ixexpr(s.start)}, {ixexpr(s.end)})){goal_mark(s.goal)};"
+    if isinstance(s, m.Event):
+        kind = f"{s.kind} " if s.kind else ""
+        return f"{kind}event({attr_value(s.attr)}, {ixexpr(s.time)}){goal_mark(s.goal)};"
+    if isinstance(s, m.ResourceUse):
+        when = (f"({ixexpr(s.when.start)}, {ixexpr(s.when.end)})" if isinstance(s.when, m.Window)
+                else ixexpr(s.when))
+        return f"{s.verb}({attr_value(s.attr)}, {when}){goal_mark(s.goal)};"
+    if isinstance(s, m.InConstraint):
+        return ("contingent " if s.contingent else "") + in_constraint(s) + ";"
+    if isinstance(s, m.RelConstraint):
+        return ("contingent " if s.contingent else "") + rel_constraint(s) + ";"
+    if isinstance(s, m.Implication):
+        consequence = s.consequence
+        then = in_constraint(consequence) if isinstance(consequence, m.InConstraint) else rel_constraint(consequence)
+        return f"{in_constraint(s.condition)} => {then};"
+    if isinstance(s, m.MacroCall):
+        return f"{s.name}({ix_args(s.args)});"
+    if isinstance(s, m.Include):
+        return f"include {s.name};"
+    raise TypeError(s)
+
+
+# ---------------------------------------------------------------- layout with comments
+
+
+@dataclass
+class _Comments:
+    """Which comment goes where: before the first element after it, or at the end of a line."""
+
+    leading: dict[tuple[int, int], list[str]]
+    trailing: dict[tuple[int, int], list[str]]
+    rest: list[str]
+
+
+def _place_comments(comments: list[Token], anchors: list[tuple[int, int]], text: str) -> _Comments:
+    ordered = sorted(set(anchors))
+    source_lines = text.splitlines()
+    placed = _Comments({}, {}, [])
+    for c in comments:
+        position = (c.line or 1, c.column or 1)
+        before = source_lines[position[0] - 1][: position[1] - 1] if position[0] <= len(source_lines) else ""
+        body = str(c).rstrip()
+        if before.strip() and "\n" not in body:
+            i = bisect.bisect_right(ordered, position) - 1
+            if i >= 0:
+                placed.trailing.setdefault(ordered[i], []).append(body)
+                continue
+        i = bisect.bisect_left(ordered, position)
+        if i < len(ordered):
+            placed.leading.setdefault(ordered[i], []).append(body)
+        else:
+            placed.rest.append(body)
+    return placed
+
+
+class Printer:
+    def __init__(self, comments: _Comments | None = None, text: str = ""):
+        self.out: list[str] = []
+        self.depth = 0
+        self.comments = comments
+        self.source_lines = text.splitlines()
+        self.anchors: list[tuple[int, int]] = []
+
+    # -- output primitives
+    def line(self, text: str, anchor: Span | None = None) -> None:
+        key = self._anchor(anchor)
+        pad = INDENT * self.depth
+        if key is not None and self.comments is not None:
+            leading = self.comments.leading.pop(key, [])
+            if leading and self._blank_before(leading, key):
+                self.blank()
+            elif not leading and self._source_blank_before(key[0]):
+                self.blank()
+            for comment in leading:
+                self.out.extend(pad + part.strip() if i else pad + part
+                                for i, part in enumerate(comment.splitlines()))
+        text = pad + text
+        if key is not None and self.comments is not None:
+            for comment in self.comments.trailing.pop(key, []):
+                text += "  " + comment
+        self.out.append(text)
+
+    def _anchor(self, span: Span | None) -> tuple[int, int] | None:
+        if span is None or span.file == "<unknown>":
+            return None
+        key = (span.line, span.column)
+        self.anchors.append(key)
+        return key
+
+    def _blank_before(self, leading: list[str], key: tuple[int, int]) -> bool:
+        # A blank line in the source just above the first leading comment is kept.
+        for number_, text in enumerate(self.source_lines[: key[0] - 1]):
+            if text.strip() == leading[0].splitlines()[0].strip():
+                return number_ > 0 and not self.source_lines[number_ - 1].strip()
+        return False
+
+    def _source_blank_before(self, line: int) -> bool:
+        return line >= 2 and line - 2 < len(self.source_lines) and not self.source_lines[line - 2].strip()
+
+    def blank(self) -> None:
+        if self.out and self.out[-1].strip() and not self.out[-1].endswith("{"):
+            self.out.append("")
+
+    @contextmanager
+    def block(self, header: str, anchor: Span | None, footer: str = "}") -> Iterator[None]:
+        self.line(header + " {", anchor)
+        self.depth += 1
+        yield
+        self.depth -= 1
+        self.out.append(INDENT * self.depth + footer)
+
+    def props(self, node: Any) -> None:
+        for f in property_fields(type(node)):
+            value = getattr(node, f.name)
+            if value is None or value == ():
+                continue
+            values = value if isinstance(value, tuple) else (value,)
+            anchor = values[0].span if hasattr(values[0], "span") else None
+            shown = ", ".join(v if isinstance(v, str) else prop_value(v) for v in values)
+            self.line(f"{f.metadata['key']}: {shown};", anchor)
+
+    # -- files and items
+    def source_file(self, source: m.SourceFile) -> None:
+        for i, item in enumerate(source.items):
+            if i:
+                self.out.append("")
+            self.item(item)
+        if self.comments is not None:
+            for comment in self.comments.rest:
+                self.out.append(comment)
+
+    def item(self, item: m.Item) -> None:
+        method: Callable[[Any], None] = getattr(self, "p_" + type(item).__name__)
+        method(item)
+
+    # -- module
+    def p_Module(self, node: m.Module) -> None:
+        with self.block(f"module {node.name}", node.span):
+            self.props(node)
+            for s in node.structs:
+                with self.block(f"struct {s.name}", s.span):
+                    self.fields(s.fields)
+            for e in node.enums:
+                self.line(f"enum {e.name} {{ {', '.join(e.values)} }}", e.span)
+            if node.internal_data:
+                with self.block("internal_data", node.internal_data[0].span):
+                    self.fields(node.internal_data)
+            for r in node.requests:
+                with self.block(f"request {r.name}", r.span):
+                    self.props_and_codels(r)
+            for t in node.exec_tasks:
+                with self.block(f"exec_task {t.name}", t.span):
+                    self.props_and_codels(t)
+            for p in node.posters:
+                with self.block(f"poster {p.name}", p.span):
+                    self.props(p)
+
+    def fields(self, fields: Iterable[m.Field]) -> None:
+        for f in fields:
+            self.line(f"{f.name}: {type_ref(f.type)};", f.span)
+
+    def props_and_codels(self, node: m.Request | m.ExecTask) -> None:
+        self.props(node)
+        for c in node.codels:
+            yields = f" -> {', '.join(c.yields)}" if c.yields else ""
+            self.line(f"codel {c.state}: {c.function}{yields};", c.span)
+
+    # -- executive
+    def p_Executive(self, node: m.Executive) -> None:
+        with self.block(f"executive {node.name}", node.span):
+            self.props(node)
+            for s in node.services:
+                with self.block(f"service {s.name}", s.span):
+                    self.service(s)
+            for p in node.parameters:
+                with self.block(f"parameter {p.name}", p.span):
+                    self.props(p)
+            for r in node.reflexes:
+                self.line(self.reflex(r), r.span)
+
+    def service(self, s: m.Service) -> None:
+        self.props(s)
+        if s.timeout is not None:
+            with self.block("timeout", s.timeout.span):
+                self.props(s.timeout)
+        if s.conflicts:
+            with self.block("conflicts", s.conflicts[0].span):
+                for c in s.conflicts:
+                    self.line(f"{c.service}: {c.policy};", c.span)
+
+    @staticmethod
+    def reflex(r: m.Reflex) -> str:
+        name = f" {r.name}" if r.name else ""
+        comparison = f" {r.comparison.op} {prop_value(r.comparison.value)}" if r.comparison else ""
+        actions = ", ".join(f"{a.verb} {a.target.text}" for a in r.actions)
+        return f"reflex{name} on {r.trigger} {r.source.text}{comparison} => {actions};"
+
+    # -- rules
+    def p_RuleBase(self, node: m.RuleBase) -> None:
+        with self.block(f"rules {node.name}", node.span):
+            for c in node.constants:
+                self.line(f"const {c.name} = {kexpr(c.value)};", c.span)
+            for role, group in _runs(node.attributes, lambda a: a.role):
+                specs = ", ".join(a.name + (f": {kdomain(a.domain)}" if a.domain else "") for a in group)
+                self.line(f"{role} {specs};", group[0].span)
+            for i in node.inits:
+                self.line(f"init @{i.name} = {kexpr(i.value)};", i.span)
+            for r in node.rules:
+                if isinstance(r, m.RuleForeach):
+                    with self.block(f"foreach {r.var} in {klist(r.items)}", r.span):
+                        for x in r.rules:
+                            self.rule(x)
+                else:
+                    self.rule(r)
+
+    def rule(self, r: m.Rule) -> None:
+        name = r.name + (f"[{r.index}]" if r.index is not None else "")
+        actions = ", ".join(action(a) for a in r.actions)
+        if r.kind == "impossible":
+            assert r.condition is not None
+            self.line(f"{name}: impossible {cond(r.condition)};", r.span)
+        elif r.kind == "else":
+            self.line(f"{name}: else {actions};", r.span)
+        else:
+            assert r.condition is not None
+            text = f"{name}: {cond(r.condition)} ==> {actions};"
+            if len(text) + len(INDENT) * self.depth <= WRAP_AT:
+                self.line(text, r.span)
+            else:
+                self.line(f"{name}: {cond(r.condition)}", r.span)
+                self.out.append(INDENT * (self.depth + 2) + f"==> {actions};")
+
+    # -- procedures
+    def p_Procedures(self, node: m.Procedures) -> None:
+        with self.block(f"procedures {node.name}", node.span):
+            for t in node.types:
+                self.line(f"type {t.name} = {pdomain(t.domain)};", t.span)
+            for p in node.predicates:
+                kinds = "".join(k + " " for k in p.kinds)
+                result = f" -> {pdomain(p.result)}" if p.result else ""
+                self.line(f"predicate {kinds}{p.name}{pparams(p.params)}{result};", p.span)
+            for a in node.actions:
+                result = f" -> {pdomain(a.result)}" if a.result else ""
+                self.line(f"action {a.name}{pparams(a.params)}{result} = {string(a.binding)};", a.span)
+            for ka in node.kas:
+                with self.block(f"ka {ka.name}", ka.span):
+                    self.ka(ka)
+
+    def ka(self, ka: m.KA) -> None:
+        if ka.invocation is not None:
+            self.line(f"invocation: {goal(ka.invocation)};", ka.invocation.span)
+        if ka.context is not None:
+            self.line(f"context: {goal(ka.context)};", ka.context.span)
+        for p in ka.properties:
+            self.line(f"property: {p};")
+        if ka.action is not None:
+            result = f" -> {ka.action.result.name}" if ka.action.result else ""
+            self.line(f"action: {sexp(ka.action.call)}{result};", ka.action.span)
+        if ka.body is not None:
+            with self.block("body", ka.body.span):
+                self.statements(ka.body)
+        if ka.effects:
+            with self.block("effects", ka.effects[0].span):
+                for g in ka.effects:
+                    self.line(goal(g) + ";", g.span)
+        if ka.documentation is not None:
+            self.line(f"documentation: {string(ka.documentation)};", ka.documentation.span)
+
+    def statements(self, block: m.Block) -> None:
+        for s in block.statements:
+            self.statement(s)
+
+    def statement(self, s: m.Stmt) -> None:
+        if isinstance(s, m.GoalStmt):
+            self.line(goal(s.goal) + ";", s.span)
+        elif isinstance(s, m.IfStmt):
+            self.if_statement(s, "if")
+        elif isinstance(s, m.WhileStmt):
+            with self.block(f"while {goal(s.condition)}", s.span):
+                self.statements(s.body)
+        elif isinstance(s, (m.ParallelStmt, m.ChooseStmt)):
+            keyword = "parallel" if isinstance(s, m.ParallelStmt) else "choose"
+            with self.block(keyword, s.span):
+                for branch in s.branches:
+                    with self.block("branch", branch.span):
+                        self.statements(branch)
+        elif isinstance(s, m.AssignStmt):
+            self.line(f"assign {s.var} = {sarg(s.value)};", s.span)
+        elif isinstance(s, m.FailStmt):
+            self.line("fail;", s.span)
+        else:
+            raise TypeError(s)
+
+    def if_statement(self, s: m.IfStmt, keyword: str) -> None:
+        self.line(f"{keyword} {goal(s.condition)} {{", s.span)
+        self.depth += 1
+        self.statements(s.then)
+        self.depth -= 1
+        self._else_tail(s)
+
+    def _else_tail(self, s: m.IfStmt) -> None:
+        orelse = s.orelse
+        if orelse is None:
+            self.out.append(INDENT * self.depth + "}")
+        elif isinstance(orelse, m.IfStmt):
+            self.out.append(INDENT * self.depth + f"}} else if {goal(orelse.condition)} {{")
+            self.depth += 1
+            self.statements(orelse.then)
+            self.depth -= 1
+            self._else_tail(orelse)
+        else:
+            self.out.append(INDENT * self.depth + "} else {")
+            self.depth += 1
+            self.statements(orelse)
+            self.depth -= 1
+            self.out.append(INDENT * self.depth + "}")
+
+    # -- IxTeT
+    def p_Domain(self, node: m.Domain) -> None:
+        with self.block(f"domain {node.name}", node.span):
+            self.members(node.members)
+
+    def p_Fragment(self, node: m.Fragment) -> None:
+        with self.block(f"fragment {node.name}", node.span):
+            self.members(node.members)
+
+    def p_Problem(self, node: m.Problem) -> None:
+        footer = "}" + (f" {node.preemption}" if node.preemption else "")
+        with self.block(f"problem {node.name} for {node.domain.text}", node.span, footer):
+            self.members(node.body)
+
+    def members(self, members: Iterable[Any]) -> None:
+        for member in members:
+            if isinstance(member, m.Constant):
+                self.line(f"constant {member.name} = {set_union(member.value)};", member.span)
+            elif isinstance(member, (m.Attribute, m.Resource)):
+                keyword = "attribute" if isinstance(member, m.Attribute) else "resource"
+                params = ", ".join(p.name for p in member.params)
+                with self.block(f"{keyword} {member.name}({params})", member.span):
+                    self.members(member.body)
+            elif isinstance(member, m.Macro):
+                with self.block(f"macro {member.name}({', '.join(member.params)})", member.span):
+                    self.members(member.body)
+            elif isinstance(member, m.Task):
+                params = ", ".join(p.name for p in member.params)
+                footer = "}" + (f" {member.preemption}" if member.preemption else "")
+                with self.block(f"task {member.name}({params}) ({member.start}, {member.end})", member.span, footer):
+                    self.members(member.body)
+            else:
+                self.line(tstmt(member), member.span)
+
+    # -- ftplan and system
+    def p_FtPlan(self, node: m.FtPlan) -> None:
+        with self.block(f"ftplan {node.name}", node.span):
+            self.props(node)
+            for p in node.planners:
+                with self.block(f"planner {p.name}", p.span):
+                    self.props(p)
+            if node.analyzer:
+                with self.block("analyzer", node.analyzer[0].span):
+                    for rule in node.analyzer:
+                        self.analyzer_rule(rule)
+            if node.state_updates:
+                with self.block("state", node.state_updates[0].span):
+                    for update in node.state_updates:
+                        self.state_update(update)
+
+    def analyzer_rule(self, r: m.AnalyzerRule) -> None:
+        if isinstance(r, m.AnalyzerCondition):
+            self.line(f"{r.kind} {r.task}({ix_args(r.args)}) requires {attr_value(r.requirement)};", r.span)
+        elif isinstance(r, m.AnalyzerNoOverlap):
+            self.line(f"no_overlap {', '.join(r.tasks)};", r.span)
+        else:
+            self.line(f"max_duration {r.task} {prop_value(r.limit)};", r.span)
+
+    def state_update(self, u: m.StateUpdate) -> None:
+        updates = ", ".join(f"{f.attribute}({ix_args(f.args)}) := {ixexpr(f.value)}" for f in u.updates)
+        self.line(f"on {u.report} {u.task}({ix_args(u.args)}) => {updates};", u.span)
+
+    def p_System(self, node: m.System) -> None:
+        with self.block(f"system {node.name}", node.span):
+            self.props(node)
+
+
+def _runs(items: Iterable[Any], key: Callable[[Any], str]) -> list[tuple[str, list[Any]]]:
+    """Consecutive items with the same key, grouped (so `inputs a, b;` stays one line)."""
+    runs: list[tuple[str, list[Any]]] = []
+    for item in items:
+        k = key(item)
+        if runs and runs[-1][0] == k:
+            runs[-1][1].append(item)
+        else:
+            runs.append((k, [item]))
+    return runs
+
+
+def print_source(source: m.SourceFile) -> str:
+    """Canonical text of one file, without comments."""
+    printer = Printer()
+    printer.source_file(source)
+    return "\n".join(printer.out) + "\n"
+
+
+def format_source(source: m.SourceFile, text: str, comments: list[Token]) -> str:
+    """Canonical text of one file, keeping its comments (what `specc fmt` writes)."""
+    dry = Printer()
+    dry.source_file(source)
+    placed = _place_comments(comments, dry.anchors, text)
+    printer = Printer(placed, text)
+    printer.source_file(source)
+    return "\n".join(printer.out).rstrip("\n") + "\n"

@@ -1,0 +1,2 @@
+def check(sdi, request)
+    return "ok"

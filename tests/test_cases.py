@@ -1,0 +1,45 @@
+"""Data-first diagnostics tests: each case under tests/cases declares, on the line where a
+diagnostic must appear, `// expect: code[, code]`. A case is a .spec file or a folder."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from specc.pipeline import load
+
+CASES = Path(__file__).parent / "cases"
+EXPECT = re.compile(r"//\s*expect:\s*([a-z\-]+(?:\s*,\s*[a-z\-]+)*)\s*$")
+
+
+def case_paths() -> list[Path]:
+    return sorted(p for p in CASES.iterdir() if p.suffix == ".spec" or p.is_dir())
+
+
+def expectations(case: Path) -> set[tuple[str, int, str]]:
+    files = [case] if case.is_file() else sorted(case.rglob("*.spec"))
+    expected = set()
+    for file in files:
+        for number, line in enumerate(file.read_text().splitlines(), start=1):
+            match = EXPECT.search(line)
+            if match:
+                for code in match.group(1).split(","):
+                    expected.add((file.name, number, code.strip()))
+    return expected
+
+
+@pytest.mark.parametrize("case", case_paths(), ids=lambda p: p.name)
+def test_case_reports_exactly_the_expected_codes(case: Path) -> None:
+    loaded = load([case])
+    found = {(Path(d.span.file).name, d.span.line, d.code) for d in loaded.diagnostics}
+    expected = expectations(case)
+    assert expected, f"{case} declares no expectation"
+    assert found == expected, (
+        f"\nmissing: {sorted(expected - found)}\nunexpected: {sorted(found - expected)}")
+
+
+def test_at_least_thirty_distinct_codes_are_covered() -> None:
+    codes = {code for case in case_paths() for _, _, code in expectations(case)}
+    assert len(codes) >= 30, sorted(codes)
