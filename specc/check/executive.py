@@ -63,7 +63,13 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
             ctx.report("missing-property", f"service '{service.name}' needs 'request: module.request;'",
                        service.span)
         else:
-            resolve_request(ctx, service.request)
+            request = resolve_request(ctx, service.request)
+            ctx.duplicates(service.args, "argument")
+            inputs = {i.name for i in request.inputs} if request is not None else None
+            for arg in service.args if inputs is not None else ():
+                if arg.name not in inputs:
+                    ctx.unknown("undefined-input", "input", arg.name, inputs, arg.span,
+                                f" of request '{service.request.text}'")
         for io in (service.input, service.output):
             if io is None:
                 continue

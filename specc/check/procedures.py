@@ -11,17 +11,18 @@ from specc.model.visitor import Visitor
 
 # Heads PRS evaluates itself: connectives, comparisons and arithmetic.
 BUILTIN_HEADS = frozenset("& | ~ < <= > >= = + - * /".split())
+# Unbounded domains: fine for the interpreter, rejected later by the Petri-net translation.
+BUILTIN_DOMAINS = frozenset({"int", "float", "number", "string", "symbol"})
 
 
 class ProcedureVisitor(Visitor):
     def __init__(self, ctx: Context, procedures: m.Procedures):
         self.ctx = ctx
         self.types = {t.name: t for t in procedures.types}
-        self.signatures: dict[str, tuple[m.PParam, ...] | None] = {}
-        for p in procedures.predicates:
-            self.signatures[p.name] = p.params
-        for a in procedures.actions:
-            self.signatures[a.name] = a.params
+        self.signatures: dict[str, tuple[m.PParam, ...] | None] = {p.name: p.params for p in procedures.predicates}
+        # Primitive actions are called from a KA's `action:` only, in a namespace of their own
+        # (Fig. 4.2: goal SEND-REQUEST $REQUEST $ID is achieved by action SEND-REQUEST $REQUEST).
+        self.actions = {a.name: a.params for a in procedures.actions}
         # A goal achieved by a KA needs no predicate declaration: its invocation declares it.
         for ka in procedures.kas:
             invocation = ka.invocation
@@ -37,7 +38,21 @@ class ProcedureVisitor(Visitor):
             return None
         return self.domain_values(declared.domain) if declared.domain != domain else None
 
+    def visit_KAAction(self, node: m.KAAction) -> None:
+        call = node.call
+        params = self.actions.get(call.head)
+        if params is None:
+            self.ctx.unknown("undefined-action", "primitive action", call.head, self.actions, call.span,
+                             "; declare it with 'action NAME(...) = \"python.module.function\";'")
+        elif len(params) != len(call.args):
+            self.ctx.report("arity-mismatch",
+                            f"action '{call.head}' takes {len(params)} argument(s), {len(call.args)} given", call.span)
+        for arg in call.args:
+            self.visit(arg)
+
     def visit_DomainRef(self, node: m.DomainRef) -> None:
+        if node.name in BUILTIN_DOMAINS:
+            return
         if node.name not in self.types:
             self.ctx.unknown("undefined-type", "type", node.name, self.types, node.span)
 
@@ -62,10 +77,11 @@ class ProcedureVisitor(Visitor):
             return
         for arg, param in zip(node.args, params, strict=True):
             values = self.domain_values(param.domain)
-            if isinstance(arg, m.Ref) and values is not None and arg.text not in values:
+            shown = arg.text if isinstance(arg, m.Ref) else str(arg.value) if isinstance(arg, m.Number) else None
+            if shown is not None and values is not None and shown not in values:
                 self.ctx.report("value-outside-domain",
-                                f"'{arg.text}' is not in the domain of {node.head}'s '{param.name}' "
-                                f"({', '.join(values)}){did_you_mean(arg.text, values)}", arg.span)
+                                f"'{shown}' is not in the domain of {node.head}'s '{param.name}' "
+                                f"({', '.join(values)}){did_you_mean(shown, values)}", arg.span)
 
     def visit_Block(self, node: m.Block) -> None:
         for previous, statement in zip(node.statements, node.statements[1:], strict=False):
@@ -94,14 +110,25 @@ class ProcedureVisitor(Visitor):
 def check(ctx: Context) -> None:
     for procedures in ctx.items(m.Procedures):
         ctx.duplicates(procedures.types, "type")
-        ctx.duplicates(procedures.predicates + procedures.actions, "predicate or action")  # type: ignore[operator]
+        ctx.duplicates(procedures.predicates, "predicate")
+        ctx.duplicates(procedures.actions, "action")
         ctx.duplicates(procedures.kas, "KA")
         visitor = ProcedureVisitor(ctx, procedures)
         visitor.visit(procedures)
         for ka in procedures.kas:
             check_ka(ctx, ka)
         for action in procedures.actions:
-            check_binding(ctx, action)
+            check_binding(ctx, action.name, action.binding)
+        for predicate in procedures.predicates:
+            evaluable = "evaluable" in predicate.kinds
+            if evaluable and predicate.binding is None:
+                ctx.report("missing-binding", f"evaluable predicate '{predicate.name}' needs "
+                           f"'= \"python.module.function\"' to be evaluated", predicate.span)
+            elif predicate.binding is not None and not evaluable:
+                ctx.report("missing-binding", f"only an evaluable predicate is bound to Python; add 'evaluable' "
+                           f"to '{predicate.name}' or remove the binding", predicate.binding.span)
+            if predicate.binding is not None:
+                check_binding(ctx, predicate.name, predicate.binding)
 
 
 def check_ka(ctx: Context, ka: m.KA) -> None:
@@ -136,13 +163,13 @@ def _variables(node: m.Node | None) -> list[m.LogicVar | m.ProgramVar]:
     return [n for n in walk(node) if isinstance(n, (m.LogicVar, m.ProgramVar))]
 
 
-def check_binding(ctx: Context, action: m.ActionDecl) -> None:
-    module, _, function = action.binding.value.rpartition(".")
+def check_binding(ctx: Context, name: str, binding: m.String) -> None:
+    module, _, function = binding.value.rpartition(".")
     if not module or not function:
-        ctx.report("bad-binding", f"bind '{action.name}' to \"python.module.function\"", action.binding.span)
+        ctx.report("bad-binding", f"bind '{name}' to \"python.module.function\"", binding.span)
         return
-    functions = python_functions(ctx, m.String(value=module, span=action.binding.span))
+    functions = python_functions(ctx, m.String(value=module, span=binding.span))
     if functions is not None and function not in functions:
         ctx.report("undefined-codel",
                    f"function '{function}' is not defined in {module}{did_you_mean(function, functions)}",
-                   action.binding.span)
+                   binding.span)

@@ -186,6 +186,14 @@ class Conflict(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class Argument(Node):
+    """A constant input of the service's request (`args { speed: 0.3; }`)."""
+
+    name: str
+    value: PropValue
+
+
+@dataclass(frozen=True, kw_only=True)
 class Service(Node):
     name: str
     request: Ref | None = prop("request", "ref", doc="module.request the service runs")
@@ -193,6 +201,7 @@ class Service(Node):
     output: Ref | None = prop("output", "ref", doc="output function receiving the final reply")
     doc: String | None = prop("doc", "string")
     timeout: Timeouts | None = None
+    args: tuple[Argument, ...] = ()
     conflicts: tuple[Conflict, ...] = ()
 
 
@@ -444,6 +453,7 @@ class PredicateDecl(Node):
     kinds: tuple[str, ...] = ()  # closed | functional | event | evaluable
     params: tuple[PParam, ...] = ()
     result: PDomain | None = None
+    binding: String | None = None  # the Python function an evaluable predicate calls
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -7,6 +7,7 @@ diagnostics here, because only the builder still sees which key each value came 
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,6 +33,9 @@ class Section:
     name: str
     props: tuple[Prop, ...]
     span: Span
+
+
+SERVICE_SECTIONS = ("args", "conflicts", "timeout")
 
 
 def _present(children: list[Any]) -> list[Any]:
@@ -242,6 +246,7 @@ class Builder(Transformer[Token, Any]):
         props, rest = self.split(members)
         timeout: m.Timeouts | None = None
         conflicts: list[m.Conflict] = []
+        args: list[m.Argument] = []
         seen_sections: set[str] = set()
         for section in rest:
             if section.name in seen_sections:
@@ -254,14 +259,26 @@ class Builder(Transformer[Token, Any]):
                 timeout = self.apply_props(m.Timeouts, section.span, list(section.props))
             elif section.name == "conflicts":
                 conflicts.extend(self.conflict_entries(section))
+            elif section.name == "args":
+                args.extend(self.arguments(section))
             else:
                 self.diagnostics.append(error(
                     "unknown-property",
                     f"a service has no section '{section.name}'"
-                    f"{did_you_mean(section.name, ['timeout', 'conflicts'])}; known: conflicts, timeout",
+                    f"{did_you_mean(section.name, SERVICE_SECTIONS)}; known: {', '.join(SERVICE_SECTIONS)}",
                     section.span))
         return self.apply_props(m.Service, self.span(meta), props, name=str(name),
-                                timeout=timeout, conflicts=tuple(conflicts))
+                                timeout=timeout, args=tuple(args), conflicts=tuple(conflicts))
+
+    def arguments(self, section: Section) -> list[m.Argument]:
+        entries = []
+        for p in section.props:
+            if len(p.values) != 1:
+                self.diagnostics.append(error(
+                    "bad-property-value", f"argument '{p.key}' takes one value", p.values[0].span))
+                continue
+            entries.append(m.Argument(name=p.key, value=p.values[0], span=p.span))
+        return entries
 
     def conflict_entries(self, section: Section) -> list[m.Conflict]:
         entries = []
@@ -297,7 +314,7 @@ class Builder(Transformer[Token, Any]):
 
     def comparison(self, meta: Meta, children: list[Any]) -> m.Comparison:
         op, value = children
-        return m.Comparison(op=str(op), value=value, span=self.span(meta))
+        return m.Comparison(op=self.plain_operator(op), value=value, span=self.span(meta))
 
     def reflex_action(self, meta: Meta, children: list[Any]) -> m.ReflexAction:
         verb, target = children
@@ -371,18 +388,29 @@ class Builder(Transformer[Token, Any]):
         var, items, *rules = children
         return m.RuleForeach(var=str(var), items=items, rules=tuple(rules), span=self.span(meta))
 
-    def k_or(self, meta: Meta, children: list[Any]) -> m.KOr:
-        return m.KOr(operands=tuple(children), span=self.span(meta))
+    # An aliased `?rule` is not inlined by lark, so one operand arrives wrapped: unwrap it.
+    def k_or(self, meta: Meta, children: list[Any]) -> Any:
+        return children[0] if len(children) == 1 else m.KOr(operands=tuple(children), span=self.span(meta))
 
-    def k_and(self, meta: Meta, children: list[Any]) -> m.KAnd:
-        return m.KAnd(operands=tuple(children), span=self.span(meta))
+    def k_and(self, meta: Meta, children: list[Any]) -> Any:
+        return children[0] if len(children) == 1 else m.KAnd(operands=tuple(children), span=self.span(meta))
 
     def k_not(self, meta: Meta, children: list[Any]) -> m.KNot:
         return m.KNot(operand=children[0], span=self.span(meta))
 
+    def plain_operator(self, op: Token) -> str:
+        """Kheops and the executive write `+ - * / ==`; IxTeT's dotted forms belong to domains."""
+        text = str(op)
+        if text.endswith("."):
+            plain = {"=.": "=="}.get(text, text[:-1])
+            self.diagnostics.append(error(
+                "bad-operator", f"'{text}' is IxTeT notation; here write '{plain}'", self.tspan(op)))
+            return plain
+        return text
+
     def k_compare(self, meta: Meta, children: list[Any]) -> m.KCompare:
         attr, op, value = children
-        return m.KCompare(attr=attr, op=str(op), value=value, span=self.span(meta))
+        return m.KCompare(attr=attr, op=self.plain_operator(op), value=value, span=self.span(meta))
 
     def k_member(self, meta: Meta, children: list[Any]) -> m.KMember:
         attr, op, items = children
@@ -435,10 +463,13 @@ class Builder(Transformer[Token, Any]):
 
     def k_binary(self, meta: Meta, children: list[Any]) -> m.KBinary:
         left, op, right = children
-        return m.KBinary(op=str(op), left=left, right=right, span=self.span(meta))
+        return m.KBinary(op=self.plain_operator(op), left=left, right=right, span=self.span(meta))
 
-    def k_negate(self, meta: Meta, children: list[Any]) -> m.KNegate:
-        return m.KNegate(operand=children[0], span=self.span(meta))
+    def k_negate(self, meta: Meta, children: list[Any]) -> Any:
+        sign, operand = children
+        if str(sign) == "+":
+            return operand  # unary plus changes nothing
+        return m.KNegate(operand=operand, span=self.span(meta))
 
     # ------------------------------------------------------------ procedures (PRS)
     def procedures(self, meta: Meta, children: list[Any]) -> m.Procedures:
@@ -458,10 +489,11 @@ class Builder(Transformer[Token, Any]):
         while isinstance(children[0], tuple):
             kinds.append(children.pop(0)[0])
         name, *rest = children
+        binding = rest.pop() if rest and isinstance(rest[-1], m.String) else None
         params = tuple(r for r in rest if isinstance(r, m.PParam))
         result = next((r for r in rest if not isinstance(r, m.PParam)), None)
         return m.PredicateDecl(name=str(name), kinds=tuple(kinds), params=params, result=result,
-                               span=self.span(meta))
+                               binding=binding, span=self.span(meta))
 
     def pred_kind(self, meta: Meta, children: list[Token]) -> tuple[str]:
         return (str(children[0]),)
@@ -470,7 +502,7 @@ class Builder(Transformer[Token, Any]):
         name, domain = children
         return m.PParam(name=str(name), domain=domain, span=self.span(meta))
 
-    def psymset(self, meta: Meta, children: list[Token]) -> m.SymbolSet:
+    def psymset(self, meta: Meta, children: list[Any]) -> m.SymbolSet:
         return m.SymbolSet(values=tuple(str(c) for c in children), span=self.span(meta))
 
     def pdomain_ref(self, meta: Meta, children: list[Token]) -> m.DomainRef:
@@ -825,9 +857,12 @@ def parse_number(text: str) -> int | float:
     return int(text)
 
 
+_ESCAPES = {"n": "\n", "t": "\t"}
+
+
 def unquote(text: str) -> str:
-    body = text[1:-1]
-    return body.replace('\\"', '"').replace("\\\\", "\\")
+    """The value of a string literal: `\\n` and `\\t` are newline and tab, `\\x` is x."""
+    return re.sub(r"\\(.)", lambda match: _ESCAPES.get(match.group(1), match.group(1)), text[1:-1])
 
 
 def build(tree: Tree[Token], path: str) -> tuple[m.SourceFile, list[Diagnostic]]:

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import functools
+import hashlib
+import os
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -43,7 +46,19 @@ def parser() -> Lark:
         propagate_positions=True,
         maybe_placeholders=True,
         lexer_callbacks={"COMMENT": _COMMENTS.append, "BLOCK_COMMENT": _COMMENTS.append},
+        cache=str(cache_file()),
     )
+
+
+def cache_file() -> Path:
+    """Where lark keeps the analysed grammar (keyed by its text): loading it is ~5x faster."""
+    folder = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "specc"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        folder = Path(tempfile.gettempdir())
+    digest = hashlib.sha256(grammar_path().read_bytes()).hexdigest()[:16]
+    return folder / f"grammar-{digest}.lark.cache"
 
 
 @functools.lru_cache(maxsize=1)

@@ -297,8 +297,9 @@ def _place_comments(comments: list[Token], anchors: list[tuple[int, int]], text:
         before = source_lines[position[0] - 1][: position[1] - 1] if position[0] <= len(source_lines) else ""
         body = str(c).rstrip()
         if before.strip() and "\n" not in body:
+            # At the end of a line: it stays there if an element starts on that line.
             i = bisect.bisect_right(ordered, position) - 1
-            if i >= 0:
+            if i >= 0 and ordered[i][0] == position[0]:
                 placed.trailing.setdefault(ordered[i], []).append(body)
                 continue
         i = bisect.bisect_left(ordered, position)
@@ -359,6 +360,8 @@ class Printer:
 
     @contextmanager
     def block(self, header: str, anchor: Span | None, footer: str = "}") -> Iterator[None]:
+        """A `header {` ... `footer` block. Sections with no node of their own pass no anchor:
+        their first element's comments then stay with that element."""
         self.line(header + " {", anchor)
         self.depth += 1
         yield
@@ -399,7 +402,7 @@ class Printer:
             for e in node.enums:
                 self.line(f"enum {e.name} {{ {', '.join(e.values)} }}", e.span)
             if node.internal_data:
-                with self.block("internal_data", node.internal_data[0].span):
+                with self.block("internal_data", None):
                     self.fields(node.internal_data)
             for r in node.requests:
                 with self.block(f"request {r.name}", r.span):
@@ -436,11 +439,15 @@ class Printer:
 
     def service(self, s: m.Service) -> None:
         self.props(s)
+        if s.args:
+            with self.block("args", None):
+                for a in s.args:
+                    self.line(f"{a.name}: {prop_value(a.value)};", a.span)
         if s.timeout is not None:
             with self.block("timeout", s.timeout.span):
                 self.props(s.timeout)
         if s.conflicts:
-            with self.block("conflicts", s.conflicts[0].span):
+            with self.block("conflicts", None):
                 for c in s.conflicts:
                     self.line(f"{c.service}: {c.policy};", c.span)
 
@@ -494,7 +501,8 @@ class Printer:
             for p in node.predicates:
                 kinds = "".join(k + " " for k in p.kinds)
                 result = f" -> {pdomain(p.result)}" if p.result else ""
-                self.line(f"predicate {kinds}{p.name}{pparams(p.params)}{result};", p.span)
+                binding = f" = {string(p.binding)}" if p.binding else ""
+                self.line(f"predicate {kinds}{p.name}{pparams(p.params)}{result}{binding};", p.span)
             for a in node.actions:
                 result = f" -> {pdomain(a.result)}" if a.result else ""
                 self.line(f"action {a.name}{pparams(a.params)}{result} = {string(a.binding)};", a.span)
@@ -516,7 +524,7 @@ class Printer:
             with self.block("body", ka.body.span):
                 self.statements(ka.body)
         if ka.effects:
-            with self.block("effects", ka.effects[0].span):
+            with self.block("effects", None):
                 for g in ka.effects:
                     self.line(goal(g) + ";", g.span)
         if ka.documentation is not None:
@@ -613,11 +621,11 @@ class Printer:
                 with self.block(f"planner {p.name}", p.span):
                     self.props(p)
             if node.analyzer:
-                with self.block("analyzer", node.analyzer[0].span):
+                with self.block("analyzer", None):
                     for rule in node.analyzer:
                         self.analyzer_rule(rule)
             if node.state_updates:
-                with self.block("state", node.state_updates[0].span):
+                with self.block("state", None):
                     for update in node.state_updates:
                         self.state_update(update)
 

@@ -1,0 +1,148 @@
+"""Codels of VISUAL (seed 000 §5.2.4, Table 5.4): simulated perception and modelling."""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import random
+import tomllib
+
+NX = NY = 64  # invented grid size (4096 cells)
+CELL = 0.30  # m (§5.6)
+R_MIN, R_MAX = 0.5, 4.0  # m, invented perception range
+THETA_OPEN = math.radians(60)  # invented field of view
+MAX_OBJECTS = 16
+N_WORLD_OBJECTS = 10  # §5.6: 10 objects scattered in the room
+
+
+def reliability(r, theta):
+    """Fig 5.4: detection reliability f(r, θ) of an object at range r and bearing θ."""
+    if R_MIN <= r <= R_MAX and -THETA_OPEN <= 2 * theta <= THETA_OPEN:
+        return math.exp(-((r / R_MAX) ** 2) - (2 * theta / THETA_OPEN) ** 2)
+    return 0.0
+
+
+def initVisual(sdi):
+    """VisualTask init: an empty model, camera straight ahead."""
+    _reset(sdi)
+    sdi.pan = 0.0
+    return "exec"
+
+
+def resetModel(sdi, request):
+    """initModel: certainty 0 everywhere, no detected object (obstacles are kept)."""
+    _reset(sdi)
+    return "end"
+
+
+def openObstacleFile(sdi, request):
+    """readObstacles start: check the environment file (the one PLAN reads)."""
+    if not pathlib.Path(request.file).is_file():
+        return "FILE_NOT_FOUND"
+    sdi.modelFile = request.file
+    return "exec"
+
+
+def markObstacleCells(sdi, request):
+    """readObstacles exec: mark the cells meeting an obstacle's bounding box as not free,
+    then place the simulated objects at random in free cells (§5.2.4)."""
+    try:
+        world = tomllib.loads(pathlib.Path(sdi.modelFile).read_text())
+    except (OSError, tomllib.TOMLDecodeError):
+        return "FILE_NOT_FOUND"
+    sdi.model.free = [True] * (NX * NY)
+    for obstacle in world.get("obstacles", []):
+        xs = [p[0] for p in obstacle["polygon"]]
+        ys = [p[1] for p in obstacle["polygon"]]
+        for i in range(int(min(xs) / CELL), int(max(xs) / CELL) + 1):
+            for j in range(int(min(ys) / CELL), int(max(ys) / CELL) + 1):
+                if 0 <= i < NX and 0 <= j < NY:
+                    sdi.model.free[j * NX + i] = False
+    free_cells = [k for k in range(NX * NY) if sdi.model.free[k]]
+    chosen = random.sample(free_cells, min(N_WORLD_OBJECTS, len(free_cells), MAX_OBJECTS))
+    for slot, k in zip(sdi.worldObjects, chosen, strict=False):
+        slot.i, slot.j = k % NX, k // NX
+        slot.x, slot.y = (slot.i + 0.5) * CELL, (slot.j + 0.5) * CELL
+    sdi.nbWorldObjects = len(chosen)
+    return "ether"
+
+
+def setCameraPan(sdi, request):
+    """moveCamera: point the camera (angle relative to the robot's heading)."""
+    if not math.isfinite(request.pan):
+        return "BAD_ORIENTATION"
+    sdi.pan = math.atan2(math.sin(request.pan), math.cos(request.pan))
+    return "end"
+
+
+def grabImage(sdi, request):
+    """takeImage: store the pose from which the (simulated) image is taken."""
+    pose = sdi.read_poster("loco.Robot").robot
+    sdi.image.pose, sdi.image.pan, sdi.image.valid = pose, sdi.pan, True
+    return "end"
+
+
+def startSearch(sdi, request):
+    """searchObject start: an image must have been taken."""
+    return "exec" if sdi.image.valid else "NO_IMAGE"
+
+
+def analyseImage(sdi, request):
+    """searchObject exec: detect objects in view with probability f, update certainties."""
+    pose, found = sdi.image.pose, 0
+    heading = pose.theta + sdi.image.pan
+    for k in range(NX * NY):
+        x, y = (k % NX + 0.5) * CELL, (k // NX + 0.5) * CELL
+        r = math.hypot(x - pose.x, y - pose.y)
+        f = reliability(r, math.remainder(math.atan2(y - pose.y, x - pose.x) - heading, math.tau))
+        if f > 0.0:
+            c = sdi.model.certainty[k]
+            sdi.model.certainty[k] = c + (1.0 - c) * f
+    detected = {(o.i, o.j) for o in sdi.objects[: sdi.nbObjects]}
+    for obj in sdi.worldObjects[: sdi.nbWorldObjects]:
+        if (obj.i, obj.j) in detected:
+            continue
+        r = math.hypot(obj.x - pose.x, obj.y - pose.y)
+        bearing = math.remainder(math.atan2(obj.y - pose.y, obj.x - pose.x) - heading, math.tau)
+        if random.random() < reliability(r, bearing) and sdi.nbObjects < MAX_OBJECTS:
+            sdi.objects[sdi.nbObjects] = obj
+            sdi.nbObjects += 1
+            found += 1
+    sdi.image.valid = False
+    request.nbFound = found
+    return "ether"
+
+
+def nearestObject(sdi, request):
+    """getObject: return the nearest detected object, which is then "récupéré" (§5.6)."""
+    if sdi.nbObjects == 0:
+        return "NO_OBJECT"
+    robot = sdi.read_poster("loco.Robot").robot
+    objects = sdi.objects[: sdi.nbObjects]
+    k = min(
+        range(len(objects)),
+        key=lambda n: math.hypot(objects[n].x - robot.x, objects[n].y - robot.y),
+    )
+    sdi.nearest = objects[k]
+    sdi.objects[k] = objects[-1]
+    sdi.nbObjects -= 1
+    world = sdi.worldObjects[: sdi.nbWorldObjects]
+    for n, obj in enumerate(world):  # retrieved: no longer to be detected
+        if (obj.i, obj.j) == (sdi.nearest.i, sdi.nearest.j):
+            sdi.worldObjects[n] = world[-1]
+            sdi.nbWorldObjects -= 1
+            break
+    request.object = sdi.nearest
+    return "end"
+
+
+def abortVisual(sdi, request):
+    """Inter phase of readObstacles and searchObject."""
+    return "ether"
+
+
+def _reset(sdi):
+    sdi.model.nx, sdi.model.ny, sdi.model.cellSize = NX, NY, CELL
+    sdi.model.certainty = [0.0] * (NX * NY)
+    sdi.nbObjects = 0
+    sdi.image.valid = False
