@@ -11,8 +11,6 @@ from typing import Annotated, Optional
 import typer
 from rich.console import Console
 
-from specc.backends import package
-from specc.backends.manifest import Output
 from specc.diagnostics import render
 from specc.pipeline import Loaded, load
 from specc.syntax.printer import format_source
@@ -73,6 +71,9 @@ def compile(paths: PathsArg,
 
     Example: specc compile examples/hilare -o generated
     """
+    from specc.backends import package  # jinja2 and the back ends load only when compiling
+    from specc.backends.manifest import Output
+
     loaded = load(paths)
     code = report(loaded)
     if code or loaded.program is None:

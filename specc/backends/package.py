@@ -7,6 +7,7 @@ Output; this one only needs the model.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import PurePosixPath
 
 from specc.backends.env import render
 from specc.backends.manifest import HEADER, Output
@@ -22,21 +23,36 @@ class PackageView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=", ".join(sorted(f.path for f in self.program.files)))
+        return HEADER.format(sources=describe_sources(self.sources))
 
     def names(self, kind: type) -> list[str]:
         return sorted(item.name for item in self.program.items if isinstance(item, kind))
 
     @property
-    def blocks(self) -> list[tuple[str, list[str]]]:
+    def blocks(self) -> list[tuple[str, str]]:
+        """(CONSTANT, Python tuple literal of block names) for each block kind."""
         kinds = (("MODULES", m.Module), ("EXECUTIVES", m.Executive), ("RULE_BASES", m.RuleBase),
                  ("PROCEDURES", m.Procedures), ("DOMAINS", m.Domain), ("PROBLEMS", m.Problem),
                  ("FTPLANS", m.FtPlan), ("SYSTEMS", m.System))
-        return [(constant, self.names(kind)) for constant, kind in kinds]
+        return [(constant, python_tuple(self.names(kind))) for constant, kind in kinds]
 
     @property
     def sources(self) -> list[str]:
         return sorted(f.path for f in self.program.files)
+
+
+def python_tuple(names: list[str]) -> str:
+    return repr(tuple(names))
+
+
+def describe_sources(paths: list[str]) -> str:
+    """`examples/hilare/*.spec (12 files)` rather than twelve names on one line."""
+    folders = sorted({str(PurePosixPath(p).parent) for p in paths})
+    if len(paths) == 1:
+        return paths[0]
+    if len(folders) == 1:
+        return f"{folders[0]}/*.spec ({len(paths)} files)"
+    return f"{len(paths)} spec files"
 
 
 def robot_name(program: m.Program, fallback: str) -> str:

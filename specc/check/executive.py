@@ -65,8 +65,8 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
         else:
             request = resolve_request(ctx, service.request)
             ctx.duplicates(service.args, "argument")
-            inputs = {i.name for i in request.inputs} if request is not None else None
-            for arg in service.args if inputs is not None else ():
+            inputs = {i.name for i in request.inputs} if request is not None else set()
+            for arg in service.args if request is not None else ():
                 if arg.name not in inputs:
                     ctx.unknown("undefined-input", "input", arg.name, inputs, arg.span,
                                 f" of request '{service.request.text}'")

@@ -1,0 +1,100 @@
+"""The examples transcribed from the seeds check clean, are formatted, and say what the seeds say."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from specc.model import nodes as m
+from specc.pipeline import Loaded, load
+from specc.syntax.parser import parse_text
+from specc.syntax.printer import format_source
+from tests.conftest import EXAMPLE_ROBOTS, EXAMPLES
+
+
+def loaded(robot: str) -> Loaded:
+    result = load([EXAMPLES / robot])
+    assert result.program is not None
+    return result
+
+
+def items(robot: str, kind: type) -> dict[str, m.Node]:
+    return {i.name: i for i in loaded(robot).program.items if isinstance(i, kind)}  # type: ignore[union-attr]
+
+
+@pytest.mark.parametrize("robot", EXAMPLE_ROBOTS)
+def test_example_checks_without_errors_or_warnings(robot: str) -> None:
+    result = loaded(robot)
+    assert [d.headline() for d in result.diagnostics] == []
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.rglob("*.spec")), ids=lambda p: str(p.relative_to(EXAMPLES)))
+def test_example_is_in_canonical_format(path: Path) -> None:
+    text = path.read_text()
+    result = parse_text(text, str(path))
+    assert result.source is not None
+    assert format_source(result.source, text, result.comments) == text, "run: specc fmt examples/"
+
+
+def test_hilare_has_the_eight_modules_and_the_21_services_of_table_5_6() -> None:
+    modules = items("hilare", m.Module)
+    assert set(modules) == {"pilo", "plan", "avoid", "us", "loco", "arm", "visual", "explor"}
+    (executive,) = items("hilare", m.Executive).values()
+    assert isinstance(executive, m.Executive)
+    assert len(executive.services) == 21
+    services = {s.name: s for s in executive.services}
+    assert services["EXEC-TRAJ-GOAL"].request is not None
+    assert services["EXEC-TRAJ-GOAL"].request.text == "pilo.execPosterTraj"
+
+
+def test_loco_is_transcribed_as_in_section_2_4_1() -> None:
+    loco = items("hilare", m.Module)["loco"]
+    assert isinstance(loco, m.Module)
+    assert loco.number is not None and loco.number.value == 700
+    track = {r.name: r for r in loco.requests}["Track"]
+    assert track.kind == "exec"
+    assert [f.text for f in track.fail] == ["MANUAL_MODE", "SHOCK", "INVALID_REFERENCE", "LOW_BATTERY",
+                                            "POSTER_NOT_FOUND", "EMERGENCY_STOP"]
+    assert {c.state: c.function for c in track.codels} == {
+        "start": "findTrackedPoster", "exec": "pumpReference", "end": "smoothStopTrack", "inter": "smoothStopTrack"}
+    assert [r.text for r in track.incompatible_with] == ["Track"]
+    tasks = {t.name: t for t in loco.exec_tasks}
+    assert tasks["PumpTask"].period is not None and tasks["PumpTask"].period.seconds == pytest.approx(0.025)
+    assert tasks["CmdTask"].delay is not None and tasks["CmdTask"].delay.seconds == pytest.approx(0.010)
+    assert [r.text for r in tasks["CmdTask"].resources] == ["wheel", "odo", "gyro", "alarm"]
+
+
+def test_generic_system_follows_table_3_1() -> None:
+    executive = items("generic", m.Executive)["generic"]
+    assert isinstance(executive, m.Executive)
+    services = {s.name: s for s in executive.services}
+    assert {"A", "B", "C", "D", "E", "F", "G", "H", "I", "J"} <= set(services)
+    assert {c.service: c.policy for c in services["C"].conflicts} == {"A": "wait", "B": "wait", "C": "wait"}
+    assert services["D"].conflicts == ()
+    assert {c.policy for c in services["J"].conflicts} == {"interrupt"}
+    i_conflicts = {c.service: c.policy for c in services["I"].conflicts}
+    assert i_conflicts["A"] == "wait" and i_conflicts["E"] == "interrupt"
+
+
+def test_kheops_base_of_fig_3_8_has_its_fifteen_rules() -> None:
+    bases = items("generic", m.RuleBase)
+    diagnosis = next(b for b in bases.values() if isinstance(b, m.RuleBase) and len(b.rules) == 15)
+    assert isinstance(diagnosis, m.RuleBase)
+    assert [r.name for r in diagnosis.rules if isinstance(r, m.Rule)] == [f"r{i:02d}" for i in range(1, 16)]
+    assert {c.name for c in diagnosis.constants} == {"LOWDIFP", "HIGHDIFP"}
+
+
+def test_atrv_has_both_models_and_every_mission() -> None:
+    problems = items("atrv", m.Problem)
+    assert {f"M{k}_model{n}" for k in range(1, 5) for n in (1, 2)} <= set(problems)
+    model1 = items("atrv", m.Domain)["model1"]
+    assert isinstance(model1, m.Domain)
+    tasks = {t.name: t for t in model1.members if isinstance(t, m.Task)}
+    assert set(tasks) == {"MOVE", "MOVE_PAN_TILT_UNIT", "TAKE_PICTURE", "COMMUNICATE", "INIT_PTU_DRIVER",
+                          "INIT_MVT_GENERATION"}
+    assert tasks["MOVE"].preemption == "latePreemptive"
+    assert tasks["TAKE_PICTURE"].preemption == "nonPreemptive"
+    m1 = problems["M1_model1"]
+    assert isinstance(m1, m.Problem)
+    assert m1.preemption == "earlyPreemptive"
