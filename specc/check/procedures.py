@@ -141,8 +141,6 @@ def check_ka(ctx: Context, ka: m.KA) -> None:
         ctx.report("empty-ka-body", f"KA '{ka.name}' has neither a body nor a primitive 'action:'", ka.span)
     if ka.body is not None and not ka.body.statements:
         ctx.report("empty-ka-body", f"KA '{ka.name}' has an empty body", ka.body.span)
-    if isinstance(ka.invocation, m.Goal) and ka.invocation.op not in ("!", "?", "^", "=>", "~>", "#", "%"):
-        ctx.report("bad-invocation", "an invocation is a goal or a fact", ka.invocation.span)
     bound = {v.name for v in _variables(ka.invocation)} | {v.name for v in _variables(ka.context)}
     if ka.body is not None:
         bound |= {v.name for v in _variables(ka.body)}
