@@ -3,46 +3,47 @@ existing services, reflexes and parameters point at real requests and posters.""
 
 from __future__ import annotations
 
+from typing import Any
+
 from specc.check.codels import python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 
 
-def resolve_request(ctx: Context, ref: m.Ref) -> m.Request | None:
-    """`module.request` -> the request, or a diagnostic saying which part is wrong."""
-    if len(ref.parts) != 2:
-        ctx.report("bad-reference", f"'{ref.text}' should be written module.request", ref.span)
+def resolve_member(ctx: Context, ref: m.Ref, collection: str, word: str, code: str, shape: str) -> Any:
+    """`module.member...` -> the module's member named by the second part, or a diagnostic."""
+    if len(ref.parts) < 2:
+        ctx.report("bad-reference", f"'{ref.text}' should be written {shape}", ref.span)
         return None
     module = ctx.lookup(m.Module, ref.parts[0], ref.span, "undefined-module")
     if module is None:
         return None
-    requests = {r.name: r for r in module.requests}
-    request = requests.get(ref.parts[1])
-    if request is None:
-        ctx.unknown("undefined-request", "request", ref.parts[1], requests, ref.span,
-                    f" in module '{module.name}'")
+    members = {member.name: member for member in getattr(module, collection)}
+    member = members.get(ref.parts[1])
+    if member is None:
+        ctx.unknown(code, word, ref.parts[1], members, ref.span, f" in module '{module.name}'")
+    return member
+
+
+def resolve_request(ctx: Context, ref: m.Ref) -> m.Request | None:
+    if len(ref.parts) > 2:
+        ctx.report("bad-reference", f"'{ref.text}' should be written module.request", ref.span)
+        return None
+    request: m.Request | None = resolve_member(ctx, ref, "requests", "request", "undefined-request",
+                                               "module.request")
     return request
 
 
 def resolve_poster(ctx: Context, ref: m.Ref) -> m.Poster | None:
     """`module.Poster[.field]` -> the poster, or a diagnostic."""
-    if len(ref.parts) < 2:
-        ctx.report("bad-reference", f"'{ref.text}' should be written module.Poster or module.Poster.field", ref.span)
-        return None
-    module = ctx.lookup(m.Module, ref.parts[0], ref.span, "undefined-module")
-    if module is None:
-        return None
-    posters = {p.name: p for p in module.posters}
-    poster = posters.get(ref.parts[1])
-    if poster is None:
-        ctx.unknown("undefined-poster", "poster", ref.parts[1], posters, ref.span, f" in module '{module.name}'")
-        return None
-    if len(ref.parts) > 2:
+    poster: m.Poster | None = resolve_member(ctx, ref, "posters", "poster", "undefined-poster",
+                                             "module.Poster or module.Poster.field")
+    if poster is not None and len(ref.parts) > 2:
         exported = {d.parts[0] for d in poster.data}
         if ref.parts[2] not in exported:
             ctx.unknown("undefined-field", "poster field", ref.parts[2], exported, ref.span,
-                        f" in poster '{module.name}.{poster.name}'")
+                        f" in poster '{ref.parts[0]}.{poster.name}'")
     return poster
 
 

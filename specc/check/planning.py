@@ -13,7 +13,7 @@ from typing import Any
 
 from specc.check.context import Context
 from specc.model import nodes as m
-from specc.model.visitor import walk
+from specc.model.visitor import Visitor, walk
 
 VALUE_VAR = "?value"
 PROBLEM_TIMEPOINTS = ("t_start", "t_end")
@@ -112,11 +112,12 @@ class Scope:
     goals_allowed: bool = False
 
 
-class ScopeChecker:
+class ScopeChecker(Visitor):
     def __init__(self, ctx: Context, domain: DomainTables):
         self.ctx = ctx
         self.domain = domain
         self.symbols = domain.symbols()
+        self.scope = Scope("task")
 
     def scope_for(self, kind: str, body: Iterable[Any], params: Iterable[m.IxVar] = (),
                   timepoints: Iterable[str] = (), macro_params: Iterable[str] = ()) -> Scope:
@@ -135,46 +136,51 @@ class ScopeChecker:
         return scope
 
     def statements(self, body: Iterable[Any], scope: Scope) -> None:
+        self.scope = scope
         for statement in body:
-            self.statement(statement, scope)
+            goal = getattr(statement, "goal", None)
+            if goal is not None and not scope.goals_allowed:
+                self.ctx.report("goal-outside-problem",
+                                "goals belong to a problem (or a fragment it includes), not to a task", goal.span)
+            self.visit(statement)
 
-    def statement(self, s: Any, scope: Scope) -> None:
-        goal = getattr(s, "goal", None)
-        if goal is not None and not scope.goals_allowed:
-            self.ctx.report("goal-outside-problem",
-                            "goals belong to a problem (or a fragment it includes), not to a task", goal.span)
-        if isinstance(s, m.Hold):
-            self.attr_value(s.attr, scope)
-            self.time(s.start, scope)
-            self.time(s.end, scope)
-        elif isinstance(s, m.Event):
-            self.attr_value(s.attr, scope)
-            self.time(s.time, scope)
-        elif isinstance(s, m.ResourceUse):
-            self.attr_value(s.attr, scope, resource=True)
-            if isinstance(s.when, m.Window):
-                self.time(s.when.start, scope)
-                self.time(s.when.end, scope)
-            else:
-                self.time(s.when, scope)
-        elif isinstance(s, m.InConstraint):
-            self.expr(s.expr, scope)
-            self.domain_value(s.domain, scope)
-        elif isinstance(s, m.RelConstraint):
-            self.expr(s.left, scope)
-            self.expr(s.right, scope)
-        elif isinstance(s, m.Implication):
-            self.statement(s.condition, scope)
-            self.statement(s.consequence, scope)
-        elif isinstance(s, m.MacroCall):
-            macro = self.domain.macros.get(s.name)
-            if macro is None:
-                self.ctx.unknown("undefined-macro", "macro", s.name, self.domain.macros, s.span)
-            elif len(macro.params) != len(s.args):
-                self.ctx.report("arity-mismatch",
-                                f"macro '{s.name}' takes {len(macro.params)} argument(s), {len(s.args)} given", s.span)
-            for arg in s.args:
-                self.expr(arg, scope)
+    # One visit method per statement kind; expressions are checked by `expr`, not visited.
+    def visit_Hold(self, s: m.Hold) -> None:
+        self.attr_value(s.attr, self.scope)
+        self.time(s.start, self.scope)
+        self.time(s.end, self.scope)
+
+    def visit_Event(self, s: m.Event) -> None:
+        self.attr_value(s.attr, self.scope)
+        self.time(s.time, self.scope)
+
+    def visit_ResourceUse(self, s: m.ResourceUse) -> None:
+        self.attr_value(s.attr, self.scope, resource=True)
+        for time in (s.when.start, s.when.end) if isinstance(s.when, m.Window) else (s.when,):
+            self.time(time, self.scope)
+
+    def visit_InConstraint(self, s: m.InConstraint) -> None:
+        self.expr(s.expr, self.scope)
+        self.domain_value(s.domain, self.scope)
+
+    def visit_RelConstraint(self, s: m.RelConstraint) -> None:
+        self.expr(s.left, self.scope)
+        self.expr(s.right, self.scope)
+
+    def visit_MacroCall(self, s: m.MacroCall) -> None:
+        macro = self.domain.macros.get(s.name)
+        if macro is None:
+            self.ctx.unknown("undefined-macro", "macro", s.name, self.domain.macros, s.span)
+        elif len(macro.params) != len(s.args):
+            self.ctx.report("arity-mismatch",
+                            f"macro '{s.name}' takes {len(macro.params)} argument(s), {len(s.args)} given", s.span)
+        for arg in s.args:
+            self.expr(arg, self.scope)
+
+    def generic_visit(self, node: m.Node) -> None:
+        # Implication visits its two constraints; declarations need nothing more.
+        if isinstance(node, m.Implication):
+            super().generic_visit(node)
 
     def attr_value(self, a: m.AttrValue, scope: Scope, resource: bool = False) -> None:
         attribute = self.domain.attributes.get(a.attribute)

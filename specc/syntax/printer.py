@@ -67,14 +67,20 @@ def kexpr(e: m.KExpr) -> str:
         inner = kexpr(e.operand)
         return f"-({inner})" if isinstance(e.operand, m.KBinary) else f"-{inner}"
     if isinstance(e, m.KBinary):
-        level = _K_PRECEDENCE[e.op]
-        left, right = kexpr(e.left), kexpr(e.right)
-        if isinstance(e.left, m.KBinary) and _K_PRECEDENCE[e.left.op] < level:
-            left = f"({left})"
-        if isinstance(e.right, m.KBinary) and _K_PRECEDENCE[e.right.op] <= level:
-            right = f"({right})"
-        return f"{left} {e.op} {right}"
+        return binary(e, m.KBinary, _K_PRECEDENCE, kexpr)
     raise TypeError(e)
+
+
+def binary(e: Any, kind: type, precedence: dict[str, int], show: Callable[[Any], str]) -> str:
+    """`left op right` with the fewest parentheses that still read back as the same tree
+    (operators are left-associative, so an equal-precedence right operand needs them)."""
+    level = precedence[e.op]
+    left, right = show(e.left), show(e.right)
+    if type(e.left) is kind and precedence[e.left.op] < level:
+        left = f"({left})"
+    if type(e.right) is kind and precedence[e.right.op] <= level:
+        right = f"({right})"
+    return f"{left} {e.op} {right}"
 
 
 def attr_ref(a: m.AttrRef) -> str:
@@ -198,13 +204,7 @@ def ixexpr(e: m.IxExpr) -> str:
         inner = ixexpr(e.operand)
         return f"{e.op}({inner})" if isinstance(e.operand, m.IxBinary) else f"{e.op}{inner}"
     if isinstance(e, m.IxBinary):
-        level = _IX_PRECEDENCE[e.op]
-        left, right = ixexpr(e.left), ixexpr(e.right)
-        if isinstance(e.left, m.IxBinary) and _IX_PRECEDENCE[e.left.op] < level:
-            left = f"({left})"
-        if isinstance(e.right, m.IxBinary) and _IX_PRECEDENCE[e.right.op] <= level:
-            right = f"({right})"
-        return f"{left} {e.op} {right}"
+        return binary(e, m.IxBinary, _IX_PRECEDENCE, ixexpr)
     raise TypeError(e)
 
 
