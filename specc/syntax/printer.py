@@ -71,14 +71,14 @@ def kexpr(e: m.KExpr) -> str:
     raise TypeError(e)
 
 
-def binary(e: Any, kind: type, precedence: dict[str, int], show: Callable[[Any], str]) -> str:
+def binary(e: Any, kind: Any, precedence: dict[str, int], show: Callable[[Any], str]) -> str:
     """`left op right` with the fewest parentheses that still read back as the same tree
     (operators are left-associative, so an equal-precedence right operand needs them)."""
     level = precedence[e.op]
     left, right = show(e.left), show(e.right)
-    if type(e.left) is kind and precedence[e.left.op] < level:
+    if isinstance(e.left, kind) and precedence[e.left.op] < level:
         left = f"({left})"
-    if type(e.right) is kind and precedence[e.right.op] <= level:
+    if isinstance(e.right, kind) and precedence[e.right.op] <= level:
         right = f"({right})"
     return f"{left} {e.op} {right}"
 
