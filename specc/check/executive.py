@@ -50,6 +50,14 @@ def resolve_poster(ctx: Context, ref: m.Ref) -> m.Poster | None:
 def check(ctx: Context) -> None:
     for executive in ctx.items(m.Executive):
         check_executive(ctx, executive)
+    # Activity trees (seed 000 §1.6.4, §2.6): what a request's codels send to other modules.
+    for module in ctx.items(m.Module):
+        for request in module.requests:
+            for ref in request.sends:
+                target = resolve_request(ctx, ref)
+                if target is not None and ref.parts[0] == module.name:
+                    ctx.report("bad-reference", f"'{request.name}' sends to its own module; a module's "
+                               "activities share its internal data instead", ref.span)
 
 
 def check_executive(ctx: Context, executive: m.Executive) -> None:

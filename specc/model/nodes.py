@@ -130,6 +130,7 @@ class Request(Node):
     task: Ref | None = prop("task", "ref", doc="exec task that runs the activity")
     fail: tuple[Ref, ...] = prop("fail", "refs", doc="the only errors a codel may report")
     incompatible_with: tuple[Ref, ...] = prop("incompatible_with", "refs")
+    sends: tuple[Ref, ...] = prop("sends", "refs", doc="module.request its codels send (activity tree)")
     doc: String | None = prop("doc", "string")
     codels: tuple[Codel, ...] = ()
 
