@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+import keyword
 import sys
 import time
 from pathlib import Path
@@ -11,7 +12,8 @@ from typing import Annotated, Optional
 import typer
 from rich.console import Console
 
-from specc.diagnostics import render
+from specc.diagnostics import error, render
+from specc.model.span import Span
 from specc.pipeline import Loaded, load
 from specc.syntax.printer import format_source
 
@@ -27,8 +29,9 @@ app = typer.Typer(
 err = Console(stderr=True, highlight=False, soft_wrap=True)
 out = Console(highlight=False, soft_wrap=True)
 
+# readable=False: an unreadable spec is reported gcc-style by the pipeline, not by click's usage error.
 PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders searched for *.spec files.",
-                                                show_default=False)]
+                                                show_default=False, readable=False)]
 
 
 def report(loaded: Loaded) -> int:
@@ -80,13 +83,19 @@ def compile(paths: PathsArg,
         raise typer.Exit(code or 1)
     fallback = paths[0].resolve().name if paths[0].is_dir() else paths[0].stem
     name = robot or package.robot_name(loaded.program, fallback)
-    if not name.isidentifier():
+    if not name.isidentifier() or keyword.iskeyword(name):  # `import class` cannot be written
         err.print(f"error: '{name}' is not a valid Python package name; pass --robot NAME", markup=False)
         raise typer.Exit(1)
     result = Output()
     package.generate(loaded.program, name, result)
     folder = output / name
-    written = result.write(folder)
+    try:
+        written = result.write(folder)
+    except OSError as exc:
+        problem = error("unwritable-output", f"cannot write the package into '{folder}': {exc.strerror}"
+                        + (f" ('{exc.filename}')" if exc.filename else ""), Span.unknown(str(folder)))
+        err.print(render(problem, {}), markup=False)
+        raise typer.Exit(1) from None
     out.print(f"wrote {len(written)} file(s) to {folder}", markup=False)
 
 
@@ -103,6 +112,7 @@ def fmt(paths: PathsArg,
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
     changed = []
+    unwritable = []
     for source in loaded.program.files:
         text = loaded.sources[source.path]
         formatted = format_source(source, text, loaded.comments[source.path])
@@ -114,13 +124,20 @@ def fmt(paths: PathsArg,
                 text.splitlines(keepends=True), formatted.splitlines(keepends=True),
                 f"{source.path} (now)", f"{source.path} (formatted)"))
         if not check_only:
-            loaded.paths[source.path].write_text(formatted, encoding="utf-8")
+            try:
+                loaded.paths[source.path].write_text(formatted, encoding="utf-8")
+            except OSError as exc:
+                changed.pop()
+                unwritable.append(error("unwritable-file", f"cannot rewrite '{source.path}': {exc.strerror}",
+                                        Span.unknown(source.path)))
     verb = "would reformat" if check_only else "reformatted"
     for path in changed:
         out.print(f"{verb} {path}", markup=False)
-    if not changed:
+    for problem in unwritable:
+        err.print(render(problem, {}), markup=False)
+    if not changed and not unwritable:
         out.print(f"{len(loaded.program.files)} file(s) already formatted", markup=False)
-    raise typer.Exit(1 if check_only and changed else 0)
+    raise typer.Exit(1 if unwritable or (check_only and changed) else 0)
 
 
 def main() -> None:

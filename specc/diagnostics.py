@@ -66,7 +66,7 @@ def _excerpt(span: Span, sources: dict[str, str]) -> list[str]:
     text = sources.get(span.file)
     if text is None:
         return []
-    source_lines = text.splitlines()
+    source_lines = text.split("\n")  # as the lexer counts lines: not at \f, \v or U+2028
     if not 1 <= span.line <= len(source_lines):
         return []
     line = source_lines[span.line - 1].expandtabs(1)

@@ -56,10 +56,14 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
 
 
 def _already_reported(diagnostic: Diagnostic, earlier: list[Diagnostic]) -> bool:
-    """A property the builder rejected as malformed is not reported missing again."""
+    """A property the builder rejected as malformed is not reported missing again, and a number
+    too large to hold (kept as infinity) is not reported again as a value out of place."""
+    s = diagnostic.span
+    if any(d.code == "number-too-large" and d.span.file == s.file and (d.span.line, d.span.column)
+           == (s.line, s.column) for d in earlier):
+        return True
     if diagnostic.code != "missing-property":
         return False
-    s = diagnostic.span
     return any(d.code == "bad-property-value" and d.span.file == s.file
                and (s.line, s.column) <= (d.span.line, d.span.column) <= (s.end_line, s.end_column)
                for d in earlier)

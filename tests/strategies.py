@@ -75,7 +75,8 @@ kexprs = st.recursive(
         st.builds(m.KNegate, operand=inner)),
     max_leaves=4)
 kitems = st.one_of(strings, numbers, refs)
-kitem_lists = small(st.one_of(kitems, st.builds(m.KRange, low=strings, high=strings)), 1)
+kitem_lists = small(st.one_of(kitems, st.builds(m.KRange, low=strings, high=strings),
+                              st.builds(m.KRange, low=numbers, high=numbers)), 1)
 cmp_ops = st.sampled_from(["==", "!=", "<", "<=", ">", ">="])
 restrictions = st.one_of(
     st.builds(m.KCompare, attr=attr_refs, op=cmp_ops, value=kexprs),

@@ -3,6 +3,8 @@ deterministic output."""
 
 from __future__ import annotations
 
+import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -107,3 +109,119 @@ def test_fmt_check_reports_and_fmt_rewrites(tmp_path: Path) -> None:
 def test_help_has_examples(command: str) -> None:
     result = specc(command, "--help")
     assert result.returncode == 0 and "Example: specc " + command in result.stdout
+
+
+def specc_unprivileged(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """specc without the power to ignore file permissions (root keeps it unless told otherwise)."""
+    prefix: list[str] = []
+    if os.geteuid() == 0:
+        setpriv = shutil.which("setpriv")
+        if setpriv is None:
+            pytest.skip("running as root without setpriv: permissions cannot be tested")
+        drop = "-dac_override,-dac_read_search"
+        prefix = [setpriv, f"--bounding-set={drop}", f"--inh-caps={drop}"]
+    return subprocess.run([*prefix, sys.executable, "-m", "specc.cli", *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=120)
+
+
+def test_unreadable_file_and_folder_are_gcc_style_errors(tmp_path: Path) -> None:
+    (tmp_path / "hidden.spec").write_text("module a { number: 1; }\n")
+    (tmp_path / "hidden.spec").chmod(0)
+    robot = tmp_path / "robot"
+    (robot / "locked").mkdir(parents=True)
+    (robot / "ok.spec").write_text("module b { number: 2; }\n")
+    (robot / "locked" / "c.spec").write_text("module c { number: 3; }\n")
+    (robot / "locked").chmod(0)
+    try:
+        for command in ("check", "fmt", "compile"):
+            result = specc_unprivileged(command, "hidden.spec", cwd=tmp_path)
+            assert result.returncode == 1, result.stderr
+            assert "hidden.spec:1:1: error: cannot read" in result.stderr and "[unreadable-file]" in result.stderr
+        # A folder that cannot be listed is not silently skipped.
+        result = specc_unprivileged("check", "robot", cwd=tmp_path)
+        assert result.returncode == 1 and "[unreadable-folder]" in result.stderr, result.stderr
+    finally:
+        (robot / "locked").chmod(0o755)
+    assert "Traceback" not in result.stderr
+
+
+def test_fmt_of_a_read_only_file_is_an_error_not_a_traceback(tmp_path: Path) -> None:
+    spec = tmp_path / "ro.spec"
+    spec.write_text("module a {number: 1;}\n")
+    spec.chmod(0o444)
+    result = specc_unprivileged("fmt", "ro.spec", cwd=tmp_path)
+    assert result.returncode == 1 and "ro.spec:1:1: error: cannot rewrite" in result.stderr, result.stderr
+    assert "[unwritable-file]" in result.stderr and "Traceback" not in result.stderr
+    assert spec.read_text() == "module a {number: 1;}\n"
+
+
+def test_compile_into_a_file_is_an_error_not_a_traceback(tmp_path: Path) -> None:
+    spec = tmp_path / "a.spec"
+    spec.write_text("module a { number: 1; }\n")
+    (tmp_path / "out").write_text("not a folder")
+    result = specc("compile", str(spec), "-o", str(tmp_path / "out"))
+    assert result.returncode == 1 and "[unwritable-output]" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_compile_never_deletes_outside_the_package_whatever_the_old_manifest_says(tmp_path: Path) -> None:
+    spec = tmp_path / "a.spec"
+    spec.write_text("module a { number: 1; }\n")
+    victim = tmp_path / "precious.txt"
+    victim.write_text("mine")
+    (tmp_path / "out" / "a" / "sub").mkdir(parents=True)
+    (tmp_path / "out" / "a" / "MANIFEST.json").write_text(
+        '{"files": [{"path": "../../precious.txt"}, {"path": "' + str(victim) + '"}, {"path": 5}, {"path": "sub"}]}')
+    result = specc("compile", str(spec), "-o", str(tmp_path / "out"))
+    assert result.returncode == 0, result.stderr
+    assert victim.read_text() == "mine" and (tmp_path / "out" / "a" / "sub").is_dir()
+
+
+@pytest.mark.parametrize(("name", "content", "expected"), [
+    ("bom.spec", "\ufeffmodule a { number: 1; }\n", "ok: 1 file(s)"),
+    ("crlf.spec", "module a {\r\n\tnumber: 1;\r\n}\r\n", "ok: 1 file(s)"),
+    ("empty.spec", "", "ok: 1 file(s), 0 block(s)"),
+    ("brace.spec", "}", "brace.spec:1:1: error: unexpected '}'"),
+    # Not kept as infinity: `specc fmt` would write it back as `inf`, a name.
+    ("huge.spec", "module a { number: 1e999; }\n", "huge.spec:1:20: error: '1e999' is too large a number"),
+    # The excerpt is the line the lexer counted, even past a U+2028 or a form feed.
+    ("sep.spec", "module a { number: 1;\u2028 }\n", "1:22: error: unexpected character 'U+2028'"),
+    ("sep2.spec", "module a {\f\n number: 1; $ }\n", "2:13: error: unexpected character '$'"),
+])
+def test_odd_inputs_give_a_clean_result(tmp_path: Path, name: str, content: str, expected: str) -> None:
+    spec = tmp_path / name
+    spec.write_bytes(content.encode("utf-8"))
+    result = specc("check", name, cwd=tmp_path)
+    assert expected in result.stdout + result.stderr
+    assert result.returncode in (0, 1) and "Traceback" not in result.stderr
+    if name == "sep2.spec":  # the excerpt shows line 2, not the empty "line" after the form feed
+        assert "\n     number: 1; $ }\n" in result.stderr
+
+
+def test_symbolic_link_loops_are_clear_errors(tmp_path: Path) -> None:
+    (tmp_path / "loop").symlink_to("loop")
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    (robot / "a.spec").write_text("module a { number: 1; }\n")
+    (robot / "again").symlink_to(robot)
+    result = specc("check", "loop", "robot", cwd=tmp_path)
+    assert "'loop' is a broken or looping symbolic link [missing-file]" in result.stderr
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert specc("check", "robot", cwd=tmp_path).stdout.startswith("ok: 1 file(s)")
+
+
+def test_a_file_named_twice_is_read_once(tmp_path: Path) -> None:
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    (robot / "a.spec").write_text("module a { number: 1; }\n")
+    (robot / "link.spec").symlink_to(robot / "a.spec")
+    result = specc("check", "robot", "robot/a.spec", "./robot/../robot/a.spec", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("ok: 1 file(s), 1 block(s)")
+
+
+def test_compile_refuses_a_package_name_python_cannot_import(tmp_path: Path) -> None:
+    (tmp_path / "class.spec").write_text("module a { number: 1; }\n")
+    result = specc("compile", "class.spec", "-o", "out", cwd=tmp_path)
+    assert result.returncode == 1 and "not a valid Python package name" in result.stderr
+    assert not (tmp_path / "out").exists()

@@ -68,12 +68,12 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
     for ref in executive.rules:
         ctx.lookup(m.RuleBase, ref, ref.span, "undefined-rules")
     for service in executive.services:
+        ctx.duplicates(service.args, "argument")
         if service.request is None:
             ctx.report("missing-property", f"service '{service.name}' needs 'request: module.request;'",
                        service.span)
         else:
             request = resolve_request(ctx, service.request)
-            ctx.duplicates(service.args, "argument")
             inputs = {i.name for i in request.inputs} if request is not None else set()
             for arg in service.args if request is not None else ():
                 if arg.name not in inputs:
@@ -108,7 +108,8 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
             resolve_poster(ctx, parameter.get)
         if parameter.set is not None:
             request = resolve_request(ctx, parameter.set)
-            if request is not None and request.kind != "control":
+            # A request without a type is reported missing-property by the modules pass.
+            if request is not None and request.kind is not None and request.kind != "control":
                 ctx.report("not-a-control-request",
                            f"SET-PARAM writes through a control request; '{parameter.set.text}' is '{request.kind}'",
                            parameter.set.span)

@@ -16,7 +16,8 @@ def check(ctx: Context) -> None:
     for module in ctx.items(m.Module):
         if module.number is not None:
             other = numbers.setdefault(module.number.value, module)
-            if other is not module:
+            # A module defined twice under one name is reported as such, not as a number clash.
+            if other is not module and other.name != module.name:
                 ctx.report("duplicate-module-number",
                            f"modules '{other.name}' and '{module.name}' both use number {module.number.value}",
                            module.number.span, (other.span, f"'{other.name}' declared here"))

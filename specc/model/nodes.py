@@ -41,6 +41,22 @@ class Node:
 # ---------------------------------------------------------------- values
 
 
+class Word(str):
+    """A keyword-like value kept as plain text (`type: exec;`, `property: x;`).
+
+    It compares and hashes as the string, so checks and back ends test `kind == "exec"`
+    and models still compare by meaning; it remembers where it was written so that the
+    formatter can keep a comment on its line (`type: exec;  // why`) where it was.
+    """
+
+    span: Span
+
+    def __new__(cls, text: str, span: Span = NO_SPAN) -> Word:
+        word = super().__new__(cls, text)
+        word.span = span
+        return word
+
+
 @dataclass(frozen=True, kw_only=True)
 class Ref(Node):
     """A name, possibly dotted (`pilo.execPosterTraj`)."""

@@ -7,6 +7,7 @@ diagnostics here, because only the builder still sees which key each value came 
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from typing import Any
@@ -80,11 +81,22 @@ class Builder(Transformer[Token, Any]):
         return m.Ref(parts=tuple(str(c) for c in children), span=self.span(meta))
 
     def number(self, meta: Meta, children: list[Token]) -> m.Number:
-        return m.Number(value=parse_number(str(children[0])), span=self.span(meta))
+        return m.Number(value=self.number_value(children[0]), span=self.span(meta))
 
     def duration(self, meta: Meta, children: list[Any]) -> m.Duration:
         number, unit = children
-        return m.Duration(value=parse_number(str(number)), unit=unit, span=self.span(meta))
+        return m.Duration(value=self.number_value(number), unit=unit, span=self.span(meta))
+
+    def number_value(self, token: Token) -> int | float:
+        value = parse_number(str(token))
+        if math.isinf(value):
+            # Stored as infinity so the checks can go on, but an error: `specc fmt` would
+            # otherwise print it as `inf`, which reads back as a name.
+            shown = str(token) if len(token) <= 24 else str(token)[:20] + "..."
+            self.diagnostics.append(error(
+                "number-too-large", f"'{shown}' is too large a number (the largest is about 1.8e308)",
+                self.tspan(token)))
+        return value
 
     def time_unit(self, meta: Meta, children: list[Token]) -> str:
         return str(children[0])
@@ -97,7 +109,8 @@ class Builder(Transformer[Token, Any]):
         return m.TypeRef(name=str(children[0]), size=size, span=self.span(meta))
 
     def array_size(self, meta: Meta, children: list[Token]) -> int:
-        return int(children[0])
+        size = self.number_value(children[0])
+        return size if isinstance(size, int) else 0
 
     # ------------------------------------------------------------ property schema
     def apply_props(self, cls: type, span: Span, props: list[Prop], **others: Any) -> Any:
@@ -153,6 +166,8 @@ class Builder(Transformer[Token, Any]):
         if kind == "int":
             if isinstance(value, m.Number) and isinstance(value.value, int):
                 return value
+            if isinstance(value, m.Number) and math.isinf(value.value):
+                return None  # reported as number-too-large
             if isinstance(value, m.Number):
                 return bad(f", got {value.value}")
             return bad()
@@ -166,7 +181,7 @@ class Builder(Transformer[Token, Any]):
             return bad()
         if kind == "symbol":
             if isinstance(value, m.Ref) and value.text in choices:
-                return value.text
+                return m.Word(value.text, value.span)
             if isinstance(value, m.Ref):
                 return bad(f"{did_you_mean(value.text, choices)}, got '{value.text}'")
             return bad()
@@ -555,7 +570,7 @@ class Builder(Transformer[Token, Any]):
         return "documentation", children[0], self.span(meta)
 
     def ka_property(self, meta: Meta, children: list[Token]) -> tuple[str, Any, Span]:
-        return "property", str(children[0]), self.span(meta)
+        return "property", m.Word(str(children[0]), self.span(meta)), self.span(meta)
 
     def goal(self, meta: Meta, children: list[Any]) -> m.Goal:
         op, body = children
@@ -852,8 +867,11 @@ class StateBlock:
 
 
 def parse_number(text: str) -> int | float:
+    """The literal's value; infinity when a float cannot hold it (`1e999`, 400 digits)."""
     if any(c in text for c in ".eE"):
         return float(text)
+    if len(text.lstrip("0")) > 308:  # past float's range (and int() refuses 4300+ digits)
+        return math.inf
     return int(text)
 
 

@@ -9,7 +9,7 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lark import Lark, Token
+from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 from lark.lexer import PatternStr
 
@@ -21,6 +21,9 @@ from specc.syntax.builder import build
 from specc.syntax.labels import describe_expected, describe_token
 
 SPEC_SUFFIX = ".spec"
+# The builder, the checks and the printer recurse once or twice per level of the parse tree;
+# past this depth Python's stack would overflow. The examples nest 15 levels at most.
+MAX_NESTING = 150
 
 
 @dataclass
@@ -75,8 +78,27 @@ def parse_text(text: str, path: str) -> ParseResult:
     except UnexpectedInput as exc:
         return ParseResult(None, [syntax_error(exc, text, path)])
     comments = list(_COMMENTS)
+    too_deep = nesting_error(tree, path)
+    if too_deep is not None:
+        return ParseResult(None, [too_deep])
     source, diagnostics = build(tree, path)
     return ParseResult(source, diagnostics, comments)
+
+
+def nesting_error(tree: Tree, path: str) -> Diagnostic | None:
+    """A diagnostic at the first construct nested deeper than MAX_NESTING, if any."""
+    stack = [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_NESTING:
+            meta = node.meta
+            line, column = getattr(meta, "line", 1), getattr(meta, "column", 1)
+            span = Span(path, line, column, getattr(meta, "end_line", line), getattr(meta, "end_column", column))
+            return error("too-deeply-nested",
+                         f"this is nested more than {MAX_NESTING} levels deep; "
+                         "split it into smaller pieces (sub-goals, shorter expressions)", span)
+        stack.extend((child, depth + 1) for child in node.children if isinstance(child, Tree))
+    return None
 
 
 def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
@@ -88,9 +110,20 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
         span = Span(path, line, column, line, column + 1)
         expected = describe_expected(getattr(exc, "expected", set()) or set(), keyword_texts())
         return error("unexpected-end", f"the file ends too early: expected {expected}; is a '}}' missing?", span)
+    position = max(getattr(exc, "pos_in_stream", None) or 0, 0)
+    # An unclosed `/*` is lexed as `/` then `*`, and neither may follow the other anywhere.
+    opener = position if text.startswith("/*", position) else position - 1
+    if opener >= 0 and text.startswith("/*", opener):
+        line, column = _line_column(text, opener)
+        span = Span(path, line, column, line, column + 2)
+        return error("unterminated-comment", "this '/*' comment is never closed by '*/'", span)
+    if isinstance(exc, UnexpectedCharacters) and text.startswith('"', position):
+        span = Span(path, line, column, line, column + 1)
+        return error("unterminated-string", "this string is not closed by '\"' on the same line", span)
     if isinstance(exc, UnexpectedCharacters):
-        position = exc.pos_in_stream or 0
         char = text[position] if position < len(text) else "?"
+        if not char.isprintable():  # a stray BOM, line separator or control byte
+            char = f"U+{ord(char):04X}"
         span = Span(path, line, column, line, column + 1)
         expected = describe_expected(exc.allowed or set(), keyword_texts())
         return error("unexpected-character",
@@ -103,22 +136,57 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
     return error("unexpected-token", f"unexpected {describe_token(token)}; expected {expected}", span)
 
 
+def _line_column(text: str, position: int) -> tuple[int, int]:
+    line = text.count("\n", 0, position) + 1
+    return line, position - (text.rfind("\n", 0, position) + 1) + 1
+
+
 def spec_files(paths: list[Path]) -> tuple[list[Path], list[Diagnostic]]:
     """The .spec files named, or found (sorted, recursively) in the folders named."""
     files: list[Path] = []
     problems: list[Diagnostic] = []
     for path in paths:
         if path.is_dir():
-            found = sorted(p for p in path.rglob("*" + SPEC_SUFFIX) if p.is_file())
-            if not found:
+            found, unreadable = _specs_in(path)
+            problems.extend(unreadable)
+            if not found and not unreadable:
                 problems.append(error("no-spec-files", f"no {SPEC_SUFFIX} files in folder '{path}'",
                                       Span.unknown(str(path))))
             files.extend(found)
         elif path.is_file():
             files.append(path)
         else:
-            problems.append(error("missing-file", f"no such file or folder: '{path}'", Span.unknown(str(path))))
-    return files, problems
+            problems.append(error("missing-file", _why_missing(path), Span.unknown(str(path))))
+    # A file named twice (`specc check robot/ robot/loco.spec`, or a link to it) is read once:
+    # twice, each of its blocks would be reported as defined twice, by itself.
+    unique: dict[Path, Path] = {}
+    for file in files:
+        unique.setdefault(file.resolve(), file)
+    return list(unique.values()), problems
+
+
+def _why_missing(path: Path) -> str:
+    if path.is_symlink() and not path.exists():
+        return f"'{path}' is a broken or looping symbolic link"
+    if path.exists():
+        return f"'{path}' is neither a file nor a folder"
+    return f"no such file or folder: '{path}'"
+
+
+def _specs_in(folder: Path) -> tuple[list[Path], list[Diagnostic]]:
+    """Every .spec file under `folder` (symbolic links to folders are not followed, so a link
+    loop cannot hang the search), and an error for each folder that cannot be listed: a robot
+    silently missing the specs of an unreadable folder would be checked as if they did not exist."""
+    unreadable: list[Diagnostic] = []
+
+    def report(exc: OSError) -> None:
+        unreadable.append(error("unreadable-folder", f"cannot list folder '{exc.filename}': {exc.strerror}",
+                                Span.unknown(str(exc.filename))))
+
+    found = [Path(root) / name
+             for root, _, names in os.walk(folder, onerror=report)
+             for name in names if name.endswith(SPEC_SUFFIX)]
+    return sorted(p for p in found if p.is_file()), unreadable
 
 
 def display_path(path: Path) -> str:
@@ -130,7 +198,8 @@ def display_path(path: Path) -> str:
 
 def read_source(path: Path) -> tuple[str | None, Diagnostic | None]:
     try:
-        return path.read_text(encoding="utf-8"), None
+        # utf-8-sig: a byte-order mark some Windows editors write is not part of the text.
+        return path.read_text(encoding="utf-8-sig"), None
     except UnicodeDecodeError as exc:
         return None, error("bad-encoding", f"'{path}' is not UTF-8 text (byte {exc.start}); save it as UTF-8",
                            Span.unknown(display_path(path)))

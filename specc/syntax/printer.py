@@ -279,34 +279,56 @@ def tstmt(s: Any) -> str:
 # ---------------------------------------------------------------- layout with comments
 
 
+@dataclass(frozen=True)
+class _Comment:
+    text: str
+    line: int
+    column: int
+
+    def lines(self, pad: str) -> list[str]:
+        """The comment at indentation `pad`. A block comment's later lines keep their indentation
+        relative to its first line, so re-indenting twice gives the same text."""
+        first, *more = self.text.split("\n")
+        shown = [pad + first]
+        for part in more:
+            part = part.rstrip()
+            indent = len(part) - len(part.lstrip())
+            shown.append(pad + part[min(indent, self.column - 1):] if part else "")
+        return shown
+
+
 @dataclass
 class _Comments:
     """Which comment goes where: before the first element after it, or at the end of a line."""
 
-    leading: dict[tuple[int, int], list[str]]
+    leading: dict[tuple[int, int], list[_Comment]]
     trailing: dict[tuple[int, int], list[str]]
-    rest: list[str]
+    rest: list[_Comment]
+    line_starts: set[tuple[int, int]]  # the first anchor of each source line
 
 
 def _place_comments(comments: list[Token], anchors: list[tuple[int, int]], text: str) -> _Comments:
+    """Anchors are where printed lines start in the source, including each block's closing
+    brace, so a comment written last in a block stays inside it."""
     ordered = sorted(set(anchors))
-    source_lines = text.splitlines()
-    placed = _Comments({}, {}, [])
+    source_lines = text.split("\n")
+    starts = {key for i, key in enumerate(ordered) if i == 0 or ordered[i - 1][0] != key[0]}
+    placed = _Comments({}, {}, [], starts)
     for c in comments:
         position = (c.line or 1, c.column or 1)
         before = source_lines[position[0] - 1][: position[1] - 1] if position[0] <= len(source_lines) else ""
-        body = str(c).rstrip()
-        if before.strip() and "\n" not in body:
+        comment = _Comment(str(c).replace("\r\n", "\n").rstrip(), *position)
+        if before.strip() and "\n" not in comment.text:
             # At the end of a line: it stays there if an element starts on that line.
             i = bisect.bisect_right(ordered, position) - 1
             if i >= 0 and ordered[i][0] == position[0]:
-                placed.trailing.setdefault(ordered[i], []).append(body)
+                placed.trailing.setdefault(ordered[i], []).append(comment.text)
                 continue
         i = bisect.bisect_left(ordered, position)
         if i < len(ordered):
-            placed.leading.setdefault(ordered[i], []).append(body)
+            placed.leading.setdefault(ordered[i], []).append(comment)
         else:
-            placed.rest.append(body)
+            placed.rest.append(comment)
     return placed
 
 
@@ -315,7 +337,7 @@ class Printer:
         self.out: list[str] = []
         self.depth = 0
         self.comments = comments
-        self.source_lines = text.splitlines()
+        self.source_lines = text.split("\n")
         self.anchors: list[tuple[int, int]] = []
 
     # -- output primitives
@@ -323,19 +345,31 @@ class Printer:
         key = self._anchor(anchor)
         pad = INDENT * self.depth
         if key is not None and self.comments is not None:
-            leading = self.comments.leading.pop(key, [])
-            if leading and self._blank_before(leading, key):
+            self.leading_comments(self.comments.leading.pop(key, []), pad)
+            if key in self.comments.line_starts and self._source_blank(key[0] - 1):
+                # A blank line kept from the source (only above an element that began its line:
+                # `{ a; b; }` after a blank line is not three paragraphs).
                 self.blank()
-            elif not leading and self._source_blank_before(key[0]):
-                self.blank()
-            for comment in leading:
-                self.out.extend(pad + part.strip() if i else pad + part
-                                for i, part in enumerate(comment.splitlines()))
-        text = pad + text
+        self.out.append(pad + text + self._trailing(key))
+
+    def closing(self, text: str, closer: Span | None) -> None:
+        """A block's last line (`}`): comments just before the brace stay inside the block."""
+        key = None if closer is None else self._anchor(
+            Span(closer.file, closer.end_line, max(closer.end_column - 1, 1), closer.end_line, closer.end_column))
         if key is not None and self.comments is not None:
-            for comment in self.comments.trailing.pop(key, []):
-                text += "  " + comment
-        self.out.append(text)
+            self.leading_comments(self.comments.leading.pop(key, []), INDENT * (self.depth + 1))
+        self.out.append(INDENT * self.depth + text + self._trailing(key))
+
+    def leading_comments(self, comments: list[_Comment], pad: str) -> None:
+        for comment in comments:
+            if self._source_blank(comment.line - 1):
+                self.blank()
+            self.out.extend(comment.lines(pad))
+
+    def _trailing(self, key: tuple[int, int] | None) -> str:
+        if key is None or self.comments is None:
+            return ""
+        return "".join("  " + comment for comment in self.comments.trailing.pop(key, []))
 
     def _anchor(self, span: Span | None) -> tuple[int, int] | None:
         if span is None or span.file == "<unknown>":
@@ -344,15 +378,8 @@ class Printer:
         self.anchors.append(key)
         return key
 
-    def _blank_before(self, leading: list[str], key: tuple[int, int]) -> bool:
-        # A blank line in the source just above the first leading comment is kept.
-        for number_, text in enumerate(self.source_lines[: key[0] - 1]):
-            if text.strip() == leading[0].splitlines()[0].strip():
-                return number_ > 0 and not self.source_lines[number_ - 1].strip()
-        return False
-
-    def _source_blank_before(self, line: int) -> bool:
-        return line >= 2 and line - 2 < len(self.source_lines) and not self.source_lines[line - 2].strip()
+    def _source_blank(self, line: int) -> bool:
+        return 1 <= line <= len(self.source_lines) and not self.source_lines[line - 1].strip()
 
     def blank(self) -> None:
         if self.out and self.out[-1].strip() and not self.out[-1].endswith("{"):
@@ -361,12 +388,13 @@ class Printer:
     @contextmanager
     def block(self, header: str, anchor: Span | None, footer: str = "}") -> Iterator[None]:
         """A `header {` ... `footer` block. Sections with no node of their own pass no anchor:
-        their first element's comments then stay with that element."""
+        their first element's comments then stay with that element, and the comments after
+        their last one go with whatever follows the section."""
         self.line(header + " {", anchor)
         self.depth += 1
         yield
         self.depth -= 1
-        self.out.append(INDENT * self.depth + footer)
+        self.closing(footer, anchor)
 
     def props(self, node: Any) -> None:
         for f in property_fields(type(node)):
@@ -385,8 +413,7 @@ class Printer:
                 self.out.append("")
             self.item(item)
         if self.comments is not None:
-            for comment in self.comments.rest:
-                self.out.append(comment)
+            self.leading_comments(self.comments.rest, "")
 
     def item(self, item: m.Item) -> None:
         method: Callable[[Any], None] = getattr(self, "p_" + type(item).__name__)
@@ -516,7 +543,7 @@ class Printer:
         if ka.context is not None:
             self.line(f"context: {goal(ka.context)};", ka.context.span)
         for p in ka.properties:
-            self.line(f"property: {p};")
+            self.line(f"property: {p};", getattr(p, "span", None))
         if ka.action is not None:
             result = f" -> {ka.action.result.name}" if ka.action.result else ""
             self.line(f"action: {sexp(ka.action.call)}{result};", ka.action.span)
@@ -565,19 +592,19 @@ class Printer:
     def _else_tail(self, s: m.IfStmt) -> None:
         orelse = s.orelse
         if orelse is None:
-            self.out.append(INDENT * self.depth + "}")
+            self.closing("}", s.then.span)
         elif isinstance(orelse, m.IfStmt):
-            self.out.append(INDENT * self.depth + f"}} else if {goal(orelse.condition)} {{")
+            self.closing(f"}} else if {goal(orelse.condition)} {{", s.then.span)
             self.depth += 1
             self.statements(orelse.then)
             self.depth -= 1
             self._else_tail(orelse)
         else:
-            self.out.append(INDENT * self.depth + "} else {")
+            self.closing("} else {", s.then.span)
             self.depth += 1
             self.statements(orelse)
             self.depth -= 1
-            self.out.append(INDENT * self.depth + "}")
+            self.closing("}", orelse.span)
 
     # -- IxTeT
     def p_Domain(self, node: m.Domain) -> None:
