@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import keyword
+import os
 import sys
 import time
 from pathlib import Path
@@ -146,6 +147,12 @@ def main() -> None:
     except KeyboardInterrupt:
         err.print("interrupted", markup=False)
         sys.exit(130)
+    except Exception as exc:  # a bug in specc itself: one line for the user, the trace on request
+        if os.environ.get("SPECC_DEBUG"):
+            raise
+        err.print(f"internal error: {type(exc).__name__}: {exc} -- this is a bug in specc; "
+                  "rerun with SPECC_DEBUG=1 to see where, and report it", markup=False)
+        sys.exit(2)
 
 
 if __name__ == "__main__":

@@ -225,3 +225,16 @@ def test_compile_refuses_a_package_name_python_cannot_import(tmp_path: Path) -> 
     result = specc("compile", "class.spec", "-o", "out", cwd=tmp_path)
     assert result.returncode == 1 and "not a valid Python package name" in result.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_an_internal_bug_is_one_line_not_a_traceback(tmp_path: Path) -> None:
+    # Simulate a bug in specc: the front end raises an unexpected exception.
+    script = ("import sys, specc.pipeline as p\n"
+              "def boom(*a, **k):\n    raise ValueError('boom')\n"
+              "p.load = boom\nimport specc.cli as c\nc.load = boom\nsys.argv = ['specc', 'check', 'x.spec']\n"
+              "c.main()\n")
+    result = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 2
+    assert "internal error: ValueError: boom" in result.stderr and "SPECC_DEBUG=1" in result.stderr
+    assert "Traceback" not in result.stderr
