@@ -75,7 +75,7 @@ def compile(paths: PathsArg,
 
     Example: specc compile examples/hilare -o generated
     """
-    from specc.backends import package  # jinja2 and the back ends load only when compiling
+    from specc.backends import modules, package  # jinja2 and the back ends load only when compiling
     from specc.backends.manifest import Output
 
     loaded = load(paths)
@@ -89,6 +89,7 @@ def compile(paths: PathsArg,
         raise typer.Exit(1)
     result = Output()
     package.generate(loaded.program, name, result)
+    modules.generate(loaded.program, result)
     folder = output / name
     try:
         written = result.write(folder)

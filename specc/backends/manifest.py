@@ -60,3 +60,13 @@ def _listed(manifest: Path) -> set[str]:
         return set()
     return {p for p in paths if p and not PurePosixPath(p).is_absolute() and ".." not in PurePosixPath(p).parts
             and "\\" not in p}
+
+
+def describe_sources(paths: list[str]) -> str:
+    """`examples/hilare/*.spec (12 files)` rather than twelve names on one line."""
+    folders = sorted({str(PurePosixPath(p).parent) for p in paths})
+    if len(paths) == 1:
+        return paths[0]
+    if len(folders) == 1:
+        return f"{folders[0]}/*.spec ({len(paths)} files)"
+    return f"{len(paths)} spec files"

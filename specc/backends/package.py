@@ -7,10 +7,9 @@ Output; this one only needs the model.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import PurePosixPath
 
 from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.manifest import HEADER, Output, describe_sources
 from specc.model import nodes as m
 
 BACKEND = "package"
@@ -43,16 +42,6 @@ class PackageView:
 
 def python_tuple(names: list[str]) -> str:
     return repr(tuple(names))
-
-
-def describe_sources(paths: list[str]) -> str:
-    """`examples/hilare/*.spec (12 files)` rather than twelve names on one line."""
-    folders = sorted({str(PurePosixPath(p).parent) for p in paths})
-    if len(paths) == 1:
-        return paths[0]
-    if len(folders) == 1:
-        return f"{folders[0]}/*.spec ({len(paths)} files)"
-    return f"{len(paths)} spec files"
 
 
 def robot_name(program: m.Program, fallback: str) -> str:

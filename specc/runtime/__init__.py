@@ -1,0 +1,1 @@
+"""What generated robot packages import at run time. Never imports the compiler."""

@@ -1,0 +1,897 @@
+"""The functional level: GenoM-style modules (seed 000 ch. 2) running on the event kernel.
+
+A module's controller receives requests, checks them, starts, interrupts and ends activities
+and sends replies; its exec tasks run the activities' codels periodically. Every activity
+follows the control graph of Fig. 2.3 (ETHER, INIT, EXEC, INTER, ZOMBIE, nine arcs); inside
+EXEC, what each codel returns picks the next codel (Fig. 2.4). Final replies carry a status of
+Table 2.1 and a report (the bilan).
+
+The generated package describes each module with the `*Spec` classes below and binds it to
+the user's codel functions; nothing here imports the compiler.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import enum
+import functools
+import itertools
+import math
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Any, Generic, TypeVar
+
+from specc.runtime.kernel import Kernel, Timer
+
+# ---------------------------------------------------------------- the dictionary of Table 2.1
+
+
+class Status(enum.StrEnum):
+    CS_ERROR = "CS_ERROR"  # the request or a reply could not be transmitted
+    WAITING = "WAITING"  # the reply asked for has not arrived yet (report: which one)
+    END = "END"  # nominal end, or an intrinsic failure (report: defined by the designer)
+    TIMEOUT = "TIMEOUT"  # the client's wait expired (report: intermediate or final)
+    INTERRUPTED = "INTERRUPTED"  # report: ABORT, or the name of the conflicting request
+    FINAL_ERROR = "FINAL_ERROR"  # extrinsic error (report: its code)
+    SERVER_ERROR = "SERVER_ERROR"  # a child activity failed (report: chains the original error)
+    ZOMBIE = "ZOMBIE"  # the activity is ZOMBIE (report: identifies the original error)
+
+
+class State(enum.StrEnum):
+    ETHER = "ETHER"
+    INIT = "INIT"
+    EXEC = "EXEC"
+    INTER = "INTER"
+    ZOMBIE = "ZOMBIE"
+
+
+# The nine arcs of Fig. 2.3: (from, event, to). Events marked `x/-` are imposed by the
+# controller, `-/x` signified by the activity itself.
+ARCS: tuple[tuple[State, str, State], ...] = (
+    (State.ETHER, "init/-", State.INIT),
+    (State.INIT, "exec/-", State.EXEC),
+    (State.INIT, "abort/-", State.ETHER),  # refused by its validation, or interrupted before starting
+    (State.EXEC, "-/ended", State.ETHER),
+    (State.EXEC, "-/failed", State.ZOMBIE),
+    (State.EXEC, "abort/-", State.INTER),
+    (State.INTER, "-/ended", State.ETHER),
+    (State.INTER, "-/failed", State.ZOMBIE),
+    (State.ZOMBIE, "abort/-", State.ETHER),
+)
+_ARC_SET = {(a, b) for a, _, b in ARCS}
+
+# What a codel may return besides its request's own codel states and fail messages.
+ENDED = "ether"
+FAILED = "zombie"
+INTERMEDIATE_REPORT = "final"  # an intermediate reply says: now waiting for the final one
+
+
+@dataclass(frozen=True)
+class Report:
+    """The bilan of a reply: a code, a human detail, and the child's reply it chains to."""
+
+    code: str
+    detail: str = ""
+    cause: Reply | None = None
+
+    def chain(self) -> list[Reply]:
+        """The chained replies, outermost first (SERVER_ERROR -> ... -> the original error)."""
+        found: list[Reply] = []
+        reply = self.cause
+        while reply is not None:
+            found.append(reply)
+            reply = reply.report.cause
+        return found
+
+
+@dataclass(frozen=True)
+class Reply:
+    rqst_id: int
+    module: str
+    request: str
+    status: Status
+    report: Report
+    output: Any = None
+    final: bool = True
+    time: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.END and self.report.code == "OK"
+
+
+ReplySink = Callable[[Reply], None]
+
+
+# ---------------------------------------------------------------- static description (generated)
+
+
+@dataclass(frozen=True)
+class RequestSpec:
+    name: str
+    kind: str  # control | exec
+    input_type: type | None = None
+    output_type: type | None = None
+    validate: str | None = None
+    codels: Mapping[str, str] = field(default_factory=dict)  # codel state -> function name
+    yields: Mapping[str, tuple[str, ...]] = field(default_factory=dict)  # declared next states
+    fail: tuple[str, ...] = ()
+    incompatible: tuple[str, ...] = ()  # request names, or "all"
+    task: str | None = None
+    sends: tuple[str, ...] = ()
+
+    def conflicts_with(self, other: RequestSpec) -> bool:
+        return ("all" in self.incompatible or other.name in self.incompatible
+                or "all" in other.incompatible or self.name in other.incompatible)
+
+    @property
+    def first_state(self) -> str:
+        return "start" if "start" in self.codels else "exec"
+
+
+@dataclass(frozen=True)
+class ExecTaskSpec:
+    name: str
+    period: float
+    delay: float = 0.0
+    priority: int = 0
+    init: str | None = None
+    permanent: str | None = None
+
+
+@dataclass(frozen=True)
+class PosterSpec:
+    name: str
+    type: type
+    fields: tuple[str, ...] = ()
+    update: str = "auto"  # auto | manual
+    activity: str | None = None  # request name or codel function whose cycles update it
+
+
+@dataclass(frozen=True)
+class ModuleSpec:
+    name: str
+    number: int
+    codel_module: str
+    sdi_type: type
+    requests: Mapping[str, RequestSpec]
+    tasks: tuple[ExecTaskSpec, ...] = ()
+    posters: tuple[PosterSpec, ...] = ()
+
+
+# ---------------------------------------------------------------- posters
+
+
+T = TypeVar("T")
+
+
+@dataclass(frozen=True)
+class Snapshot(Generic[T]):
+    """A consistent copy of a poster's content and the date it was written."""
+
+    data: T
+    date: float
+
+
+class Poster(Generic[T]):
+    """One writer (its module), any number of readers; readers get a private copy."""
+
+    def __init__(self, spec: PosterSpec):
+        self.spec = spec
+        self._snapshot: Snapshot[T] | None = None
+
+    def write(self, data: T, date: float) -> None:
+        self._snapshot = Snapshot(copy.deepcopy(data), date)
+
+    def read(self) -> Snapshot[T] | None:
+        if self._snapshot is None:
+            return None
+        return Snapshot(copy.deepcopy(self._snapshot.data), self._snapshot.date)
+
+
+@dataclass(frozen=True)
+class ActivityInfo:
+    rqst_id: int
+    request: str
+    state: State
+    codel_state: str
+    started: float
+
+
+# ---------------------------------------------------------------- activities
+
+
+class Activity:
+    __slots__ = ("id", "spec", "module", "input", "output", "state", "codel_state", "sink", "parent",
+                 "children", "started", "cause", "waiting_for", "pending_final", "pending_state", "fail_report",
+                 "task")
+
+    def __init__(self, rqst_id: int, spec: RequestSpec, module: Module, input_: Any, sink: ReplySink,
+                 parent: Activity | None, now: float):
+        self.id = rqst_id
+        self.spec = spec
+        self.module = module
+        self.input = input_
+        self.output = spec.output_type() if spec.output_type is not None else None
+        self.state = State.ETHER
+        self.codel_state = ""
+        self.sink = sink
+        self.parent = parent
+        self.children: list[Activity] = []
+        self.started = now
+        self.cause = ""  # why it was interrupted: ABORT, or the conflicting request's name
+        self.waiting_for: set[int] = set()  # activities that must end before it may start
+        self.pending_final: Reply | None = None  # held until every child has ended
+        self.pending_state = State.ETHER  # where it goes once they have
+        self.fail_report: Report | None = None  # an intrinsic failure going through the end codel
+        self.task: TaskRunner | None = None
+
+    @property
+    def live_children(self) -> list[Activity]:
+        return [c for c in self.children if c.state is not State.ETHER]
+
+    def __getattr__(self, name: str) -> Any:
+        # Codels read inputs and write outputs as `request.<field>` (GenoM's request record).
+        get = object.__getattribute__
+        for slot in ("input", "output"):
+            record = get(self, slot)
+            if record is not None and hasattr(record, name):
+                return getattr(record, name)
+        raise AttributeError(f"request '{get(self, 'spec').name}' has no input or output '{name}'")
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in Activity.__slots__:
+            object.__setattr__(self, name, value)
+            return
+        output = object.__getattribute__(self, "output")
+        if output is not None and hasattr(output, name):
+            setattr(output, name, value)
+            return
+        raise AttributeError(f"request '{self.spec.name}' has no output '{name}'")
+
+
+class TransitionError(RuntimeError):
+    """An arc that Fig. 2.3 does not have: a bug in the runtime, never a user error."""
+
+
+class InternalData:
+    """Base of each module's generated SDI: what codels reach besides their own data."""
+
+    _module: Module | None = None
+
+    def read_poster(self, name: str) -> Any:
+        """Another module's poster content (`"module.Poster"`), or None if it has none yet.
+
+        A poster exporting a single field gives that field's value directly."""
+        module = self._module
+        if module is None:
+            return None
+        snapshot = module.registry.read_poster(name)
+        if snapshot is None:
+            return None
+        data = snapshot.data
+        names = [f.name for f in dataclasses.fields(data)]
+        return getattr(data, names[0]) if len(names) == 1 else data
+
+    def write_poster(self, name: str) -> None:
+        """Update one of this module's `update: manual` posters from the SDI now."""
+        assert self._module is not None
+        self._module.update_poster(name)
+
+    def send_request(self, name: str, **inputs: Any) -> RequestHandle:
+        """Send `"module.request"` from the running codel: the new activity is its child."""
+        assert self._module is not None
+        return self._module.registry.send_from_codel(name, inputs)
+
+
+@dataclass
+class RequestHandle:
+    """What a codel gets back from `send_request`: the child's id and its replies so far."""
+
+    id: int
+    interm: Reply | None = None
+    final: Reply | None = None
+
+    def receive(self, reply: Reply) -> None:
+        if reply.final:
+            self.final = reply
+        else:
+            self.interm = reply
+
+
+# ---------------------------------------------------------------- exec tasks
+
+
+class TaskRunner:
+    """An exec task: every period, the permanent codel, then one codel of each activity."""
+
+    def __init__(self, module: Module, spec: ExecTaskSpec):
+        self.module = module
+        self.spec = spec
+        self.activities: list[Activity] = []
+        self.timer: Timer | None = None
+        self.last_tick: float | None = None
+        self.initialised = False
+        self.cycles = 0
+
+    @property
+    def permanent(self) -> bool:
+        return self.spec.init is not None or self.spec.permanent is not None
+
+    def start(self) -> None:
+        if self.permanent:
+            self.schedule()
+
+    def schedule(self) -> None:
+        """Next tick on the grid delay + k * period: now at the earliest, never twice an instant."""
+        if self.timer is not None:
+            return
+        kernel = self.module.kernel
+        period, delay = self.spec.period, self.spec.delay
+        k = max(0, math.ceil((kernel.now - delay) / period - 1e-9))
+        if self.last_tick is not None and delay + k * period <= self.last_tick + 1e-12:
+            k = round((self.last_tick - delay) / period) + 1
+        self.timer = kernel.call_at(delay + k * period, self.tick, self.spec.priority)
+
+    def tick(self) -> None:
+        self.timer = None
+        self.last_tick = self.module.kernel.now
+        module = self.module
+        self.cycles += 1
+        if not self.initialised and self.spec.init is not None:
+            module.call_permanent(self.spec.init)
+        self.initialised = True
+        if self.spec.permanent is not None:
+            module.call_permanent(self.spec.permanent)
+            module.cycle_done(self.spec.permanent)
+        for activity in list(self.activities):
+            module.step(activity)
+        if self.permanent or self.activities:
+            self.schedule()
+
+
+# ---------------------------------------------------------------- the module and its controller
+
+
+class Module:
+    def __init__(self, spec: ModuleSpec, registry: Registry, codels: ModuleType | Any):
+        self.spec = spec
+        self.registry = registry
+        self.kernel = registry.kernel
+        self.name = spec.name
+        self.codels = codels
+        self.sdi = spec.sdi_type()
+        self.sdi._module = self
+        self.activities: dict[int, Activity] = {}  # every activity not in ETHER
+        self.posters = {p.name: Poster[Any](p) for p in spec.posters}
+        self.tasks = {t.name: TaskRunner(self, t) for t in spec.tasks}
+        self.zombie: Activity | None = None
+        self.transitions: list[tuple[int, State, State]] = []  # (id, from, to), for tests and logs
+        self.observers: list[Callable[[Module, Activity, State, State], None]] = []
+        self._functions: dict[str, Callable[..., Any]] = {}
+
+    def start(self) -> None:
+        for runner in self.tasks.values():
+            runner.start()
+
+    # -- codel binding
+    def function(self, name: str) -> Callable[..., Any]:
+        found = self._functions.get(name)
+        if found is None:
+            found = getattr(self.codels, name, None)
+            if not callable(found):
+                raise LookupError(f"codel '{name}' is not defined in {self.spec.codel_module}")
+            self._functions[name] = found
+        return found
+
+    # -- requests
+    def submit(self, request: str, input_: Any, sink: ReplySink, parent: Activity | None = None) -> int:
+        """Receive a request; every outcome is a reply through `sink` (now or later)."""
+        rqst_id = self.registry.new_id()
+        spec = self.spec.requests.get(request)
+        if spec is None:
+            sink(self.reply(rqst_id, request, Status.CS_ERROR, Report(
+                "UNKNOWN_REQUEST", f"module '{self.name}' has no request '{request}'")))
+            return rqst_id
+        problem = check_record(input_, spec.input_type)
+        if problem:
+            sink(self.reply(rqst_id, request, Status.FINAL_ERROR, Report("BAD_INPUT", problem)))
+            return rqst_id
+        if spec.kind == "control":
+            self.run_control(rqst_id, spec, input_, sink)
+            return rqst_id
+        if self.zombie is not None:
+            sink(self.reply(rqst_id, request, Status.ZOMBIE, Report(
+                "MODULE_FROZEN", f"activity {self.zombie.id} ({self.zombie.spec.name}) is ZOMBIE; abort it first")))
+            return rqst_id
+        activity = Activity(rqst_id, spec, self, input_, sink, parent, self.kernel.now)
+        if parent is not None:
+            parent.children.append(activity)
+        self.move(activity, State.INIT)
+        self.activities[rqst_id] = activity
+        if spec.validate is not None:
+            outcome = self.call_codel(activity, spec.validate, validating=True)
+            if outcome is not None:
+                self.move(activity, State.ETHER)
+                del self.activities[rqst_id]
+                self.deliver(activity, self.reply(rqst_id, request, Status.FINAL_ERROR, outcome))
+                return rqst_id
+        for other in list(self.activities.values()):
+            if other is not activity and other.state in (State.INIT, State.EXEC, State.INTER) \
+                    and spec.conflicts_with(other.spec) and not is_ancestor(other, activity):
+                activity.waiting_for.add(other.id)
+                if other.state is not State.INTER:
+                    self.interrupt(other, spec.name)
+        self.try_start(activity)
+        return rqst_id
+
+    def run_control(self, rqst_id: int, spec: RequestSpec, input_: Any, sink: ReplySink) -> None:
+        """A control request takes no time: its validate codel runs and the final reply goes now."""
+        output = spec.output_type() if spec.output_type is not None else None
+        record = ControlRecord(spec, input_, output)
+        outcome: Report | None = None
+        if spec.validate is not None:
+            outcome = self.call_codel(record, spec.validate, validating=True)
+        if outcome is None:
+            # A control request interrupts the activities it is incompatible with (Table 3.1, mod2f3).
+            for other in list(self.activities.values()):
+                if other.state in (State.INIT, State.EXEC) and spec.conflicts_with(other.spec):
+                    self.interrupt(other, spec.name)
+        status = Status.END if outcome is None else Status.FINAL_ERROR
+        sink(self.reply(rqst_id, spec.name, status, outcome or Report("OK"), output))
+
+    def abort(self, target: int, sink: ReplySink | None = None) -> int:
+        """The module's abort control request (modAbortRqstSend)."""
+        rqst_id = self.registry.new_id()
+        activity = self.activities.get(target)
+        if activity is None:
+            report, status = Report("UNKNOWN_ACTIVITY", f"no activity {target} in module '{self.name}'"), \
+                Status.FINAL_ERROR
+        else:
+            self.interrupt(activity, "ABORT")
+            report, status = Report("OK"), Status.END
+        if sink is not None:
+            sink(self.reply(rqst_id, "abort", status, report))
+        return rqst_id
+
+    def interrupt(self, activity: Activity, cause: str) -> None:
+        if activity.state is State.INIT:
+            activity.cause = cause
+            self.finish(activity, State.ETHER, Status.INTERRUPTED, Report(cause))
+        elif activity.state is State.EXEC:
+            activity.cause = cause
+            self.move(activity, State.INTER)
+            for child in activity.live_children:
+                child.module.interrupt(child, "ABORT")
+        elif activity.state is State.ZOMBIE:
+            self.move(activity, State.ETHER)
+            self.forget(activity)
+            if self.zombie is activity:
+                self.zombie = None
+
+    def try_start(self, activity: Activity) -> None:
+        if activity.state is not State.INIT or activity.waiting_for:
+            return
+        self.move(activity, State.EXEC)
+        activity.codel_state = activity.spec.first_state
+        runner = self.tasks.get(activity.spec.task or "")
+        if runner is None:
+            self.finish(activity, State.ETHER, Status.FINAL_ERROR,
+                        Report("NO_EXEC_TASK", f"request '{activity.spec.name}' has no exec task to run in"))
+            return
+        activity.task = runner
+        runner.activities.append(activity)
+        activity.sink(self.reply(activity.id, activity.spec.name, Status.WAITING, Report(INTERMEDIATE_REPORT),
+                                 final=False))
+        runner.schedule()
+
+    # -- running codels
+    def step(self, activity: Activity) -> None:
+        """One codel of `activity`, then the transition its result asks for."""
+        if activity.pending_final is not None:
+            return  # done; waiting for its children to end
+        if activity.state is State.INTER:
+            self.step_inter(activity)
+            return
+        if activity.state is not State.EXEC:
+            return
+        spec = activity.spec
+        name = spec.codels.get(activity.codel_state)
+        if name is None:  # e.g. `end` requested without an end codel: the activity is over
+            self.end(activity, activity.fail_report or Report("OK"))
+            return
+        result = self.run_codel(activity, name)
+        if result is None:
+            return
+        self.cycle_done(spec.name)
+        if result == ENDED:
+            self.end(activity, activity.fail_report or Report("OK"))
+        elif result == FAILED:
+            self.fail(activity, Report("ZOMBIE", f"codel '{name}' failed"))
+        elif result in spec.fail:
+            if activity.codel_state != "end" and "end" in spec.codels:
+                activity.fail_report = Report(result)
+                activity.codel_state = "end"
+            else:
+                self.end(activity, Report(result))
+        elif result == "end" and activity.codel_state == "end":
+            self.end(activity, activity.fail_report or Report("OK"))
+        elif result in spec.codels or result == "end":
+            declared = spec.yields.get(activity.codel_state)
+            if declared and result not in declared:
+                self.extrinsic(activity, "UNDECLARED_STATE",
+                               f"codel '{name}' returned '{result}', not one of its declared {declared}")
+            else:
+                activity.codel_state = result
+        else:
+            self.extrinsic(activity, "UNDECLARED_STATE",
+                           f"codel '{name}' returned {result!r}: not a codel state of '{spec.name}' "
+                           f"({', '.join(sorted(spec.codels))}), 'end', 'ether', 'zombie' or a fail message "
+                           f"({', '.join(spec.fail) or 'none declared'})")
+
+    def step_inter(self, activity: Activity) -> None:
+        name = activity.spec.codels.get("inter")
+        result = ENDED if name is None else self.run_codel(activity, name)
+        if result is None:
+            return
+        if result == FAILED:
+            self.fail(activity, Report("ZOMBIE", f"inter codel '{name}' failed"))
+        elif result != "inter":  # `inter` asks for one more cycle of the interruption codel
+            self.finish(activity, State.ETHER, Status.INTERRUPTED, Report(activity.cause or "ABORT"))
+
+    def run_codel(self, activity: Activity, name: str) -> str | None:
+        """The codel's result, or None when it raised (the activity is then already ended)."""
+        try:
+            result = self.call_with_parent(activity, self.function(name), self.sdi, activity)
+        except Exception as exc:  # a codel's bug is the activity's extrinsic error, not the runtime's
+            self.extrinsic(activity, "CODEL_ERROR", f"codel '{name}' raised {type(exc).__name__}: {exc}")
+            return None
+        if not isinstance(result, str):
+            self.extrinsic(activity, "UNDECLARED_STATE", f"codel '{name}' returned {result!r}, not a state name")
+            return None
+        return result
+
+    def call_codel(self, record: Any, name: str, validating: bool) -> Report | None:
+        """A validate codel: None to accept, else the report refusing the request."""
+        try:
+            result = self.function(name)(self.sdi, record)
+        except Exception as exc:
+            return Report("CODEL_ERROR", f"codel '{name}' raised {type(exc).__name__}: {exc}")
+        if result in (None, "end", "ok", "OK", ENDED, "exec"):
+            return None
+        if isinstance(result, str) and result in record.spec.fail:
+            return Report(result)
+        return Report("UNDECLARED_STATE", f"validate codel '{name}' returned {result!r}: accept with 'end', "
+                      f"refuse with a fail message ({', '.join(record.spec.fail) or 'none declared'})")
+
+    def call_with_parent(self, activity: Activity, function: Callable[..., Any], *args: Any) -> Any:
+        previous = self.registry.current
+        self.registry.current = activity
+        try:
+            return function(*args)
+        finally:
+            self.registry.current = previous
+
+    def call_permanent(self, name: str) -> None:
+        try:
+            self.function(name)(self.sdi)
+        except Exception as exc:
+            self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: permanent codel '{name}' "
+                                           f"raised {type(exc).__name__}: {exc}")
+
+    # -- endings
+    def end(self, activity: Activity, report: Report) -> None:
+        self.finish(activity, State.ETHER, Status.END, report)
+
+    def extrinsic(self, activity: Activity, code: str, detail: str) -> None:
+        self.finish(activity, State.ETHER, Status.FINAL_ERROR, Report(code, detail))
+
+    def fail(self, activity: Activity, report: Report) -> None:
+        self.finish(activity, State.ZOMBIE, Status.ZOMBIE, Report(report.code, report.detail or
+                                                                  f"activity {activity.id}"))
+
+    def finish(self, activity: Activity, target: State, status: Status, report: Report) -> None:
+        """End an activity: children first (the parent ends only when they have), then the reply."""
+        reply = self.reply(activity.id, activity.spec.name, status, report, activity.output)
+        live = activity.live_children
+        if live:
+            activity.pending_final = reply
+            activity.pending_state = target
+            for child in live:
+                if child.state in (State.INIT, State.EXEC):
+                    child.module.interrupt(child, "ABORT")
+            return
+        self.complete(activity, target, reply)
+
+    def complete(self, activity: Activity, target: State, reply: Reply) -> None:
+        if activity.state is State.INIT and target is State.ZOMBIE:
+            target = State.ETHER
+        self.move(activity, target)
+        if activity.task is not None and activity in activity.task.activities:
+            activity.task.activities.remove(activity)
+        if target is State.ZOMBIE:
+            self.zombie = activity
+        else:
+            self.forget(activity)
+        self.deliver(activity, reply)
+        for other in list(self.activities.values()):
+            if activity.id in other.waiting_for:
+                other.waiting_for.discard(activity.id)
+                self.try_start(other)
+
+    def forget(self, activity: Activity) -> None:
+        self.activities.pop(activity.id, None)
+
+    def deliver(self, activity: Activity, reply: Reply) -> None:
+        activity.sink(reply)
+        parent = activity.parent
+        if parent is None:
+            return
+        if parent.pending_final is not None and not parent.live_children:
+            parent.module.complete(parent, parent.pending_state, parent.pending_final)
+        elif reply.status not in (Status.END, Status.INTERRUPTED) and parent.state is State.EXEC:
+            # A child's error reaches its parent, which ends with SERVER_ERROR chaining it.
+            parent.module.finish(parent, State.ETHER, Status.SERVER_ERROR, Report(
+                "CHILD_ERROR", f"{reply.module}.{reply.request} ended {reply.status.value}", cause=reply))
+
+    def move(self, activity: Activity, target: State) -> None:
+        source = activity.state
+        if source is target:
+            return
+        if (source, target) not in _ARC_SET:
+            raise TransitionError(f"{self.name}: no arc {source.value} -> {target.value} (activity {activity.id})")
+        activity.state = target
+        self.transitions.append((activity.id, source, target))
+        for observer in self.observers:
+            observer(self, activity, source, target)
+
+    def reply(self, rqst_id: int, request: str, status: Status, report: Report, output: Any = None,
+              final: bool = True) -> Reply:
+        return Reply(rqst_id, self.name, request, status, report, output, final, self.kernel.now)
+
+    # -- posters
+    def cycle_done(self, activity_name: str) -> None:
+        for poster in self.posters.values():
+            if poster.spec.update == "auto" and poster.spec.activity == activity_name:
+                self.update_poster(poster.spec.name)
+
+    def update_poster(self, name: str) -> None:
+        poster = self.posters[name]
+        data = poster.spec.type(**{f: getattr(self.sdi, f) for f in poster.spec.fields})
+        poster.write(data, self.kernel.now)
+
+    def control_poster(self) -> Snapshot[tuple[ActivityInfo, ...]]:
+        """The standard control poster: every activity, its state and when it started."""
+        return Snapshot(tuple(ActivityInfo(a.id, a.spec.name, a.state, a.codel_state, a.started)
+                              for a in sorted(self.activities.values(), key=lambda a: a.id)), self.kernel.now)
+
+
+@dataclass
+class ControlRecord:
+    """What a control request's validate codel sees as `request`."""
+
+    spec: RequestSpec
+    input: Any
+    output: Any
+
+    def __getattr__(self, name: str) -> Any:
+        for record in (self.input, self.output):
+            if record is not None and hasattr(record, name):
+                return getattr(record, name)
+        raise AttributeError(f"request '{self.spec.name}' has no input or output '{name}'")
+
+
+def is_ancestor(candidate: Activity, activity: Activity) -> bool:
+    parent = activity.parent
+    while parent is not None:
+        if parent is candidate:
+            return True
+        parent = parent.parent
+    return False
+
+
+# ---------------------------------------------------------------- type checking of records
+
+_PRIMITIVES: dict[str, tuple[type, ...]] = {"float": (float, int), "int": (int,), "bool": (bool,), "str": (str,)}
+
+
+def check_record(value: Any, expected: type | None) -> str:
+    """'' when `value` fits the generated record type `expected`, else what is wrong."""
+    if expected is None:
+        return "" if value is None else "this request takes no input"
+    if not isinstance(value, expected):
+        return f"expected {expected.__name__}, got {type(value).__name__}"
+    for f in getattr(expected, "__specc_fields__", ()):
+        problem = check_value(getattr(value, f[0]), f[1], f[2])
+        if problem:
+            return f"{f[0]}: {problem}"
+    return ""
+
+
+def check_value(value: Any, kind: Any, size: int | None) -> str:
+    if size is not None:
+        if not isinstance(value, list) or len(value) != size:
+            return f"expected a list of {size}"
+        for item in value:
+            problem = check_value(item, kind, None)
+            if problem:
+                return problem
+        return ""
+    if isinstance(kind, str):
+        allowed = _PRIMITIVES[kind]
+        if isinstance(value, bool) and bool not in allowed:
+            return f"expected {kind}, got bool"
+        return "" if isinstance(value, allowed) else f"expected {kind}, got {type(value).__name__}"
+    return check_record(value, kind)
+
+
+# ---------------------------------------------------------------- the robot's modules together
+
+
+class Registry:
+    """The modules of one robot on one kernel: request ids, posters by name, activity trees."""
+
+    def __init__(self, kernel: Kernel | None = None):
+        self.kernel = kernel or Kernel()
+        self.modules: dict[str, Module] = {}
+        self.current: Activity | None = None  # the activity whose codel is running
+        self.incidents: list[str] = []
+        self._ids = itertools.count(1)
+
+    def new_id(self) -> int:
+        return next(self._ids)
+
+    def add(self, spec: ModuleSpec, codels: Any) -> Module:
+        module = Module(spec, self, codels)
+        self.modules[spec.name] = module
+        module.start()
+        return module
+
+    def read_poster(self, name: str) -> Snapshot[Any] | None:
+        module_name, _, poster_name = name.partition(".")
+        module = self.modules.get(module_name)
+        poster = module.posters.get(poster_name) if module is not None else None
+        return poster.read() if poster is not None else None
+
+    def send_from_codel(self, name: str, inputs: Mapping[str, Any]) -> RequestHandle:
+        module_name, _, request = name.partition(".")
+        handle = RequestHandle(0)
+        module = self.modules.get(module_name)
+        if module is None:
+            reply = Reply(self.new_id(), module_name, request, Status.CS_ERROR,
+                          Report("UNKNOWN_MODULE", f"no module '{module_name}'"), time=self.kernel.now)
+            handle.id = reply.rqst_id
+            handle.receive(reply)
+            return handle
+        spec = module.spec.requests.get(request)
+        input_: Any = None
+        if spec is not None and spec.input_type is not None:
+            try:
+                input_ = spec.input_type(**inputs)
+            except TypeError as exc:
+                reply = Reply(self.new_id(), module_name, request, Status.FINAL_ERROR, Report("BAD_INPUT", str(exc)),
+                              time=self.kernel.now)
+                handle.id = reply.rqst_id
+                handle.receive(reply)
+                return handle
+        handle.id = module.submit(request, input_, handle.receive, self.current)
+        return handle
+
+
+# ---------------------------------------------------------------- the client (modFuncRqstSend / ReplyRcv)
+
+
+@dataclass
+class _Exchange:
+    request: str
+    interm: Reply | None = None
+    final: Reply | None = None
+    timers: list[Timer] = field(default_factory=list)
+
+
+DEFAULT_WAIT = 3600.0  # s of simulated time a blocking wait gives up after, when no timeout is set
+
+
+class ModuleClient:
+    """Send requests to one module and receive their replies (seed 000 §2.5)."""
+
+    def __init__(self, module: Module):
+        self.module = module
+        self.kernel = module.kernel
+        self._exchanges: dict[int, _Exchange] = {}
+
+    def send(self, request: str, input_: Any = None, *, interm_timeout: float | None = None,
+             final_timeout: float | None = None) -> int:
+        """modFuncRqstSend: the request's id; its replies arrive through the kernel."""
+        exchange = _Exchange(request)
+        receive = self._receiver(exchange)
+        rqst_id = self.module.submit(request, input_, receive)
+        self._exchanges[rqst_id] = exchange
+        for timeout, which in ((interm_timeout, "interm"), (final_timeout, "final")):
+            if timeout is not None and exchange.final is None:
+                exchange.timers.append(self.kernel.call_later(timeout, functools.partial(self._expire, rqst_id, which)))
+        return rqst_id
+
+    @staticmethod
+    def _receiver(exchange: _Exchange) -> ReplySink:
+        def receive(reply: Reply) -> None:
+            if exchange.final is not None:
+                return  # the client already gave up (TIMEOUT)
+            if reply.final:
+                exchange.final = reply
+                for timer in exchange.timers:
+                    timer.cancel()
+            else:
+                exchange.interm = reply
+        return receive
+
+    def _expire(self, rqst_id: int, which: str) -> None:
+        exchange = self._exchanges[rqst_id]
+        if exchange.final is not None or (which == "interm" and exchange.interm is not None):
+            return
+        exchange.final = Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT,
+                               Report(which, f"no {'intermediate' if which == 'interm' else 'final'} reply in time"),
+                               time=self.kernel.now)
+
+    def reply(self, rqst_id: int) -> Reply:
+        """modFuncReplyRcv without waiting: the final reply, or WAITING (report: which one)."""
+        exchange = self._exchanges.get(rqst_id)
+        if exchange is None:
+            return Reply(rqst_id, self.module.name, "?", Status.CS_ERROR, Report("UNKNOWN_ID"),
+                         time=self.kernel.now)
+        if exchange.final is not None:
+            return exchange.final
+        which = "final" if exchange.interm is not None else "interm"
+        return Reply(rqst_id, self.module.name, exchange.request, Status.WAITING, Report(which), final=False,
+                     time=self.kernel.now)
+
+    def interm(self, rqst_id: int, timeout: float | None = None) -> Reply:
+        """Wait for the intermediate reply (or the final one, if the request ended first)."""
+        exchange = self._exchanges.get(rqst_id)
+        if exchange is None:
+            return self.reply(rqst_id)
+        self._wait(lambda: exchange.interm is None and exchange.final is None, timeout)
+        return exchange.interm or self.reply(rqst_id)
+
+    def final(self, rqst_id: int, timeout: float | None = None) -> Reply:
+        """Wait for the final reply; TIMEOUT (report 'final') if `timeout` expires first."""
+        exchange = self._exchanges.get(rqst_id)
+        if exchange is None:
+            return self.reply(rqst_id)
+        done = self._wait(lambda: exchange.final is None, timeout)
+        if not done and exchange.final is None:
+            return Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT,
+                         Report("final", "gave up waiting"), time=self.kernel.now)
+        return self.reply(rqst_id)
+
+    def _wait(self, pending: Callable[[], bool], timeout: float | None) -> bool:
+        deadline = self.kernel.now + (DEFAULT_WAIT if timeout is None else timeout)
+        return self.kernel.run_while(pending, deadline)
+
+    def abort(self, rqst_id: int) -> Reply:
+        """modAbortRqstSend + modAbortReplyRcv: interrupt an activity of this module."""
+        box: list[Reply] = []
+        self.module.abort(rqst_id, box.append)
+        return box[0]
+
+    def call(self, request: str, input_: Any = None, timeout: float | None = None) -> Reply:
+        """Send and wait for the final reply."""
+        return self.final(self.send(request, input_), timeout)
+
+    def poster(self, name: str) -> Snapshot[Any] | None:
+        return self.module.posters[name].read()
+
+
+def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
+    """The user's codel module: the one given, else imported by the name the spec declares."""
+    if codels is not None:
+        return codels
+    import importlib
+
+    return importlib.import_module(spec.codel_module)
+
+
+def iter_arcs() -> Iterable[tuple[State, str, State]]:
+    return iter(ARCS)

@@ -1,0 +1,125 @@
+"""The event kernel: one clock for every delay, period and timeout in a specc robot.
+
+Simulated time (the default) jumps from event to event, so a run is deterministic and far
+faster than real time; `WallClock` paces the same events on the real clock for demonstrations.
+Events at the same instant run by (priority, order of scheduling): lower priority numbers first.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class Clock:
+    """Simulated time: waiting costs nothing."""
+
+    def wait_until(self, instant: float, now: float) -> None:
+        del instant, now
+
+
+class WallClock(Clock):
+    """Real time: the kernel sleeps until each event is due (scaled by `speed`)."""
+
+    def __init__(self, speed: float = 1.0):
+        self.speed = speed
+        self._origin: tuple[float, float] | None = None
+
+    def wait_until(self, instant: float, now: float) -> None:
+        if self._origin is None:
+            self._origin = (time.monotonic(), now)
+        real_start, sim_start = self._origin
+        delay = real_start + (instant - sim_start) / self.speed - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+
+
+@dataclass(order=True)
+class _Event:
+    when: float
+    priority: int
+    order: int
+    action: Callable[[], Any] = field(compare=False)
+    cancelled: bool = field(default=False, compare=False)
+
+
+class Timer:
+    """A scheduled event that can be cancelled before it fires."""
+
+    __slots__ = ("_event",)
+
+    def __init__(self, event: _Event):
+        self._event = event
+
+    def cancel(self) -> None:
+        self._event.cancelled = True
+
+    @property
+    def when(self) -> float:
+        return self._event.when
+
+
+class Kernel:
+    def __init__(self, clock: Clock | None = None, start: float = 0.0):
+        self.clock = clock or Clock()
+        self.now = start
+        self._queue: list[_Event] = []
+        self._order = itertools.count()
+
+    def call_at(self, when: float, action: Callable[[], Any], priority: int = 0) -> Timer:
+        if when < self.now:
+            when = self.now
+        event = _Event(when, priority, next(self._order), action)
+        heapq.heappush(self._queue, event)
+        return Timer(event)
+
+    def call_later(self, delay: float, action: Callable[[], Any], priority: int = 0) -> Timer:
+        return self.call_at(self.now + max(delay, 0.0), action, priority)
+
+    def step(self) -> bool:
+        """Run the next event; False when nothing is scheduled."""
+        while self._queue:
+            event = heapq.heappop(self._queue)
+            if event.cancelled:
+                continue
+            self.clock.wait_until(event.when, self.now)
+            self.now = event.when
+            event.action()
+            return True
+        return False
+
+    def next_time(self) -> float | None:
+        while self._queue and self._queue[0].cancelled:
+            heapq.heappop(self._queue)
+        return self._queue[0].when if self._queue else None
+
+    def run_until(self, instant: float) -> None:
+        """Run every event due at or before `instant`, then set the clock to `instant`."""
+        while True:
+            upcoming = self.next_time()
+            if upcoming is None or upcoming > instant:
+                break
+            self.step()
+        if instant > self.now:
+            self.clock.wait_until(instant, self.now)
+            self.now = instant
+
+    def run_for(self, duration: float) -> None:
+        self.run_until(self.now + duration)
+
+    def run_while(self, condition: Callable[[], bool], deadline: float) -> bool:
+        """Run events while `condition()` holds and time stays within `deadline`.
+
+        Returns True when the condition became false (what was awaited happened)."""
+        while condition():
+            upcoming = self.next_time()
+            if upcoming is None or upcoming > deadline:
+                if deadline != float("inf") and deadline > self.now:
+                    self.run_until(deadline)
+                return not condition()
+            self.step()
+        return True
