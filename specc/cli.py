@@ -14,6 +14,7 @@ import typer
 from rich.console import Console
 
 from specc.diagnostics import error, render
+from specc.model import nodes as m
 from specc.model.span import Span
 from specc.pipeline import Loaded, load
 from specc.syntax.printer import format_source
@@ -140,6 +141,37 @@ def fmt(paths: PathsArg,
     if not changed and not unwritable:
         out.print(f"{len(loaded.program.files)} file(s) already formatted", markup=False)
     raise typer.Exit(1 if unwritable or (check_only and changed) else 0)
+
+
+@app.command()
+def skeleton(paths: PathsArg) -> None:
+    """Write stubs for the codels a spec names but its codel modules lack; never rewrites code.
+
+    Example: specc skeleton examples/hilare
+    """
+    from specc.backends import skeleton as stubs
+
+    loaded = load(paths, check=False)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    wrote = 0
+    for source in loaded.program.files:
+        spec_dir = loaded.paths[source.path].resolve().parent
+        for item in source.items:
+            if not isinstance(item, m.Module):
+                continue
+            try:
+                change = stubs.write_stubs(item, spec_dir)
+            except (OSError, SyntaxError) as exc:
+                err.print(f"{source.path}: error: module '{item.name}': {exc} [skeleton-failed]", markup=False)
+                raise typer.Exit(1) from None
+            if change is None or not change.functions:
+                continue
+            wrote += len(change.functions)
+            verb = "created" if change.created else "added to"
+            out.print(f"{verb} {change.path}: {', '.join(change.functions)}", markup=False)
+    if not wrote:
+        out.print("every codel named by the specs already exists", markup=False)
 
 
 def main() -> None:

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from specc.check.context import Context
-from specc.check.pysource import find_module, top_level_functions
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.span import Span
+from specc.pysource import find_module, top_level_functions
 
 
 def check(ctx: Context) -> None:

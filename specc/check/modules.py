@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import keyword
+
 from specc.check.context import Context
 from specc.model import nodes as m
 
@@ -24,7 +26,26 @@ def check(ctx: Context) -> None:
         check_module(ctx, module)
 
 
+# The generated client already has these methods, and Python reserves its keywords.
+RESERVED = frozenset({"send", "reply", "interm", "final", "abort", "call", "poster", "module", "kernel", "create",
+                      "client"}) | frozenset(keyword.kwlist)
+
+
+def check_names(ctx: Context, module: m.Module) -> None:
+    """Requests, fields and types become Python names in the generated module."""
+    named: list[tuple[str, m.Span, str]] = [(module.name, module.span, "module")]
+    named += [(r.name, r.span, "request") for r in module.requests]
+    named += [(f.name, f.span, "field") for s in module.structs for f in s.fields]
+    named += [(f.name, f.span, "internal data field") for f in module.internal_data]
+    named += [(t.name, t.span, "input or output") for r in module.requests for t in r.inputs + r.outputs]
+    for name, span, what in named:
+        if keyword.iskeyword(name) or (what == "request" and name in RESERVED):
+            ctx.report("reserved-name", f"{what} '{name}' would clash with a Python keyword or a method of the "
+                       "generated client; rename it", span)
+
+
 def check_module(ctx: Context, module: m.Module) -> None:
+    check_names(ctx, module)
     ctx.duplicates(module.structs + module.enums, "type")  # type: ignore[operator]
     ctx.duplicates(module.internal_data, "internal data field")
     ctx.duplicates(module.requests, "request")

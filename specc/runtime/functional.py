@@ -230,7 +230,8 @@ class Activity:
 
     @property
     def live_children(self) -> list[Activity]:
-        return [c for c in self.children if c.state is not State.ETHER]
+        """Children still running; a ZOMBIE child has sent its final reply, so it is over here."""
+        return [c for c in self.children if c.state in (State.INIT, State.EXEC, State.INTER)]
 
     def __getattr__(self, name: str) -> Any:
         # Codels read inputs and write outputs as `request.<field>` (GenoM's request record).
@@ -881,7 +882,12 @@ class ModuleClient:
         return self.final(self.send(request, input_), timeout)
 
     def poster(self, name: str) -> Snapshot[Any] | None:
-        return self.module.posters[name].read()
+        """The poster's latest content and date; None before its first write."""
+        poster = self.module.posters.get(name)
+        if poster is None:
+            raise LookupError(f"module '{self.module.name}' has no poster '{name}' "
+                              f"(its posters: {', '.join(self.module.posters) or 'none'})")
+        return poster.read()
 
 
 def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
@@ -890,7 +896,11 @@ def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
         return codels
     import importlib
 
-    return importlib.import_module(spec.codel_module)
+    try:
+        return importlib.import_module(spec.codel_module)
+    except ImportError as exc:
+        raise ImportError(f"module '{spec.name}': cannot import its codels '{spec.codel_module}' ({exc}); "
+                          "put the folder holding them on sys.path, or pass `codels=`") from exc
 
 
 def iter_arcs() -> Iterable[tuple[State, str, State]]:

@@ -1,0 +1,61 @@
+from __future__ import annotations
+
+import importlib
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import pytest
+
+from specc.backends import modules, package
+from specc.backends.manifest import Output
+from specc.pipeline import load
+from specc.runtime import functional as rt
+
+HERE = Path(__file__).parent
+
+
+def compile_robot(spec: Path, target: Path) -> str:
+    loaded = load([spec])
+    assert loaded.program is not None and not loaded.errors, [d.headline() for d in loaded.diagnostics]
+    name = package.robot_name(loaded.program, spec.stem)
+    output = Output()
+    package.generate(loaded.program, name, output)
+    modules.generate(loaded.program, output)
+    output.write(target / name)
+    return name
+
+
+@pytest.fixture(scope="session")
+def scripted_package(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+    target = tmp_path_factory.mktemp("generated")
+    name = compile_robot(HERE / "scripted.spec", target)
+    sys.path[:0] = [str(target), str(HERE)]
+    return importlib.import_module(f"{name}.modules")
+
+
+@dataclass
+class Robot:
+    registry: rt.Registry
+    alpha: rt.Module
+    beta: rt.Module
+    package: ModuleType
+
+    @property
+    def kernel(self) -> Any:
+        return self.registry.kernel
+
+    def client(self, name: str = "alpha") -> rt.ModuleClient:
+        return rt.ModuleClient(self.registry.modules[name])
+
+    def script(self, text: str) -> Any:
+        return self.package.alpha.AInput(script=text)
+
+
+@pytest.fixture
+def robot(scripted_package: ModuleType) -> Robot:
+    registry = rt.Registry()
+    made = scripted_package.create_all(registry)
+    return Robot(registry, made["alpha"], made["beta"], scripted_package)

@@ -1,0 +1,19 @@
+"""Codels that play the script of their request: `script` is a comma-separated list of what
+the successive codel calls return. `raise` raises, `none` returns None, `send:X` sends
+beta.Child with script X (X's own steps separated by `;`) and continues with `exec`."""
+
+def play(state, sdi, request):
+    script = [s for s in request.script.split(",") if s]
+    request.trace = (request.trace + "," if request.trace else "") + state
+    if request.step >= len(script):
+        return "ether"
+    outcome = script[request.step]
+    request.step += 1
+    if outcome == "raise":
+        raise ValueError("scripted failure")
+    if outcome == "none":
+        return None
+    if outcome.startswith("send:"):
+        sdi.send_request("beta.Child", script=outcome[5:].replace(";", ","))
+        return "exec"
+    return outcome
