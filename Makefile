@@ -18,7 +18,7 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/specc check $(EXAMPLES)
 	$(BIN)/specc compile examples/hilare -o generated
-	$(BIN)/python -c "import sys; sys.path.insert(0, 'generated'); import hilare; print('robot', hilare.ROBOT, 'modules:', ', '.join(hilare.MODULES))"
+	$(BIN)/python examples/hilare/run_modules.py
 
 test: $(STAMP)
 	$(BIN)/ruff check specc tests

@@ -881,6 +881,10 @@ class ModuleClient:
         """Send and wait for the final reply."""
         return self.final(self.send(request, input_), timeout)
 
+    def control_poster(self) -> Snapshot[tuple[ActivityInfo, ...]]:
+        """The module's control poster: its activities, their states and start dates."""
+        return self.module.control_poster()
+
     def poster(self, name: str) -> Snapshot[Any] | None:
         """The poster's latest content and date; None before its first write."""
         poster = self.module.posters.get(name)
