@@ -144,6 +144,52 @@ def fmt(paths: PathsArg,
 
 
 @app.command()
+def graph(paths: PathsArg,
+          incompat: Annotated[bool, typer.Option("--incompat", help="Draw the executive's service "
+                                                 "incompatibility graph and its groups.")] = False,
+          output: Annotated[Path, typer.Option("--output", "-o", help="Picture file (PNG, SVG, PDF).")]
+          = Path("incompat.png"),
+          executive: Annotated[Optional[str], typer.Option(help="Which executive, when there are several.")]
+          = None) -> None:
+    """Draw a picture of the spec; prints the service groups and the controller's state count.
+
+    Example: specc graph --incompat examples/hilare -o hilare-incompat.png
+    """
+    from specc.analysis.incompat import build_graph, service_groups, state_count
+    from specc.pictures import draw_incompatibility_graph
+
+    if not incompat:
+        err.print("error: say what to draw: --incompat", markup=False)
+        raise typer.Exit(1)
+    loaded = load(paths)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    executives = {e.name: e for e in loaded.program.items if isinstance(e, m.Executive)}
+    if not executives:
+        err.print("error: no executive block in these specs", markup=False)
+        raise typer.Exit(1)
+    if executive is None and len(executives) > 1:
+        err.print(f"error: several executives ({', '.join(sorted(executives))}); pick one with --executive",
+                  markup=False)
+        raise typer.Exit(1)
+    chosen = executives.get(executive) if executive else next(iter(executives.values()))
+    if chosen is None:
+        err.print(f"error: no executive '{executive}' (there are: {', '.join(sorted(executives))})", markup=False)
+        raise typer.Exit(1)
+    incompatibility = build_graph(loaded.program, chosen)
+    groups = service_groups(incompatibility)
+    for group in groups:
+        out.print(f"group {group.name}: {' | '.join(group.states)}", markup=False)
+    out.print(f"{len(groups)} group(s), {state_count(groups)} resource-controller states", markup=False)
+    try:
+        picture = draw_incompatibility_graph(incompatibility, output, f"executive {chosen.name}")
+    except (OSError, ValueError) as exc:
+        err.print(f"error: cannot write '{output}': {exc}", markup=False)
+        raise typer.Exit(1) from None
+    out.print(f"wrote {picture}", markup=False)
+
+
+@app.command()
 def skeleton(paths: PathsArg) -> None:
     """Write stubs for the codels a spec names but its codel modules lack; never rewrites code.
 

@@ -1,0 +1,1 @@
+"""Analyses over the checked model (incompatibility groups, rule compilation, ...)."""
