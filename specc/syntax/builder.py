@@ -367,7 +367,16 @@ class Builder(Transformer[Token, Any]):
         return str(children[0])
 
     def attr_spec(self, meta: Meta, children: list[Any]) -> tuple[str, Any, Span]:
-        return str(children[0]), (children[1] if len(children) > 1 else None), self.span(meta)
+        name, *rest = children
+        text = str(name)
+        if rest and isinstance(rest[0], AttrIndex):
+            text += f"[{rest.pop(0).text}]"
+        return text, (rest[0] if rest else None), self.span(meta)
+
+    def attr_index(self, meta: Meta, children: list[Any]) -> AttrIndex:
+        item = children[0]
+        value = item.text if isinstance(item, m.Ref) else item.value
+        return AttrIndex(str(int(value)) if isinstance(value, float) and value.is_integer() else str(value))
 
     def numeric_domain(self, meta: Meta, children: list[Any]) -> m.NumericDomain:
         low, high = (children + [None, None])[:2]
@@ -849,6 +858,11 @@ class Builder(Transformer[Token, Any]):
 
     def __default__(self, data: str, children: list[Any], meta: Meta) -> Any:
         raise AssertionError(f"grammar rule '{data}' has no builder method")
+
+
+@dataclass(frozen=True)
+class AttrIndex:
+    text: str
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,809 @@
+"""Kheops rule bases (seed 000 §3.7, annex A): normalisation, a reference interpreter, and the
+compiler into a decision DAG whose depth bounds the reaction time.
+
+Semantics (annex A.1): every attribute has a finite set of possible values — symbols, booleans,
+or, for numeric attributes, the intervals cut by the constants they are compared with. Inputs
+are known; an attribute nobody determined yet may still take every value of its domain. A
+condition is TRUE when it holds for every value still possible, FALSE when for none, and
+UNDETERMINED otherwise; a rule fires only when its condition is TRUE. Firing restricts
+attributes (set intersection, so reasoning is monotone and the firing order does not matter)
+and runs `do` actions (an assignment makes an intermediate attribute known from then on).
+When nothing more fires: `else` rules fire if an output is still undetermined; an output left
+with several values is *incomplete*, an attribute left with none is *inconsistent*; an
+`impossible` rule whose condition is TRUE marks the input combination as one that never occurs.
+
+Symbolic attributes without a declared domain take the constants they are compared with plus
+OTHER (any value the rules do not mention), so an undeclared intermediate such as Fig. 3.8's
+`diagn` stays undetermined until a rule restricts it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Union
+
+from specc.model import nodes as m
+
+OTHER = "*other*"  # the values of an undeclared symbolic domain that no rule mentions
+NUMERIC_OPS = ("<", "<=", ">", ">=", "==", "!=")
+
+
+class KheopsError(Exception):
+    """A rule base outside the propositional subset (carries the offending node's span)."""
+
+    def __init__(self, message: str, node: m.Node):
+        super().__init__(message)
+        self.node = node
+
+
+# ---------------------------------------------------------------- normalised rules
+
+
+@dataclass(frozen=True)
+class Atom:
+    """`attribute op value` or `attribute [not] in values`; booleans test `== True`."""
+
+    attribute: str
+    op: str  # one of NUMERIC_OPS, "in", "notin"
+    value: Any  # a constant, or a frozenset for in/notin
+
+    def holds(self, actual: Any) -> bool:
+        if self.op == "in":
+            return actual in self.value
+        if self.op == "notin":
+            return actual not in self.value
+        return compare(actual, self.op, self.value)
+
+
+@dataclass(frozen=True)
+class Not:
+    operand: Cond
+
+
+@dataclass(frozen=True)
+class All:
+    operands: tuple[Cond, ...]
+
+
+@dataclass(frozen=True)
+class Any_:
+    operands: tuple[Cond, ...]
+
+
+Cond = Union[Atom, Not, All, Any_]
+
+
+@dataclass(frozen=True)
+class Expr:
+    """An arithmetic expression over attributes, evaluated on actual values at run time."""
+
+    op: str  # const | attr | + - * / | neg
+    args: tuple[Any, ...]
+
+    def attributes(self) -> set[str]:
+        if self.op == "attr":
+            return {self.args[0]}
+        if self.op == "const":
+            return set()
+        return set().union(*(a.attributes() for a in self.args))
+
+    def evaluate(self, values: Mapping[str, Any]) -> Any:
+        if self.op == "const":
+            return self.args[0]
+        if self.op == "attr":
+            return values[self.args[0]]
+        if self.op == "neg":
+            return -self.args[0].evaluate(values)
+        left, right = (a.evaluate(values) for a in self.args)
+        if self.op == "+":
+            return left + right
+        if self.op == "-":
+            return left - right
+        if self.op == "*":
+            return left * right
+        return left / right if right else math.copysign(math.inf, left) if left else 0.0
+
+    def python(self, name: Any) -> str:
+        if self.op == "const":
+            return repr(self.args[0])
+        if self.op == "attr":
+            return str(name(self.args[0]))
+        if self.op == "neg":
+            return f"(-{self.args[0].python(name)})"
+        left, right = (a.python(name) for a in self.args)
+        if self.op == "/":
+            return f"_divide({left}, {right})"
+        return f"({left} {self.op} {right})"
+
+
+@dataclass(frozen=True)
+class Restrict:
+    atom: Atom
+
+
+@dataclass(frozen=True)
+class Assign:
+    target: str
+    expr: Expr
+
+
+@dataclass(frozen=True)
+class Call:
+    function: str
+    args: tuple[Expr, ...]
+
+
+Action = Union[Restrict, Assign, Call]
+
+
+@dataclass(frozen=True)
+class Rule:
+    name: str
+    kind: str  # when | impossible | else
+    condition: Cond | None
+    actions: tuple[Action, ...]
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One interval of a numeric attribute's partition."""
+
+    low: float
+    high: float
+    low_closed: bool
+    high_closed: bool
+
+    def contains(self, x: float) -> bool:
+        above = x > self.low or (self.low_closed and x == self.low)
+        below = x < self.high or (self.high_closed and x == self.high)
+        return above and below
+
+    def sample(self) -> float:
+        if self.low == self.high:
+            return self.low
+        if math.isinf(self.low) and math.isinf(self.high):
+            return 0.0
+        if math.isinf(self.low):
+            return self.high - 1.0
+        if math.isinf(self.high):
+            return self.low + 1.0
+        return (self.low + self.high) / 2
+
+    def __str__(self) -> str:
+        if self.low == self.high:
+            return f"{self.low:g}"
+        left = "[" if self.low_closed else "]"
+        right = "]" if self.high_closed else "["
+        return f"{left}{self.low:g}, {self.high:g}{right}"
+
+
+@dataclass
+class Attribute:
+    name: str
+    role: str  # inputs | outputs | intermediate | previous
+    kind: str = "symbol"  # symbol | bool | number
+    values: tuple[Any, ...] = ()  # symbols, booleans, or Pieces
+    declared: bool = False
+    init: Any = None  # for `@x`: the value before the first cycle
+    assigned: bool = False  # given its value by a `do` assignment
+
+
+@dataclass
+class Base:
+    """A normalised rule base: foreach expanded, constants substituted, domains computed."""
+
+    name: str
+    attributes: dict[str, Attribute]
+    rules: tuple[Rule, ...]
+    source: m.RuleBase | None = None
+
+    @property
+    def inputs(self) -> list[str]:
+        return [a.name for a in self.attributes.values() if a.role in ("inputs", "previous")]
+
+    @property
+    def outputs(self) -> list[str]:
+        return [a.name for a in self.attributes.values() if a.role == "outputs"]
+
+    def element(self, attribute: str, actual: Any) -> Any:
+        """The domain element an actual value falls in (its interval, or OTHER)."""
+        attr = self.attributes[attribute]
+        if attr.kind == "number":
+            for piece in attr.values:
+                if piece.contains(actual):
+                    return piece
+            raise ValueError(f"{attribute}={actual!r} falls outside its domain")
+        if actual in attr.values:
+            return actual
+        if OTHER in attr.values:
+            return OTHER
+        raise ValueError(f"{attribute}={actual!r} is not one of {attr.values}")
+
+
+def compare(actual: Any, op: str, value: Any) -> bool:
+    if op == "==":
+        return bool(actual == value)
+    if op == "!=":
+        return bool(actual != value)
+    if not isinstance(actual, (int, float)) or isinstance(actual, bool):
+        return False
+    if op == "<":
+        return bool(actual < value)
+    if op == "<=":
+        return bool(actual <= value)
+    if op == ">":
+        return bool(actual > value)
+    return bool(actual >= value)
+
+
+# ---------------------------------------------------------------- normalisation
+
+
+def normalise(base: m.RuleBase) -> Base:
+    constants: dict[str, Any] = {}
+    for const in base.constants:
+        constants[const.name] = constant_value(const.value, constants)
+    rules: list[Rule] = []
+    for item in base.rules:
+        if isinstance(item, m.RuleForeach):
+            for value in expand_items(item.items):
+                for rule in item.rules:
+                    rules.append(convert_rule(rule, {**constants, item.var: value}, {item.var: value}))
+        else:
+            rules.append(convert_rule(item, constants, {}))
+    attributes = collect_attributes(base, rules, constants)
+    return Base(base.name, attributes, tuple(rules), base)
+
+
+def expand_items(items: Iterable[m.KItem]) -> list[Any]:
+    values: list[Any] = []
+    for item in items:
+        if isinstance(item, m.KRange):
+            low, high = item_value(item.low), item_value(item.high)
+            try:
+                start, stop = int(low), int(high)
+            except (TypeError, ValueError) as exc:
+                raise KheopsError("a range runs between integers, like [\"1\"..\"3\"]", item) from exc
+            values += [type(low)(i) if isinstance(low, str) else i for i in range(start, stop + 1)]
+        else:
+            values.append(item_value(item))
+    return values
+
+
+def item_value(item: m.KItem) -> Any:
+    if isinstance(item, (m.String, m.Number)):
+        return item.value
+    if isinstance(item, m.Ref):
+        return {"true": True, "false": False}.get(item.text, item.text)
+    raise TypeError(item)
+
+
+def constant_value(expr: m.KExpr, constants: Mapping[str, Any]) -> Any:
+    converted = convert_expr(expr, constants, {})
+    if converted.op != "const":
+        raise KheopsError("a constant must be a literal or other constants", expr)
+    return converted.args[0]
+
+
+def attribute_key(ref: m.AttrRef, loop: Mapping[str, Any]) -> str:
+    name = ref.name
+    if ref.index is not None:
+        if ref.index not in loop:
+            raise KheopsError(f"'{ref.index}' is not a foreach variable here", ref)
+        name = f"{name}[{loop[ref.index]}]"
+    return ("@" if ref.previous else "") + name
+
+
+def convert_expr(expr: m.KExpr, constants: Mapping[str, Any], loop: Mapping[str, Any]) -> Expr:
+    if isinstance(expr, (m.Number, m.String)):
+        return Expr("const", (expr.value,))
+    if isinstance(expr, m.AttrRef):
+        if not expr.previous and expr.index is None:
+            if expr.name in constants:
+                return Expr("const", (constants[expr.name],))
+            if expr.name in ("true", "false"):
+                return Expr("const", (expr.name == "true",))
+        return Expr("attr", (attribute_key(expr, loop),))
+    if isinstance(expr, m.KNegate):
+        inner = convert_expr(expr.operand, constants, loop)
+        return Expr("const", (-inner.args[0],)) if inner.op == "const" else Expr("neg", (inner,))
+    assert isinstance(expr, m.KBinary)
+    left, right = convert_expr(expr.left, constants, loop), convert_expr(expr.right, constants, loop)
+    if left.op == right.op == "const":
+        return Expr("const", (Expr(expr.op, (left, right)).evaluate({}),))
+    return Expr(expr.op, (left, right))
+
+
+def convert_atom(node: Any, constants: Mapping[str, Any], loop: Mapping[str, Any], negate: bool = False) -> Atom:
+    key = attribute_key(node.attr, loop)
+    if isinstance(node, m.KTrue):
+        return Atom(key, "==", not negate)
+    if isinstance(node, m.KFalse):
+        return Atom(key, "==", negate)
+    if isinstance(node, m.KMember):
+        values = frozenset(item_value(i) if not isinstance(i, m.Ref) or i.text not in constants
+                           else constants[i.text] for i in node.items)
+        op = "in" if node.op == "oneof" else "notin"
+        return Atom(key, op, values)
+    assert isinstance(node, m.KCompare)
+    value = convert_expr(node.value, constants, loop)
+    if value.op != "const":
+        raise KheopsError("Kheops compares an attribute with a constant; compute the other side with "
+                          "`do {x = ...}` first", node.value)
+    return Atom(key, node.op, value.args[0])
+
+
+def convert_cond(cond: m.Cond, constants: Mapping[str, Any], loop: Mapping[str, Any]) -> Cond:
+    if isinstance(cond, m.KAnd):
+        return All(tuple(convert_cond(c, constants, loop) for c in cond.operands))
+    if isinstance(cond, m.KOr):
+        return Any_(tuple(convert_cond(c, constants, loop) for c in cond.operands))
+    if isinstance(cond, m.KNot):
+        return Not(convert_cond(cond.operand, constants, loop))
+    if isinstance(cond, m.KForeach):
+        return All(tuple(convert_cond(cond.body, {**constants, cond.var: v}, {**loop, cond.var: v})
+                         for v in expand_items(cond.items)))
+    return convert_atom(cond, constants, loop)
+
+
+def convert_rule(rule: m.Rule, constants: Mapping[str, Any], loop: Mapping[str, Any]) -> Rule:
+    name = rule.name if rule.index is None else f"{rule.name}[{loop.get(rule.index, rule.index)}]"
+    condition = convert_cond(rule.condition, constants, loop) if rule.condition is not None else None
+    actions: list[Action] = []
+    for action in rule.actions:
+        if isinstance(action, m.Restrict):
+            atom = convert_atom(action.restriction, constants, loop)
+            if atom.attribute.startswith("@"):
+                raise KheopsError("the previous cycle's value cannot be restricted", action)
+            actions.append(Restrict(atom))
+            continue
+        for statement in action.statements:
+            if isinstance(statement, m.DoAssign):
+                actions.append(Assign(statement.target, convert_expr(statement.value, constants, loop)))
+            else:
+                actions.append(Call(statement.function,
+                                    tuple(convert_expr(a, constants, loop) for a in statement.args)))
+    return Rule(name, rule.kind, condition, tuple(actions))
+
+
+def atoms(cond: Cond | None) -> Iterator[Atom]:
+    if cond is None:
+        return
+    if isinstance(cond, Atom):
+        yield cond
+    elif isinstance(cond, Not):
+        yield from atoms(cond.operand)
+    else:
+        for operand in cond.operands:
+            yield from atoms(operand)
+
+
+def collect_attributes(source: m.RuleBase, rules: Iterable[Rule], constants: Mapping[str, Any]) -> dict[str, Attribute]:
+    attributes: dict[str, Attribute] = {}
+    for decl in source.attributes:
+        attributes[decl.name] = Attribute(decl.name, decl.role)
+    mentioned: dict[str, list[Atom]] = {}
+    assigned: set[str] = set()
+    for rule in rules:
+        for atom in atoms(rule.condition):
+            mentioned.setdefault(atom.attribute, []).append(atom)
+        for action in rule.actions:
+            if isinstance(action, Restrict):
+                mentioned.setdefault(action.atom.attribute, []).append(action.atom)
+            elif isinstance(action, Assign):
+                assigned.add(action.target)
+                mentioned.setdefault(action.target, [])
+            for expr in ([action.expr] if isinstance(action, Assign) else
+                         list(action.args) if isinstance(action, Call) else []):
+                for name in expr.attributes():  # read at run time, so part of the observable space
+                    mentioned.setdefault(name, [])
+    inits = {i.name: constant_value(i.value, constants) for i in source.inits}
+    for name in list(mentioned):
+        if name.startswith("@"):
+            mentioned.setdefault(name[1:], [])
+    for name in mentioned:
+        attribute = attributes.get(name)
+        if attribute is None:
+            if name.startswith("@"):
+                attribute = Attribute(name, "previous", init=inits.get(name[1:]))
+            else:
+                attribute = Attribute(name, "intermediate")
+            attributes[name] = attribute
+        attribute.assigned = name in assigned
+    declared = {d.name: d for d in source.attributes}
+    for name, attribute in attributes.items():
+        own = name[1:] if name.startswith("@") else name
+        related = mentioned.get(own, []) + mentioned.get("@" + own, [])
+        decide_domain(attribute, declared.get(own), related, own in assigned)
+    return attributes
+
+
+def decide_domain(attribute: Attribute, declared: m.AttrDecl | None, found: list[Atom], assigned: bool) -> None:
+    constants: list[Any] = []
+    for atom in found:
+        constants += list(atom.value) if atom.op in ("in", "notin") else [atom.value]
+    numeric = assigned or any(isinstance(c, (int, float)) and not isinstance(c, bool) for c in constants) \
+        or any(a.op in ("<", "<=", ">", ">=") for a in found)
+    domain = declared.domain if declared is not None else None
+    if isinstance(domain, m.BoolDomain) or (domain is None and constants and all(isinstance(c, bool)
+                                                                                  for c in constants)):
+        attribute.kind, attribute.values, attribute.declared = "bool", (False, True), domain is not None
+    elif isinstance(domain, m.SymbolDomain):
+        attribute.kind, attribute.declared = "symbol", True
+        attribute.values = tuple(dict.fromkeys(item_value(v) for v in domain.values))
+    elif isinstance(domain, m.NumericDomain) or numeric:
+        attribute.kind = "number"
+        thresholds = sorted({float(c) for c in constants if isinstance(c, (int, float)) and not isinstance(c, bool)})
+        low = high = None
+        if isinstance(domain, m.NumericDomain) and domain.low is not None and domain.high is not None:
+            low = constant_literal(domain.low)
+            high = constant_literal(domain.high)
+        attribute.values = partition(thresholds, found, low, high)
+        attribute.declared = domain is not None
+    else:
+        attribute.kind = "symbol"
+        attribute.values = tuple(dict.fromkeys(constants)) + (OTHER,)
+
+
+def constant_literal(expr: m.KExpr) -> float:
+    converted = convert_expr(expr, {}, {})
+    if converted.op != "const":
+        raise KheopsError("a numeric domain's bounds are numbers", expr)
+    return float(converted.args[0])
+
+
+def partition(thresholds: list[float], found: list[Atom], low: float | None, high: float | None) -> tuple[Piece, ...]:
+    """The coarsest intervals on which every comparison the rules make is constant."""
+    lo = -math.inf if low is None else low
+    hi = math.inf if high is None else high
+    cuts = [t for t in thresholds if lo <= t <= hi]
+    elementary: list[Piece] = []
+    previous, previous_closed = lo, low is not None
+    for cut in cuts:
+        if cut > previous or (cut == previous and not previous_closed and not elementary):
+            if cut > previous:
+                elementary.append(Piece(previous, cut, previous_closed, False))
+        elementary.append(Piece(cut, cut, True, True))
+        previous, previous_closed = cut, False
+    if previous < hi or (previous == hi and high is not None and not elementary):
+        elementary.append(Piece(previous, hi, previous_closed, high is not None))
+    if not elementary:
+        elementary = [Piece(lo, hi, low is not None, high is not None)]
+    numeric_atoms = [a for a in found if a.op in NUMERIC_OPS and isinstance(a.value, (int, float))]
+    merged: list[Piece] = []
+    signature_of = lambda p: tuple(a.holds(p.sample()) for a in numeric_atoms)  # noqa: E731
+    for piece in elementary:
+        if merged and signature_of(merged[-1]) == signature_of(piece):
+            last = merged.pop()
+            piece = Piece(last.low, piece.high, last.low_closed, piece.high_closed)
+        merged.append(piece)
+    return tuple(merged)
+
+
+# ---------------------------------------------------------------- three-valued evaluation
+
+
+TRUE, FALSE, UNKNOWN = 1, 0, -1
+
+
+def atom_truth(atom: Atom, possible: Iterable[Any]) -> int:
+    results = {atom_holds(atom, value) for value in possible}
+    if results == {True}:
+        return TRUE
+    if results == {False} or not results:
+        return FALSE
+    return UNKNOWN
+
+
+def atom_holds(atom: Atom, element: Any) -> bool:
+    if isinstance(element, Piece):
+        return atom.holds(element.sample())
+    if element == OTHER:
+        return atom.op in ("!=", "notin")
+    return atom.holds(element)
+
+
+def truth(cond: Cond | None, memory: Mapping[str, frozenset[Any]]) -> int:
+    if cond is None:
+        return TRUE
+    if isinstance(cond, Atom):
+        return atom_truth(cond, memory[cond.attribute])
+    if isinstance(cond, Not):
+        inner = truth(cond.operand, memory)
+        return UNKNOWN if inner == UNKNOWN else 1 - inner
+    values = [truth(c, memory) for c in cond.operands]
+    if isinstance(cond, All):
+        return FALSE if FALSE in values else UNKNOWN if UNKNOWN in values else TRUE
+    return TRUE if TRUE in values else UNKNOWN if UNKNOWN in values else FALSE
+
+
+def restrict(memory: dict[str, frozenset[Any]], atom: Atom) -> None:
+    memory[atom.attribute] = frozenset(v for v in memory[atom.attribute] if atom_holds(atom, v))
+
+
+# ---------------------------------------------------------------- the reference interpreter
+
+
+@dataclass
+class Outcome:
+    outputs: dict[str, Any]  # determined outputs; None for an undetermined one
+    fired: list[str]
+    calls: list[tuple[str, tuple[Any, ...]]]
+    inconsistent: list[str] = field(default_factory=list)  # attributes left with no value
+    incomplete: list[str] = field(default_factory=list)  # outputs left with several values
+    impossible: str | None = None  # the `impossible` rule the inputs match
+
+    def key(self) -> tuple[Any, ...]:
+        return (tuple(sorted(self.outputs.items(), key=lambda kv: kv[0])), tuple(sorted(self.calls, key=repr)),
+                tuple(self.inconsistent), tuple(self.incomplete), self.impossible)
+
+
+def initial_memory(base: Base) -> dict[str, frozenset[Any]]:
+    return {name: frozenset(attr.values) for name, attr in base.attributes.items()}
+
+
+def interpret(base: Base, inputs: Mapping[str, Any]) -> Outcome:
+    """Naive forward chaining on actual input values: the oracle the compiled DAG must match."""
+    memory = initial_memory(base)
+    actual: dict[str, Any] = {}
+    for name in base.inputs:
+        value = inputs[name]
+        actual[name] = value
+        memory[name] = frozenset({base.element(name, value)})
+    outcome = Outcome({}, [], [])
+    pending = [r for r in base.rules if r.kind != "else"]
+    elses = [r for r in base.rules if r.kind == "else"]
+    while True:
+        progress = True
+        while progress:
+            progress = False
+            for rule in list(pending):
+                if truth(rule.condition, memory) != TRUE:
+                    continue
+                pending.remove(rule)
+                if rule.kind == "impossible":
+                    outcome.impossible = rule.name
+                    return outcome
+                fire(base, rule, memory, actual, outcome)
+                progress = True
+        undetermined = [o for o in base.outputs if len(memory[o]) > 1]
+        if not undetermined or not elses:
+            break
+        for rule in elses:
+            fire(base, rule, memory, actual, outcome)
+        elses = []
+    finish(base, memory, outcome)
+    return outcome
+
+
+def fire(base: Base, rule: Rule, memory: dict[str, frozenset[Any]], actual: dict[str, Any], outcome: Outcome) -> None:
+    outcome.fired.append(rule.name)
+    for action in rule.actions:
+        if isinstance(action, Restrict):
+            restrict(memory, action.atom)
+        elif isinstance(action, Assign):
+            value = action.expr.evaluate(actual)
+            actual[action.target] = value
+            memory[action.target] = memory[action.target] & frozenset({base.element(action.target, value)})
+        else:
+            outcome.calls.append((action.function, tuple(a.evaluate(actual) for a in action.args)))
+
+
+def finish(base: Base, memory: Mapping[str, frozenset[Any]], outcome: Outcome) -> None:
+    outcome.inconsistent = sorted(name for name, values in memory.items() if not values)
+    for name in base.outputs:
+        values = memory[name]
+        outcome.outputs[name] = next(iter(values)) if len(values) == 1 else None
+        if len(values) > 1:
+            outcome.incomplete.append(name)
+
+
+# ---------------------------------------------------------------- the compiler
+
+
+@dataclass(frozen=True)
+class Leaf:
+    outputs: tuple[tuple[str, Any], ...]
+    inconsistent: tuple[str, ...] = ()
+    incomplete: tuple[str, ...] = ()
+    impossible: str | None = None
+
+
+@dataclass(frozen=True)
+class Test:
+    attribute: str
+    branches: tuple[tuple[Any, Node], ...]  # (domain element, subgraph)
+
+
+@dataclass(frozen=True)
+class Do:
+    """Procedural node: assignments and external calls, in rule order, then what follows."""
+
+    actions: tuple[Assign | Call, ...]
+    next: Node
+
+
+Node = Union[Leaf, Test, Do]
+
+
+@dataclass(frozen=True)
+class Finding:
+    kind: str  # inconsistent | incomplete
+    attributes: tuple[str, ...]
+    witness: tuple[tuple[str, Any], ...]  # the tests on the path: attribute, domain element
+    fired: tuple[str, ...]
+
+
+@dataclass
+class Compiled:
+    base: Base
+    root: Node
+    findings: list[Finding]
+    tree_nodes: int
+    dag_nodes: int
+
+    @property
+    def depth(self) -> int:
+        return depth(self.root)
+
+
+class Compiler:
+    def __init__(self, base: Base):
+        self.base = base
+        self.findings: list[Finding] = []
+        self.tree_nodes = 0
+        self.shared: dict[Node, Node] = {}
+        self.observable = {n for n, a in base.attributes.items() if a.role in ("inputs", "previous")}
+
+    def compile(self) -> Compiled:
+        memory = initial_memory(self.base)
+        root = self.node(memory, frozenset(), frozenset(self.observable), (), ())
+        return Compiled(self.base, root, self.findings, self.tree_nodes, len(self.shared))
+
+    def intern(self, node: Node) -> Node:
+        """Identical subtrees become one node of the DAG."""
+        self.tree_nodes += 1
+        return self.shared.setdefault(node, node)
+
+    def node(self, memory: dict[str, frozenset[Any]], fired: frozenset[str], testable: frozenset[str],
+             path: tuple[tuple[str, Any], ...], history: tuple[str, ...]) -> Node:
+        memory = dict(memory)
+        procedural: list[Assign | Call] = []
+        fired_now: list[str] = []
+        rules = [r for r in self.base.rules if r.name not in fired and r.kind != "else"]
+        progress = True
+        while progress:
+            progress = False
+            for rule in rules:
+                if rule.name in fired_now or truth(rule.condition, memory) != TRUE:
+                    continue
+                if rule.kind == "impossible":
+                    return self.wrap(procedural, self.intern(Leaf((), impossible=rule.name)))
+                fired_now.append(rule.name)
+                progress = True
+                for action in rule.actions:
+                    if isinstance(action, Restrict):
+                        restrict(memory, action.atom)
+                    else:
+                        procedural.append(action)
+                        if isinstance(action, Assign):
+                            testable = testable | {action.target}
+        fired = fired | set(fired_now)
+        history = history + tuple(fired_now)
+        if any(not values for values in memory.values()):
+            return self.wrap(procedural, self.leaf(memory, path, history))
+        valid = [r for r in self.base.rules if r.name not in fired and r.kind != "else"
+                 and truth(r.condition, memory) == UNKNOWN]
+        candidates: dict[str, int] = {}
+        for rule in valid:
+            for atom in atoms(rule.condition):
+                if atom.attribute in testable and len(memory[atom.attribute]) > 1 \
+                        and atom_truth(atom, memory[atom.attribute]) == UNKNOWN:
+                    candidates[atom.attribute] = candidates.get(atom.attribute, 0) + 1
+        if not candidates:
+            undetermined = [o for o in self.base.outputs if len(memory[o]) > 1]
+            elses = [r for r in self.base.rules if r.kind == "else" and r.name not in fired]
+            if undetermined and elses:
+                for rule in elses:
+                    for action in rule.actions:
+                        if isinstance(action, Restrict):
+                            restrict(memory, action.atom)
+                        else:
+                            procedural.append(action)
+                history = history + tuple(r.name for r in elses)
+            return self.wrap(procedural, self.leaf(memory, path, history))
+        # Heuristic: the attribute most valid rules wait for; then the fewest values; then declaration order.
+        order = list(self.base.attributes)
+        chosen = min(candidates, key=lambda a: (-candidates[a], len(memory[a]), order.index(a)))
+        branches = []
+        for value in self.ordered(chosen, memory[chosen]):
+            child_memory = {**memory, chosen: frozenset({value})}
+            child = self.node(child_memory, fired, testable - {chosen}, path + ((chosen, value),), history)
+            branches.append((value, child))
+        return self.wrap(procedural, self.intern(Test(chosen, tuple(branches))))
+
+    def ordered(self, attribute: str, values: frozenset[Any]) -> list[Any]:
+        domain = self.base.attributes[attribute].values
+        return [v for v in domain if v in values]
+
+    def wrap(self, procedural: list[Assign | Call], node: Node) -> Node:
+        return self.intern(Do(tuple(procedural), node)) if procedural else node
+
+    def leaf(self, memory: Mapping[str, frozenset[Any]], path: tuple[tuple[str, Any], ...],
+             history: tuple[str, ...]) -> Node:
+        inconsistent = tuple(sorted(n for n, v in memory.items() if not v))
+        incomplete = tuple(o for o in self.base.outputs if len(memory[o]) > 1)
+        outputs = tuple((o, next(iter(memory[o]))) for o in self.base.outputs if len(memory[o]) == 1)
+        if inconsistent:
+            self.findings.append(Finding("inconsistent", inconsistent, path, history))
+        elif incomplete:
+            self.findings.append(Finding("incomplete", incomplete, path, history))
+        return self.intern(Leaf(outputs, inconsistent, incomplete if not inconsistent else ()))
+
+
+def compile_base(base: Base) -> Compiled:
+    return Compiler(base).compile()
+
+
+def depth(node: Node) -> int:
+    """Tests on the longest root-to-leaf path: the bound on the decision's reaction time."""
+    memo: dict[int, int] = {}
+
+    def visit(n: Node) -> int:
+        key = id(n)
+        if key not in memo:
+            if isinstance(n, Leaf):
+                memo[key] = 0
+            elif isinstance(n, Do):
+                memo[key] = visit(n.next)
+            else:
+                memo[key] = 1 + max(visit(child) for _, child in n.branches)
+        return memo[key]
+
+    return visit(node)
+
+
+def evaluate(compiled: Compiled, inputs: Mapping[str, Any]) -> Outcome:
+    """Walk the DAG on actual inputs (what the generated function does, unrolled as code)."""
+    base = compiled.base
+    actual = {name: inputs[name] for name in base.inputs}
+    outcome = Outcome({}, [], [])
+    node = compiled.root
+    while True:
+        if isinstance(node, Do):
+            for action in node.actions:
+                if isinstance(action, Assign):
+                    actual[action.target] = action.expr.evaluate(actual)
+                else:
+                    outcome.calls.append((action.function, tuple(a.evaluate(actual) for a in action.args)))
+            node = node.next
+        elif isinstance(node, Test):
+            element = base.element(node.attribute, actual[node.attribute])
+            node = next(child for value, child in node.branches if value == element)
+        else:
+            if node.impossible:
+                outcome.impossible = node.impossible
+                return outcome
+            outcome.outputs = {o: None for o in base.outputs} | dict(node.outputs)
+            outcome.inconsistent = list(node.inconsistent)
+            outcome.incomplete = list(node.incomplete)
+            return outcome
+
+
+def sample_inputs(base: Base) -> Iterator[dict[str, Any]]:
+    """Every combination of one representative value per input domain element (small bases)."""
+    names = base.inputs
+    choices = [[sample_of(base.attributes[n], v) for v in base.attributes[n].values] for n in names]
+    for combination in itertools.product(*choices):
+        yield dict(zip(names, combination, strict=True))
+
+
+def sample_of(attribute: Attribute, element: Any) -> Any:
+    if isinstance(element, Piece):
+        return element.sample()
+    if element == OTHER:
+        return "<unmentioned>"
+    return element

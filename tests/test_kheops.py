@@ -1,0 +1,154 @@
+"""The Kheops rule compiler (seed 000 §3.7, annex A): the decision DAG agrees with the naive
+forward-chaining interpreter, and compilation reports inconsistent and incomplete inputs."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from specc.analysis import kheops as k
+from specc.model import nodes as m
+from specc.pipeline import load
+from specc.syntax.parser import parse_text
+from tests.conftest import EXAMPLES
+
+
+def repository_bases() -> list[m.RuleBase]:
+    bases = []
+    for robot in ("generic", "hilare"):
+        loaded = load([EXAMPLES / robot])
+        assert loaded.program is not None
+        bases += [i for i in loaded.program.items if isinstance(i, m.RuleBase)]
+    return bases
+
+
+BASES = {b.name: k.normalise(b) for b in repository_bases()}
+COMPILED = {name: k.compile_base(base) for name, base in BASES.items()}
+
+
+def base_from(text: str) -> k.Base:
+    result = parse_text(text, "test.spec")
+    assert result.source is not None, [d.headline() for d in result.diagnostics]
+    (rules,) = result.source.items
+    assert isinstance(rules, m.RuleBase)
+    return k.normalise(rules)
+
+
+def input_values(base: k.Base) -> st.SearchStrategy[dict[str, Any]]:
+    """Random actual inputs: any symbol of the domain (or one it does not mention), any number."""
+    fields = {}
+    for name in base.inputs:
+        attribute = base.attributes[name]
+        if attribute.kind == "number":
+            fields[name] = st.one_of(st.floats(-1e4, 1e4, allow_nan=False),
+                                     st.sampled_from([p.low for p in attribute.values if p.low > -1e308]
+                                                     or [0.0]))
+        elif attribute.kind == "bool":
+            fields[name] = st.booleans()
+        else:
+            choices = [v for v in attribute.values if v != k.OTHER]
+            fields[name] = st.sampled_from(choices + (["not-mentioned"] if k.OTHER in attribute.values else []))
+    return st.fixed_dictionaries(fields)
+
+
+@pytest.mark.parametrize("name", sorted(BASES))
+def test_compiled_dag_equals_the_reference_interpreter_on_every_domain_combination(name: str) -> None:
+    base, compiled = BASES[name], COMPILED[name]
+    for inputs in k.sample_inputs(base):
+        assert k.evaluate(compiled, inputs).key() == k.interpret(base, inputs).key(), inputs
+
+
+@pytest.mark.parametrize("name", sorted(BASES))
+def test_compiled_dag_equals_the_reference_interpreter_on_random_inputs(name: str) -> None:
+    base, compiled = BASES[name], COMPILED[name]
+
+    @settings(max_examples=200, deadline=None)
+    @given(input_values(base))
+    def check(inputs: dict[str, Any]) -> None:
+        assert k.evaluate(compiled, inputs).key() == k.interpret(base, inputs).key()
+
+    check()
+
+
+def test_fig_3_8_domains_come_from_the_constants_the_rules_compare_with() -> None:
+    base = BASES["diagnosis"]
+    assert [str(p) for p in base.attributes["pres1"].values] == ["]-inf, 138[", "[138, 160[", "[160, inf["]
+    assert [str(p) for p in base.attributes["difP"].values] == ["]-inf, 0[", "[0, 10[", "[10, inf["]
+    assert set(base.attributes["diagn"].values) == {"b1", "b2", "b3", k.OTHER}
+    assert base.attributes["difP"].assigned and base.attributes["diagn"].role == "intermediate"
+
+
+def test_fig_3_8_decisions() -> None:
+    base, compiled = BASES["diagnosis"], COMPILED["diagnosis"]
+    normal = dict(pres1=150.0, pres2=50.0, deltaP=1.0, temp=300.0, drain="off", level="high", valve="open")
+    assert k.evaluate(compiled, normal).outputs == {"proced": "i3"}
+    drained = {**normal, "drain": "on"}
+    assert k.evaluate(compiled, drained).outputs == {"proced": "a3"}
+    # Low pressure, big jump: diagnosis b2 (r05), hot -> a22 (r07); difP is computed (r04) on the way.
+    hot = {**normal, "pres1": 100.0, "deltaP": 25.0}
+    assert k.evaluate(compiled, hot).outputs == {"proced": "a22"}
+    assert k.interpret(base, hot).fired[:2] == ["r01", "r03"]
+    assert compiled.depth <= len(base.inputs) + 1  # every observable attribute tested at most once
+    assert compiled.dag_nodes < compiled.tree_nodes  # identical subtrees are shared
+
+
+COMPLETE = """
+rules door {
+  inputs sensor: {"open", "closed"}, armed: bool;
+  outputs alarm: {"ring", "quiet"};
+  r1: sensor == "open", armed ==> restrict alarm == "ring";
+  r2: sensor == "closed" ==> restrict alarm == "quiet";
+  r3: !armed ==> restrict alarm == "quiet";
+}
+"""
+
+
+def test_a_complete_base_has_no_findings() -> None:
+    compiled = k.compile_base(base_from(COMPLETE))
+    assert compiled.findings == []
+    assert compiled.depth == 2
+
+
+def test_a_deleted_rule_is_reported_incomplete_with_a_witness() -> None:
+    compiled = k.compile_base(base_from(COMPLETE.replace('  r3: !armed ==> restrict alarm == "quiet";\n', "")))
+    (finding,) = compiled.findings
+    assert finding.kind == "incomplete" and finding.attributes == ("alarm",)
+    assert dict(finding.witness) == {"sensor": "open", "armed": False}
+
+
+def test_a_contradictory_rule_is_reported_inconsistent_with_the_rules_fired() -> None:
+    text = COMPLETE.replace("}\n", '  r4: sensor == "closed" ==> restrict alarm == "ring";\n}\n')
+    compiled = k.compile_base(base_from(text))
+    kinds = {(f.kind, f.attributes) for f in compiled.findings}
+    assert kinds == {("inconsistent", ("alarm",))}
+    assert all({"r2", "r4"} <= set(f.fired) and dict(f.witness)["sensor"] == "closed" for f in compiled.findings)
+
+
+def test_else_impossible_previous_values_and_foreach() -> None:
+    base = base_from("""
+rules cycle {
+  inputs zeroOrOne: [0, 1], level[1]: [0, 20], level[2]: [0, 20];
+  outputs out: bool, stab: bool, alert: {"yes", "no"};
+  init @out = false;
+  r1: zeroOrOne == 0 ==> restrict !out;
+  r2: zeroOrOne != 0 ==> restrict out;
+  r3: (@out, out) | (!@out, !out) ==> restrict stab;
+  r4: (@out, !out) | (!@out, out) ==> restrict !stab;
+  foreach i in ["1".."2"] {
+    high[i]: level[i] > 10.0 ==> restrict alert == "yes";
+  }
+  quiet: else restrict alert == "no";
+  never: impossible zeroOrOne == 0.5;
+}
+""")
+    compiled = k.compile_base(base)
+    assert compiled.findings == []
+    run = k.evaluate(compiled, {"zeroOrOne": 1, "@out": False, "level[1]": 3.0, "level[2]": 12.0})
+    assert run.outputs == {"out": True, "stab": False, "alert": "yes"}
+    calm = k.evaluate(compiled, {"zeroOrOne": 0, "@out": False, "level[1]": 3.0, "level[2]": 2.0})
+    assert calm.outputs == {"out": False, "stab": True, "alert": "no"}
+    assert k.evaluate(compiled, {"zeroOrOne": 0.5, "@out": False, "level[1]": 0, "level[2]": 0}).impossible == "never"
+    assert base.attributes["@out"].init is False
