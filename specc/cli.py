@@ -76,8 +76,8 @@ def compile(paths: PathsArg,
 
     Example: specc compile examples/hilare -o generated
     """
-    from specc.backends import modules, package  # jinja2 and the back ends load only when compiling
-    from specc.backends.manifest import Output
+    from specc.analysis.kheops import KheopsError
+    from specc.backends import generate_all, package  # jinja2 and the back ends load only when compiling
 
     loaded = load(paths)
     code = report(loaded)
@@ -88,9 +88,11 @@ def compile(paths: PathsArg,
     if not name.isidentifier() or keyword.iskeyword(name):  # `import class` cannot be written
         err.print(f"error: '{name}' is not a valid Python package name; pass --robot NAME", markup=False)
         raise typer.Exit(1)
-    result = Output()
-    package.generate(loaded.program, name, result)
-    modules.generate(loaded.program, result)
+    try:
+        result = generate_all(loaded.program, name)
+    except KheopsError as exc:
+        err.print(f"{exc.node.span}: error: {exc} [not-propositional]", markup=False)
+        raise typer.Exit(1) from None
     folder = output / name
     try:
         written = result.write(folder)
@@ -187,6 +189,45 @@ def graph(paths: PathsArg,
         err.print(f"error: cannot write '{output}': {exc}", markup=False)
         raise typer.Exit(1) from None
     out.print(f"wrote {picture}", markup=False)
+
+
+@app.command(name="rules")
+def rules_report(paths: PathsArg,
+                 limit: Annotated[int, typer.Option(help="Findings shown per rule base (0: all).")] = 20) -> None:
+    """Compile every Kheops rule base: domains, decision-graph depth, and the input configurations
+    that leave an attribute without value (inconsistent) or an output undetermined (incomplete).
+
+    Example: specc rules examples/generic
+    """
+    from specc.analysis import kheops
+    from specc.backends.rules import describe
+
+    loaded = load(paths)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    bases = [i for i in loaded.program.items if isinstance(i, m.RuleBase)]
+    if not bases:
+        out.print("no rules block in these specs", markup=False)
+    for base in bases:
+        try:
+            compiled = kheops.compile_base(kheops.normalise(base))
+        except kheops.KheopsError as exc:
+            err.print(f"{exc.node.span}: error: {exc} [not-propositional]", markup=False)
+            raise typer.Exit(1) from None
+        normal = compiled.base
+        out.print(f"rules {base.name}: {len(normal.rules)} rules, decision graph of depth {compiled.depth} "
+                  f"({compiled.tree_nodes} tree nodes -> {compiled.dag_nodes} shared)", markup=False)
+        for attribute in normal.attributes.values():
+            values = ", ".join(str(v) for v in attribute.values)
+            out.print(f"  {attribute.role:12} {attribute.name}: {attribute.kind} {{{values}}}", markup=False)
+        findings = compiled.findings
+        shown = findings if limit <= 0 else findings[:limit]
+        for finding in shown:
+            out.print(f"  {describe(finding)}", markup=False)
+        if len(shown) < len(findings):
+            out.print(f"  ... {len(findings) - len(shown)} more (--limit 0 shows all)", markup=False)
+        if not findings:
+            out.print("  complete and consistent for every input", markup=False)
 
 
 @app.command()

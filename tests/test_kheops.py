@@ -152,3 +152,41 @@ rules cycle {
     assert calm.outputs == {"out": False, "stab": True, "alert": "no"}
     assert k.evaluate(compiled, {"zeroOrOne": 0.5, "@out": False, "level[1]": 0, "level[2]": 0}).impossible == "never"
     assert base.attributes["@out"].init is False
+
+
+def test_generated_decision_functions_equal_the_interpreter(tmp_path_factory: pytest.TempPathFactory) -> None:
+    import importlib
+    import sys
+
+    from tests.functional.conftest import compile_robot
+
+    target = tmp_path_factory.mktemp("rules")
+    package = {robot: compile_robot(EXAMPLES / robot, target) for robot in ("generic", "hilare")}
+    sys.path.insert(0, str(target))
+    try:
+        generated = {name: importlib.import_module(f"{package[robot]}.rules.{name}")
+                     for robot, names in (("generic", ("diagnosis", "generic_controller")),
+                                          ("hilare", ("hilare_controller",)))
+                     for name in names}
+    finally:
+        sys.path.remove(str(target))
+    for name, module in generated.items():
+        base = BASES[name]
+        assert module.DEPTH == COMPILED[name].depth and module.INPUTS == base.inputs
+
+        @settings(max_examples=150, deadline=None)
+        @given(input_values(base))
+        def check(inputs: dict[str, Any]) -> None:
+            calls: list[tuple[str, tuple[Any, ...]]] = []
+            decision = module.decide(inputs, lambda f, args: calls.append((f, args)))
+            expected = k.interpret(base, inputs)
+            shown = {o: str(v) if isinstance(v, k.Piece) else v for o, v in expected.outputs.items()}
+            if expected.impossible:
+                assert decision.impossible == expected.impossible
+                return
+            assert dict(decision.outputs) == shown
+            assert list(decision.inconsistent) == expected.inconsistent
+            assert list(decision.incomplete) == expected.incomplete
+            assert sorted(calls, key=repr) == sorted(expected.calls, key=repr)
+
+        check()

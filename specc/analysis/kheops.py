@@ -664,8 +664,11 @@ class Compiler:
         return Compiled(self.base, root, self.findings, self.tree_nodes, len(self.shared))
 
     def intern(self, node: Node) -> Node:
-        """Identical subtrees become one node of the DAG."""
+        """Identical subtrees become one node of the DAG; a test whose branches all lead to
+        the same place decides nothing and disappears."""
         self.tree_nodes += 1
+        if isinstance(node, Test) and len({id(child) for _, child in node.branches}) == 1:
+            return node.branches[0][1]
         return self.shared.setdefault(node, node)
 
     def node(self, memory: dict[str, frozenset[Any]], fired: frozenset[str], testable: frozenset[str],

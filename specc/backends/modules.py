@@ -273,7 +273,7 @@ def tuple_literal(items: object) -> str:
     return "(" + ", ".join(values) + ("," if len(values) == 1 else "") + ")"
 
 
-def generate(program: m.Program, output: Output) -> None:
+def generate(program: m.Program, output: Output, robot: str = "") -> None:
     modules = sorted((item for item in program.items if isinstance(item, m.Module)), key=lambda x: x.name)
     for module in modules:
         view = ModuleView(module, module.span.file)

@@ -50,6 +50,6 @@ def robot_name(program: m.Program, fallback: str) -> str:
     return systems[0].name if len(systems) == 1 else fallback
 
 
-def generate(program: m.Program, robot: str, output: Output) -> None:
+def generate_package(program: m.Program, output: Output, robot: str) -> None:
     view = PackageView(robot, program)
     output.add(BACKEND, "__init__.py", render("package/__init__.py.j2", view=view))

@@ -9,8 +9,7 @@ from typing import Any
 
 import pytest
 
-from specc.backends import modules, package
-from specc.backends.manifest import Output
+from specc.backends import generate_all, package
 from specc.pipeline import load
 from specc.runtime import functional as rt
 
@@ -21,10 +20,7 @@ def compile_robot(spec: Path, target: Path) -> str:
     loaded = load([spec])
     assert loaded.program is not None and not loaded.errors, [d.headline() for d in loaded.diagnostics]
     name = package.robot_name(loaded.program, spec.stem)
-    output = Output()
-    package.generate(loaded.program, name, output)
-    modules.generate(loaded.program, output)
-    output.write(target / name)
+    generate_all(loaded.program, name).write(target / name)
     return name
 
 

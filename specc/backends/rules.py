@@ -1,0 +1,185 @@
+"""Back end `rules`: each Kheops rule base becomes a plain Python decision function.
+
+The compiled decision DAG is unrolled into nested tests; a node reached by several paths
+becomes a function of its own, so the code stays as small as the DAG. No inference engine
+runs at run time: a decision costs at most DEPTH tests.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass
+from typing import Any
+
+from specc.analysis import kheops as k
+from specc.backends.env import render
+from specc.backends.manifest import HEADER, Output
+from specc.model import nodes as m
+
+BACKEND = "rules"
+INDENT = "    "
+
+
+def python_name(base: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in base)
+
+
+@dataclass
+class DecisionView:
+    compiled: k.Compiled
+    source: str
+
+    def __post_init__(self) -> None:
+        self.base = self.compiled.base
+        counts: Counter[int] = Counter()
+        self.nodes: dict[int, k.Node] = {}
+
+        def count(node: k.Node) -> None:
+            counts[id(node)] += 1
+            if counts[id(node)] > 1:
+                return
+            self.nodes[id(node)] = node
+            for child in children(node):
+                count(child)
+
+        count(self.compiled.root)
+        self.shared = {key for key, n in counts.items() if n > 1}
+        self.numbers = {key: i for i, key in enumerate(sorted(self.shared, key=list(self.nodes).index))}
+        self.leaves: dict[k.Leaf, str] = {}
+        for node in self.nodes.values():
+            if isinstance(node, k.Leaf) and node not in self.leaves:
+                self.leaves[node] = f"_LEAF_{len(self.leaves)}"
+
+    @property
+    def header(self) -> str:
+        return HEADER.format(sources=self.source)
+
+    @property
+    def name(self) -> str:
+        return self.base.name
+
+    @property
+    def inputs(self) -> list[str]:
+        return self.base.inputs
+
+    @property
+    def outputs(self) -> list[str]:
+        return self.base.outputs
+
+    @property
+    def copies_inputs(self) -> bool:
+        return any(isinstance(n, k.Do) and any(isinstance(a, k.Assign) for a in n.actions)
+                   for n in self.nodes.values())
+
+    @property
+    def leaf_constants(self) -> list[str]:
+        lines = []
+        for leaf, name in self.leaves.items():
+            outputs = {o: None for o in self.outputs} | dict(leaf.outputs)
+            shown = ", ".join(f"{o!r}: {literal(v)}" for o, v in outputs.items())
+            lines.append(f"{name} = Decision(MappingProxyType({{{shown}}}), {leaf.inconsistent!r}, "
+                         f"{leaf.incomplete!r}, {leaf.impossible!r})")
+        return lines
+
+    @property
+    def root_body(self) -> list[str]:
+        return self.body(self.compiled.root, 1, root=True)
+
+    @property
+    def shared_functions(self) -> list[tuple[str, list[str]]]:
+        return [(f"_node_{self.numbers[key]}", self.body(self.nodes[key], 1, root=True))
+                for key in sorted(self.shared, key=self.numbers.__getitem__)]
+
+    @property
+    def findings(self) -> list[str]:
+        return [describe(f) for f in self.compiled.findings]
+
+    def body(self, node: k.Node, depth: int, root: bool = False) -> list[str]:
+        pad = INDENT * depth
+        if not root and id(node) in self.shared:
+            return [f"{pad}return _node_{self.numbers[id(node)]}(a, calls)"]
+        if isinstance(node, k.Leaf):
+            return [f"{pad}return {self.leaves[node]}"]
+        if isinstance(node, k.Do):
+            lines = []
+            for action in node.actions:
+                if isinstance(action, k.Assign):
+                    lines.append(f"{pad}a[{action.target!r}] = {action.expr.python(read)}")
+                else:
+                    args = ", ".join(arg.python(read) for arg in action.args)
+                    lines.append(f"{pad}calls({action.function!r}, ({args}{',' if len(action.args) == 1 else ''}))")
+            return lines + self.body(node.next, depth)
+        assert isinstance(node, k.Test)
+        attribute = self.base.attributes[node.attribute]
+        lines = [f"{pad}v = a[{node.attribute!r}]"]
+        keyword = "if"
+        otherwise: list[str] | None = None
+        for value, child in node.branches:
+            if value == k.OTHER:
+                otherwise = self.body(child, depth + 1)
+                continue
+            lines.append(f"{pad}{keyword} {condition(attribute, value)}:")
+            lines += self.body(child, depth + 1)
+            keyword = "elif"
+        lines.append(f"{pad}else:")
+        if otherwise is not None:
+            lines += otherwise
+        else:
+            lines.append(f"{pad}{INDENT}raise ValueError(f\"{node.attribute}={{v!r}} is outside its domain\")")
+        return lines
+
+
+def children(node: k.Node) -> list[k.Node]:
+    if isinstance(node, k.Test):
+        return [child for _, child in node.branches]
+    if isinstance(node, k.Do):
+        return [node.next]
+    return []
+
+
+def read(attribute: str) -> str:
+    return f"a[{attribute!r}]"
+
+
+def literal(value: Any) -> str:
+    if isinstance(value, k.Piece):
+        return repr(str(value))
+    return repr(value)
+
+
+def condition(attribute: k.Attribute, value: Any) -> str:
+    if isinstance(value, k.Piece):
+        if value.low == value.high:
+            return f"v == {value.low!r}"
+        parts = []
+        if not math.isinf(value.low):
+            parts.append(f"{value.low!r} {'<=' if value.low_closed else '<'} v")
+        if not math.isinf(value.high):
+            parts.append(f"v {'<=' if value.high_closed else '<'} {value.high!r}")
+        return " and ".join(parts) or "True"
+    if attribute.kind == "bool":
+        return "v" if value else "not v"
+    return f"v == {value!r}"
+
+
+def describe(finding: k.Finding) -> str:
+    witness = ", ".join(f"{a}={v}" for a, v in finding.witness) or "any input"
+    fired = ", ".join(finding.fired) or "none"
+    what = "no value left for" if finding.kind == "inconsistent" else "undetermined"
+    return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
+
+
+def generate(program: m.Program, output: Output, robot: str = "") -> list[k.Compiled]:
+    compiled_all = []
+    bases = sorted((i for i in program.items if isinstance(i, m.RuleBase)), key=lambda b: b.name)
+    for base in bases:
+        compiled = k.compile_base(k.normalise(base))
+        compiled_all.append(compiled)
+        view = DecisionView(compiled, base.span.file)
+        output.add(BACKEND, f"rules/{python_name(base.name)}.py", render("rules/decision.py.j2", view=view))
+    if bases:
+        output.add(BACKEND, "rules/__init__.py", render(
+            "rules/__init__.py.j2", names=[python_name(b.name) for b in bases],
+            header=HEADER.format(sources="the rule bases")))
+    return compiled_all

@@ -1,0 +1,33 @@
+"""What generated decision functions (compiled Kheops rule bases) share at run time."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any, NamedTuple
+
+
+class Decision(NamedTuple):
+    """The outcome of one deduction cycle: the outputs (None when undetermined) and what went wrong."""
+
+    outputs: Mapping[str, Any]
+    inconsistent: tuple[str, ...] = ()  # attributes the rules left without a possible value
+    incomplete: tuple[str, ...] = ()  # outputs the rules left undetermined
+    impossible: str | None = None  # the `impossible` rule matching these inputs
+
+    @property
+    def ok(self) -> bool:
+        return not (self.inconsistent or self.incomplete or self.impossible)
+
+
+Calls = Callable[[str, tuple[Any, ...]], object]
+
+
+def no_calls(function: str, args: tuple[Any, ...]) -> None:
+    """The default for `do {f(...)}` actions: nothing to call."""
+
+
+def divide(left: float, right: float) -> float:
+    if right:
+        return left / right
+    return math.copysign(math.inf, left) if left else 0.0
