@@ -1,0 +1,56 @@
+"""`make bench`: microseconds per evaluation of a compiled Kheops decision function, against
+the reference forward-chaining interpreter measured in the same run (goal: 20x faster), on the
+rule base of Fig 3.8 and on the Hilare controller. (The CLIPS comparison is still to come.)"""
+
+from __future__ import annotations
+
+import importlib
+import random
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from specc.analysis import kheops as k
+from specc.model import nodes as m
+from specc.pipeline import load
+from tests.conftest import EXAMPLES
+from tests.functional.conftest import compile_robot
+
+pytestmark = pytest.mark.bench
+
+
+def per_call_us(function, inputs: list[dict[str, object]], repeat: int = 3) -> float:  # type: ignore[no-untyped-def]
+    best = float("inf")
+    for _ in range(repeat):
+        started = time.perf_counter()
+        for values in inputs:
+            function(values)
+        best = min(best, (time.perf_counter() - started) / len(inputs))
+    return best * 1e6
+
+
+@pytest.mark.parametrize("robot, name", [("generic", "diagnosis"), ("hilare", "hilare_controller")])
+def test_decision_function_against_the_interpreter(robot: str, name: str, tmp_path: Path) -> None:
+    loaded = load([EXAMPLES / robot])
+    assert loaded.program is not None
+    source = next(i for i in loaded.program.items if isinstance(i, m.RuleBase) and i.name == name)
+    base = k.normalise(source)
+    package = compile_robot(EXAMPLES / robot, tmp_path)
+    sys.path.insert(0, str(tmp_path))
+    try:
+        decide = importlib.import_module(f"{package}.rules.{name}").decide
+    finally:
+        sys.path.remove(str(tmp_path))
+    rng = random.Random(7)
+    samples = list(k.sample_inputs(base))
+    inputs = [rng.choice(samples) for _ in range(2000)]
+    compiled_us = per_call_us(decide, inputs)
+    interpreted_us = per_call_us(lambda values: k.interpret(base, values), inputs[:300])
+    print(f"\nrules {name} ({len(base.rules)} rules, depth {k.compile_base(base).depth}):"
+          f"\n  reference interpreter  {interpreted_us:9.2f} us/evaluation (baseline)"
+          f"\n  compiled decision      {compiled_us:9.2f} us/evaluation  "
+          f"({interpreted_us / compiled_us:.0f}x faster; goal 20x)")
+    assert all(decide(v).outputs == {o: (str(x) if isinstance(x, k.Piece) else x)
+                                     for o, x in k.interpret(base, v).outputs.items()} for v in inputs[:50])
