@@ -278,8 +278,12 @@ class InternalData:
 
     def write_poster(self, name: str) -> None:
         """Update one of this module's `update: manual` posters from the SDI now."""
-        assert self._module is not None
-        self._module.update_poster(name)
+        module = self._module
+        assert module is not None
+        if name not in module.posters:
+            raise LookupError(f"module '{module.name}' has no poster '{name}' "
+                              f"(its posters: {', '.join(module.posters) or 'none'})")
+        module.update_poster(name)
 
     def send_request(self, name: str, **inputs: Any) -> RequestHandle:
         """Send `"module.request"` from the running codel: the new activity is its child."""
@@ -334,7 +338,8 @@ class TaskRunner:
         k = max(0, math.ceil((kernel.now - delay) / period - 1e-9))
         if self.last_tick is not None and delay + k * period <= self.last_tick + 1e-12:
             k = round((self.last_tick - delay) / period) + 1
-        self.timer = kernel.call_at(delay + k * period, self.tick, self.spec.priority)
+        # Rounded to the nanosecond: 3 x 0.1 s and 1 x 0.3 s are one instant, so priority orders them.
+        self.timer = kernel.call_at(round(delay + k * period, 9), self.tick, self.spec.priority)
 
     def tick(self) -> None:
         self.timer = None
@@ -343,6 +348,7 @@ class TaskRunner:
         self.cycles += 1
         if not self.initialised and self.spec.init is not None:
             module.call_permanent(self.spec.init)
+            module.cycle_done(self.spec.init)
         self.initialised = True
         if self.spec.permanent is not None:
             module.call_permanent(self.spec.permanent)
@@ -368,10 +374,20 @@ class Module:
         self.activities: dict[int, Activity] = {}  # every activity not in ETHER
         self.posters = {p.name: Poster[Any](p) for p in spec.posters}
         self.tasks = {t.name: TaskRunner(self, t) for t in spec.tasks}
-        self.zombie: Activity | None = None
+        self.zombies: dict[int, Activity] = {}  # any of them freezes the module (§2.2)
         self.transitions: list[tuple[int, State, State]] = []  # (id, from, to), for tests and logs
         self.observers: list[Callable[[Module, Activity, State, State], None]] = []
         self._functions: dict[str, Callable[..., Any]] = {}
+        # A poster's activity is a request, or a codel (of a request or an exec task) whose cycles update it.
+        self._auto_posters: dict[str, list[str]] = {}
+        for poster_spec in spec.posters:
+            if poster_spec.update == "auto" and poster_spec.activity is not None:
+                self._auto_posters.setdefault(poster_spec.activity, []).append(poster_spec.name)
+
+    @property
+    def zombie(self) -> Activity | None:
+        """The oldest activity in ZOMBIE, if any: the module is frozen until every one is aborted."""
+        return next(iter(self.zombies.values()), None)
 
     def start(self) -> None:
         for runner in self.tasks.values():
@@ -393,19 +409,19 @@ class Module:
         rqst_id = self.registry.new_id()
         spec = self.spec.requests.get(request)
         if spec is None:
-            sink(self.reply(rqst_id, request, Status.CS_ERROR, Report(
-                "UNKNOWN_REQUEST", f"module '{self.name}' has no request '{request}'")))
+            self.refuse(self.reply(rqst_id, request, Status.CS_ERROR, Report(
+                "UNKNOWN_REQUEST", f"module '{self.name}' has no request '{request}'")), sink, parent)
             return rqst_id
         problem = check_record(input_, spec.input_type)
         if problem:
-            sink(self.reply(rqst_id, request, Status.FINAL_ERROR, Report("BAD_INPUT", problem)))
+            self.refuse(self.reply(rqst_id, request, Status.FINAL_ERROR, Report("BAD_INPUT", problem)), sink,
+                        parent if spec.kind == "exec" else None)
             return rqst_id
         if spec.kind == "control":
             self.run_control(rqst_id, spec, input_, sink)
             return rqst_id
-        if self.zombie is not None:
-            sink(self.reply(rqst_id, request, Status.ZOMBIE, Report(
-                "MODULE_FROZEN", f"activity {self.zombie.id} ({self.zombie.spec.name}) is ZOMBIE; abort it first")))
+        if self.zombies:
+            self.refuse(self.frozen_reply(rqst_id, request), sink, parent)
             return rqst_id
         activity = Activity(rqst_id, spec, self, input_, sink, parent, self.kernel.now)
         if parent is not None:
@@ -413,28 +429,47 @@ class Module:
         self.move(activity, State.INIT)
         self.activities[rqst_id] = activity
         if spec.validate is not None:
-            outcome = self.call_codel(activity, spec.validate, validating=True)
+            outcome = self.call_codel(activity, spec, spec.validate)
             if outcome is not None:
                 self.move(activity, State.ETHER)
                 del self.activities[rqst_id]
                 self.deliver(activity, self.reply(rqst_id, request, Status.FINAL_ERROR, outcome))
                 return rqst_id
-        for other in list(self.activities.values()):
-            if other is not activity and other.state in (State.INIT, State.EXEC, State.INTER) \
-                    and spec.conflicts_with(other.spec) and not is_ancestor(other, activity):
-                activity.waiting_for.add(other.id)
-                if other.state is not State.INTER:
-                    self.interrupt(other, spec.name)
+        # Wait for every conflicting activity before interrupting any: one that gives way at once
+        # (in INIT) must not let the newcomer start while another is still to leave INTER.
+        conflicting = [other for other in self.activities.values()
+                       if other is not activity and other.state in (State.INIT, State.EXEC, State.INTER)
+                       and spec.conflicts_with(other.spec) and not is_ancestor(other, activity)]
+        for other in conflicting:
+            activity.waiting_for.add(other.id)
+        for other in conflicting:
+            if other.state is not State.INTER:
+                self.interrupt(other, spec.name)
         self.try_start(activity)
         return rqst_id
+
+    def frozen_reply(self, rqst_id: int, request: str) -> Reply:
+        zombie = next(iter(self.zombies.values()))
+        return self.reply(rqst_id, request, Status.ZOMBIE, Report(
+            "MODULE_FROZEN", f"activity {zombie.id} ({zombie.spec.name}) is ZOMBIE; abort it first"))
+
+    def refuse(self, reply: Reply, sink: ReplySink, parent: Activity | None) -> None:
+        """A request refused before it became an activity; sent from a codel, it ends its parent."""
+        sink(reply)
+        if parent is not None:
+            child_failed(parent, reply, activated=False)
 
     def run_control(self, rqst_id: int, spec: RequestSpec, input_: Any, sink: ReplySink) -> None:
         """A control request takes no time: its validate codel runs and the final reply goes now."""
         output = spec.output_type() if spec.output_type is not None else None
-        record = ControlRecord(spec, input_, output)
         outcome: Report | None = None
         if spec.validate is not None:
-            outcome = self.call_codel(record, spec.validate, validating=True)
+            record = ControlRecord(spec, input_, output)
+            outcome = self.call_codel(record, spec, spec.validate)
+            if record.written():
+                problem = record.flush()
+                if problem:
+                    outcome = Report("CODEL_ERROR", f"codel '{spec.validate}': {problem}")
         if outcome is None:
             # A control request interrupts the activities it is incompatible with (Table 3.1, mod2f3).
             for other in list(self.activities.values()):
@@ -469,11 +504,13 @@ class Module:
         elif activity.state is State.ZOMBIE:
             self.move(activity, State.ETHER)
             self.forget(activity)
-            if self.zombie is activity:
-                self.zombie = None
+            self.zombies.pop(activity.id, None)
 
     def try_start(self, activity: Activity) -> None:
         if activity.state is not State.INIT or activity.waiting_for:
+            return
+        if self.zombies:  # what it waited for went ZOMBIE: the module is frozen, it may not start
+            self.finish(activity, State.ETHER, Status.ZOMBIE, self.frozen_reply(activity.id, activity.spec.name).report)
             return
         self.move(activity, State.EXEC)
         activity.codel_state = activity.spec.first_state
@@ -507,6 +544,9 @@ class Module:
         if result is None:
             return
         self.cycle_done(spec.name)
+        self.cycle_done(name)
+        if activity.state is not State.EXEC or activity.pending_final is not None:
+            return  # ended or interrupted while its codel ran (a child refused, a control request): moot
         if result == ENDED:
             self.end(activity, activity.fail_report or Report("OK"))
         elif result == FAILED:
@@ -535,7 +575,7 @@ class Module:
     def step_inter(self, activity: Activity) -> None:
         name = activity.spec.codels.get("inter")
         result = ENDED if name is None else self.run_codel(activity, name)
-        if result is None:
+        if result is None or activity.state is not State.INTER or activity.pending_final is not None:
             return
         if result == FAILED:
             self.fail(activity, Report("ZOMBIE", f"inter codel '{name}' failed"))
@@ -554,18 +594,25 @@ class Module:
             return None
         return result
 
-    def call_codel(self, record: Any, name: str, validating: bool) -> Report | None:
+    def call_codel(self, record: Any, spec: RequestSpec, name: str) -> Report | None:
         """A validate codel: None to accept, else the report refusing the request."""
+        registry = self.registry
+        running = registry.current
+        if running is not None:  # a request it sends is nobody's child, not a child of the codel that sent ours
+            registry.current = None
         try:
             result = self.function(name)(self.sdi, record)
         except Exception as exc:
             return Report("CODEL_ERROR", f"codel '{name}' raised {type(exc).__name__}: {exc}")
+        finally:
+            if running is not None:
+                registry.current = running
         if result in (None, "end", "ok", "OK", ENDED, "exec"):
             return None
-        if isinstance(result, str) and result in record.spec.fail:
+        if isinstance(result, str) and result in spec.fail:
             return Report(result)
         return Report("UNDECLARED_STATE", f"validate codel '{name}' returned {result!r}: accept with 'end', "
-                      f"refuse with a fail message ({', '.join(record.spec.fail) or 'none declared'})")
+                      f"refuse with a fail message ({', '.join(spec.fail) or 'none declared'})")
 
     def call_with_parent(self, activity: Activity, function: Callable[..., Any], *args: Any) -> Any:
         previous = self.registry.current
@@ -595,6 +642,8 @@ class Module:
 
     def finish(self, activity: Activity, target: State, status: Status, report: Report) -> None:
         """End an activity: children first (the parent ends only when they have), then the reply."""
+        if activity.pending_final is not None or activity.state is State.ETHER or activity.state is State.ZOMBIE:
+            return  # already ended: one final reply only
         reply = self.reply(activity.id, activity.spec.name, status, report, activity.output)
         live = activity.live_children
         if live:
@@ -613,7 +662,7 @@ class Module:
         if activity.task is not None and activity in activity.task.activities:
             activity.task.activities.remove(activity)
         if target is State.ZOMBIE:
-            self.zombie = activity
+            self.zombies[activity.id] = activity
         else:
             self.forget(activity)
         self.deliver(activity, reply)
@@ -632,10 +681,8 @@ class Module:
             return
         if parent.pending_final is not None and not parent.live_children:
             parent.module.complete(parent, parent.pending_state, parent.pending_final)
-        elif reply.status not in (Status.END, Status.INTERRUPTED) and parent.state is State.EXEC:
-            # A child's error reaches its parent, which ends with SERVER_ERROR chaining it.
-            parent.module.finish(parent, State.ETHER, Status.SERVER_ERROR, Report(
-                "CHILD_ERROR", f"{reply.module}.{reply.request} ended {reply.status.value}", cause=reply))
+        else:
+            child_failed(parent, reply, activated=activity.codel_state != "")
 
     def move(self, activity: Activity, target: State) -> None:
         source = activity.state
@@ -654,9 +701,11 @@ class Module:
 
     # -- posters
     def cycle_done(self, activity_name: str) -> None:
-        for poster in self.posters.values():
-            if poster.spec.update == "auto" and poster.spec.activity == activity_name:
-                self.update_poster(poster.spec.name)
+        """A cycle of a request or of a codel ended: update the auto posters named after it."""
+        names = self._auto_posters.get(activity_name)
+        if names:
+            for name in names:
+                self.update_poster(name)
 
     def update_poster(self, name: str) -> None:
         poster = self.posters[name]
@@ -669,19 +718,50 @@ class Module:
                               for a in sorted(self.activities.values(), key=lambda a: a.id)), self.kernel.now)
 
 
-@dataclass
 class ControlRecord:
-    """What a control request's validate codel sees as `request`."""
+    """What a control request's validate codel sees as `request`: its inputs and outputs.
 
-    spec: RequestSpec
-    input: Any
-    output: Any
+    What the codel writes lands in the record's own dict (no `__setattr__` hook on the control
+    path) and is moved into the output record by `flush` once the codel has returned."""
+
+    def __init__(self, spec: RequestSpec, input_: Any, output: Any):
+        self._spec = spec
+        self._input = input_
+        self._output = output
 
     def __getattr__(self, name: str) -> Any:
-        for record in (self.input, self.output):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        for record in (self._input, self._output):
             if record is not None and hasattr(record, name):
                 return getattr(record, name)
-        raise AttributeError(f"request '{self.spec.name}' has no input or output '{name}'")
+        raise AttributeError(f"request '{self._spec.name}' has no input or output '{name}'")
+
+    def written(self) -> bool:
+        return len(self.__dict__) > 3
+
+    def flush(self) -> str:
+        """Move what the codel wrote into the output record; '' or what it wrote that is no output."""
+        output = self._output
+        for name in [n for n in self.__dict__ if n not in ("_spec", "_input", "_output")]:
+            value = self.__dict__.pop(name)
+            if output is None or not hasattr(output, name):
+                return f"request '{self._spec.name}' has no output '{name}'"
+            setattr(output, name, value)
+        return ""
+
+
+def child_failed(parent: Activity, reply: Reply, activated: bool) -> None:
+    """A child's error ends its running parent: SERVER_ERROR when the child ran, FINAL_ERROR
+    (Table 2.1: "non activation d'activité fille") when it never started; both chain the reply."""
+    if reply.status is Status.END or reply.status is Status.INTERRUPTED or parent.state is not State.EXEC:
+        return
+    if activated:
+        status, code = Status.SERVER_ERROR, "CHILD_ERROR"
+    else:
+        status, code = Status.FINAL_ERROR, "CHILD_NOT_ACTIVATED"
+    parent.module.finish(parent, State.ETHER, status, Report(
+        code, f"{reply.module}.{reply.request} ended {reply.status.value}", cause=reply))
 
 
 def is_ancestor(candidate: Activity, activity: Activity) -> bool:
@@ -759,26 +839,38 @@ class Registry:
     def send_from_codel(self, name: str, inputs: Mapping[str, Any]) -> RequestHandle:
         module_name, _, request = name.partition(".")
         handle = RequestHandle(0)
+        parent = self.current
         module = self.modules.get(module_name)
         if module is None:
-            reply = Reply(self.new_id(), module_name, request, Status.CS_ERROR,
-                          Report("UNKNOWN_MODULE", f"no module '{module_name}'"), time=self.kernel.now)
-            handle.id = reply.rqst_id
-            handle.receive(reply)
+            self.refused(handle, parent, Reply(self.new_id(), module_name, request, Status.CS_ERROR,
+                                               Report("UNKNOWN_MODULE", f"no module '{module_name}'"),
+                                               time=self.kernel.now))
             return handle
         spec = module.spec.requests.get(request)
         input_: Any = None
-        if spec is not None and spec.input_type is not None:
-            try:
-                input_ = spec.input_type(**inputs)
-            except TypeError as exc:
-                reply = Reply(self.new_id(), module_name, request, Status.FINAL_ERROR, Report("BAD_INPUT", str(exc)),
-                              time=self.kernel.now)
-                handle.id = reply.rqst_id
-                handle.receive(reply)
+        if spec is not None:
+            problem = ""
+            if spec.input_type is not None:
+                try:
+                    input_ = spec.input_type(**inputs)
+                except TypeError as exc:
+                    problem = str(exc)
+            elif inputs:
+                problem = f"request '{name}' takes no input (given: {', '.join(inputs)})"
+            if problem:
+                self.refused(handle, parent if spec.kind == "exec" else None, Reply(
+                    self.new_id(), module_name, request, Status.FINAL_ERROR, Report("BAD_INPUT", problem),
+                    time=self.kernel.now))
                 return handle
-        handle.id = module.submit(request, input_, handle.receive, self.current)
+        handle.id = module.submit(request, input_, handle.receive, parent)
         return handle
+
+    @staticmethod
+    def refused(handle: RequestHandle, parent: Activity | None, reply: Reply) -> None:
+        handle.id = reply.rqst_id
+        handle.receive(reply)
+        if parent is not None:
+            child_failed(parent, reply, activated=False)
 
 
 # ---------------------------------------------------------------- the client (modFuncRqstSend / ReplyRcv)
@@ -853,7 +945,10 @@ class ModuleClient:
         exchange = self._exchanges.get(rqst_id)
         if exchange is None:
             return self.reply(rqst_id)
-        self._wait(lambda: exchange.interm is None and exchange.final is None, timeout)
+        done = self._wait(lambda: exchange.interm is None and exchange.final is None, timeout)
+        if not done and exchange.interm is None and exchange.final is None:
+            return Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT,
+                         Report("interm", "gave up waiting"), time=self.kernel.now)
         return exchange.interm or self.reply(rqst_id)
 
     def final(self, rqst_id: int, timeout: float | None = None) -> Reply:

@@ -1,6 +1,9 @@
 """Codels that play the script of their request: `script` is a comma-separated list of what
 the successive codel calls return. `raise` raises, `none` returns None, `send:X` sends
-beta.Child with script X (X's own steps separated by `;`) and continues with `exec`."""
+beta.Child with script X (X's own steps separated by `;`) and continues with `exec`.
+`to:module.request:X:R` sends that request (script X, steps separated by `;`; `-` for a request
+without input) and returns R; `write:P` writes poster P by hand and continues with `exec`;
+`copy` copies the SDI's value into `copied` and continues with `exec`."""
 
 def play(state, sdi, request):
     script = [s for s in request.script.split(",") if s]
@@ -15,5 +18,18 @@ def play(state, sdi, request):
         return None
     if outcome.startswith("send:"):
         sdi.send_request("beta.Child", script=outcome[5:].replace(";", ","))
+        return "exec"
+    if outcome.startswith("to:"):
+        _, target, child_script, result = outcome.split(":")
+        if child_script == "-":
+            sdi.send_request(target)
+        else:
+            sdi.send_request(target, script=child_script.replace(";", ","))
+        return result
+    if outcome.startswith("write:"):
+        sdi.write_poster(outcome[6:])
+        return "exec"
+    if outcome == "copy":
+        sdi.copied = sdi.value
         return "exec"
     return outcome

@@ -48,3 +48,8 @@ def init_perm(sdi):
 def perm(sdi):
     sdi.counter += 1
     return "exec"
+
+
+def get_value(sdi, request):
+    request.value = sdi.value
+    return "end"

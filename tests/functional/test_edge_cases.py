@@ -1,0 +1,232 @@
+"""Corner cases of the functional level: reply order when several activities must give way,
+codels that end their own activity while running, children that cannot be activated, several
+ZOMBIEs, control request outputs, posters named by a request's codel, the exec task grid."""
+
+from __future__ import annotations
+
+import types
+from dataclasses import dataclass
+
+from specc.runtime import functional as rt
+from specc.runtime.functional import State, Status
+from tests.functional.conftest import Robot
+
+E, INIT, X, N, Z = State.ETHER, State.INIT, State.EXEC, State.INTER, State.ZOMBIE
+
+
+def send(robot: Robot, request: str, script: str, log: list[rt.Reply] | None = None) -> tuple[int, list[rt.Reply]]:
+    replies: list[rt.Reply] = [] if log is None else log
+    record = getattr(robot.package.alpha, f"{request}Input")(script=script)
+    return robot.alpha.submit(request, record, replies.append), replies
+
+
+def test_a_newcomer_waits_for_every_activity_it_interrupts(robot: Robot) -> None:
+    # A (INTER for a long time) holds up B (INIT); C runs. E conflicts with B and C, not A:
+    # it must not start before C has left INTER, and C's final reply comes before E's
+    # intermediate one, even though B (earlier in the module's list) gives way at once.
+    robot.alpha.sdi.inter_outcome = "inter"
+    log: list[rt.Reply] = []
+    a, _ = send(robot, "A", "exec," * 50, log)
+    robot.kernel.run_for(0.02)
+    b, _ = send(robot, "B", "exec", log)
+    c, _ = send(robot, "C", "exec," * 50, log)
+    robot.kernel.run_for(0.02)
+    assert robot.alpha.activities[b].state is INIT and robot.alpha.activities[c].state is X
+    e, _ = send(robot, "E", "exec", log)
+    assert robot.alpha.activities[e].state is INIT
+    robot.alpha.sdi.inter_outcome = "ether"
+    robot.kernel.run_for(0.1)
+    order = [(r.rqst_id, r.final) for r in log if r.rqst_id in (c, e)]
+    assert order == [(c, False), (c, True), (e, False), (e, True)]
+
+
+def test_a_codel_that_sends_a_refused_child_and_returns_zombie_does_not_crash(robot: Robot) -> None:
+    # alpha.Checked refuses a "bad" script in its validate codel: the parent ends at once with the
+    # child's error chained, and what its codel returns afterwards is ignored (one final reply).
+    for outcome in ("zombie", "ether", "OOPS", "exec"):
+        rqst, replies = send(robot, "C", f"to:alpha.Checked:bad:{outcome}")
+        robot.kernel.run_for(0.05)
+        assert [r.final for r in replies] == [False, True], outcome
+        assert replies[-1].status is Status.FINAL_ERROR and replies[-1].report.code == "CHILD_NOT_ACTIVATED"
+        assert [(r.request, r.report.code) for r in replies[-1].report.chain()] == [("Checked", "BAD_SCRIPT")]
+        assert transitions(robot.alpha, rqst) == [(E, INIT), (INIT, X), (X, E)]
+        assert robot.alpha.zombie is None and not robot.alpha.activities
+
+
+def transitions(module: rt.Module, rqst_id: int) -> list[tuple[State, State]]:
+    return [(a, b) for i, a, b in module.transitions if i == rqst_id]
+
+
+def test_a_codel_interrupting_its_own_activity_goes_through_inter(robot: Robot) -> None:
+    # Reset (control, incompatible with A) sent by A's own codel interrupts A: whatever the codel
+    # returns, A passes through INTER, runs its inter codel and ends INTERRUPTED.
+    rqst, replies = send(robot, "A", "to:alpha.Reset:-:ether")
+    robot.kernel.run_for(0.05)
+    assert transitions(robot.alpha, rqst) == [(E, INIT), (INIT, X), (X, N), (N, E)]
+    assert (replies[-1].status, replies[-1].report.code) == (Status.INTERRUPTED, "Reset")
+    assert replies[-1].output.trace.endswith(",inter")
+
+
+def test_children_that_cannot_be_activated_end_the_parent(robot: Robot) -> None:
+    cases: dict[str, tuple[Status, str] | None] = {
+        "to:beta.Nope:x:exec": (Status.CS_ERROR, "UNKNOWN_REQUEST"),
+        "to:gamma.Child:x:exec": (Status.CS_ERROR, "UNKNOWN_MODULE"),
+        "to:beta.Child:exec;exec:exec": None,  # accepted: the parent runs on (reference case)
+    }
+    for script, expected in cases.items():
+        status, code = expected or (None, "")
+        _, replies = send(robot, "C", script + "," + "exec," * 20)
+        robot.kernel.run_for(0.3)
+        final = replies[-1]
+        if status is None:
+            assert final.status is Status.END, script
+            continue
+        assert (final.status, final.report.code) == (Status.FINAL_ERROR, "CHILD_NOT_ACTIVATED"), script
+        assert [(r.status, r.report.code) for r in final.report.chain()] == [(status, code)], script
+    # A control request is no child: its refusal (Reset takes no input) is the codel's to handle.
+    _, replies = send(robot, "C", "to:alpha.Reset:x:exec,exec")
+    robot.kernel.run_for(0.05)
+    assert replies[-1].status is Status.END
+
+
+def test_a_child_refused_by_a_frozen_module_ends_the_parent(robot: Robot) -> None:
+    zombie = robot.beta.submit("Child", robot.package.beta.ChildInput(script="zombie"), lambda reply: None)
+    robot.kernel.run_for(0.05)
+    assert robot.beta.zombie is not None and robot.beta.zombie.id == zombie
+    _, replies = send(robot, "Parent", "send:exec," + "exec," * 20)
+    robot.kernel.run_for(0.05)
+    assert (replies[-1].status, replies[-1].report.code) == (Status.FINAL_ERROR, "CHILD_NOT_ACTIVATED")
+    (cause,) = replies[-1].report.chain()
+    assert (cause.module, cause.status, cause.report.code) == ("beta", Status.ZOMBIE, "MODULE_FROZEN")
+
+
+def test_a_child_that_goes_zombie_ends_its_parent_with_server_error(robot: Robot) -> None:
+    _, replies = send(robot, "Parent", "send:exec;zombie," + "exec," * 20)
+    robot.kernel.run_for(0.1)
+    assert (replies[-1].status, replies[-1].report.code) == (Status.SERVER_ERROR, "CHILD_ERROR")
+    (cause,) = replies[-1].report.chain()
+    assert (cause.module, cause.status) == ("beta", Status.ZOMBIE)
+    assert robot.beta.zombie is not None and not robot.alpha.activities
+
+
+def test_the_module_stays_frozen_while_any_activity_is_zombie(robot: Robot) -> None:
+    first, _ = send(robot, "C", "zombie")
+    second, _ = send(robot, "C", "zombie")
+    robot.kernel.run_for(0.05)
+    assert robot.client().abort(second).status is Status.END
+    _, refused = send(robot, "B", "exec")
+    assert [(r.status, r.report.code) for r in refused] == [(Status.ZOMBIE, "MODULE_FROZEN")]
+    assert robot.client().abort(first).status is Status.END
+    _, accepted = send(robot, "B", "exec")
+    assert accepted[0].status is Status.WAITING
+
+
+def test_an_activity_waiting_in_init_does_not_start_once_the_module_is_frozen(robot: Robot) -> None:
+    robot.alpha.sdi.inter_outcome = "zombie"
+    old, _ = send(robot, "A", "exec," * 50)
+    robot.kernel.run_for(0.02)
+    new, replies = send(robot, "B", "exec")  # waits for A's interruption, which goes ZOMBIE
+    robot.kernel.run_for(0.05)
+    assert robot.alpha.activities[old].state is Z
+    assert transitions(robot.alpha, new) == [(E, INIT), (INIT, E)]
+    assert [(r.final, r.status, r.report.code) for r in replies] == [(True, Status.ZOMBIE, "MODULE_FROZEN")]
+
+
+def test_a_control_request_validate_codel_fills_its_output(robot: Robot) -> None:
+    client = robot.client()
+    client.call("Set", robot.package.alpha.SetInput(value=4.5))
+    reply = client.call("Get")
+    assert reply.status is Status.END and reply.output.value == 4.5
+
+
+def test_a_poster_named_after_a_request_codel_is_updated_by_its_cycles(robot: Robot) -> None:
+    client = robot.client()
+    client.call("Set", robot.package.alpha.SetInput(value=7.0))
+    assert client.poster("Named") is None
+    send(robot, "A", "copy,named,exec,exec")
+    robot.kernel.run_for(0.1)
+    snapshot = client.poster("Named")
+    assert snapshot is not None and snapshot.data.copied == 7.0
+    assert abs(snapshot.date - 0.02) < 1e-9  # start at 0, exec (copy) at 10 ms, named at 20 ms
+
+
+def test_manual_posters_are_written_by_codels_and_unknown_ones_are_codel_errors(robot: Robot) -> None:
+    client = robot.client()
+    client.call("Set", robot.package.alpha.SetInput(value=3.0))
+    send(robot, "C", "write:Manual")
+    robot.kernel.run_for(0.05)
+    snapshot = client.poster("Manual")
+    assert snapshot is not None and snapshot.data.value == 3.0 and snapshot.date == 0.0
+    _, replies = send(robot, "C", "write:Nope")
+    robot.kernel.run_for(0.05)
+    assert (replies[-1].status, replies[-1].report.code) == (Status.FINAL_ERROR, "CODEL_ERROR")
+    assert "no poster 'Nope'" in replies[-1].report.detail
+
+
+def test_waiting_for_the_intermediate_reply_can_time_out(robot: Robot) -> None:
+    client = robot.client()
+    robot.alpha.sdi.inter_outcome = "inter"
+    client.send("A", robot.package.alpha.AInput(script="exec," * 50))
+    robot.kernel.run_for(0.02)
+    waiting = client.send("B", robot.package.alpha.BInput(script="exec"))
+    reply = client.interm(waiting, timeout=0.05)
+    assert (reply.status, reply.report.code) == (Status.TIMEOUT, "interm")
+    assert client.reply(waiting).status is Status.WAITING  # only this wait gave up
+
+
+@dataclass
+class _Data(rt.InternalData):
+    pass
+
+
+def test_tasks_due_at_the_same_instant_run_in_priority_order_despite_rounding() -> None:
+    # 3 x 0.1 s is 0.30000000000000004 in floating point: the 100 ms and 300 ms grids still meet.
+    registry = rt.Registry()
+    calls: list[tuple[float, str]] = []
+    codels = types.SimpleNamespace(
+        fast=lambda sdi: calls.append((registry.kernel.now, "fast")),
+        slow=lambda sdi: calls.append((registry.kernel.now, "slow")))
+    spec = rt.ModuleSpec(name="grid", number=0, codel_module="", sdi_type=_Data, requests={}, tasks=(
+        rt.ExecTaskSpec(name="Slow", period=0.3, priority=2, permanent="slow"),
+        rt.ExecTaskSpec(name="Fast", period=0.1, priority=1, permanent="fast")))
+    registry.add(spec, codels)
+    registry.kernel.run_for(0.65)
+    at = {round(t, 6): [n for u, n in calls if round(u, 6) == round(t, 6)] for t, _ in calls}
+    assert at[0.0] == at[0.3] == at[0.6] == ["fast", "slow"]
+    assert len(calls) == 7 + 3
+
+
+def with_codels(robot: Robot, **replaced: object) -> Robot:
+    """The scripted robot on a fresh registry, some alpha codels replaced."""
+    import scripted_codels.alpha as alpha  # type: ignore[import-not-found]
+
+    codels = types.SimpleNamespace(**{n: getattr(alpha, n) for n in dir(alpha) if not n.startswith("_")})
+    for name, function in replaced.items():
+        setattr(codels, name, function)
+    registry = rt.Registry()
+    made = robot.package.create_all(registry, {"alpha": codels})
+    return Robot(registry, made["alpha"], made["beta"], robot.package)
+
+
+def test_a_control_codel_writing_no_output_is_a_codel_error(robot: Robot) -> None:
+    def get_value(sdi, request):  # type: ignore[no-untyped-def]
+        request.valeu = sdi.value
+        return "end"
+
+    reply = with_codels(robot, get_value=get_value).client().call("Get")
+    assert (reply.status, reply.report.code) == (Status.FINAL_ERROR, "CODEL_ERROR")
+    assert "no output 'valeu'" in reply.report.detail
+
+
+def test_a_request_sent_by_a_validate_codel_is_nobody_s_child(robot: Robot) -> None:
+    def check_script(sdi, request):  # type: ignore[no-untyped-def]
+        sdi.send_request("beta.Child", script="exec")
+        return "end"
+
+    other = with_codels(robot, check_script=check_script)
+    parent, _ = send(other, "C", "to:alpha.Checked:exec:exec,exec,exec")
+    other.kernel.run_for(0.005)
+    (child,) = other.alpha.activities[parent].children
+    assert child.spec.name == "Checked" and not child.children
+    (sent,) = other.beta.activities.values()
+    assert sent.parent is None
