@@ -489,7 +489,20 @@ def partition(thresholds: list[float], found: list[Atom], low: float | None, hig
 TRUE, FALSE, UNKNOWN = 1, 0, -1
 
 
-def atom_truth(atom: Atom, possible: Iterable[Any]) -> int:
+_TRUTH_CACHE: dict[tuple[Atom, frozenset[Any]], int] = {}
+
+
+def atom_truth(atom: Atom, possible: frozenset[Any]) -> int:
+    key = (atom, possible)
+    cached = _TRUTH_CACHE.get(key)
+    if cached is None:
+        if len(_TRUTH_CACHE) > 200_000:
+            _TRUTH_CACHE.clear()
+        cached = _TRUTH_CACHE[key] = _atom_truth(atom, possible)
+    return cached
+
+
+def _atom_truth(atom: Atom, possible: Iterable[Any]) -> int:
     results = {atom_holds(atom, value) for value in possible}
     if results == {True}:
         return TRUE
@@ -656,35 +669,67 @@ class Compiler:
         self.findings: list[Finding] = []
         self.tree_nodes = 0
         self.shared: dict[Node, Node] = {}
+        self.explored: dict[tuple[Any, ...], Node] = {}
+        self.reads: dict[str, tuple[str, ...]] = {}
+        self.truths: dict[tuple[Any, ...], int] = {}
+        self.order = list(base.attributes)
         self.observable = {n for n, a in base.attributes.items() if a.role in ("inputs", "previous")}
 
     def compile(self) -> Compiled:
         memory = initial_memory(self.base)
-        root = self.node(memory, frozenset(), frozenset(self.observable), (), ())
+        alive = tuple(r for r in self.base.rules if r.kind != "else")
+        root = self.node(memory, alive, frozenset(self.observable), (), ())
         return Compiled(self.base, root, self.findings, self.tree_nodes, len(self.shared))
+
+    def truth(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> int:
+        """A rule condition's truth, cached on the values of the attributes it reads."""
+        attributes = self.reads.get(rule.name)
+        if attributes is None:
+            attributes = self.reads[rule.name] = tuple(sorted({a.attribute for a in atoms(rule.condition)}))
+        key = (rule.name, tuple(memory[a] for a in attributes))
+        cached = self.truths.get(key)
+        if cached is None:
+            cached = self.truths[key] = truth(rule.condition, memory)
+        return cached
 
     def intern(self, node: Node) -> Node:
         """Identical subtrees become one node of the DAG; a test whose branches all lead to
         the same place decides nothing and disappears."""
-        self.tree_nodes += 1
         if isinstance(node, Test) and len({id(child) for _, child in node.branches}) == 1:
             return node.branches[0][1]
         return self.shared.setdefault(node, node)
 
-    def node(self, memory: dict[str, frozenset[Any]], fired: frozenset[str], testable: frozenset[str],
+    def node(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
              path: tuple[tuple[str, Any], ...], history: tuple[str, ...]) -> Node:
+        """The subgraph for one state of the deduction: the values still possible, the rules
+        that may still fire (not fired, condition not FALSE — monotony keeps a FALSE condition
+        FALSE), the attributes still testable. Paths reaching the same state share it, so the
+        search explores the DAG rather than the whole tree; a shared state's findings carry
+        the witness of the first path that reached it."""
+        self.tree_nodes += 1
+        alive = tuple(r for r in alive if self.truth(r, memory) != FALSE)
+        key = (tuple(memory[a] for a in self.order), tuple(r.name for r in alive), testable)
+        found = self.explored.get(key)
+        if found is None:
+            found = self.explore(memory, alive, testable, path, history)
+            self.explored[key] = found
+        return found
+
+    def explore(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
+                path: tuple[tuple[str, Any], ...], history: tuple[str, ...]) -> Node:
         memory = dict(memory)
         procedural: list[Assign | Call] = []
         fired_now: list[str] = []
-        rules = [r for r in self.base.rules if r.name not in fired and r.kind != "else"]
+        pending = list(alive)
         progress = True
         while progress:
             progress = False
-            for rule in rules:
-                if rule.name in fired_now or truth(rule.condition, memory) != TRUE:
+            for rule in list(pending):
+                if self.truth(rule, memory) != TRUE:
                     continue
                 if rule.kind == "impossible":
                     return self.wrap(procedural, self.intern(Leaf((), impossible=rule.name)))
+                pending.remove(rule)
                 fired_now.append(rule.name)
                 progress = True
                 for action in rule.actions:
@@ -694,12 +739,10 @@ class Compiler:
                         procedural.append(action)
                         if isinstance(action, Assign):
                             testable = testable | {action.target}
-        fired = fired | set(fired_now)
         history = history + tuple(fired_now)
         if any(not values for values in memory.values()):
             return self.wrap(procedural, self.leaf(memory, path, history))
-        valid = [r for r in self.base.rules if r.name not in fired and r.kind != "else"
-                 and truth(r.condition, memory) == UNKNOWN]
+        valid = [r for r in pending if self.truth(r, memory) == UNKNOWN]
         candidates: dict[str, int] = {}
         for rule in valid:
             for atom in atoms(rule.condition):
@@ -708,7 +751,7 @@ class Compiler:
                     candidates[atom.attribute] = candidates.get(atom.attribute, 0) + 1
         if not candidates:
             undetermined = [o for o in self.base.outputs if len(memory[o]) > 1]
-            elses = [r for r in self.base.rules if r.kind == "else" and r.name not in fired]
+            elses = [r for r in self.base.rules if r.kind == "else"]
             if undetermined and elses:
                 for rule in elses:
                     for action in rule.actions:
@@ -719,12 +762,12 @@ class Compiler:
                 history = history + tuple(r.name for r in elses)
             return self.wrap(procedural, self.leaf(memory, path, history))
         # Heuristic: the attribute most valid rules wait for; then the fewest values; then declaration order.
-        order = list(self.base.attributes)
-        chosen = min(candidates, key=lambda a: (-candidates[a], len(memory[a]), order.index(a)))
+        chosen = min(candidates, key=lambda a: (-candidates[a], len(memory[a]), self.order.index(a)))
+        remaining = tuple(valid)
         branches = []
         for value in self.ordered(chosen, memory[chosen]):
             child_memory = {**memory, chosen: frozenset({value})}
-            child = self.node(child_memory, fired, testable - {chosen}, path + ((chosen, value),), history)
+            child = self.node(child_memory, remaining, testable - {chosen}, path + ((chosen, value),), history)
             branches.append((value, child))
         return self.wrap(procedural, self.intern(Test(chosen, tuple(branches))))
 
