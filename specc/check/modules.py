@@ -29,6 +29,11 @@ def check(ctx: Context) -> None:
 # The generated client already has these methods, and Python reserves its keywords.
 RESERVED = frozenset({"send", "reply", "interm", "final", "abort", "call", "poster", "module", "kernel", "create",
                       "client"}) | frozenset(keyword.kwlist)
+# What a codel's `request` already carries at run time (specc.runtime.functional.Activity):
+# an input or output with one of these names would be hidden behind it.
+ACTIVITY_ATTRIBUTES = frozenset({"id", "spec", "module", "input", "output", "state", "codel_state", "sink", "parent",
+                                 "children", "started", "cause", "waiting_for", "pending_final", "pending_state",
+                                 "fail_report", "task", "live_children"})
 
 
 def check_names(ctx: Context, module: m.Module) -> None:
@@ -42,6 +47,9 @@ def check_names(ctx: Context, module: m.Module) -> None:
         if keyword.iskeyword(name) or (what == "request" and name in RESERVED):
             ctx.report("reserved-name", f"{what} '{name}' would clash with a Python keyword or a method of the "
                        "generated client; rename it", span)
+        elif what == "input or output" and name in ACTIVITY_ATTRIBUTES:
+            ctx.report("reserved-name", f"{what} '{name}' would be hidden by the activity's own '{name}' "
+                       "when a codel reads request.{name}; rename it", span)
 
 
 def check_module(ctx: Context, module: m.Module) -> None:
