@@ -33,8 +33,14 @@ goldens: $(STAMP)
 	$(BIN)/specc compile examples/generic -o generated
 	$(BIN)/specc compile examples/atrv -o generated
 
-bench: $(STAMP)
-	$(BIN)/python -m pytest -m bench --benchmark-enable -p no:randomly -s
+BENCH_STAMP := $(VENV)/.bench-stamp
+
+$(BENCH_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
+	touch $(BENCH_STAMP)
+
+bench: $(BENCH_STAMP)
+	$(BIN)/python -m pytest -m bench --benchmark-enable -s
 
 style: $(STAMP)
 	$(BIN)/ruff check specc tests
