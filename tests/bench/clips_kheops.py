@@ -108,7 +108,8 @@ def program(base: k.Base) -> list[str]:
     collect = " ".join(
         f'(bind ?n 0) (bind ?x "?") (do-for-all-facts ((?f val)) (eq ?f:a "{o}") (bind ?n (+ ?n 1)) (bind ?x ?f:v)) '
         f'(if (<> ?n 1) then (bind ?x "?")) (bind ?out (str-cat ?out "|" ?x))' for o in outputs)
-    constructs.append(f'(deffunction cycle ({params}) (reset) {asserts} {unknowns} (run) (bind ?out "") {collect} ?out)')
+    constructs.append(f'(deffunction cycle ({params}) (reset) {asserts} {unknowns} (run) '
+                      f'(bind ?out "") {collect} ?out)')
     return constructs
 
 
