@@ -46,6 +46,12 @@ def expand(ctx: Context, members: Iterable[Any], chain: tuple[str, ...] = ()) ->
         if not isinstance(member, m.Include):
             yield member
         elif member.name not in chain:
+            other = next((kind for kind in (m.Domain, m.Problem) if member.name in ctx.named(kind)), None)
+            if member.name not in ctx.named(m.Fragment) and other is not None:
+                word = "domain" if other is m.Domain else "problem"
+                ctx.report("undefined-fragment", f"'{member.name}' is a {word}: only fragments are included; "
+                           "move what both need into a fragment", member.span)
+                continue
             fragment = ctx.lookup(m.Fragment, member.name, member.span, "undefined-fragment")
             if fragment is not None:
                 yield from expand(ctx, fragment.members, chain + (member.name,))
@@ -319,3 +325,9 @@ def check(ctx: Context) -> None:
         if not any(getattr(s, "goal", None) is not None for s in statements):
             ctx.warn("no-goals", f"problem '{problem.name}' has no goal(...) to plan for", problem.span)
     check_include_cycles(ctx)
+    included = {member.name for item in ctx.program.items if isinstance(item, (m.Domain, m.Problem, m.Fragment))
+                for member in getattr(item, "members", getattr(item, "body", ())) if isinstance(member, m.Include)}
+    for fragment in ctx.items(m.Fragment):
+        if fragment.name not in included:
+            ctx.warn("unused-fragment", f"fragment '{fragment.name}' is included by no domain, problem or "
+                     "fragment, so nothing checks or uses it", fragment.span)
