@@ -842,12 +842,12 @@ def evaluate(compiled: Compiled, inputs: Mapping[str, Any]) -> Outcome:
 def sample_inputs(base: Base) -> Iterator[dict[str, Any]]:
     """Every combination of one representative value per input domain element (small bases)."""
     names = base.inputs
-    choices = [[sample_of(base.attributes[n], v) for v in base.attributes[n].values] for n in names]
+    choices = [[sample_of(v) for v in base.attributes[n].values] for n in names]
     for combination in itertools.product(*choices):
         yield dict(zip(names, combination, strict=True))
 
 
-def sample_of(attribute: Attribute, element: Any) -> Any:
+def sample_of(element: Any) -> Any:
     if isinstance(element, Piece):
         return element.sample()
     if element == OTHER:

@@ -91,8 +91,6 @@ class ModuleView:
     def field(self, name: str, type_ref: m.TypeRef) -> FieldView:
         annotation, default, kind = self.scalar(type_ref.name)
         if type_ref.size is None:
-            if default.startswith("field("):
-                return FieldView(name, annotation, default, kind, "None")
             return FieldView(name, annotation, default, kind, "None")
         element = default.removeprefix("field(default_factory=").removesuffix(")")
         if default.startswith("field("):

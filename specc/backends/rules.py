@@ -44,7 +44,8 @@ class DecisionView:
                 count(child)
 
         count(self.compiled.root)
-        self.shared = {key for key, n in counts.items() if n > 1}
+        # A leaf is a constant: every path returns it directly, only inner nodes become functions.
+        self.shared = {key for key, n in counts.items() if n > 1 and not isinstance(self.nodes[key], k.Leaf)}
         self.numbers = {key: i for i, key in enumerate(sorted(self.shared, key=list(self.nodes).index))}
         self.leaves: dict[k.Leaf, str] = {}
         for node in self.nodes.values():
@@ -113,13 +114,17 @@ class DecisionView:
         assert isinstance(node, k.Test)
         attribute = self.base.attributes[node.attribute]
         lines = [f"{pad}v = a[{node.attribute!r}]"]
+        # Values leading to the same subgraph share one test: `if v in ('A', 'B'):`.
+        grouped: dict[int, tuple[k.Node, list[Any]]] = {}
+        for value, child in node.branches:
+            grouped.setdefault(id(child), (child, []))[1].append(value)
         keyword = "if"
         otherwise: list[str] | None = None
-        for value, child in node.branches:
-            if value == k.OTHER:
+        for child, values in grouped.values():
+            if k.OTHER in values:  # the values nobody mentions: whatever the other tests leave
                 otherwise = self.body(child, depth + 1)
                 continue
-            lines.append(f"{pad}{keyword} {condition(attribute, value)}:")
+            lines.append(f"{pad}{keyword} {conditions(attribute, values)}:")
             lines += self.body(child, depth + 1)
             keyword = "elif"
         lines.append(f"{pad}else:")
@@ -146,6 +151,14 @@ def literal(value: Any) -> str:
     if isinstance(value, k.Piece):
         return repr(str(value))
     return repr(value)
+
+
+def conditions(attribute: k.Attribute, values: list[Any]) -> str:
+    if len(values) == 1:
+        return condition(attribute, values[0])
+    if attribute.kind == "symbol":
+        return f"v in {tuple(values)!r}"
+    return " or ".join(f"({condition(attribute, v)})" for v in values)
 
 
 def condition(attribute: k.Attribute, value: Any) -> str:

@@ -18,7 +18,7 @@ import enum
 import functools
 import itertools
 import math
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Generic, TypeVar
@@ -1000,7 +1000,3 @@ def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
     except ImportError as exc:
         raise ImportError(f"module '{spec.name}': cannot import its codels '{spec.codel_module}' ({exc}); "
                           "put the folder holding them on sys.path, or pass `codels=`") from exc
-
-
-def iter_arcs() -> Iterable[tuple[State, str, State]]:
-    return iter(ARCS)

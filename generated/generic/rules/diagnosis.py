@@ -57,18 +57,16 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     v = a['deltaP']
     if v < 4.0:
         v = a['pres1']
-        if v < 138.0:
+        if (v < 138.0) or (160.0 <= v):
             return _node_0(a, calls)
         elif 138.0 <= v and v < 160.0:
             v = a['drain']
             if v == 'on':
-                return _node_1(a, calls)
+                return _LEAF_0
             elif v == 'off':
                 return _LEAF_8
             else:
-                return _node_5(a, calls)
-        elif 160.0 <= v:
-            return _node_0(a, calls)
+                return _LEAF_4
         else:
             raise ValueError(f"pres1={v!r} is outside its domain")
     elif 4.0 <= v and v < 20.0:
@@ -78,21 +76,21 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
         if v < 286.0:
             v = a['drain']
             if v == 'on':
-                return _node_1(a, calls)
+                return _LEAF_0
             elif v == 'off':
                 a['difP'] = (a['pres2'] - a['pres1'])
-                return _node_8(a, calls)
+                return _node_2(a, calls)
             else:
-                return _node_5(a, calls)
+                return _LEAF_4
         elif 286.0 <= v:
             v = a['drain']
             if v == 'on':
-                return _node_1(a, calls)
+                return _LEAF_0
             elif v == 'off':
                 a['difP'] = (a['pres2'] - a['pres1'])
-                return _node_11(a, calls)
+                return _LEAF_7
             else:
-                return _node_5(a, calls)
+                return _LEAF_4
         else:
             raise ValueError(f"temp={v!r} is outside its domain")
     else:
@@ -108,44 +106,38 @@ def _node_0(a: Any, calls: Calls) -> Decision:
             if v < 40.0:
                 v = a['drain']
                 if v == 'on':
-                    return _node_1(a, calls)
+                    return _LEAF_0
                 elif v == 'off':
                     a['difP'] = (a['pres2'] - a['pres1'])
                     v = a['level']
                     if v == 'high':
                         v = a['difP']
-                        if v < 0.0:
-                            return _node_2(a, calls)
-                        elif 0.0 <= v and v < 10.0:
-                            return _node_2(a, calls)
+                        if (v < 0.0) or (0.0 <= v and v < 10.0):
+                            return _LEAF_1
                         elif 10.0 <= v:
-                            return _node_3(a, calls)
+                            return _LEAF_2
                         else:
                             raise ValueError(f"difP={v!r} is outside its domain")
                     elif v == 'low':
                         v = a['difP']
-                        if v < 0.0:
-                            return _node_4(a, calls)
-                        elif 0.0 <= v and v < 10.0:
-                            return _node_4(a, calls)
+                        if (v < 0.0) or (0.0 <= v and v < 10.0):
+                            return _LEAF_3
                         elif 10.0 <= v:
-                            return _node_3(a, calls)
+                            return _LEAF_2
                         else:
                             raise ValueError(f"difP={v!r} is outside its domain")
                     else:
                         v = a['difP']
-                        if v < 0.0:
-                            return _node_5(a, calls)
-                        elif 0.0 <= v and v < 10.0:
-                            return _node_5(a, calls)
+                        if (v < 0.0) or (0.0 <= v and v < 10.0):
+                            return _LEAF_4
                         elif 10.0 <= v:
-                            return _node_3(a, calls)
+                            return _LEAF_2
                         else:
                             raise ValueError(f"difP={v!r} is outside its domain")
                 else:
-                    return _node_5(a, calls)
+                    return _LEAF_4
             elif 40.0 <= v:
-                return _node_6(a, calls)
+                return _node_1(a, calls)
             else:
                 raise ValueError(f"pres2={v!r} is outside its domain")
         else:
@@ -153,22 +145,20 @@ def _node_0(a: Any, calls: Calls) -> Decision:
             if v < 40.0:
                 v = a['drain']
                 if v == 'on':
-                    return _node_1(a, calls)
+                    return _LEAF_0
                 elif v == 'off':
                     a['difP'] = (a['pres2'] - a['pres1'])
                     v = a['difP']
-                    if v < 0.0:
-                        return _node_8(a, calls)
-                    elif 0.0 <= v and v < 10.0:
-                        return _node_8(a, calls)
+                    if (v < 0.0) or (0.0 <= v and v < 10.0):
+                        return _node_2(a, calls)
                     elif 10.0 <= v:
-                        return _node_3(a, calls)
+                        return _LEAF_2
                     else:
                         raise ValueError(f"difP={v!r} is outside its domain")
                 else:
-                    return _node_5(a, calls)
+                    return _LEAF_4
             elif 40.0 <= v:
-                return _node_9(a, calls)
+                return _node_3(a, calls)
             else:
                 raise ValueError(f"pres2={v!r} is outside its domain")
     elif 286.0 <= v:
@@ -176,17 +166,17 @@ def _node_0(a: Any, calls: Calls) -> Decision:
         if v == 'open':
             v = a['pres2']
             if v < 40.0:
-                return _node_10(a, calls)
+                return _node_4(a, calls)
             elif 40.0 <= v:
-                return _node_6(a, calls)
+                return _node_1(a, calls)
             else:
                 raise ValueError(f"pres2={v!r} is outside its domain")
         else:
             v = a['pres2']
             if v < 40.0:
-                return _node_10(a, calls)
+                return _node_4(a, calls)
             elif 40.0 <= v:
-                return _node_9(a, calls)
+                return _node_3(a, calls)
             else:
                 raise ValueError(f"pres2={v!r} is outside its domain")
     else:
@@ -194,95 +184,61 @@ def _node_0(a: Any, calls: Calls) -> Decision:
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:
-    return _LEAF_0
-
-
-def _node_2(a: Any, calls: Calls) -> Decision:
-    return _LEAF_1
-
-
-def _node_3(a: Any, calls: Calls) -> Decision:
-    return _LEAF_2
-
-
-def _node_4(a: Any, calls: Calls) -> Decision:
-    return _LEAF_3
-
-
-def _node_5(a: Any, calls: Calls) -> Decision:
-    return _LEAF_4
-
-
-def _node_6(a: Any, calls: Calls) -> Decision:
     v = a['drain']
     if v == 'on':
-        return _node_1(a, calls)
+        return _LEAF_0
     elif v == 'off':
         a['difP'] = (a['pres2'] - a['pres1'])
         v = a['difP']
-        if v < 0.0:
-            return _node_7(a, calls)
-        elif 0.0 <= v and v < 10.0:
-            return _node_7(a, calls)
+        if (v < 0.0) or (0.0 <= v and v < 10.0):
+            return _LEAF_5
         elif 10.0 <= v:
-            return _node_3(a, calls)
+            return _LEAF_2
         else:
             raise ValueError(f"difP={v!r} is outside its domain")
     else:
-        return _node_5(a, calls)
+        return _LEAF_4
 
 
-def _node_7(a: Any, calls: Calls) -> Decision:
-    return _LEAF_5
-
-
-def _node_8(a: Any, calls: Calls) -> Decision:
+def _node_2(a: Any, calls: Calls) -> Decision:
     v = a['level']
     if v == 'high':
-        return _node_2(a, calls)
+        return _LEAF_1
     elif v == 'low':
-        return _node_4(a, calls)
+        return _LEAF_3
     else:
-        return _node_5(a, calls)
+        return _LEAF_4
 
 
-def _node_9(a: Any, calls: Calls) -> Decision:
+def _node_3(a: Any, calls: Calls) -> Decision:
     v = a['drain']
     if v == 'on':
-        return _node_1(a, calls)
+        return _LEAF_0
     elif v == 'off':
         a['difP'] = (a['pres2'] - a['pres1'])
         v = a['difP']
         if v < 0.0:
             return _LEAF_6
-        elif 0.0 <= v and v < 10.0:
-            return _node_3(a, calls)
-        elif 10.0 <= v:
-            return _node_3(a, calls)
+        elif (0.0 <= v and v < 10.0) or (10.0 <= v):
+            return _LEAF_2
         else:
             raise ValueError(f"difP={v!r} is outside its domain")
     else:
-        return _node_5(a, calls)
+        return _LEAF_4
 
 
-def _node_10(a: Any, calls: Calls) -> Decision:
+def _node_4(a: Any, calls: Calls) -> Decision:
     v = a['drain']
     if v == 'on':
-        return _node_1(a, calls)
+        return _LEAF_0
     elif v == 'off':
         a['difP'] = (a['pres2'] - a['pres1'])
         v = a['difP']
-        if v < 0.0:
-            return _node_11(a, calls)
-        elif 0.0 <= v and v < 10.0:
-            return _node_11(a, calls)
+        if (v < 0.0) or (0.0 <= v and v < 10.0):
+            return _LEAF_7
         elif 10.0 <= v:
-            return _node_3(a, calls)
+            return _LEAF_2
         else:
             raise ValueError(f"difP={v!r} is outside its domain")
     else:
-        return _node_5(a, calls)
-
-
-def _node_11(a: Any, calls: Calls) -> Decision:
-    return _LEAF_7
+        return _LEAF_4

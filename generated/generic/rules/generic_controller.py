@@ -56,174 +56,116 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
         v = a['@ABCstate']
         if v == 'A':
             return _node_0(a, calls)
-        elif v == 'B':
-            return _node_3(a, calls)
-        elif v == 'C':
-            return _node_3(a, calls)
-        elif v == 'IDLE':
-            return _node_3(a, calls)
+        elif v in ('B', 'C', 'IDLE'):
+            return _node_1(a, calls)
         else:
             raise ValueError(f"@ABCstate={v!r} is outside its domain")
     elif v == 'B':
         v = a['@ABCstate']
-        if v == 'A':
-            return _node_3(a, calls)
+        if v in ('A', 'C'):
+            return _node_1(a, calls)
         elif v == 'B':
             return _node_0(a, calls)
-        elif v == 'C':
-            return _node_3(a, calls)
         elif v == 'IDLE':
             v = a['event']
             if v == 'START':
-                return _node_1(a, calls)
+                return _LEAF_0
             elif v == 'INTERM':
                 return _LEAF_3
-            elif v == 'END':
-                return _node_4(a, calls)
-            elif v == 'ABORT':
-                return _node_4(a, calls)
-            elif v == 'ZOMBIE':
-                return _node_4(a, calls)
+            elif v in ('END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_2
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
             raise ValueError(f"@ABCstate={v!r} is outside its domain")
     elif v == 'C':
         v = a['@ABCstate']
-        if v == 'A':
-            return _node_5(a, calls)
-        elif v == 'B':
-            return _node_5(a, calls)
+        if v in ('A', 'B'):
+            return _node_2(a, calls)
         elif v == 'C':
             v = a['event']
             if v == 'START':
-                return _node_6(a, calls)
-            elif v == 'INTERM':
-                return _node_1(a, calls)
+                return _LEAF_4
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_0
             elif v == 'END':
-                return _node_2(a, calls)
-            elif v == 'ABORT':
-                return _node_1(a, calls)
-            elif v == 'ZOMBIE':
-                return _node_1(a, calls)
+                return _LEAF_1
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['event']
             if v == 'START':
-                return _node_7(a, calls)
+                return _LEAF_5
             elif v == 'INTERM':
-                return _node_1(a, calls)
-            elif v == 'END':
-                return _node_4(a, calls)
-            elif v == 'ABORT':
-                return _node_4(a, calls)
-            elif v == 'ZOMBIE':
-                return _node_4(a, calls)
+                return _LEAF_0
+            elif v in ('END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_2
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
             raise ValueError(f"@ABCstate={v!r} is outside its domain")
     elif v == 'D':
         v = a['event']
-        if v == 'START':
-            return _node_7(a, calls)
-        elif v == 'INTERM':
-            return _node_7(a, calls)
-        elif v == 'END':
-            return _node_7(a, calls)
-        elif v == 'ABORT':
-            return _node_1(a, calls)
-        elif v == 'ZOMBIE':
-            return _node_1(a, calls)
+        if v in ('START', 'INTERM', 'END'):
+            return _LEAF_5
+        elif v in ('ABORT', 'ZOMBIE'):
+            return _LEAF_0
         else:
             raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'E':
-        return _node_8(a, calls)
-    elif v == 'F':
-        return _node_8(a, calls)
-    elif v == 'G':
-        return _node_8(a, calls)
+    elif v in ('E', 'F', 'G'):
+        return _node_3(a, calls)
     elif v == 'H':
         v = a['event']
         if v == 'START':
             v = a['@EFGstate']
-            if v == 'E':
-                return _node_10(a, calls)
-            elif v == 'F':
-                return _node_10(a, calls)
-            elif v == 'G':
-                return _node_10(a, calls)
+            if v in ('E', 'F', 'G'):
+                return _node_5(a, calls)
             elif v == 'IDLE':
-                return _node_7(a, calls)
+                return _LEAF_5
             else:
                 raise ValueError(f"@EFGstate={v!r} is outside its domain")
         elif v == 'INTERM':
-            return _node_4(a, calls)
-        elif v == 'END':
-            return _node_1(a, calls)
-        elif v == 'ABORT':
-            return _node_1(a, calls)
-        elif v == 'ZOMBIE':
-            return _node_1(a, calls)
+            return _LEAF_2
+        elif v in ('END', 'ABORT', 'ZOMBIE'):
+            return _LEAF_0
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'I':
         v = a['event']
         if v == 'START':
             v = a['@ABCstate']
-            if v == 'A':
-                return _node_6(a, calls)
-            elif v == 'B':
-                return _node_6(a, calls)
-            elif v == 'C':
-                return _node_6(a, calls)
+            if v in ('A', 'B', 'C'):
+                return _LEAF_4
             elif v == 'IDLE':
                 v = a['@EFGstate']
-                if v == 'E':
-                    return _node_10(a, calls)
-                elif v == 'F':
-                    return _node_10(a, calls)
-                elif v == 'G':
-                    return _node_10(a, calls)
+                if v in ('E', 'F', 'G'):
+                    return _node_5(a, calls)
                 elif v == 'IDLE':
-                    return _node_1(a, calls)
+                    return _LEAF_0
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             else:
                 raise ValueError(f"@ABCstate={v!r} is outside its domain")
         elif v == 'INTERM':
-            return _node_4(a, calls)
-        elif v == 'END':
-            return _node_1(a, calls)
-        elif v == 'ABORT':
-            return _node_1(a, calls)
-        elif v == 'ZOMBIE':
-            return _node_1(a, calls)
+            return _LEAF_2
+        elif v in ('END', 'ABORT', 'ZOMBIE'):
+            return _LEAF_0
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'J':
         v = a['event']
         if v == 'START':
             v = a['@ABCstate']
-            if v == 'A':
-                return _node_11(a, calls)
-            elif v == 'B':
-                return _node_11(a, calls)
-            elif v == 'C':
-                return _node_11(a, calls)
+            if v in ('A', 'B', 'C'):
+                return _node_6(a, calls)
             elif v == 'IDLE':
-                return _node_1(a, calls)
+                return _LEAF_0
             else:
                 raise ValueError(f"@ABCstate={v!r} is outside its domain")
         elif v == 'INTERM':
-            return _node_4(a, calls)
-        elif v == 'END':
-            return _node_1(a, calls)
-        elif v == 'ABORT':
-            return _node_1(a, calls)
-        elif v == 'ZOMBIE':
-            return _node_1(a, calls)
+            return _LEAF_2
+        elif v in ('END', 'ABORT', 'ZOMBIE'):
+            return _LEAF_0
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     else:
@@ -232,120 +174,70 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
 
 def _node_0(a: Any, calls: Calls) -> Decision:
     v = a['event']
-    if v == 'START':
-        return _node_1(a, calls)
-    elif v == 'INTERM':
-        return _node_1(a, calls)
+    if v in ('START', 'INTERM', 'ABORT', 'ZOMBIE'):
+        return _LEAF_0
     elif v == 'END':
-        return _node_2(a, calls)
-    elif v == 'ABORT':
-        return _node_1(a, calls)
-    elif v == 'ZOMBIE':
-        return _node_1(a, calls)
+        return _LEAF_1
     else:
         raise ValueError(f"event={v!r} is outside its domain")
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:
-    return _LEAF_0
+    v = a['event']
+    if v in ('START', 'INTERM'):
+        return _LEAF_0
+    elif v in ('END', 'ABORT', 'ZOMBIE'):
+        return _LEAF_2
+    else:
+        raise ValueError(f"event={v!r} is outside its domain")
 
 
 def _node_2(a: Any, calls: Calls) -> Decision:
-    return _LEAF_1
+    v = a['event']
+    if v == 'START':
+        return _LEAF_4
+    elif v == 'INTERM':
+        return _LEAF_0
+    elif v in ('END', 'ABORT', 'ZOMBIE'):
+        return _LEAF_2
+    else:
+        raise ValueError(f"event={v!r} is outside its domain")
 
 
 def _node_3(a: Any, calls: Calls) -> Decision:
-    v = a['event']
-    if v == 'START':
-        return _node_1(a, calls)
-    elif v == 'INTERM':
-        return _node_1(a, calls)
-    elif v == 'END':
-        return _node_4(a, calls)
-    elif v == 'ABORT':
-        return _node_4(a, calls)
-    elif v == 'ZOMBIE':
-        return _node_4(a, calls)
-    else:
-        raise ValueError(f"event={v!r} is outside its domain")
-
-
-def _node_4(a: Any, calls: Calls) -> Decision:
-    return _LEAF_2
-
-
-def _node_5(a: Any, calls: Calls) -> Decision:
-    v = a['event']
-    if v == 'START':
-        return _node_6(a, calls)
-    elif v == 'INTERM':
-        return _node_1(a, calls)
-    elif v == 'END':
-        return _node_4(a, calls)
-    elif v == 'ABORT':
-        return _node_4(a, calls)
-    elif v == 'ZOMBIE':
-        return _node_4(a, calls)
-    else:
-        raise ValueError(f"event={v!r} is outside its domain")
-
-
-def _node_6(a: Any, calls: Calls) -> Decision:
-    return _LEAF_4
-
-
-def _node_7(a: Any, calls: Calls) -> Decision:
-    return _LEAF_5
-
-
-def _node_8(a: Any, calls: Calls) -> Decision:
     v = a['@EFGstate']
-    if v == 'E':
-        return _node_9(a, calls)
-    elif v == 'F':
-        return _node_9(a, calls)
-    elif v == 'G':
-        return _node_9(a, calls)
+    if v in ('E', 'F', 'G'):
+        return _node_4(a, calls)
     elif v == 'IDLE':
         v = a['event']
         if v == 'START':
-            return _node_7(a, calls)
-        elif v == 'INTERM':
-            return _node_1(a, calls)
-        elif v == 'END':
-            return _node_1(a, calls)
-        elif v == 'ABORT':
-            return _node_1(a, calls)
-        elif v == 'ZOMBIE':
-            return _node_1(a, calls)
+            return _LEAF_5
+        elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+            return _LEAF_0
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     else:
         raise ValueError(f"@EFGstate={v!r} is outside its domain")
 
 
-def _node_9(a: Any, calls: Calls) -> Decision:
+def _node_4(a: Any, calls: Calls) -> Decision:
     v = a['event']
     if v == 'START':
-        return _node_10(a, calls)
+        return _node_5(a, calls)
     elif v == 'INTERM':
-        return _node_4(a, calls)
-    elif v == 'END':
-        return _node_1(a, calls)
-    elif v == 'ABORT':
-        return _node_1(a, calls)
-    elif v == 'ZOMBIE':
-        return _node_1(a, calls)
+        return _LEAF_2
+    elif v in ('END', 'ABORT', 'ZOMBIE'):
+        return _LEAF_0
     else:
         raise ValueError(f"event={v!r} is outside its domain")
 
 
-def _node_10(a: Any, calls: Calls) -> Decision:
+def _node_5(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@EFGstate'],))
-    return _node_7(a, calls)
+    return _LEAF_5
 
 
-def _node_11(a: Any, calls: Calls) -> Decision:
+def _node_6(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ABCstate'],))
     calls('sendAbortRequest', (a['@ABCstate'],))
-    return _node_6(a, calls)
+    return _LEAF_4

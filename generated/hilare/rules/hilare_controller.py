@@ -49,32 +49,14 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 3 tests; `calls(name, args)` runs `do` calls."""
     a = inputs
     v = a['@ExecTrajState']
-    if v == 'EXEC-TRAJ-OBJ':
-        return _node_0(a, calls)
+    if v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+        return _LEAF_0
     elif v == 'EXEC-TRAJ-GOAL':
         v = a['event']
         if v == 'START':
             v = a['service']
-            if v == 'AVOID-ON':
-                return _node_0(a, calls)
-            elif v == 'SET-DYNAMIC':
-                return _node_0(a, calls)
-            elif v == 'AUTOBOX-OFF':
-                return _node_0(a, calls)
-            elif v == 'SET-BOX':
-                return _node_0(a, calls)
-            elif v == 'READ-MODEL':
-                return _node_0(a, calls)
-            elif v == 'INIT-MODEL':
-                return _node_0(a, calls)
-            elif v == 'READ-OBST':
-                return _node_0(a, calls)
-            elif v == 'EXEC-TRAJ-GOAL':
-                return _node_0(a, calls)
-            elif v == 'EXEC-TRAJ-OBJ':
-                return _node_0(a, calls)
-            elif v == 'CALC-TRAJ-GOAL':
-                return _node_0(a, calls)
+            if v in ('AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'READ-MODEL', 'INIT-MODEL', 'READ-OBST', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'CALC-TRAJ-GOAL', 'ARM-BACK', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'TAKE-IMAGE', 'SEARCH-OBJ', 'GET-NEAR-OBJ', 'CALC-GOAL', 'CALC-OBJ'):
+                return _LEAF_0
             elif v == 'CALC-TRAJ-OBJ':
                 calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                 calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
@@ -83,41 +65,11 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                 calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
                 return _LEAF_2
-            elif v == 'ARM-BACK':
-                return _node_0(a, calls)
-            elif v == 'OPEN-GRIP':
-                return _node_0(a, calls)
-            elif v == 'CLOSE-GRIP':
-                return _node_0(a, calls)
-            elif v == 'TURN-CAMERA':
-                return _node_0(a, calls)
-            elif v == 'TAKE-IMAGE':
-                return _node_0(a, calls)
-            elif v == 'SEARCH-OBJ':
-                return _node_0(a, calls)
-            elif v == 'GET-NEAR-OBJ':
-                return _node_0(a, calls)
-            elif v == 'CALC-GOAL':
-                return _node_0(a, calls)
-            elif v == 'CALC-OBJ':
-                return _node_0(a, calls)
             else:
                 raise ValueError(f"service={v!r} is outside its domain")
-        elif v == 'INTERM':
-            return _node_0(a, calls)
-        elif v == 'END':
-            return _node_0(a, calls)
-        elif v == 'ABORT':
-            return _node_0(a, calls)
-        elif v == 'ZOMBIE':
-            return _node_0(a, calls)
+        elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+            return _LEAF_0
         else:
             raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'IDLE':
-        return _node_0(a, calls)
     else:
         raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-
-
-def _node_0(a: Any, calls: Calls) -> Decision:
-    return _LEAF_0
