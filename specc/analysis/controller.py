@@ -9,11 +9,23 @@ Inputs: `service`, `event` (START INTERM END ABORT ZOMBIE) and, for every servic
 state in the previous cycle (`@<group>state`). Outputs: `status` (OK WAIT REFUSE ERROR) and each
 group's new state. External calls: changeInterState(service) marks an activity its own module
 is interrupting; sendAbortRequest(service) asks another module to interrupt one.
+
+An executive's own rule bases (`executive { rules: ...; }`, e.g. Fig 5.6) join the generated
+ones (`executive_controller`): where a hand-written rule applies, it takes over the decisions it
+makes (the attributes it restricts, the calls it makes on a group), and the generated rules
+deciding the same thing step aside; everywhere else the generated rules decide. A hand-written
+output whose values are a group's services plus IDLE names that group's state (Fig 5.6 calls
+the pilo group ExecTrajState).
 """
 
 from __future__ import annotations
 
-from specc.analysis.incompat import Group, IncompatibilityGraph, service_groups
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from specc.analysis import kheops as k
+from specc.analysis.incompat import Group, IncompatibilityGraph, build_graph, service_groups
 from specc.model import nodes as m
 
 EVENTS = ("START", "INTERM", "END", "ABORT", "ZOMBIE")
@@ -21,7 +33,10 @@ STATUSES = ("OK", "WAIT", "REFUSE", "ERROR")
 IDLE = "IDLE"
 
 
-def state_attribute(group: Group) -> str:
+def state_attribute(group: Group, names: Mapping[Group, str] | None = None) -> str:
+    """The group's state attribute: the name a hand-written base gave it, else <group>state."""
+    if names and group in names:
+        return names[group]
     return "".join(c if c.isalnum() else "_" for c in group.name) + "state"
 
 
@@ -50,23 +65,24 @@ def _restrict(name: str, value: str) -> m.Restrict:
     return m.Restrict(restriction=_is(name, value))
 
 
-def _call(function: str, group: Group) -> m.DoAction:
-    return m.DoAction(statements=(m.DoCall(function=function, args=(_attr(state_attribute(group), True),)),))
+def _call(function: str, group: Group, names: Mapping[Group, str] | None) -> m.DoAction:
+    return m.DoAction(statements=(m.DoCall(function=function, args=(_attr(state_attribute(group, names), True),)),))
 
 
 def _rule(name: str, condition: m.Cond, *actions: m.Action) -> m.Rule:
     return m.Rule(name=name, kind="when", condition=condition, actions=actions)
 
 
-def controller_rules(name: str, graph: IncompatibilityGraph, groups: list[Group] | None = None) -> m.RuleBase:
+def controller_rules(name: str, graph: IncompatibilityGraph, groups: list[Group] | None = None,
+                     names: Mapping[Group, str] | None = None) -> m.RuleBase:
     groups = service_groups(graph) if groups is None else groups
     group_of = {s: g for g in groups for s in g.services}
     rules: list[m.Rule] = []
     for service in graph.services:
-        rules += start_rules(service, graph, groups)
-        rules += reply_rules(service, graph, group_of.get(service))
+        rules += start_rules(service, graph, groups, names)
+        rules += reply_rules(service, graph, group_of.get(service), names)
     for group in groups:
-        rules += frame_rules(group)
+        rules += frame_rules(group, names)
     attributes = [
         m.AttrDecl(role="inputs", name="service", domain=m.SymbolDomain(values=tuple(
             m.String(value=s) for s in graph.services))),
@@ -74,13 +90,14 @@ def controller_rules(name: str, graph: IncompatibilityGraph, groups: list[Group]
         m.AttrDecl(role="outputs", name="status", domain=m.SymbolDomain(values=tuple(
             m.String(value=s) for s in STATUSES))),
     ]
-    attributes += [m.AttrDecl(role="outputs", name=state_attribute(g), domain=m.SymbolDomain(
+    attributes += [m.AttrDecl(role="outputs", name=state_attribute(g, names), domain=m.SymbolDomain(
         values=tuple(m.String(value=v) for v in g.states))) for g in groups]
-    inits = tuple(m.InitDecl(name=state_attribute(g), value=m.String(value=IDLE)) for g in groups)
+    inits = tuple(m.InitDecl(name=state_attribute(g, names), value=m.String(value=IDLE)) for g in groups)
     return m.RuleBase(name=name, attributes=tuple(attributes), inits=inits, rules=tuple(rules))
 
 
-def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group]) -> list[m.Rule]:
+def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group],
+                names: Mapping[Group, str] | None = None) -> list[m.Rule]:
     """START: wait while a service it waits for runs; otherwise interrupt what it conflicts with
     (its own module by marking the activity, another module by an abort request, then WAIT)."""
     start = (_is("event", "START"), _is("service", service))
@@ -91,19 +108,23 @@ def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group]) 
     rules: list[m.Rule] = []
     for group, members in waited:
         rules.append(_rule(f"{service}_waits_{group.name}",
-                           _and(*start, _one_of(state_attribute(group), members, previous=True)),
+                           _and(*start, _one_of(state_attribute(group, names), members, previous=True)),
                            _restrict("status", "WAIT")))
-    none_waited = tuple(_one_of(state_attribute(g), members, previous=True, negate=True) for g, members in waited)
+    none_waited = tuple(_one_of(state_attribute(g, names), members, previous=True, negate=True)
+                        for g, members in waited)
     must_wait_for_abort: list[m.Cond] = []
     for group in groups:
         targets = tuple(s for s in group.services if s in interrupts)
         if not targets:
             continue
-        running = _one_of(state_attribute(group), targets, previous=True)
-        local = all(graph.modules.get(t) == graph.modules.get(service) for t in targets)
-        actions: list[m.Action] = [_call("changeInterState", group)]
+        running = _one_of(state_attribute(group, names), targets, previous=True)
+        # The module interrupts an activity by itself only when its requests are incompatible
+        # (a physical arc); a logical conflict needs an explicit abort, even in the same module.
+        local = all(graph.modules.get(t) == graph.modules.get(service) and physical(graph, service, t)
+                    for t in targets)
+        actions: list[m.Action] = [_call("changeInterState", group, names)]
         if not local:
-            actions.append(_call("sendAbortRequest", group))
+            actions.append(_call("sendAbortRequest", group, names))
             must_wait_for_abort.append(running)
         rules.append(_rule(f"{service}_interrupts_{group.name}", _and(*start, *none_waited, running), *actions))
     if must_wait_for_abort:
@@ -114,7 +135,12 @@ def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group]) 
     return rules
 
 
-def reply_rules(service: str, graph: IncompatibilityGraph, group: Group | None) -> list[m.Rule]:
+def physical(graph: IncompatibilityGraph, source: str, target: str) -> bool:
+    return any(a.physical for a in graph.arcs if a.source == source and a.target == target)
+
+
+def reply_rules(service: str, graph: IncompatibilityGraph, group: Group | None,
+                names: Mapping[Group, str] | None = None) -> list[m.Rule]:
     """INTERM, END, ABORT, ZOMBIE: a group records its running service from the intermediate
     reply to the end; anything that cannot happen in the current state is an ERROR (§3.4.2)."""
     me = _is("service", service)
@@ -125,7 +151,7 @@ def reply_rules(service: str, graph: IncompatibilityGraph, group: Group | None) 
     if group is None:
         return [_rule(f"{service}_replies", _and(_one_of("event", ("INTERM", "END", "ABORT", "ZOMBIE")), me),
                       _restrict("status", "OK"))]
-    state = state_attribute(group)
+    state = state_attribute(group, names)
     return [
         _rule(f"{service}_interm", _and(_is("event", "INTERM"), me, _is(state, IDLE, previous=True)),
               _restrict("status", "OK"), _restrict(state, service)),
@@ -143,13 +169,157 @@ def reply_rules(service: str, graph: IncompatibilityGraph, group: Group | None) 
     ]
 
 
-def frame_rules(group: Group) -> list[m.Rule]:
+def frame_rules(group: Group, names: Mapping[Group, str] | None = None) -> list[m.Rule]:
     """A group keeps its state unless an intermediate reply starts one of its services in it,
     or the end of its running service empties it."""
-    state = state_attribute(group)
+    state = state_attribute(group, names)
     changes = _or(
         _and(_is("event", "INTERM"), _one_of("service", group.services), _is(state, IDLE, previous=True)),
         _and(_is("event", "END"), _or(*(_and(_is("service", s), _is(state, s, previous=True))
                                         for s in group.services))))
     return [_rule(f"keep_{state}_{value}", _and(_is(state, value, previous=True), m.KNot(operand=changes)),
                   _restrict(state, value)) for value in group.states]
+
+
+# ---------------------------------------------------------------- the executive's whole controller
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Why a hand-written base cannot join the controller (reported by the executive check)."""
+
+    code: str
+    message: str
+    node: m.Node
+
+
+@dataclass
+class Controller:
+    """An executive's resource controller: the groups and the merged, normalised rule base."""
+
+    executive: m.Executive
+    graph: IncompatibilityGraph
+    groups: list[Group]
+    names: dict[Group, str]
+    base: k.Base
+    problems: list[Problem] = field(default_factory=list)
+
+    @property
+    def name(self) -> str:
+        return self.base.name
+
+    def state_attribute(self, group: Group) -> str:
+        return state_attribute(group, self.names)
+
+
+def controller_name(executive: m.Executive) -> str:
+    return f"{executive.name}_controller"
+
+
+def executive_controller(program: m.Program, executive: m.Executive) -> Controller:
+    """The generated rules of `executive`, joined by its hand-written bases."""
+    graph = build_graph(program, executive)
+    groups = service_groups(graph)
+    bases = {b.name: b for b in program.items if isinstance(b, m.RuleBase)}
+    hand = [bases[ref.text] for ref in executive.rules if ref.text in bases]
+    problems: list[Problem] = []
+    names: dict[Group, str] = {}
+    for base in hand:
+        problems += name_groups(base, graph, groups, names)
+    generated = k.normalise(controller_rules(controller_name(executive), graph, groups, names))
+    if problems:
+        return Controller(executive, graph, groups, names, generated, problems)
+    merged = generated
+    for base in hand:
+        merged = take_over(merged, k.normalise(base), groups, names)
+    return Controller(executive, graph, groups, names, merged, problems)
+
+
+def name_groups(base: m.RuleBase, graph: IncompatibilityGraph, groups: list[Group],
+                names: dict[Group, str]) -> list[Problem]:
+    """Check a hand-written base's attributes against what the executive gives its controller,
+    and learn the names it gives group states."""
+    problems = []
+    fixed = {"service": ("inputs", graph.services), "event": ("inputs", EVENTS), "status": ("outputs", STATUSES)}
+    for decl in base.attributes:
+        values = [getattr(v, "value", getattr(v, "text", None)) for v in decl.domain.values] \
+            if isinstance(decl.domain, m.SymbolDomain) else None
+        if decl.name in fixed:
+            role, allowed = fixed[decl.name]
+            unknown = [v for v in values or () if v not in allowed]
+            if decl.role != role or values is None or unknown:
+                problems.append(Problem("controller-attribute", (
+                    f"in an executive's rules, '{decl.name}' is one of its {role} with values among "
+                    f"{', '.join(allowed)}" + (f" (not: {', '.join(map(str, unknown))})" if unknown else "")), decl))
+        elif decl.role == "outputs":
+            group = next((g for g in groups if values is not None and set(values) == set(g.states)), None)
+            taken = {name: g for g, name in names.items()}
+            if group is None:
+                listed = "; ".join(" ".join(g.states) for g in groups) or "none"
+                problems.append(Problem("unknown-group-state", (
+                    f"output '{decl.name}' must be a service group's state: its values are one group's "
+                    f"services plus \"{IDLE}\" (groups of this executive: {listed})"), decl))
+            elif names.get(group, decl.name) != decl.name or taken.get(decl.name, group) != group:
+                problems.append(Problem("unknown-group-state", (
+                    f"'{decl.name}' names group {group.name} differently from another rule base"), decl))
+            else:
+                names[group] = decl.name
+        elif decl.role == "inputs":
+            problems.append(Problem("controller-attribute", (
+                f"the executive gives its controller only service, event and the groups' previous states; "
+                f"it cannot supply input '{decl.name}'"), decl))
+    return problems
+
+
+def decisions(rule: k.Rule, groups: list[Group], names: Mapping[Group, str]) -> set[tuple[Any, ...]]:
+    """What a rule decides: the attributes it restricts, and each call on a group (or service)."""
+    group_of_service = {s: g for g in groups for s in g.services}
+    group_of_attribute = {"@" + state_attribute(g, names): g for g in groups}
+    found: set[tuple[Any, ...]] = set()
+    for action in rule.actions:
+        if isinstance(action, k.Restrict):
+            found.add(("restrict", action.atom.attribute))
+        elif isinstance(action, k.Assign):
+            found.add(("restrict", action.target))
+        else:
+            targets = []
+            for arg in action.args:
+                if arg.op == "attr":
+                    targets.append(group_of_attribute.get(arg.args[0], arg.args[0]))
+                elif arg.op == "const":
+                    targets.append(group_of_service.get(arg.args[0], arg.args[0]))
+                else:
+                    targets.append(repr(arg))
+            found.add(("call", action.function, *targets))
+    return found
+
+
+def take_over(generated: k.Base, hand: k.Base, groups: list[Group], names: Mapping[Group, str]) -> k.Base:
+    """Hand-written rules first; a generated rule deciding something a hand-written one decides
+    holds only where none of those hand-written rules applies."""
+    rules: list[k.Rule] = list(hand.rules)
+    when = [(rule, decisions(rule, groups, names)) for rule in hand.rules if rule.kind == "when"]
+    for rule in generated.rules:
+        mine = decisions(rule, groups, names)
+        overriding = tuple(h.condition for h, theirs in when if theirs & mine and h.condition is not None)
+        if overriding and rule.condition is not None:
+            rule = k.Rule(rule.name, rule.kind, k.All((rule.condition, k.Not(k.Any_(overriding)))), rule.actions)
+        rules.append(rule)
+    attributes = dict(generated.attributes)
+    for name, attribute in hand.attributes.items():
+        attributes.setdefault(name, attribute)
+    return k.Base(generated.name, attributes, tuple(rules), generated.source)
+
+
+def hand_rule_problems(program: m.Program, executive: m.Executive) -> list[Problem]:
+    """What `executive_controller` would reject in the executive's own rule bases (cheap: no rules
+    are normalised or compiled)."""
+    graph = build_graph(program, executive)
+    groups = service_groups(graph)
+    bases = {b.name: b for b in program.items if isinstance(b, m.RuleBase)}
+    names: dict[Group, str] = {}
+    problems: list[Problem] = []
+    for ref in executive.rules:
+        if ref.text in bases:
+            problems += name_groups(bases[ref.text], graph, groups, names)
+    return problems

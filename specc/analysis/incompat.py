@@ -76,13 +76,14 @@ def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGr
         if module_of[first] == module_of[second] and incompatible(requests[first], requests[second]):
             if second not in control:
                 arcs[(first, second)] = Arc(first, second, "interrupt", True)
+    declared = {s.name for s in executive.services}
     for service in executive.services:
         for conflict in service.conflicts:
-            if conflict.service in control:
+            if conflict.service in control or conflict.service not in declared:  # unknown: reported by checks
                 continue
             physical = (service.name, conflict.service) in arcs
             arcs[(service.name, conflict.service)] = Arc(service.name, conflict.service, conflict.policy, physical)
-    names = tuple(s.name for s in executive.services)
+    names = tuple(dict.fromkeys(s.name for s in executive.services))
     ordered = tuple(sorted(arcs.values(), key=lambda a: (names.index(a.source), names.index(a.target))))
     return IncompatibilityGraph(names, ordered, module_of, control)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from specc.analysis.controller import hand_rule_problems
 from specc.check.codels import python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
@@ -115,6 +116,8 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                            parameter.set.span)
     for reflex in executive.reflexes:
         check_reflex(ctx, reflex, services)
+    for problem in hand_rule_problems(ctx.program, executive):
+        ctx.report(problem.code, problem.message, problem.node.span)
 
 
 def check_reflex(ctx: Context, reflex: m.Reflex, services: dict[str, m.Service]) -> None:

@@ -377,6 +377,7 @@ class Module:
         self.zombies: dict[int, Activity] = {}  # any of them freezes the module (§2.2)
         self.transitions: list[tuple[int, State, State]] = []  # (id, from, to), for tests and logs
         self.observers: list[Callable[[Module, Activity, State, State], None]] = []
+        self.reply_listeners: list[ReplySink] = []  # see every reply the module sends (reflexes, logs)
         self._functions: dict[str, Callable[..., Any]] = {}
         # A poster's activity is a request, or a codel (of a request or an exec task) whose cycles update it.
         self._auto_posters: dict[str, list[str]] = {}
@@ -455,9 +456,14 @@ class Module:
 
     def refuse(self, reply: Reply, sink: ReplySink, parent: Activity | None) -> None:
         """A request refused before it became an activity; sent from a codel, it ends its parent."""
-        sink(reply)
+        self.emit(sink, reply)
         if parent is not None:
             child_failed(parent, reply, activated=False)
+
+    def emit(self, sink: ReplySink, reply: Reply) -> None:
+        for listener in self.reply_listeners:
+            listener(reply)
+        sink(reply)
 
     def run_control(self, rqst_id: int, spec: RequestSpec, input_: Any, sink: ReplySink) -> None:
         """A control request takes no time: its validate codel runs and the final reply goes now."""
@@ -476,7 +482,7 @@ class Module:
                 if other.state in (State.INIT, State.EXEC) and spec.conflicts_with(other.spec):
                     self.interrupt(other, spec.name)
         status = Status.END if outcome is None else Status.FINAL_ERROR
-        sink(self.reply(rqst_id, spec.name, status, outcome or Report("OK"), output))
+        self.emit(sink, self.reply(rqst_id, spec.name, status, outcome or Report("OK"), output))
 
     def abort(self, target: int, sink: ReplySink | None = None) -> int:
         """The module's abort control request (modAbortRqstSend)."""
@@ -489,7 +495,7 @@ class Module:
             self.interrupt(activity, "ABORT")
             report, status = Report("OK"), Status.END
         if sink is not None:
-            sink(self.reply(rqst_id, "abort", status, report))
+            self.emit(sink, self.reply(rqst_id, "abort", status, report))
         return rqst_id
 
     def interrupt(self, activity: Activity, cause: str) -> None:
@@ -521,8 +527,8 @@ class Module:
             return
         activity.task = runner
         runner.activities.append(activity)
-        activity.sink(self.reply(activity.id, activity.spec.name, Status.WAITING, Report(INTERMEDIATE_REPORT),
-                                 final=False))
+        self.emit(activity.sink, self.reply(activity.id, activity.spec.name, Status.WAITING,
+                                            Report(INTERMEDIATE_REPORT), final=False))
         runner.schedule()
 
     # -- running codels
@@ -675,7 +681,7 @@ class Module:
         self.activities.pop(activity.id, None)
 
     def deliver(self, activity: Activity, reply: Reply) -> None:
-        activity.sink(reply)
+        self.emit(activity.sink, reply)
         parent = activity.parent
         if parent is None:
             return
@@ -791,6 +797,30 @@ def check_record(value: Any, expected: type | None) -> str:
     return ""
 
 
+def build_record(kind: Any, value: Any) -> Any:
+    """A generated record (or enum, or list of them) from plain data: mappings become records,
+    names become enum members; what does not fit is left for `check_record` to report."""
+    if isinstance(kind, type) and issubclass(kind, enum.Enum) and isinstance(value, str):
+        return kind.__members__.get(value, value)
+    fields = getattr(kind, "__specc_fields__", None)
+    if fields is None or not isinstance(value, Mapping):
+        return value
+    known = {f[0]: f for f in fields}
+    built = {}
+    for name, item in value.items():
+        spec = known.get(name)
+        if spec is None:
+            built[name] = item
+        elif spec[2] is not None and isinstance(item, list):
+            built[name] = [build_record(spec[1], x) for x in item]
+        else:
+            built[name] = build_record(spec[1], item)
+    try:
+        return kind(**built)
+    except TypeError:
+        return value
+
+
 def check_value(value: Any, kind: Any, size: int | None) -> str:
     if size is not None:
         if not isinstance(value, list) or len(value) != size:
@@ -851,10 +881,8 @@ class Registry:
         if spec is not None:
             problem = ""
             if spec.input_type is not None:
-                try:
-                    input_ = spec.input_type(**inputs)
-                except TypeError as exc:
-                    problem = str(exc)
+                input_ = build_record(spec.input_type, dict(inputs))
+                problem = check_record(input_, spec.input_type)
             elif inputs:
                 problem = f"request '{name}' takes no input (given: {', '.join(inputs)})"
             if problem:

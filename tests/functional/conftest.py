@@ -16,10 +16,11 @@ from specc.runtime import functional as rt
 HERE = Path(__file__).parent
 
 
-def compile_robot(spec: Path, target: Path) -> str:
-    loaded = load([spec])
+def compile_robot(spec: Path | list[Path], target: Path, name: str | None = None) -> str:
+    specs = spec if isinstance(spec, list) else [spec]
+    loaded = load(specs)
     assert loaded.program is not None and not loaded.errors, [d.headline() for d in loaded.diagnostics]
-    name = package.robot_name(loaded.program, spec.stem)
+    name = name or package.robot_name(loaded.program, specs[0].stem)
     generate_all(loaded.program, name).write(target / name)
     return name
 
@@ -55,3 +56,12 @@ def robot(scripted_package: ModuleType) -> Robot:
     registry = rt.Registry()
     made = scripted_package.create_all(registry)
     return Robot(registry, made["alpha"], made["beta"], scripted_package)
+
+
+@pytest.fixture(scope="session")
+def shop_package(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
+    """The scripted robot with the executive of executive.spec, as package `shop`."""
+    target = tmp_path_factory.mktemp("generated")
+    compile_robot([HERE / "scripted.spec", HERE / "executive.spec"], target, "shop")
+    sys.path[:0] = [str(target), str(HERE)]
+    return importlib.import_module("shop")

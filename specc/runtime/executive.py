@@ -1,0 +1,618 @@
+"""The executive (seed 000 ch. 3): the link between the decision level and the modules.
+
+The task level asks for *services* by name with a unique id (RQST EXEC) and may interrupt them
+(RQST INT); the executive turns each into a module request and answers with facts
+`(REPLY id result)` and `(WARNING service id type)` (§3.9). Inside, as in Fig 3.2:
+
+- the service description list (`ExecutiveSpec.services`, generated from the spec);
+- the activity list: one `Activity` per service request, in a state of Fig 3.3
+  (WAIT, INIT, EXEC, INTER, ZOMBIE; ETHER when it leaves the list);
+- the request manager (`request`, `interrupt`, the WAIT retries of every cycle, start timeouts);
+- the reply manager (intermediate and final replies, ZOMBIE warnings, output functions);
+- the resource controller: the generated decision function of the executive's Kheops rules
+  (inputs service, event, the groups' previous states; outputs status and the new group
+  states; calls changeInterState and sendAbortRequest).
+
+Every input (a task request, a module reply, a timer) runs one *cycle*: the event, then a new
+start authorisation for every WAIT activity. Replies that modules send during a cycle queue up
+for the next one, so a cycle never re-enters itself.
+
+What the controller is told: START for every authorisation asked; for an exec service, INTERM
+when its intermediate reply arrives (its group is held from then on), then END, ZOMBIE or ABORT;
+for a control service, START then END. An exec activity that ends before its intermediate reply
+(refused by its module, interrupted while starting) never held a group and is not reported.
+
+One precaution the seed leaves implicit: a START waits while an activity it conflicts with (an
+arc either way of the incompatibility graph) is between its request and its intermediate reply.
+The controller only sees groups, which such an activity does not hold yet; without the wait,
+both could end up running.
+
+Results of (REPLY id result): OK, or what the service's output function returns; the module's
+report code for an intrinsic failure (a REPLY END whose bilan is not OK); INT when interrupted;
+TIMEOUT, REFUSED, ZOMBIE (ended after a ZOMBIE and its abort), BAD-SERVICE, or the module's
+error status (FINAL_ERROR, SERVER_ERROR, CS_ERROR, TIMEOUT) for REPLY ERROR. WARNING types:
+ZOMBIE (§3.4.1), BAD-ID (RQST INT for an unknown id), ERROR (the executive entered its general
+ERROR state, §3.4.2; service EXECUTIVE, id 0).
+"""
+
+from __future__ import annotations
+
+import enum
+import functools
+import itertools
+import operator
+import time
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+from specc.runtime.functional import Registry, Reply, Status, build_record, check_record
+from specc.runtime.kernel import Timer
+from specc.runtime.rules import Decision
+
+# ---------------------------------------------------------------- Fig 3.3
+
+
+class Phase(enum.StrEnum):
+    ETHER = "ETHER"
+    WAIT = "WAIT"
+    INIT = "INIT"
+    EXEC = "EXEC"
+    INTER = "INTER"
+    ZOMBIE = "ZOMBIE"
+
+
+# The activity representation graph of Fig 3.3: (from, what moves it, to).
+ARCS: tuple[tuple[Phase, str, Phase], ...] = (
+    (Phase.ETHER, "RQST EXEC", Phase.WAIT),
+    (Phase.WAIT, "controller OK", Phase.INIT),
+    (Phase.WAIT, "RQST INT, start timeout, REFUSE", Phase.ETHER),
+    (Phase.INIT, "REPLY INTERM", Phase.EXEC),
+    (Phase.INIT, "final reply (control request, refused by the module)", Phase.ETHER),
+    (Phase.INIT, "RQST INT, reply timeout", Phase.INTER),
+    (Phase.EXEC, "REPLY END, REPLY ERROR", Phase.ETHER),
+    (Phase.EXEC, "changeInterState, RQST INT, reply timeout", Phase.INTER),
+    (Phase.EXEC, "REPLY ZOMBIE", Phase.ZOMBIE),
+    (Phase.INTER, "REPLY INT (or any final reply)", Phase.ETHER),
+    (Phase.INTER, "REPLY ZOMBIE", Phase.ZOMBIE),
+    (Phase.ZOMBIE, "REPLY ABORT", Phase.ETHER),
+)
+_ARC_SET = {(a, b) for a, _, b in ARCS}
+
+IDLE = "IDLE"
+LIVE = (Phase.WAIT, Phase.INIT, Phase.EXEC, Phase.INTER, Phase.ZOMBIE)
+
+
+class TransitionError(RuntimeError):
+    pass
+
+
+# ---------------------------------------------------------------- static description (generated)
+
+
+@dataclass(frozen=True)
+class ServiceSpec:
+    name: str
+    module: str
+    request: str
+    kind: str  # control | exec: the module request's type
+    args: Mapping[str, Any] = field(default_factory=dict)  # constant inputs
+    input: str | None = None  # input function, or module.Poster[.field]
+    output: str | None = None  # output function
+    start_timeout: float | None = None  # s in WAIT before REPLY TIMEOUT
+    interm_timeout: float | None = None  # s from the request to its intermediate reply
+    final_timeout: float | None = None  # s from the request to its final reply
+    conflicts: frozenset[str] = frozenset()  # services it has an arc to, or from
+
+    @property
+    def control(self) -> bool:
+        return self.kind == "control"
+
+
+@dataclass(frozen=True)
+class ReflexSpec:
+    """§3.5: on a reply (or intermediate reply, or ZOMBIE warning) of a service or a module
+    request, optionally matching its report code, send requests or start or abort services."""
+
+    name: str
+    trigger: str  # reply | interm | warning
+    source: str  # SERVICE or module.request
+    op: str | None = None
+    value: Any = None
+    actions: tuple[tuple[str, str], ...] = ()  # (request | abort | start, target)
+
+    def matches(self, trigger: str, source: str, code: str) -> bool:
+        if trigger != self.trigger or source != self.source:
+            return False
+        if self.op is None:
+            return True
+        try:
+            return bool(_OPS[self.op](code, self.value))
+        except TypeError:  # an ordering between a code and a number: no match
+            return False
+
+
+_OPS: dict[str, Callable[[Any, Any], Any]] = {"==": operator.eq, "!=": operator.ne, "<": operator.lt,
+                                               "<=": operator.le, ">": operator.gt, ">=": operator.ge}
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    name: str
+    get: str | None = None  # module.Poster[.field]
+    set: str | None = None  # module.request (control)
+
+
+@dataclass(frozen=True)
+class ExecutiveSpec:
+    name: str
+    services: Mapping[str, ServiceSpec]
+    groups: Mapping[str, tuple[str, ...]]  # group state attribute -> its services
+    reflexes: tuple[ReflexSpec, ...] = ()
+    parameters: Mapping[str, ParameterSpec] = field(default_factory=dict)
+    codel_module: str | None = None
+
+
+# ---------------------------------------------------------------- run time
+
+
+class Message(NamedTuple):
+    """What the executive tells the task level (§3.9)."""
+
+    kind: str  # REPLY | WARNING
+    service: str
+    id: int
+    result: Any  # REPLY: the result; WARNING: the event type
+    detail: str = ""
+    time: float = 0.0
+
+    @property
+    def fact(self) -> tuple[Any, ...]:
+        if self.kind == "REPLY":
+            return ("REPLY", self.id, self.result)
+        return ("WARNING", self.service, self.id, self.result)
+
+
+@dataclass(eq=False)
+class Activity:
+    """An entry of the activity list (§3.3.2)."""
+
+    id: int  # the task level's id
+    service: ServiceSpec
+    requested: float  # when it entered the list
+    state: Phase = Phase.ETHER
+    input: Any = None
+    module_id: int | None = None  # the module's id for its request
+    holds_group: bool = False  # the controller has seen its intermediate reply
+    answered: bool = False  # its (REPLY id result) is sent
+    abort_sent: bool = False
+    timers: list[Timer] = field(default_factory=list)
+
+
+class Context:
+    """What input and output functions see: executive variables, posters, the world file."""
+
+    def __init__(self, registry: Registry, world: str | None):
+        self.vars: dict[str, Any] = {}
+        self.world = world
+        self._registry = registry
+
+    def read_poster(self, name: str) -> Any:
+        """The data of poster `module.Poster` (None before its first write)."""
+        snapshot = self._registry.read_poster(name)
+        return snapshot.data if snapshot is not None else None
+
+
+class Executive:
+    def __init__(self, spec: ExecutiveSpec, decide: Callable[..., Decision], registry: Registry,
+                 codels: Any = None, world: str | None = None, measure: bool = False):
+        self.spec = spec
+        self.decide = decide
+        self.registry = registry
+        self.kernel = registry.kernel
+        self.codels = codels
+        self.context = Context(registry, world)
+        self.activities: dict[int, Activity] = {}  # the activity list, by task-level id
+        self.groups: dict[str, str] = dict.fromkeys(spec.groups, IDLE)  # the controller's state
+        self.zombies: dict[str, Activity] = {}  # module -> its ZOMBIE activity: requests refused
+        self.error: str | None = None  # the general ERROR state (§3.4.2): why
+        self.messages: list[Message] = []
+        self.listeners: list[Callable[[Message], None]] = []
+        self.observers: list[Callable[[Activity, Phase, Phase], None]] = []
+        self.reflex_replies: list[Reply] = []  # replies to requests sent by reflexes
+        self.cycle_durations: list[float] | None = [] if measure else None
+        self._inbox: deque[tuple[Callable[..., None], tuple[Any, ...]]] = deque()
+        self._busy = False
+        self._internal_ids = itertools.count(-1, -1)
+        for name in {r.source.partition(".")[0] for r in spec.reflexes if "." in r.source}:
+            module = registry.modules.get(name)
+            if module is not None:
+                module.reply_listeners.append(self._module_reply_seen)
+
+    # ------------------------------------------------------------ the task level's interface
+    def request(self, service: str, ident: int | None = None) -> int:
+        """RQST EXEC: ask for `service`; its (REPLY id result) comes later. Returns the id."""
+        ident = next(self._internal_ids) if ident is None else ident
+        self._post(self._on_request, service, ident)
+        return ident
+
+    def interrupt(self, ident: int) -> None:
+        """RQST INT: the client no longer wants service `ident` (no reply of its own, §3.4.1)."""
+        self._post(self._on_interrupt, ident)
+
+    def get_param(self, name: str) -> Any:
+        """GET-PARAM: the value of a parameter (None before the poster's first write)."""
+        parameter = self._parameter(name)
+        if parameter.get is None:
+            raise LookupError(f"parameter '{name}' cannot be read (it has no 'get:')")
+        module, _, rest = parameter.get.partition(".")
+        poster, _, path = rest.partition(".")
+        value = self.context.read_poster(f"{module}.{poster}")
+        for part in path.split(".") if path and value is not None else ():
+            value = getattr(value, part)
+        return value
+
+    def set_param(self, name: str, value: Any) -> str:
+        """SET-PARAM: write a parameter through its control request; OK or the error code."""
+        parameter = self._parameter(name)
+        if parameter.set is None:
+            raise LookupError(f"parameter '{name}' cannot be written (it has no 'set:')")
+        module_name, _, request = parameter.set.partition(".")
+        module = self.registry.modules[module_name]
+        spec = module.spec.requests[request]
+        replies: list[Reply] = []
+        module.submit(request, _as_input(spec.input_type, value), replies.append)
+        reply = replies[-1] if replies else None
+        if reply is None or not reply.final:
+            return "ERROR"
+        return "OK" if reply.ok else reply.report.code
+
+    def _parameter(self, name: str) -> ParameterSpec:
+        parameter = self.spec.parameters.get(name)
+        if parameter is None:
+            known = ", ".join(sorted(self.spec.parameters)) or "none"
+            raise LookupError(f"executive '{self.spec.name}' has no parameter '{name}' (it has: {known})")
+        return parameter
+
+    def live(self) -> list[Activity]:
+        return list(self.activities.values())
+
+    # ------------------------------------------------------------ cycles
+    def _post(self, handler: Callable[..., None], *args: Any) -> None:
+        self._inbox.append((handler, args))
+        if self._busy:
+            return
+        self._busy = True
+        try:
+            while self._inbox:
+                started = time.perf_counter()
+                handler, args = self._inbox.popleft()
+                handler(*args)
+                self._retry_waiting()
+                if self.cycle_durations is not None:
+                    self.cycle_durations.append(time.perf_counter() - started)
+        finally:
+            self._busy = False
+
+    def _retry_waiting(self) -> None:
+        """§3.3.3: a WAIT activity asks again for its start at every cycle."""
+        for activity in [a for a in self.activities.values() if a.state is Phase.WAIT]:
+            if activity.state is Phase.WAIT:
+                self._try_start(activity)
+
+    # ------------------------------------------------------------ the request manager
+    def _on_request(self, name: str, ident: int) -> None:
+        service = self.spec.services.get(name)
+        if service is None:
+            self._tell("REPLY", name, ident, "BAD-SERVICE", f"the executive offers no service '{name}'")
+            return
+        if ident in self.activities:
+            self._tell("REPLY", name, ident, "BAD-ID", f"id {ident} is already in use")
+            return
+        activity = Activity(ident, service, self.kernel.now)
+        self.activities[ident] = activity
+        self._move(activity, Phase.WAIT)
+        try:
+            activity.input = self._input(service)
+        except Exception as exc:  # the user's input function: report it, keep running
+            self._end(activity, "ERROR", f"input of {name}: {type(exc).__name__}: {exc}")
+            return
+        if service.start_timeout is not None:
+            activity.timers.append(self.kernel.call_later(
+                service.start_timeout, functools.partial(self._post, self._on_timeout, activity, "start")))
+
+    def _input(self, service: ServiceSpec) -> Any:
+        """The request's input: the constant args, completed by the input function or poster."""
+        module = self.registry.modules[service.module]
+        input_type = module.spec.requests[service.request].input_type
+        values: dict[str, Any] = dict(service.args)
+        if service.input is not None:
+            if "." in service.input:
+                found = self._read_path(service.input)
+            else:
+                found = getattr(self.codels, service.input)(self.context)
+            if isinstance(found, Mapping):
+                values.update(found)
+            elif input_type is not None and isinstance(found, input_type):
+                return found
+            elif len(fields := tuple(getattr(input_type, "__specc_fields__", ()))) == 1:
+                values[fields[0][0]] = found
+            else:
+                raise TypeError(f"'{service.input}' gave {type(found).__name__}; give a dict of the inputs")
+        if input_type is None:
+            return None
+        built = build_record(input_type, values)
+        problem = check_record(built, input_type)
+        if problem:
+            raise TypeError(problem)
+        return built
+
+    def _read_path(self, path: str) -> Any:
+        module, _, rest = path.partition(".")
+        poster, _, fields = rest.partition(".")
+        value = self.context.read_poster(f"{module}.{poster}")
+        for part in fields.split(".") if fields and value is not None else ():
+            value = getattr(value, part)
+        return value
+
+    def _try_start(self, activity: Activity) -> None:
+        service = activity.service
+        if self.error is not None:
+            self._end(activity, "REFUSED", f"the executive is in its ERROR state: {self.error}")
+            return
+        zombie = self.zombies.get(service.module)
+        if zombie is not None:
+            self._end(activity, "REFUSED", f"module {service.module} is frozen by ZOMBIE service "
+                                           f"{zombie.service.name} (id {zombie.id}): interrupt it first")
+            return
+        if any(other.state is Phase.INIT and not other.service.control and other.service.name in service.conflicts
+               for other in self.activities.values() if other is not activity):
+            return  # a conflicting activity is about to hold its group: ask again next cycle
+        status = self._control(service.name, "START")
+        if status == "OK":
+            self._move(activity, Phase.INIT)
+            self._send(activity)
+        elif status == "REFUSE":
+            self._end(activity, "REFUSED", "refused by the resource controller")
+        elif status == "ERROR":
+            self._fatal(f"the controller answered ERROR to the start of {service.name}")
+        # WAIT (or an ERROR state just entered): stays in the list
+
+    def _send(self, activity: Activity) -> None:
+        service = activity.service
+        module = self.registry.modules[service.module]
+        for timeout, which in ((service.interm_timeout, "interm"), (service.final_timeout, "final")):
+            if timeout is not None and not (which == "interm" and service.control):
+                activity.timers.append(self.kernel.call_later(
+                    timeout, functools.partial(self._post, self._on_timeout, activity, which)))
+        # Replies the module sends before `submit` returns queue up for the next cycle.
+        activity.module_id = module.submit(service.request, activity.input,
+                                           lambda reply: self._post(self._on_reply, activity, reply))
+
+    def _on_interrupt(self, ident: int) -> None:
+        activity = self.activities.get(ident)
+        if activity is None:
+            self._tell("WARNING", "INT", ident, "BAD-ID", f"no service with id {ident} to interrupt")
+            return
+        if activity.state is Phase.WAIT:
+            self._end(activity, "INT", "interrupted before it started")
+        else:
+            self._abort(activity)
+
+    def _abort(self, activity: Activity) -> None:
+        """Interrupt a running activity: the controller hears it (ABORT), then the module does."""
+        if activity.state is Phase.EXEC and activity.holds_group and self.error is None:
+            if self._control(activity.service.name, "ABORT") == "ERROR":
+                self._fatal(f"the controller refused the interruption of {activity.service.name}")
+        if activity.state in (Phase.INIT, Phase.EXEC) and not activity.service.control:
+            self._move(activity, Phase.INTER)
+        self._send_abort(activity)
+
+    def _send_abort(self, activity: Activity) -> None:
+        if activity.abort_sent or activity.module_id is None or activity.service.control:
+            return
+        activity.abort_sent = True
+        module = self.registry.modules[activity.service.module]
+        module.abort(activity.module_id, lambda reply: self._post(self._on_abort_reply, activity, reply))
+
+    def _on_timeout(self, activity: Activity, which: str) -> None:
+        if activity.state is Phase.ETHER or activity.answered:
+            return
+        if which == "start":
+            if activity.state is Phase.WAIT:
+                self._end(activity, "TIMEOUT", "not allowed to start in time")
+            return
+        if which == "interm" and activity.state is not Phase.INIT:
+            return
+        if activity.state is Phase.ZOMBIE:
+            return  # it already answered with a WARNING; the task level decides
+        # The client hears TIMEOUT now; the activity stays listed until its module lets it go.
+        self._answer(activity, "TIMEOUT", f"no {'intermediate' if which == 'interm' else 'final'} reply in time")
+        self._abort(activity)
+
+    # ------------------------------------------------------------ the reply manager
+    def _on_reply(self, activity: Activity, reply: Reply) -> None:
+        if activity.state is Phase.ETHER:
+            self._fatal(f"reply {reply.status} for {activity.service.name} (id {activity.id}), which has ended")
+            return
+        service = activity.service
+        if not reply.final:
+            if activity.state is Phase.INIT:
+                self._move(activity, Phase.EXEC)
+            elif activity.state is not Phase.INTER:
+                self._fatal(f"intermediate reply for {service.name} (id {activity.id}) in {activity.state}")
+                return
+            if not service.control and self.error is None:
+                activity.holds_group = True
+                if self._control(service.name, "INTERM") == "ERROR":
+                    self._fatal(f"the controller rejected the intermediate reply of {service.name}")
+            self._reflexes("interm", service.name, reply)
+            return
+        if reply.status is Status.ZOMBIE and reply.report.code != "MODULE_FROZEN":
+            self._move(activity, Phase.ZOMBIE)
+            self.zombies[service.module] = activity
+            if activity.holds_group and self.error is None and self._control(service.name, "ZOMBIE") == "ERROR":
+                self._fatal(f"the controller rejected the ZOMBIE of {service.name}")
+            if not activity.answered:
+                self._tell("WARNING", service.name, activity.id, "ZOMBIE", reply.report.detail)
+            self._reflexes("warning", service.name, reply)
+            return
+        if reply.status is Status.INTERRUPTED and activity.state is not Phase.INTER:
+            # §3.4.2: an interruption nobody decided
+            self._fatal(f"{service.name} (id {activity.id}) was interrupted ({reply.report.code}) "
+                        f"while {activity.state}, not INTER")
+        self._release(activity)
+        self._end(activity, *self._result(activity, reply))
+        self._reflexes("reply", service.name, reply)
+
+    def _release(self, activity: Activity) -> None:
+        """The controller hears that the activity ended (END), if it ever held a group."""
+        service = activity.service
+        if self.error is None and (activity.holds_group or service.control):
+            if self._control(service.name, "END") == "ERROR":
+                self._fatal(f"the controller rejected the end of {service.name}")
+
+    def _result(self, activity: Activity, reply: Reply) -> tuple[Any, str]:
+        if reply.status is Status.END:
+            if reply.report.code != "OK":
+                return reply.report.code, reply.report.detail
+            output = activity.service.output
+            if output is None:
+                return "OK", ""
+            try:
+                return getattr(self.codels, output)(self.context, reply.output), ""
+            except Exception as exc:  # the user's output function
+                return "ERROR", f"output of {activity.service.name}: {type(exc).__name__}: {exc}"
+        if reply.status is Status.INTERRUPTED:
+            return "INT", reply.report.code
+        if reply.status is Status.ZOMBIE:  # refused because its module is frozen
+            return "REFUSED", reply.report.detail
+        return reply.status.value, f"{reply.report.code}: {reply.report.detail}".strip(": ")
+
+    def _on_abort_reply(self, activity: Activity, reply: Reply) -> None:
+        """REPLY ABORT: only news for a ZOMBIE, whose module it unfreezes (§3.4.1)."""
+        if activity.state is not Phase.ZOMBIE or reply.status is not Status.END:
+            return
+        self.zombies.pop(activity.service.module, None)
+        self._release(activity)
+        self._end(activity, "ZOMBIE", "ended after ZOMBIE and its interruption")
+
+    def _module_reply_seen(self, reply: Reply) -> None:
+        if reply.request != "abort":
+            self._post(self._reflexes, "reply" if reply.final else "interm", f"{reply.module}.{reply.request}",
+                       reply)
+
+    # ------------------------------------------------------------ the resource controller
+    def _control(self, service: str, event: str) -> str:
+        """One decision of the resource controller; its calls act on the activity list."""
+        if self.error is not None:
+            return "ERROR"
+        inputs: dict[str, Any] = {"service": service, "event": event}
+        for attribute, value in self.groups.items():
+            inputs["@" + attribute] = value
+        calls: list[tuple[str, tuple[Any, ...]]] = []
+        decision = self.decide(inputs, lambda function, args: calls.append((function, args)))
+        status = decision.outputs.get("status")
+        if not decision.ok or status is None:
+            what = decision.impossible or ", ".join(decision.inconsistent or decision.incomplete)
+            self._fatal(f"the controller cannot decide {event} of {service}: {what} "
+                        f"(groups: {', '.join(f'{k}={v}' for k, v in self.groups.items())})")
+            return "ERROR"
+        for attribute in self.groups:
+            self.groups[attribute] = decision.outputs[attribute]
+        for function, args in calls:
+            targets = [a for a in self.activities.values() if a.service.name == args[0] and a.holds_group
+                       and a.state in (Phase.EXEC, Phase.INTER)] if args else []
+            for target in targets:
+                if function == "changeInterState" and target.state is Phase.EXEC:
+                    self._move(target, Phase.INTER)
+                elif function == "sendAbortRequest":
+                    self._send_abort(target)
+        return str(status)
+
+    def _fatal(self, reason: str) -> None:
+        """§3.4.2: the general ERROR state; every request is refused, running activities are
+        interrupted so the system can be reviewed."""
+        if self.error is not None:
+            return
+        self.error = reason
+        self._tell("WARNING", "EXECUTIVE", 0, "ERROR", reason)
+        for activity in list(self.activities.values()):
+            if activity.state is Phase.WAIT:
+                self._end(activity, "REFUSED", f"the executive is in its ERROR state: {reason}")
+            elif activity.state in (Phase.INIT, Phase.EXEC):
+                self._abort(activity)
+
+    # ------------------------------------------------------------ reflexes (§3.5)
+    def _reflexes(self, trigger: str, source: str, reply: Reply) -> None:
+        for reflex in self.spec.reflexes:
+            if reflex.matches(trigger, source, reply.report.code):
+                for verb, target in reflex.actions:
+                    self._reflex_action(verb, target)
+
+    def _reflex_action(self, verb: str, target: str) -> None:
+        if verb == "request":
+            module_name, _, request = target.partition(".")
+            self.registry.modules[module_name].submit(request, None, self.reflex_replies.append)
+        elif verb == "start":
+            self._on_request(target, next(self._internal_ids))
+        else:
+            for activity in [a for a in self.activities.values() if a.service.name == target]:
+                self._on_interrupt(activity.id)
+
+    # ------------------------------------------------------------ bookkeeping
+    def _move(self, activity: Activity, target: Phase) -> None:
+        source = activity.state
+        if source is target:
+            return
+        if (source, target) not in _ARC_SET:
+            raise TransitionError(f"{activity.service.name} (id {activity.id}): no arc {source} -> {target}")
+        activity.state = target
+        for observer in self.observers:
+            observer(activity, source, target)
+
+    def _answer(self, activity: Activity, result: Any, detail: str = "") -> None:
+        if not activity.answered:
+            activity.answered = True
+            self._tell("REPLY", activity.service.name, activity.id, result, detail)
+
+    def _end(self, activity: Activity, result: Any, detail: str = "") -> None:
+        """The activity leaves the list (ETHER); the client hears its result unless it already has."""
+        self._answer(activity, result, detail)
+        for timer in activity.timers:
+            timer.cancel()
+        self._move(activity, Phase.ETHER)
+        self.activities.pop(activity.id, None)
+        if self.zombies.get(activity.service.module) is activity:
+            del self.zombies[activity.service.module]
+
+    def _tell(self, kind: str, service: str, ident: int, result: Any, detail: str = "") -> None:
+        message = Message(kind, service, ident, result, detail, self.kernel.now)
+        self.messages.append(message)
+        for listener in self.listeners:
+            listener(message)
+
+
+def _as_input(input_type: Any, value: Any) -> Any:
+    if input_type is None or isinstance(value, input_type):
+        return value
+    if isinstance(value, Mapping):
+        return build_record(input_type, value)
+    fields: tuple[Any, ...] = tuple(getattr(input_type, "__specc_fields__", ()))
+    if len(fields) == 1:
+        return build_record(input_type, {fields[0][0]: value})
+    return value
+
+
+def load_codels(spec: ExecutiveSpec, codels: Any = None) -> Any:
+    """The module of input and output functions: the one given, else the one the spec names."""
+    if codels is not None or spec.codel_module is None:
+        return codels
+    import importlib
+
+    try:
+        return importlib.import_module(spec.codel_module)
+    except ImportError as exc:
+        raise ImportError(f"executive '{spec.name}': cannot import its functions '{spec.codel_module}' ({exc}); "
+                          "put the folder holding them on sys.path, or pass `codels=`") from exc
