@@ -166,18 +166,7 @@ def graph(paths: PathsArg,
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
-    executives = {e.name: e for e in loaded.program.items if isinstance(e, m.Executive)}
-    if not executives:
-        err.print("error: no executive block in these specs", markup=False)
-        raise typer.Exit(1)
-    if executive is None and len(executives) > 1:
-        err.print(f"error: several executives ({', '.join(sorted(executives))}); pick one with --executive",
-                  markup=False)
-        raise typer.Exit(1)
-    chosen = executives.get(executive) if executive else next(iter(executives.values()))
-    if chosen is None:
-        err.print(f"error: no executive '{executive}' (there are: {', '.join(sorted(executives))})", markup=False)
-        raise typer.Exit(1)
+    chosen = choose_executive(loaded.program, executive)
     incompatibility = build_graph(loaded.program, chosen)
     groups = service_groups(incompatibility)
     for group in groups:
@@ -189,6 +178,64 @@ def graph(paths: PathsArg,
         err.print(f"error: cannot write '{output}': {exc}", markup=False)
         raise typer.Exit(1) from None
     out.print(f"wrote {picture}", markup=False)
+
+
+def choose_executive(program: m.Program, name: str | None) -> m.Executive:
+    """The executive the user means: the only one, or the one named by --executive."""
+    executives = {e.name: e for e in program.items if isinstance(e, m.Executive)}
+    if not executives:
+        err.print("error: no executive block in these specs", markup=False)
+        raise typer.Exit(1)
+    if name is None and len(executives) > 1:
+        err.print(f"error: several executives ({', '.join(sorted(executives))}); pick one with --executive",
+                  markup=False)
+        raise typer.Exit(1)
+    chosen = executives.get(name) if name else next(iter(executives.values()))
+    if chosen is None:
+        err.print(f"error: no executive '{name}' (there are: {', '.join(sorted(executives))})", markup=False)
+        raise typer.Exit(1)
+    return chosen
+
+
+@app.command()
+def verify(paths: PathsArg,
+           executive: Annotated[Optional[str], typer.Option(help="Which executive, when there are several.")]
+           = None,
+           requests: Annotated[int, typer.Option(min=1, help="Requests the task level may have outstanding "
+                                                 "at once (the bound of the exploration).")] = 2,
+           max_states: Annotated[int, typer.Option(min=1, help="Stop after this many states.")] = 500_000
+           ) -> None:
+    """Explore every state the executive can reach and prove or refute, with a shortest
+    counterexample: exclusion of incompatible services, exactly one final reply per request,
+    no starvation in WAIT without a start timeout, no general ERROR state.
+
+    Example: specc verify examples/generic --executive generic
+    """
+    from rich.status import Status
+
+    from specc.analysis import kheops
+    from specc.analysis.verify import describe
+    from specc.analysis.verify import verify as explore
+
+    loaded = load(paths)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    chosen = choose_executive(loaded.program, executive)
+    started = time.perf_counter()
+    with Status("compiling the controller", console=err) as status:
+        try:
+            result = explore(loaded.program, chosen, requests, max_states,
+                             lambda states: status.update(f"exploring: {states} states"))
+        except kheops.KheopsError as exc:
+            err.print(f"{exc.node.span}: error: {exc} [not-propositional]", markup=False)
+            raise typer.Exit(1) from None
+    for line in describe(result):
+        out.print(line, markup=False)
+    out.print(f"{result.states} states, {result.transitions} transitions, at most {requests} outstanding "
+              f"request(s), in {time.perf_counter() - started:.1f} s", markup=False)
+    if not result.complete:
+        err.print(f"warning: stopped at {max_states} states; raise --max-states to explore them all", markup=False)
+    raise typer.Exit(0 if result.ok else 1)
 
 
 @app.command(name="rules")

@@ -105,7 +105,7 @@ def test_fmt_check_reports_and_fmt_rewrites(tmp_path: Path) -> None:
     assert specc("fmt", "--check", str(spec)).returncode == 0
 
 
-@pytest.mark.parametrize("command", ["check", "compile", "fmt"])
+@pytest.mark.parametrize("command", ["check", "compile", "fmt", "verify", "graph", "rules"])
 def test_help_has_examples(command: str) -> None:
     result = specc(command, "--help")
     assert result.returncode == 0 and "Example: specc " + command in result.stdout
@@ -238,3 +238,18 @@ def test_an_internal_bug_is_one_line_not_a_traceback(tmp_path: Path) -> None:
     assert result.returncode == 2
     assert "internal error: ValueError: boom" in result.stderr and "SPECC_DEBUG=1" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> None:
+    proved = specc("verify", str(EXAMPLES / "generic"), "--executive", "fig35", "--requests", "1")
+    assert proved.returncode == 0, proved.stderr
+    assert proved.stdout.count(": holds - ") == 4 and "states" in proved.stdout
+    from tests.test_verify import robot
+
+    spec = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";')
+    refuted = specc("verify", str(spec[0]))
+    assert refuted.returncode == 1
+    assert "exclusion: REFUTED" in refuted.stdout and "2. task: RQST EXEC BACK" in refuted.stdout
+    ambiguous = specc("verify", str(EXAMPLES / "generic"))
+    assert ambiguous.returncode == 1 and "pick one with --executive" in ambiguous.stderr
+    assert "Traceback" not in ambiguous.stderr + refuted.stderr

@@ -3,58 +3,31 @@ resource controller (generated rules + the executive's own, compiled to a decisi
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
 from specc.analysis import kheops as k
 from specc.analysis.controller import Controller, executive_controller
+from specc.analysis.service_list import executive_spec
 from specc.backends.env import render
 from specc.backends.manifest import HEADER, Output
 from specc.backends.rules import DecisionView, python_name
 from specc.model import nodes as m
+from specc.runtime import executive as rx
 
 BACKEND = "executive"
 
 
-def value_literal(value: Any) -> str:
-    """A spec value (service argument, reflex constant) as Python source."""
-    if isinstance(value, (m.String, m.Number)):
-        return repr(value.value)
-    if isinstance(value, m.Duration):
-        return repr(value.seconds)
-    if isinstance(value, m.Ref):
-        return repr({"true": True, "false": False}.get(value.text, value.text))
-    return repr(str(value))
+def source(value: Any) -> str:
+    """Deterministic Python source for a spec value (sets print sorted)."""
+    if isinstance(value, frozenset):
+        return f"frozenset({tuple(sorted(value))!r})"
+    return repr(value)
 
 
-def seconds(duration: m.Duration | None) -> str:
-    return "None" if duration is None else repr(duration.seconds)
-
-
-@dataclass
-class ServiceView:
-    service: m.Service
-    controller: Controller
-    requests: dict[str, m.Request]
-
-    @property
-    def name(self) -> str:
-        return self.service.name
-
-    @property
-    def fields(self) -> list[str]:
-        service, graph = self.service, self.controller.graph
-        module, request = service.request.parts[0], service.request.parts[1]  # type: ignore[union-attr]
-        kind = self.requests[self.name].kind
-        timeout = service.timeout or m.Timeouts()
-        linked = sorted({a.target for a in graph.arcs if a.source == self.name}
-                        | {a.source for a in graph.arcs if a.target == self.name})
-        args = "{" + ", ".join(f"{a.name!r}: {value_literal(a.value)}" for a in service.args) + "}"
-        return [f"name={self.name!r}", f"module={module!r}", f"request={request!r}", f"kind={kind!r}",
-                f"args={args}", f"input={service.input.text if service.input else None!r}",
-                f"output={service.output.text if service.output else None!r}",
-                f"start_timeout={seconds(timeout.start)}", f"interm_timeout={seconds(timeout.interm)}",
-                f"final_timeout={seconds(timeout.final)}", f"conflicts=frozenset({linked!r})"]
+def arguments(record: Any) -> list[str]:
+    return [f"{f.name}={source(getattr(record, f.name))}" for f in dataclasses.fields(record)]
 
 
 @dataclass
@@ -62,7 +35,7 @@ class ExecutiveView:
     executive: m.Executive
     controller: Controller
     compiled: k.Compiled
-    requests: dict[str, m.Request]
+    spec: rx.ExecutiveSpec
 
     @property
     def header(self) -> str:
@@ -91,47 +64,28 @@ class ExecutiveView:
 
     @property
     def group_summary(self) -> str:
-        return "; ".join(f"{self.controller.state_attribute(g)} = {' | '.join(g.states)}"
-                         for g in self.controller.groups) or "none"
+        return "; ".join(f"{name} = {' | '.join((*services, 'IDLE'))}"
+                         for name, services in self.spec.groups.items()) or "none"
 
     @property
-    def services(self) -> list[ServiceView]:
-        return [ServiceView(s, self.controller, self.requests) for s in self.executive.services]
+    def services(self) -> list[tuple[str, list[str]]]:
+        return [(name, arguments(service)) for name, service in self.spec.services.items()]
 
     @property
     def groups(self) -> list[tuple[str, str]]:
-        return [(self.controller.state_attribute(g), repr(g.services)) for g in self.controller.groups]
+        return [(name, repr(services)) for name, services in self.spec.groups.items()]
 
     @property
     def reflexes(self) -> list[str]:
-        lines = []
-        for number, reflex in enumerate(self.executive.reflexes):
-            comparison = reflex.comparison
-            op = repr(comparison.op) if comparison else "None"
-            value = value_literal(comparison.value) if comparison else "None"
-            actions = tuple((a.verb, a.target.text) for a in reflex.actions)
-            lines.append(f"rt.ReflexSpec({reflex.name or f'reflex{number + 1}'!r}, {reflex.trigger!r}, "
-                         f"{reflex.source.text!r}, {op}, {value}, {actions!r})")
-        return lines
+        return [f"rt.ReflexSpec({', '.join(arguments(r))})" for r in self.spec.reflexes]
 
     @property
     def parameters(self) -> list[tuple[str, str]]:
-        return [(p.name, f"rt.ParameterSpec({p.name!r}, {p.get.text if p.get else None!r}, "
-                         f"{p.set.text if p.set else None!r})") for p in self.executive.parameters]
+        return [(name, f"rt.ParameterSpec({', '.join(arguments(p))})") for name, p in self.spec.parameters.items()]
 
     @property
     def codel_module(self) -> str:
-        return repr(self.executive.codel_module.value) if self.executive.codel_module else "None"
-
-
-def service_requests(program: m.Program, executive: m.Executive) -> dict[str, m.Request]:
-    modules = {i.name: i for i in program.items if isinstance(i, m.Module)}
-    found = {}
-    for service in executive.services:
-        assert service.request is not None  # checked
-        module, request = service.request.parts
-        found[service.name] = next(r for r in modules[module].requests if r.name == request)
-    return found
+        return repr(self.spec.codel_module)
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> None:
@@ -139,12 +93,12 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     for executive in executives:
         controller = executive_controller(program, executive)
         compiled = k.compile_base(controller.base)
-        sources = ", ".join(sorted({executive.span.file} | {r.span.file for r in program.items
-                                                              if isinstance(r, m.RuleBase)
-                                                              and r.name in {x.text for x in executive.rules}}))
+        hand = {ref.text for ref in executive.rules}
+        sources = ", ".join(sorted({executive.span.file} | {
+            r.span.file for r in program.items if isinstance(r, m.RuleBase) and r.name in hand}))
         output.add(BACKEND, f"executive/{python_name(controller.name)}.py",
                    render("rules/decision.py.j2", view=DecisionView(compiled, sources)))
-        view = ExecutiveView(executive, controller, compiled, service_requests(program, executive))
+        view = ExecutiveView(executive, controller, compiled, executive_spec(program, controller))
         output.add(BACKEND, f"executive/{python_name(executive.name)}.py",
                    render("executive/executive.py.j2", view=view))
     if executives:

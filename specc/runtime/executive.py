@@ -388,7 +388,7 @@ class Executive:
                     timeout, functools.partial(self._post, self._on_timeout, activity, which)))
         # Replies the module sends before `submit` returns queue up for the next cycle.
         activity.module_id = module.submit(service.request, activity.input,
-                                           lambda reply: self._post(self._on_reply, activity, reply))
+                                           functools.partial(self._post, self._on_reply, activity))
 
     def _on_interrupt(self, ident: int) -> None:
         activity = self.activities.get(ident)
@@ -414,7 +414,7 @@ class Executive:
             return
         activity.abort_sent = True
         module = self.registry.modules[activity.service.module]
-        module.abort(activity.module_id, lambda reply: self._post(self._on_abort_reply, activity, reply))
+        module.abort(activity.module_id, functools.partial(self._post, self._on_abort_reply, activity))
 
     def _on_timeout(self, activity: Activity, which: str) -> None:
         if activity.state is Phase.ETHER or activity.answered:
@@ -452,9 +452,12 @@ class Executive:
         if reply.status is Status.ZOMBIE and reply.report.code != "MODULE_FROZEN":
             self._move(activity, Phase.ZOMBIE)
             self.zombies[service.module] = activity
+            activity.abort_sent = False  # an abort sent before it froze is spent: a new one releases it
             if activity.holds_group and self.error is None and self._control(service.name, "ZOMBIE") == "ERROR":
                 self._fatal(f"the controller rejected the ZOMBIE of {service.name}")
-            if not activity.answered:
+            if activity.answered:  # its client gave up (TIMEOUT): release the module on its behalf
+                self._send_abort(activity)
+            else:
                 self._tell("WARNING", service.name, activity.id, "ZOMBIE", reply.report.detail)
             self._reflexes("warning", service.name, reply)
             return

@@ -27,7 +27,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "B": rt.ServiceSpec(
         name='B',
@@ -40,7 +40,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['B']),
+        conflicts=frozenset(('B',)),
     ),
     "C": rt.ServiceSpec(
         name='C',
@@ -53,7 +53,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['E']),
+        conflicts=frozenset(('E',)),
     ),
     "D": rt.ServiceSpec(
         name='D',
@@ -66,7 +66,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['D', 'E', 'F']),
+        conflicts=frozenset(('D', 'E', 'F')),
     ),
     "E": rt.ServiceSpec(
         name='E',
@@ -79,7 +79,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['C', 'D', 'E', 'F']),
+        conflicts=frozenset(('C', 'D', 'E', 'F')),
     ),
     "F": rt.ServiceSpec(
         name='F',
@@ -92,7 +92,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['D', 'E', 'F']),
+        conflicts=frozenset(('D', 'E', 'F')),
     ),
     "G": rt.ServiceSpec(
         name='G',
@@ -105,7 +105,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['G', 'H', 'I']),
+        conflicts=frozenset(('G', 'H', 'I')),
     ),
     "H": rt.ServiceSpec(
         name='H',
@@ -118,7 +118,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['G', 'H', 'I']),
+        conflicts=frozenset(('G', 'H', 'I')),
     ),
     "I": rt.ServiceSpec(
         name='I',
@@ -131,7 +131,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['G', 'H', 'I', 'J']),
+        conflicts=frozenset(('G', 'H', 'I', 'J')),
     ),
     "J": rt.ServiceSpec(
         name='J',
@@ -144,7 +144,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['I', 'J']),
+        conflicts=frozenset(('I', 'J')),
     ),
 }
 

@@ -27,7 +27,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['A', 'B', 'C', 'I', 'J']),
+        conflicts=frozenset(('A', 'B', 'C', 'I', 'J')),
     ),
     "B": rt.ServiceSpec(
         name='B',
@@ -40,7 +40,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['A', 'B', 'C', 'I', 'J']),
+        conflicts=frozenset(('A', 'B', 'C', 'I', 'J')),
     ),
     "C": rt.ServiceSpec(
         name='C',
@@ -53,7 +53,7 @@ SERVICES = {
         start_timeout=60.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['A', 'B', 'C', 'I', 'J']),
+        conflicts=frozenset(('A', 'B', 'C', 'I', 'J')),
     ),
     "D": rt.ServiceSpec(
         name='D',
@@ -66,7 +66,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "E": rt.ServiceSpec(
         name='E',
@@ -79,7 +79,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['E', 'F', 'G', 'H', 'I', 'J']),
+        conflicts=frozenset(('E', 'F', 'G', 'H', 'I', 'J')),
     ),
     "F": rt.ServiceSpec(
         name='F',
@@ -92,7 +92,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['E', 'F', 'G', 'H', 'I', 'J']),
+        conflicts=frozenset(('E', 'F', 'G', 'H', 'I', 'J')),
     ),
     "G": rt.ServiceSpec(
         name='G',
@@ -105,7 +105,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['E', 'F', 'G', 'H', 'I', 'J']),
+        conflicts=frozenset(('E', 'F', 'G', 'H', 'I', 'J')),
     ),
     "H": rt.ServiceSpec(
         name='H',
@@ -118,7 +118,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset(['E', 'F', 'G']),
+        conflicts=frozenset(('E', 'F', 'G')),
     ),
     "I": rt.ServiceSpec(
         name='I',
@@ -131,7 +131,7 @@ SERVICES = {
         start_timeout=60.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset(['A', 'B', 'C', 'E', 'F', 'G']),
+        conflicts=frozenset(('A', 'B', 'C', 'E', 'F', 'G')),
     ),
     "J": rt.ServiceSpec(
         name='J',
@@ -144,7 +144,7 @@ SERVICES = {
         start_timeout=5.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset(['A', 'B', 'C', 'E', 'F', 'G']),
+        conflicts=frozenset(('A', 'B', 'C', 'E', 'F', 'G')),
     ),
 }
 

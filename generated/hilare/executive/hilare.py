@@ -27,7 +27,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "SET-DYNAMIC": rt.ServiceSpec(
         name='SET-DYNAMIC',
@@ -40,7 +40,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "AUTOBOX-OFF": rt.ServiceSpec(
         name='AUTOBOX-OFF',
@@ -53,7 +53,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "SET-BOX": rt.ServiceSpec(
         name='SET-BOX',
@@ -66,7 +66,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "READ-MODEL": rt.ServiceSpec(
         name='READ-MODEL',
@@ -79,7 +79,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=30.0,
-        conflicts=frozenset(['CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL']),
+        conflicts=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
     ),
     "INIT-MODEL": rt.ServiceSpec(
         name='INIT-MODEL',
@@ -92,7 +92,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset(['READ-OBST', 'SEARCH-OBJ']),
+        conflicts=frozenset(('READ-OBST', 'SEARCH-OBJ')),
     ),
     "READ-OBST": rt.ServiceSpec(
         name='READ-OBST',
@@ -105,7 +105,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=30.0,
-        conflicts=frozenset(['INIT-MODEL', 'READ-OBST', 'SEARCH-OBJ']),
+        conflicts=frozenset(('INIT-MODEL', 'READ-OBST', 'SEARCH-OBJ')),
     ),
     "EXEC-TRAJ-GOAL": rt.ServiceSpec(
         name='EXEC-TRAJ-GOAL',
@@ -118,7 +118,7 @@ SERVICES = {
         start_timeout=1.0,
         interm_timeout=1.0,
         final_timeout=120.0,
-        conflicts=frozenset(['ARM-OBJ', 'CALC-OBJ', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ']),
+        conflicts=frozenset(('ARM-OBJ', 'CALC-OBJ', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
     ),
     "EXEC-TRAJ-OBJ": rt.ServiceSpec(
         name='EXEC-TRAJ-OBJ',
@@ -131,7 +131,7 @@ SERVICES = {
         start_timeout=5.0,
         interm_timeout=1.0,
         final_timeout=120.0,
-        conflicts=frozenset(['CALC-GOAL', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ']),
+        conflicts=frozenset(('CALC-GOAL', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
     ),
     "CALC-TRAJ-GOAL": rt.ServiceSpec(
         name='CALC-TRAJ-GOAL',
@@ -144,7 +144,7 @@ SERVICES = {
         start_timeout=30.0,
         interm_timeout=1.0,
         final_timeout=30.0,
-        conflicts=frozenset(['CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL']),
+        conflicts=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
     ),
     "CALC-TRAJ-OBJ": rt.ServiceSpec(
         name='CALC-TRAJ-OBJ',
@@ -157,7 +157,7 @@ SERVICES = {
         start_timeout=30.0,
         interm_timeout=1.0,
         final_timeout=30.0,
-        conflicts=frozenset(['CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'READ-MODEL']),
+        conflicts=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'READ-MODEL')),
     ),
     "ARM-OBJ": rt.ServiceSpec(
         name='ARM-OBJ',
@@ -170,7 +170,7 @@ SERVICES = {
         start_timeout=5.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['ARM-BACK', 'ARM-OBJ', 'EXEC-TRAJ-GOAL']),
+        conflicts=frozenset(('ARM-BACK', 'ARM-OBJ', 'EXEC-TRAJ-GOAL')),
     ),
     "ARM-BACK": rt.ServiceSpec(
         name='ARM-BACK',
@@ -183,7 +183,7 @@ SERVICES = {
         start_timeout=60.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['ARM-BACK', 'ARM-OBJ']),
+        conflicts=frozenset(('ARM-BACK', 'ARM-OBJ')),
     ),
     "OPEN-GRIP": rt.ServiceSpec(
         name='OPEN-GRIP',
@@ -196,7 +196,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "CLOSE-GRIP": rt.ServiceSpec(
         name='CLOSE-GRIP',
@@ -209,7 +209,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "TURN-CAMERA": rt.ServiceSpec(
         name='TURN-CAMERA',
@@ -222,7 +222,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "TAKE-IMAGE": rt.ServiceSpec(
         name='TAKE-IMAGE',
@@ -235,7 +235,7 @@ SERVICES = {
         start_timeout=30.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset(['SEARCH-OBJ']),
+        conflicts=frozenset(('SEARCH-OBJ',)),
     ),
     "SEARCH-OBJ": rt.ServiceSpec(
         name='SEARCH-OBJ',
@@ -248,7 +248,7 @@ SERVICES = {
         start_timeout=30.0,
         interm_timeout=1.0,
         final_timeout=30.0,
-        conflicts=frozenset(['INIT-MODEL', 'READ-OBST', 'SEARCH-OBJ', 'TAKE-IMAGE']),
+        conflicts=frozenset(('INIT-MODEL', 'READ-OBST', 'SEARCH-OBJ', 'TAKE-IMAGE')),
     ),
     "GET-NEAR-OBJ": rt.ServiceSpec(
         name='GET-NEAR-OBJ',
@@ -261,7 +261,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=None,
         final_timeout=5.0,
-        conflicts=frozenset([]),
+        conflicts=frozenset(()),
     ),
     "CALC-GOAL": rt.ServiceSpec(
         name='CALC-GOAL',
@@ -274,7 +274,7 @@ SERVICES = {
         start_timeout=180.0,
         interm_timeout=1.0,
         final_timeout=60.0,
-        conflicts=frozenset(['CALC-GOAL', 'EXEC-TRAJ-OBJ']),
+        conflicts=frozenset(('CALC-GOAL', 'EXEC-TRAJ-OBJ')),
     ),
     "CALC-OBJ": rt.ServiceSpec(
         name='CALC-OBJ',
@@ -287,7 +287,7 @@ SERVICES = {
         start_timeout=2.0,
         interm_timeout=1.0,
         final_timeout=30.0,
-        conflicts=frozenset(['CALC-OBJ', 'EXEC-TRAJ-GOAL']),
+        conflicts=frozenset(('CALC-OBJ', 'EXEC-TRAJ-GOAL')),
     ),
 }
 
@@ -302,12 +302,12 @@ GROUPS = {
 }
 
 REFLEXES = (
-    rt.ReflexSpec('emergencyStop', 'reply', 'us.watchObstacle', '==', 'OBSTACLE', (('request', 'loco.Stop'),)),
+    rt.ReflexSpec(name='emergencyStop', trigger='reply', source='us.watchObstacle', op='==', value='OBSTACLE', actions=(('request', 'loco.Stop'),)),
 )
 
 PARAMETERS = {
-    "ROBOT-POSITION": rt.ParameterSpec('ROBOT-POSITION', 'loco.Robot.robot', None),
-    "GOAL-POSITION": rt.ParameterSpec('GOAL-POSITION', 'explor.Goals.goal', None),
+    "ROBOT-POSITION": rt.ParameterSpec(name='ROBOT-POSITION', get='loco.Robot.robot', set=None),
+    "GOAL-POSITION": rt.ParameterSpec(name='GOAL-POSITION', get='explor.Goals.goal', set=None),
 }
 
 SPEC = rt.ExecutiveSpec(

@@ -1,0 +1,551 @@
+"""`specc verify`: every state the executive can reach, and four properties proved or refuted.
+
+The executive that runs is the real one (`specc.runtime.executive`) deciding with the compiled
+controller; only its surroundings are abstract. Modules are models of the functional level
+(requests, physical incompatibilities, intermediate replies when an activity starts, final
+replies, ZOMBIE, aborts, as in `specc.runtime.functional`), whose activities may end, fail or
+freeze at any moment; any pending timeout may expire at any moment; the task level may ask for
+any service while fewer than `requests` are outstanding, and interrupt any of them. Time is
+abstracted away, so every interleaving is covered.
+
+The exploration is breadth-first over canonical states (activity ids renumbered by age), so
+each counterexample is a shortest event sequence. Properties:
+
+- exclusion: an activity never enters EXEC while a service it has an arc to (must interrupt
+  or wait for) is in EXEC;
+- one-reply: no request gets two (REPLY ...) facts or leaves without one, and from every state
+  the modules and timers alone (plus the interruption the protocol demands of a ZOMBIE) can
+  bring every outstanding request to its final reply;
+- no-starvation: from every state, a WAIT activity of a service without a start timeout can
+  leave WAIT without the task level's help;
+- no-error: the executive never enters its general ERROR state (§3.4.2), which in normal
+  operation "ne doit jamais se produire".
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import itertools
+from collections import deque
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+from typing import Any
+
+from specc.analysis import kheops as k
+from specc.analysis.controller import executive_controller
+from specc.analysis.service_list import executive_spec
+from specc.model import nodes as m
+from specc.runtime import executive as rx
+from specc.runtime.functional import Reply, Report, RequestSpec, Status
+from specc.runtime.rules import Calls, Decision
+
+PROPERTIES = {
+    "exclusion": "never two mutually incompatible services in EXEC",
+    "one-reply": "every accepted request ends with exactly one final reply",
+    "no-starvation": "no WAIT service without a start timeout starves forever",
+    "no-error": "the executive never enters its general ERROR state",
+}
+
+
+# ---------------------------------------------------------------- the abstract surroundings
+
+
+class ModelTimer:
+    def __init__(self, action: Callable[[], Any]):
+        self.action = action
+        self.cancelled = False
+
+    def cancel(self) -> None:
+        self.cancelled = True
+
+
+class ModelKernel:
+    """No clock: a pending timer may expire at any moment."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+        self.timers: list[ModelTimer] = []
+
+    def call_later(self, delay: float, action: Callable[[], Any], priority: int = 0) -> ModelTimer:
+        timer = ModelTimer(action)
+        self.timers.append(timer)
+        return timer
+
+    def pending(self) -> list[ModelTimer]:
+        self.timers = [t for t in self.timers if not t.cancelled]
+        return self.timers
+
+
+@dataclass(eq=False)
+class ModelActivity:
+    id: int
+    spec: RequestSpec
+    sink: Callable[[Reply], None]
+    state: str = "INIT"  # INIT EXEC INTER ZOMBIE
+    waiting_for: set[int] = field(default_factory=set)
+    cause: str = "ABORT"
+
+
+class ModelModule:
+    """A module as its clients see it: what `specc.runtime.functional.Module` does on a request
+    or an abort, with the activities' own endings left to the explorer."""
+
+    def __init__(self, name: str, requests: Mapping[str, RequestSpec], registry: ModelRegistry):
+        self.name = name
+        self.requests = requests
+        self.registry = registry
+        self.spec = described(requests)  # what the executive reads: no request takes an input here
+        self.activities: dict[int, ModelActivity] = {}
+        self.zombies: set[int] = set()
+        self.reply_listeners: list[Callable[[Reply], None]] = []
+
+    def emit(self, sink: Callable[[Reply], None], reply: Reply) -> None:
+        for listener in self.reply_listeners:
+            listener(reply)
+        sink(reply)
+
+    def reply(self, rqst_id: int, request: str, status: Status, code: str = "OK", final: bool = True) -> Reply:
+        return Reply(rqst_id, self.name, request, status, Report(code), None, final)
+
+    def submit(self, request: str, input_: Any, sink: Callable[[Reply], None], parent: Any = None) -> int:
+        rqst_id = self.registry.new_id()
+        spec = self.requests.get(request)
+        if spec is None:
+            self.emit(sink, self.reply(rqst_id, request, Status.CS_ERROR, "UNKNOWN_REQUEST"))
+            return rqst_id
+        if spec.kind == "control":
+            for other in list(self.activities.values()):
+                if other.state in ("INIT", "EXEC") and spec.conflicts_with(other.spec):
+                    self.interrupt(other, request)
+            self.emit(sink, self.reply(rqst_id, request, Status.END))
+            return rqst_id
+        if self.zombies:
+            self.emit(sink, self.reply(rqst_id, request, Status.ZOMBIE, "MODULE_FROZEN"))
+            return rqst_id
+        activity = ModelActivity(rqst_id, spec, sink)
+        conflicting = [o for o in self.activities.values()
+                       if o.state in ("INIT", "EXEC", "INTER") and spec.conflicts_with(o.spec)]
+        activity.waiting_for = {o.id for o in conflicting}
+        self.activities[rqst_id] = activity
+        for other in conflicting:
+            if other.state != "INTER":
+                self.interrupt(other, request)
+        self.try_start(activity)
+        return rqst_id
+
+    def abort(self, target: int, sink: Callable[[Reply], None] | None = None) -> int:
+        rqst_id = self.registry.new_id()
+        activity = self.activities.get(target)
+        if activity is not None:
+            self.interrupt(activity, "ABORT")
+        if sink is not None:
+            status, code = (Status.END, "OK") if activity is not None else (Status.FINAL_ERROR, "UNKNOWN_ACTIVITY")
+            self.emit(sink, self.reply(rqst_id, "abort", status, code))
+        return rqst_id
+
+    def interrupt(self, activity: ModelActivity, cause: str) -> None:
+        activity.cause = cause
+        if activity.state == "INIT":
+            self.finish(activity, Status.INTERRUPTED, cause)
+        elif activity.state == "EXEC":
+            activity.state = "INTER"
+        elif activity.state == "ZOMBIE":
+            del self.activities[activity.id]
+            self.zombies.discard(activity.id)
+
+    def try_start(self, activity: ModelActivity) -> None:
+        if activity.state != "INIT" or activity.waiting_for:
+            return
+        if self.zombies:
+            self.finish(activity, Status.ZOMBIE, "MODULE_FROZEN")
+            return
+        activity.state = "EXEC"
+        self.emit(activity.sink, self.reply(activity.id, activity.spec.name, Status.WAITING, "final", final=False))
+
+    def finish(self, activity: ModelActivity, status: Status, code: str) -> None:
+        if status is Status.ZOMBIE and code != "MODULE_FROZEN":
+            activity.state = "ZOMBIE"
+            self.zombies.add(activity.id)
+        else:
+            del self.activities[activity.id]
+        self.emit(activity.sink, self.reply(activity.id, activity.spec.name, status, code))
+        for other in list(self.activities.values()):
+            if activity.id in other.waiting_for:
+                other.waiting_for.discard(activity.id)
+                self.try_start(other)
+
+    def endings(self, activity: ModelActivity) -> list[tuple[str, Callable[[], None]]]:
+        """What the activity itself may do next."""
+        if activity.state == "EXEC":
+            return [("ends", functools.partial(self.finish, activity, Status.END, "OK")),
+                    ("fails", functools.partial(self.finish, activity, Status.FINAL_ERROR, "FAILED")),
+                    ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
+        if activity.state == "INTER":
+            return [("is interrupted", functools.partial(self.finish, activity, Status.INTERRUPTED, activity.cause)),
+                    ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
+        return []
+
+
+@functools.cache
+def _described(requests: tuple[str, ...]) -> SimpleNamespace:
+    return SimpleNamespace(requests={n: SimpleNamespace(input_type=None) for n in requests})
+
+
+def described(requests: Mapping[str, RequestSpec]) -> SimpleNamespace:
+    return _described(tuple(requests))
+
+
+class ModelRegistry:
+    def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]]):
+        self.kernel = ModelKernel()
+        self._ids = itertools.count(1)
+        self.modules = {name: ModelModule(name, requests, self) for name, requests in modules.items()}
+
+    def new_id(self) -> int:
+        return next(self._ids)
+
+    def read_poster(self, name: str) -> None:
+        return None
+
+
+# ---------------------------------------------------------------- the explored world
+
+
+def decision_function(compiled: k.Compiled) -> Callable[..., Decision]:
+    """The compiled decision graph as the runtime calls it (the generated code unrolls the same graph)."""
+
+    def decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
+        outcome = k.evaluate(compiled, inputs)
+        for function, args in outcome.calls:
+            calls(function, args)
+        return Decision(outcome.outputs, tuple(outcome.inconsistent), tuple(outcome.incomplete), outcome.impossible)
+
+    return decide
+
+
+@dataclass
+class World:
+    executive: rx.Executive
+    registry: ModelRegistry
+    next_id: int = 1
+    problems: list[tuple[str, str]] = field(default_factory=list)  # (property, what) seen in the last step
+
+
+@dataclass(frozen=True)
+class Event:
+    label: str
+    helped: bool  # needs the task level (a new request, or interrupting what is not a ZOMBIE)
+    run: Callable[[World], None]
+
+
+@dataclass
+class Violation:
+    property: str
+    message: str
+    trace: list[str]
+
+
+@dataclass
+class Verification:
+    executive: str
+    requests: int
+    states: int
+    transitions: int
+    complete: bool  # False when the state limit stopped the exploration
+    violations: dict[str, Violation]
+
+    @property
+    def ok(self) -> bool:
+        return self.complete and not self.violations
+
+
+class Explorer:
+    def __init__(self, spec: rx.ExecutiveSpec, decide: Callable[..., Decision],
+                 modules: Mapping[str, Mapping[str, RequestSpec]], arcs: set[tuple[str, str]], requests: int):
+        self.spec = dataclasses.replace(spec, services={
+            name: dataclasses.replace(s, args={}, input=None, output=None) for name, s in spec.services.items()})
+        self.decide = decide
+        self.modules = modules
+        self.arcs = arcs
+        self.requests = requests
+
+    # -- states: a world is rebuilt from its canonical key before each step (cheaper than copying it)
+    def initial(self) -> World:
+        registry = ModelRegistry(self.modules)
+        executive = rx.Executive(self.spec, self.decide, registry)  # type: ignore[arg-type]
+        world = World(executive, registry)
+        executive.observers.append(functools.partial(_check_exclusion, world, self.arcs))
+        return world
+
+    def key(self, world: World) -> Key:
+        """The world's state, canonical: activities numbered by age, module activities by owner."""
+        executive = world.executive
+        ordered = sorted(executive.activities.values(), key=lambda a: abs(a.id))
+        ranks = {a.id: rank for rank, a in enumerate(ordered)}
+        owners = {(a.service.module, a.module_id): rank for rank, a in enumerate(ordered)}
+        timers: dict[int, list[str]] = {}
+        for timer in world.registry.kernel.pending():
+            activity, which = _timer_parts(timer)
+            if isinstance(activity, rx.Activity) and activity.id in ranks:
+                timers.setdefault(ranks[activity.id], []).append(which)
+        modules = []
+        for name, module in sorted(world.registry.modules.items()):
+            entries = sorted(module.activities.values(), key=lambda a: (owners.get((name, a.id), len(ordered)), a.id))
+            index = {a.id: i for i, a in enumerate(entries)}
+            modules.append(tuple((owners.get((name, a.id), -1), a.spec.name, a.state, a.cause,
+                                  tuple(sorted(index[w] for w in a.waiting_for if w in index))) for a in entries))
+        activities = tuple((a.service.name, str(a.state), a.holds_group, a.answered, a.abort_sent,
+                            tuple(sorted(timers.get(rank, ()))))
+                           for rank, a in enumerate(ordered))
+        zombies = tuple(sorted((module, ranks[a.id]) for module, a in executive.zombies.items()))
+        return (activities, tuple(modules), tuple(executive.groups.values()), zombies, executive.error is not None)
+
+    def world(self, key: Key) -> World:
+        activities, modules, groups, zombies, error = key
+        world = self.initial()
+        executive, registry = world.executive, world.registry
+        made = []
+        for rank, (service, state, holds, answered, abort_sent, timers) in enumerate(activities):
+            activity = rx.Activity(rank + 1, self.spec.services[service], 0.0, rx.Phase(state), None,
+                                   None, holds, answered, abort_sent)
+            for which in timers:
+                activity.timers.append(registry.kernel.call_later(  # type: ignore[arg-type]
+                    0.0, functools.partial(executive._post, executive._on_timeout, activity, which)))
+            executive.activities[activity.id] = activity
+            made.append(activity)
+        for name, entries in zip(sorted(registry.modules), modules, strict=True):
+            module = registry.modules[name]
+            built = []
+            for owner, request, state, cause, _ in entries:
+                owned = made[owner] if owner >= 0 else None
+                sink = (functools.partial(executive._post, executive._on_reply, owned) if owned is not None
+                        else executive.reflex_replies.append)
+                entry = ModelActivity(registry.new_id(), module.requests[request], sink, state, set(), cause)
+                module.activities[entry.id] = entry
+                if state == "ZOMBIE":
+                    module.zombies.add(entry.id)
+                if owned is not None:
+                    owned.module_id = entry.id
+                built.append(entry)
+            for entry, (_, _, _, _, waiting) in zip(built, entries, strict=True):
+                entry.waiting_for = {built[i].id for i in waiting}
+        for activity in made:
+            if activity.module_id is None and activity.state is not rx.Phase.WAIT:
+                activity.module_id = registry.new_id()  # its module has forgotten it
+        executive.groups = dict(zip(self.spec.groups, groups, strict=True))
+        executive.zombies = {module: made[rank] for module, rank in zombies}
+        executive.error = "ERROR" if error else None
+        world.next_id = len(made) + 1
+        return world
+
+    def events(self, world: World) -> list[Event]:
+        executive = world.executive
+        found: list[Event] = []
+        if len(executive.activities) < self.requests:
+            for service in self.spec.services:
+                found.append(Event(f"task: RQST EXEC {service}", True, functools.partial(_request, service)))
+        for activity in executive.activities.values():
+            zombie = activity.state is rx.Phase.ZOMBIE
+            found.append(Event(f"task: RQST INT of {activity.service.name}{' (ZOMBIE)' if zombie else ''}",
+                               not zombie, functools.partial(_interrupt, activity.id)))
+        for name, module in world.registry.modules.items():
+            for entry in list(module.activities.values()):
+                for verb, _ in module.endings(entry):
+                    found.append(Event(f"{name}: {entry.spec.name} {verb}", False,
+                                       functools.partial(_module_event, name, entry.id, verb)))
+        for index, timer in enumerate(world.registry.kernel.pending()):
+            found.append(Event(f"timer: {_timer_label(timer)}", False, functools.partial(_fire, index)))
+        return found
+
+    def step(self, key: Key, index: int) -> tuple[World, Event]:
+        """Rebuild the world of `key`, run its `index`th event, note what went wrong."""
+        world = self.world(key)
+        event = self.events(world)[index]
+        executive = world.executive
+        before = {a.id: a.answered for a in executive.activities.values()}
+        fresh = world.next_id
+        try:
+            event.run(world)
+        except Exception as exc:  # the runtime itself failed: a finding, not a crash of the verifier
+            world.problems.append(("no-error", f"the executive raised {type(exc).__name__}: {exc}"))
+            return world, event
+        replied: set[int] = set()
+        for message in executive.messages:
+            if message.kind == "WARNING" and message.result == "ERROR":
+                world.problems.append(("no-error", f"ERROR state: {message.detail}"))
+            if message.kind != "REPLY":
+                continue
+            if message.id in replied or before.get(message.id, False) or (
+                    message.id not in before and message.id != fresh and message.id > 0):
+                world.problems.append(("one-reply", f"a second (REPLY ...) for {message.service}"))
+            replied.add(message.id)
+        for ident, answered in before.items():
+            if ident not in executive.activities and not answered and ident not in replied:
+                world.problems.append(("one-reply", f"request {ident} left the activity list without a reply"))
+        return world, event
+
+    # -- the search
+    def explore(self, limit: int = 200_000, progress: Callable[[int], None] | None = None) -> Verification:
+        start = self.key(self.initial())
+        keys = {start: 0}
+        states = [start]
+        parents: list[tuple[int, str] | None] = [None]
+        edges: list[list[tuple[int, bool]]] = [[]]
+        violations: dict[str, Violation] = {}
+        queue = deque([0])
+        transitions = 0
+        complete = True
+        while queue:
+            index = queue.popleft()
+            key = states[index]
+            for number in range(len(self.events(self.world(key)))):
+                after, event = self.step(key, number)
+                transitions += 1
+                for prop, message in after.problems:
+                    if prop not in violations:
+                        violations[prop] = Violation(prop, message, self.trace(parents, index) + [event.label])
+                reached = self.key(after)
+                target = keys.get(reached)
+                if target is None:
+                    if len(states) >= limit:
+                        complete = False
+                        continue
+                    target = len(states)
+                    keys[reached] = target
+                    states.append(reached)
+                    parents.append((index, event.label))
+                    edges.append([])
+                    queue.append(target)
+                edges[index].append((target, event.helped))
+            if progress is not None and index % 1000 == 0:
+                progress(len(states))
+        self.liveness(states, edges, parents, violations)
+        return Verification(self.spec.name, self.requests, len(states), transitions, complete, violations)
+
+    def liveness(self, states: list[Key], edges: list[list[tuple[int, bool]]],
+                 parents: list[tuple[int, str] | None], violations: dict[str, Violation]) -> None:
+        untimed = {name for name, s in self.spec.services.items() if s.start_timeout is None}
+        goals: dict[str, Callable[[Key], bool]] = {
+            "one-reply": lambda key: not key[0],
+            "no-starvation": lambda key: not any(a[1] == "WAIT" and a[0] in untimed for a in key[0]),
+        }
+        backwards: list[list[int]] = [[] for _ in states]
+        for source, targets in enumerate(edges):
+            for target, helped in targets:
+                if not helped:
+                    backwards[target].append(source)
+        for prop, goal in goals.items():
+            if prop in violations:
+                continue
+            reached = {i for i, key in enumerate(states) if goal(key)}
+            queue = deque(reached)
+            while queue:
+                for source in backwards[queue.popleft()]:
+                    if source not in reached:
+                        reached.add(source)
+                        queue.append(source)
+            stuck = next((i for i in range(len(states)) if i not in reached), None)
+            if stuck is not None:
+                waiting = ", ".join(f"{a[0]} in {a[1]}" for a in states[stuck][0])
+                message = (f"stuck with {waiting}: only new requests could end them" if prop == "one-reply"
+                           else f"a WAIT without start timeout can never start: {waiting}")
+                violations[prop] = Violation(prop, message, self.trace(parents, stuck))
+
+    @staticmethod
+    def trace(parents: list[tuple[int, str] | None], index: int) -> list[str]:
+        labels: list[str] = []
+        step = parents[index]
+        while step is not None:
+            labels.append(step[1])
+            step = parents[step[0]]
+        return labels[::-1]
+
+
+Key = tuple[Any, ...]
+
+
+def _request(service: str, world: World) -> None:
+    world.executive.request(service, world.next_id)
+
+
+def _interrupt(ident: int, world: World) -> None:
+    world.executive.interrupt(ident)
+
+
+def _module_event(module_name: str, ident: int, verb: str, world: World) -> None:
+    module = world.registry.modules[module_name]
+    activity = module.activities[ident]
+    dict(module.endings(activity))[verb]()
+
+
+def _fire(index: int, world: World) -> None:
+    timer = world.registry.kernel.pending()[index]
+    timer.cancelled = True
+    timer.action()
+
+
+def _timer_parts(timer: ModelTimer) -> tuple[Any, str]:
+    action = timer.action
+    if isinstance(action, functools.partial) and len(action.args) == 3:  # _post(_on_timeout, activity, which)
+        return action.args[1], action.args[2]
+    return None, repr(action)
+
+
+def _timer_label(timer: ModelTimer) -> str:
+    activity, which = _timer_parts(timer)
+    if isinstance(activity, rx.Activity):
+        return f"{which} timeout of {activity.service.name} (id {activity.id})"
+    return which
+
+
+def _timer_key(timer: ModelTimer, ranks: Mapping[int, int]) -> tuple[Any, ...]:
+    activity, which = _timer_parts(timer)
+    return (ranks.get(activity.id, -1) if isinstance(activity, rx.Activity) else -1, which)
+
+
+def _check_exclusion(world: World, arcs: set[tuple[str, str]], activity: rx.Activity, source: rx.Phase,
+                     target: rx.Phase) -> None:
+    if target is not rx.Phase.EXEC:
+        return
+    for other in world.executive.activities.values():
+        if other is not activity and other.state is rx.Phase.EXEC and (activity.service.name,
+                                                                       other.service.name) in arcs:
+            world.problems.append(("exclusion", f"{activity.service.name} (id {activity.id}) entered EXEC while "
+                                                f"{other.service.name} (id {other.id}), which it must interrupt "
+                                                "or wait for, is in EXEC"))
+
+
+# ---------------------------------------------------------------- from a spec
+
+
+def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) -> Explorer:
+    controller = executive_controller(program, executive)
+    compiled = k.compile_base(controller.base)
+    spec = executive_spec(program, controller)
+    modules: dict[str, dict[str, RequestSpec]] = {}
+    for module in (i for i in program.items if isinstance(i, m.Module)):
+        modules[module.name] = {r.name: RequestSpec(r.name, r.kind or "exec",
+                                                    incompatible=tuple(x.text for x in r.incompatible_with))
+                                for r in module.requests}
+    arcs = {(a.source, a.target) for a in controller.graph.arcs}
+    return Explorer(spec, decision_function(compiled), modules, arcs, requests)
+
+
+def verify(program: m.Program, executive: m.Executive, requests: int = 2, limit: int = 200_000,
+           progress: Callable[[int], None] | None = None) -> Verification:
+    return explorer_for(program, executive, requests).explore(limit, progress)
+
+
+def describe(result: Verification) -> Iterator[str]:
+    for prop, text in PROPERTIES.items():
+        violation = result.violations.get(prop)
+        if violation is None:
+            verdict = "holds" if result.complete else "holds in the states explored"
+            yield f"{prop}: {verdict} - {text}"
+            continue
+        yield f"{prop}: REFUTED - {text}"
+        yield f"  {violation.message}"
+        for number, label in enumerate(violation.trace, start=1):
+            yield f"  {number:3}. {label}"

@@ -1,0 +1,105 @@
+"""`specc verify`: the executive's reachable states, explored with abstract modules, prove the
+four properties for the repository's executives and refute them, with a shortest trace, for
+rule bases that break them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from specc.analysis.verify import PROPERTIES, Verification, verify
+from specc.model import nodes as m
+from specc.pipeline import load
+from tests.conftest import EXAMPLES, ROOT
+
+SCRIPTED = ROOT / "tests" / "functional"
+
+
+def run(paths: list[Path], executive: str, requests: int) -> Verification:
+    loaded = load(paths)
+    assert loaded.program is not None and not loaded.errors
+    chosen = next(i for i in loaded.program.items if isinstance(i, m.Executive) and i.name == executive)
+    return verify(loaded.program, chosen, requests)
+
+
+@pytest.mark.parametrize("paths, executive, requests", [
+    ([EXAMPLES / "generic"], "generic", 1),
+    ([EXAMPLES / "generic"], "fig35", 1),
+    ([EXAMPLES / "hilare"], "hilare", 1),
+    ([SCRIPTED / "scripted.spec", SCRIPTED / "executive.spec"], "shop", 2),
+])
+def test_the_repositorys_executives_satisfy_every_property(paths: list[Path], executive: str,
+                                                           requests: int) -> None:
+    result = run(paths, executive, requests)
+    assert result.complete and result.violations == {}, result.violations
+    assert result.states > 100  # requests, replies, timeouts and ZOMBIEs really were explored
+
+
+@pytest.mark.slow
+def test_the_generic_executive_with_two_outstanding_requests() -> None:
+    result = run([EXAMPLES / "generic"], "generic", 2)
+    assert result.ok and result.states > 10_000
+
+
+ROBOT = """
+module arm {
+  codels: "arm_codels";
+  request Go { type: exec; task: T; codel exec: go; incompatible_with: Go; }
+  request Back { type: exec; task: T; codel exec: go; incompatible_with: Back; }
+  exec_task T { period: 10 ms; }
+}
+module base {
+  codels: "arm_codels";
+  request Move { type: exec; task: T; codel exec: go; incompatible_with: Move; }
+  exec_task T { period: 10 ms; }
+}
+executive shop {
+  rules: policy;
+  service GO { request: arm.Go; }
+  service BACK { request: arm.Back; %(back)s conflicts { GO: wait; } }
+  service MOVE { request: base.Move; }
+}
+rules policy {
+  inputs service: {"GO", "BACK", "MOVE"}, event: {"START", "INTERM", "END", "ABORT", "ZOMBIE"};
+  outputs status: {"OK", "WAIT", "REFUSE", "ERROR"};
+  %(rule)s
+}
+"""
+
+
+def robot(tmp_path: Path, rule: str, back: str = "") -> list[Path]:
+    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    spec = tmp_path / "shop.spec"
+    spec.write_text(ROBOT % {"rule": rule, "back": back})
+    return [spec]
+
+
+def test_a_rule_letting_a_service_start_beside_the_one_it_waits_for_breaks_exclusion(tmp_path: Path) -> None:
+    rule = 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";'
+    result = run(robot(tmp_path, rule), "shop", 2)
+    assert set(result.violations) == {"exclusion"}
+    trace = result.violations["exclusion"].trace
+    # Shortest: GO starts and runs, then BACK is let in beside it.
+    assert trace == ["task: RQST EXEC GO", "task: RQST EXEC BACK"]
+
+
+def test_a_rule_keeping_a_service_waiting_starves_it_unless_it_has_a_start_timeout(tmp_path: Path) -> None:
+    rule = 'backNever: event == "START", service == "BACK" ==> restrict status == "WAIT";'
+    starving = run(robot(tmp_path, rule), "shop", 1)
+    assert set(starving.violations) == {"no-starvation", "one-reply"}
+    assert starving.violations["no-starvation"].trace == ["task: RQST EXEC BACK"]
+    timed = run(robot(tmp_path, rule, back="timeout { start: 1 s; }"), "shop", 1)
+    assert timed.ok
+
+
+def test_a_rule_the_controller_cannot_follow_puts_the_executive_in_error(tmp_path: Path) -> None:
+    rule = 'moveIsError: event == "START", service == "MOVE" ==> restrict status == "ERROR";'
+    result = run(robot(tmp_path, rule), "shop", 1)
+    assert "no-error" in result.violations
+    assert "start of MOVE" in result.violations["no-error"].message
+    assert result.violations["no-error"].trace == ["task: RQST EXEC MOVE"]
+
+
+def test_every_property_is_named_and_explained() -> None:
+    assert set(PROPERTIES) == {"exclusion", "one-reply", "no-starvation", "no-error"}
