@@ -88,8 +88,8 @@ def test_d_conflicts_with_nothing_and_always_starts(packages: None) -> None:
 
 
 @pytest.fixture(scope="module")
-def hilare_controller(packages: None) -> ModuleType:
-    return importlib.import_module("hilare.executive.hilare_controller")
+def resource_controller(packages: None) -> ModuleType:
+    return importlib.import_module("hilare.executive.hilare_resource_controller")
 
 
 def decide(controller: ModuleType, service: str, event: str = "START", **groups: str) -> tuple[Any, list[Any]]:
@@ -101,16 +101,16 @@ def decide(controller: ModuleType, service: str, event: str = "START", **groups:
     return decision.outputs["status"], sorted(calls)
 
 
-def test_fig_5_6_rules_take_over_where_they_apply(hilare_controller: ModuleType) -> None:
+def test_fig_5_6_rules_take_over_where_they_apply(resource_controller: ModuleType) -> None:
     # Fig 5.6 names the pilo group; the generated controller uses that name.
-    assert "@ExecTrajState" in hilare_controller.INPUTS and hilare_controller.FINDINGS == 0
+    assert "@ExecTrajState" in resource_controller.INPUTS and resource_controller.FINDINGS == 0
     abort_goal = [("changeInterState", ("EXEC-TRAJ-GOAL",)), ("sendAbortRequest", ("EXEC-TRAJ-GOAL",))]
     # CalcTrajObjWhenExecTrajGoal: abort the exploration trajectory and start at once (the
     # generated rule would have waited for the abort: the conflict is only one of efficiency).
-    assert decide(hilare_controller, "CALC-TRAJ-OBJ", ExecTrajState="EXEC-TRAJ-GOAL") == ("OK", abort_goal)
+    assert decide(resource_controller, "CALC-TRAJ-OBJ", ExecTrajState="EXEC-TRAJ-GOAL") == ("OK", abort_goal)
     # ArmGoWhenExecTrajGoal: abort it too, but WAIT for the robot to stand still.
-    assert decide(hilare_controller, "ARM-OBJ", ExecTrajState="EXEC-TRAJ-GOAL") == ("WAIT", abort_goal)
+    assert decide(resource_controller, "ARM-OBJ", ExecTrajState="EXEC-TRAJ-GOAL") == ("WAIT", abort_goal)
     # Where Fig 5.6 says nothing, the generated rules decide.
-    assert decide(hilare_controller, "CALC-TRAJ-OBJ") == ("OK", [])
-    assert decide(hilare_controller, "CALC-GOAL", ExecTrajState="EXEC-TRAJ-OBJ")[0] == "WAIT"
-    assert decide(hilare_controller, "EXEC-TRAJ-GOAL", ExecTrajState="EXEC-TRAJ-OBJ")[0] == "WAIT"
+    assert decide(resource_controller, "CALC-TRAJ-OBJ") == ("OK", [])
+    assert decide(resource_controller, "CALC-GOAL", ExecTrajState="EXEC-TRAJ-OBJ")[0] == "WAIT"
+    assert decide(resource_controller, "EXEC-TRAJ-GOAL", ExecTrajState="EXEC-TRAJ-OBJ")[0] == "WAIT"

@@ -213,7 +213,7 @@ class Controller:
 
 
 def controller_name(executive: m.Executive) -> str:
-    return f"{executive.name}_controller"
+    return f"{executive.name}_resource_controller"
 
 
 def executive_controller(program: m.Program, executive: m.Executive) -> Controller:

@@ -47,7 +47,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from specc.runtime.functional import Registry, Reply, Status, build_record, check_record
+from specc.runtime.functional import HISTORY, Registry, Reply, Status, build_record, check_record
 from specc.runtime.kernel import Timer
 from specc.runtime.rules import Decision
 
@@ -217,11 +217,14 @@ class Executive:
         self.groups: dict[str, str] = dict.fromkeys(spec.groups, IDLE)  # the controller's state
         self.zombies: dict[str, Activity] = {}  # module -> its ZOMBIE activity: requests refused
         self.error: str | None = None  # the general ERROR state (§3.4.2): why
-        self.messages: list[Message] = []
+        self.messages: deque[Message] = deque(maxlen=HISTORY)  # the latest ones; listeners get them all
         self.listeners: list[Callable[[Message], None]] = []
         self.observers: list[Callable[[Activity, Phase, Phase], None]] = []
         self.reflex_replies: list[Reply] = []  # replies to requests sent by reflexes
+        # With `measure`: each cycle's duration, without the time modules spend handling what it
+        # sends them (in-process here, they are other processes on the robot).
         self.cycle_durations: list[float] | None = [] if measure else None
+        self._in_modules = 0.0
         self._inbox: deque[tuple[Callable[..., None], tuple[Any, ...]]] = deque()
         self._busy = False
         self._internal_ids = itertools.count(-1, -1)
@@ -287,11 +290,12 @@ class Executive:
         try:
             while self._inbox:
                 started = time.perf_counter()
+                self._in_modules = 0.0
                 handler, args = self._inbox.popleft()
                 handler(*args)
                 self._retry_waiting()
                 if self.cycle_durations is not None:
-                    self.cycle_durations.append(time.perf_counter() - started)
+                    self.cycle_durations.append(time.perf_counter() - started - self._in_modules)
         finally:
             self._busy = False
 
@@ -387,8 +391,17 @@ class Executive:
                 activity.timers.append(self.kernel.call_later(
                     timeout, functools.partial(self._post, self._on_timeout, activity, which)))
         # Replies the module sends before `submit` returns queue up for the next cycle.
-        activity.module_id = module.submit(service.request, activity.input,
-                                           functools.partial(self._post, self._on_reply, activity))
+        activity.module_id = self._to_module(module.submit, service.request, activity.input,
+                                             functools.partial(self._post, self._on_reply, activity))
+
+    def _to_module(self, call: Callable[..., Any], *args: Any) -> Any:
+        if self.cycle_durations is None:
+            return call(*args)
+        started = time.perf_counter()
+        try:
+            return call(*args)
+        finally:
+            self._in_modules += time.perf_counter() - started
 
     def _on_interrupt(self, ident: int) -> None:
         activity = self.activities.get(ident)
@@ -414,7 +427,7 @@ class Executive:
             return
         activity.abort_sent = True
         module = self.registry.modules[activity.service.module]
-        module.abort(activity.module_id, functools.partial(self._post, self._on_abort_reply, activity))
+        self._to_module(module.abort, activity.module_id, functools.partial(self._post, self._on_abort_reply, activity))
 
     def _on_timeout(self, activity: Activity, which: str) -> None:
         if activity.state is Phase.ETHER or activity.answered:
@@ -557,7 +570,7 @@ class Executive:
     def _reflex_action(self, verb: str, target: str) -> None:
         if verb == "request":
             module_name, _, request = target.partition(".")
-            self.registry.modules[module_name].submit(request, None, self.reflex_replies.append)
+            self._to_module(self.registry.modules[module_name].submit, request, None, self.reflex_replies.append)
         elif verb == "start":
             self._on_request(target, next(self._internal_ids))
         else:

@@ -18,12 +18,15 @@ import enum
 import functools
 import itertools
 import math
+from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Generic, TypeVar
 
 from specc.runtime.kernel import Kernel, Timer
+
+HISTORY = 1_000  # transitions a module (and messages an executive) remembers
 
 # ---------------------------------------------------------------- the dictionary of Table 2.1
 
@@ -375,7 +378,8 @@ class Module:
         self.posters = {p.name: Poster[Any](p) for p in spec.posters}
         self.tasks = {t.name: TaskRunner(self, t) for t in spec.tasks}
         self.zombies: dict[int, Activity] = {}  # any of them freezes the module (§2.2)
-        self.transitions: list[tuple[int, State, State]] = []  # (id, from, to), for tests and logs
+        # (id, from, to), the latest HISTORY of them, for tests and logs: a robot runs for hours.
+        self.transitions: deque[tuple[int, State, State]] = deque(maxlen=HISTORY)
         self.observers: list[Callable[[Module, Activity, State, State], None]] = []
         self.reply_listeners: list[ReplySink] = []  # see every reply the module sends (reflexes, logs)
         self._functions: dict[str, Callable[..., Any]] = {}

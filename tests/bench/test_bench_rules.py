@@ -1,7 +1,8 @@
 """`make bench`: microseconds per evaluation of a compiled Kheops decision function, against
 the reference forward-chaining interpreter (goal: 20x faster) and CLIPS running the same rules
 (clipspy, bench only; goal: 50x faster), all measured in the same run, on the rule base of
-Fig 3.8 and on the Hilare controller. CLIPS asserts the inputs and reads the outputs itself
+Fig 3.8 and on the Hilare executive's resource controller (the rules generated from its conflicts
+joined by those of Fig 5.6). CLIPS asserts the inputs and reads the outputs itself
 (`cycle`), since clipspy leaks every fact object handed back to Python."""
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from specc.analysis import kheops as k
+from specc.analysis.controller import executive_controller
 from specc.model import nodes as m
 from specc.pipeline import load
 from tests.conftest import EXAMPLES
@@ -33,16 +35,23 @@ def per_call_us(function, inputs: list[dict[str, object]], repeat: int = 3) -> f
     return best * 1e6
 
 
-@pytest.mark.parametrize("robot, name", [("generic", "diagnosis"), ("hilare", "hilare_controller")])
-def test_decision_function_against_the_interpreter(robot: str, name: str, tmp_path: Path) -> None:
+def rule_base(program: m.Program, kind: str, name: str) -> k.Base:
+    if kind == "executive":
+        executive = next(i for i in program.items if isinstance(i, m.Executive) and i.name == name)
+        return executive_controller(program, executive).base
+    return k.normalise(next(i for i in program.items if isinstance(i, m.RuleBase) and i.name == name))
+
+
+@pytest.mark.parametrize("robot, kind, name", [("generic", "rules", "diagnosis"), ("hilare", "executive", "hilare")])
+def test_decision_function_against_the_interpreter(robot: str, kind: str, name: str, tmp_path: Path) -> None:
     loaded = load([EXAMPLES / robot])
     assert loaded.program is not None
-    source = next(i for i in loaded.program.items if isinstance(i, m.RuleBase) and i.name == name)
-    base = k.normalise(source)
+    base = rule_base(loaded.program, kind, name)
     package = compile_robot(EXAMPLES / robot, tmp_path)
     sys.path.insert(0, str(tmp_path))
     try:
-        decide = importlib.import_module(f"{package}.rules.{name}").decide
+        module = f"{package}.rules.{name}" if kind == "rules" else f"{package}.executive.{name}_resource_controller"
+        decide = importlib.import_module(module).decide
     finally:
         sys.path.remove(str(tmp_path))
     rng = random.Random(7)
@@ -59,7 +68,7 @@ def test_decision_function_against_the_interpreter(robot: str, name: str, tmp_pa
     cycles = [clips_kheops.call(base, values) for values in inputs[:500]]
     assert all(str(env.eval(c)) == clips_kheops.expected(base, v) for c, v in zip(cycles[:100], inputs, strict=False))
     clips_us = per_call_us(env.eval, cycles)
-    print(f"\nrules {name} ({len(base.rules)} rules, depth {k.compile_base(base).depth}):"
+    print(f"\n{kind} {name} ({len(base.rules)} rules, depth {k.compile_base(base).depth}):"
           f"\n  CLIPS 6.4 (clipspy)    {clips_us:9.2f} us/evaluation"
           f"\n  reference interpreter  {interpreted_us:9.2f} us/evaluation"
           f"\n  compiled decision      {compiled_us:9.2f} us/evaluation  "
