@@ -19,6 +19,8 @@ demo: $(STAMP)
 	$(BIN)/specc check $(EXAMPLES)
 	$(BIN)/specc compile examples/hilare -o generated
 	$(BIN)/python examples/hilare/run_modules.py
+	$(BIN)/python examples/hilare/run_executive.py
+	$(BIN)/specc verify examples/hilare --requests 1
 
 test: $(STAMP)
 	$(BIN)/ruff check specc tests

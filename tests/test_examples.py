@@ -98,3 +98,18 @@ def test_atrv_has_both_models_and_every_mission() -> None:
     m1 = problems["M1_model1"]
     assert isinstance(m1, m.Problem)
     assert m1.preemption == "earlyPreemptive"
+
+
+@pytest.mark.parametrize("script", ["run_modules.py", "run_executive.py"])
+def test_the_hilare_demo_scripts_run(script: str) -> None:
+    """`make demo` runs these against the committed generated package."""
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, str(EXAMPLES / "hilare" / script)], capture_output=True, text=True,
+                            timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "Traceback" not in result.stderr
+    if script == "run_executive.py":
+        assert "ERROR state: never" in result.stdout
+        assert "EXEC-TRAJ-GOAL -> INT, CALC-TRAJ-OBJ -> OK" in result.stdout  # Fig 5.6, rule 1

@@ -44,6 +44,7 @@ def scoreCandidates(sdi, request):
     if sdi.bestScore < 0.0:
         return "NO_FREE_CELL"
     request.goal = sdi.goal
+    sdi.write_poster("Goals")
     return "ether"
 
 
@@ -62,6 +63,7 @@ def checkReachable(sdi, request):
     cell = model.model.cellSize
     sdi.graspPos.x, sdi.graspPos.y = (o.i + 0.5) * cell, (o.j + 0.5) * cell
     request.position = sdi.graspPos
+    sdi.write_poster("Goals")
     return "ether"
 
 

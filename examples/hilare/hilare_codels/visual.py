@@ -32,6 +32,7 @@ def initVisual(sdi):
 def resetModel(sdi, request):
     """initModel: certainty 0 everywhere, no detected object (obstacles are kept)."""
     _reset(sdi)
+    sdi.write_poster("Model")
     return "end"
 
 
@@ -64,6 +65,7 @@ def markObstacleCells(sdi, request):
         slot.i, slot.j = k % NX, k // NX
         slot.x, slot.y = (slot.i + 0.5) * CELL, (slot.j + 0.5) * CELL
     sdi.nbWorldObjects = len(chosen)
+    sdi.write_poster("Model")  # the free cells changed
     return "ether"
 
 
@@ -72,6 +74,7 @@ def setCameraPan(sdi, request):
     if not math.isfinite(request.pan):
         return "BAD_ORIENTATION"
     sdi.pan = math.atan2(math.sin(request.pan), math.cos(request.pan))
+    sdi.write_poster("Model")
     return "end"
 
 
@@ -110,6 +113,7 @@ def analyseImage(sdi, request):
             found += 1
     sdi.image.valid = False
     request.nbFound = found
+    sdi.write_poster("Model")  # the certainties changed
     return "ether"
 
 
