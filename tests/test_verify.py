@@ -103,3 +103,17 @@ def test_a_rule_the_controller_cannot_follow_puts_the_executive_in_error(tmp_pat
 
 def test_every_property_is_named_and_explained() -> None:
     assert set(PROPERTIES) == {"exclusion", "one-reply", "no-starvation", "no-error"}
+
+
+def test_a_refusing_rule_is_answered_refused_and_keeps_every_property(tmp_path: Path) -> None:
+    from specc.analysis.verify import explorer_for
+
+    rule = 'moveRefused: event == "START", service == "MOVE" ==> restrict status == "REFUSE";'
+    paths = robot(tmp_path, rule)
+    assert run(paths, "shop", 2).ok
+    loaded = load(paths)
+    assert loaded.program is not None
+    executive = next(i for i in loaded.program.items if isinstance(i, m.Executive))
+    world = explorer_for(loaded.program, executive).initial()
+    world.executive.request("MOVE", 7)
+    assert [msg.fact for msg in world.executive.messages] == [("REPLY", 7, "REFUSED")]

@@ -80,11 +80,16 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                 if arg.name not in inputs:
                     ctx.unknown("undefined-input", "input", arg.name, inputs, arg.span,
                                 f" of request '{service.request.text}'")
+        if service.output is not None and len(service.output.parts) >= 2:
+            ctx.report("bad-reference", f"'{service.output.text}': a service's output is a function of the "
+                       "executive's codels (it prepares the result for the task level); only modules write posters",
+                       service.output.span)
         for io in (service.input, service.output):
             if io is None:
                 continue
             if len(io.parts) >= 2:
-                resolve_poster(ctx, io)
+                if io is service.input:
+                    resolve_poster(ctx, io)
             elif functions is None:
                 ctx.report("missing-property",
                            f"'{io.text}' is a function: give the executive 'codels: \"python.module\";'", io.span)
