@@ -101,6 +101,8 @@ def compile(paths: PathsArg,
                         + (f" ('{exc.filename}')" if exc.filename else ""), Span.unknown(str(folder)))
         err.print(render(problem, {}), markup=False)
         raise typer.Exit(1) from None
+    for warning in result.warnings:
+        err.print(render(warning, loaded.sources), markup=False)
     out.print(f"wrote {len(written)} file(s) to {folder}", markup=False)
 
 
@@ -241,8 +243,9 @@ def verify(paths: PathsArg,
 @app.command(name="rules")
 def rules_report(paths: PathsArg,
                  limit: Annotated[int, typer.Option(help="Findings shown per rule base (0: all).")] = 20) -> None:
-    """Compile every Kheops rule base: domains, decision-graph depth, and the input configurations
-    that leave an attribute without value (inconsistent) or an output undetermined (incomplete).
+    """Compile every Kheops rule base and every executive's resource controller: domains,
+    decision-graph depth, and the input configurations that leave an attribute without value
+    (inconsistent) or an output undetermined (incomplete).
 
     Example: specc rules examples/generic
     """
@@ -252,17 +255,23 @@ def rules_report(paths: PathsArg,
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
-    bases = [i for i in loaded.program.items if isinstance(i, m.RuleBase)]
-    if not bases:
-        out.print("no rules block in these specs", markup=False)
-    for base in bases:
+    from specc.analysis.controller import executive_controller
+
+    items = [i for i in loaded.program.items if isinstance(i, (m.RuleBase, m.Executive))]
+    if not items:
+        out.print("no rules or executive block in these specs", markup=False)
+    for item in items:
         try:
-            compiled = kheops.compile_base(kheops.normalise(base))
+            if isinstance(item, m.RuleBase):
+                title, normal = f"rules {item.name}", kheops.normalise(item)
+            else:
+                title = f"executive {item.name}: resource controller"
+                normal = executive_controller(loaded.program, item).base
+            compiled = kheops.compile_base(normal)
         except kheops.KheopsError as exc:
             err.print(f"{exc.node.span}: error: {exc} [not-propositional]", markup=False)
             raise typer.Exit(1) from None
-        normal = compiled.base
-        out.print(f"rules {base.name}: {len(normal.rules)} rules, decision graph of depth {compiled.depth} "
+        out.print(f"{title}: {len(normal.rules)} rules, decision graph of depth {compiled.depth} "
                   f"({compiled.tree_nodes} tree nodes -> {compiled.dag_nodes} shared)", markup=False)
         for attribute in normal.attributes.values():
             values = ", ".join(str(v) for v in attribute.values)

@@ -253,3 +253,15 @@ def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> 
     ambiguous = specc("verify", str(EXAMPLES / "generic"))
     assert ambiguous.returncode == 1 and "pick one with --executive" in ambiguous.stderr
     assert "Traceback" not in ambiguous.stderr + refuted.stderr
+
+
+def test_compile_warns_about_rule_bases_that_leave_inputs_unsettled(tmp_path: Path) -> None:
+    result = specc("compile", str(EXAMPLES / "generic"), "-o", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    warnings = [line for line in result.stderr.splitlines() if "[rules-unsettled]" in line]
+    # Fig 3.8 is "quelques règles": incomplete on its own. The executives' controllers are complete,
+    # and the hand-written §3.8.1 rules are completed by the generated ones, so neither is reported.
+    assert len(warnings) == 1 and "rule base 'diagnosis'" in warnings[0] and ": warning: " in warnings[0]
+    listed = specc("rules", str(EXAMPLES / "generic"))
+    assert "executive generic: resource controller" in listed.stdout
+    assert listed.stdout.count("complete and consistent for every input") == 2

@@ -12,7 +12,7 @@ from specc.analysis.controller import Controller, executive_controller
 from specc.analysis.service_list import executive_spec
 from specc.backends.env import render
 from specc.backends.manifest import HEADER, Output
-from specc.backends.rules import DecisionView, python_name
+from specc.backends.rules import DecisionView, python_name, warn_unsettled
 from specc.model import nodes as m
 from specc.runtime import executive as rx
 
@@ -93,6 +93,7 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     for executive in executives:
         controller = executive_controller(program, executive)
         compiled = k.compile_base(controller.base)
+        warn_unsettled(output, compiled, f"the resource controller of executive '{executive.name}'", executive)
         hand = {ref.text for ref in executive.rules}
         sources = ", ".join(sorted({executive.span.file} | {
             r.span.file for r in program.items if isinstance(r, m.RuleBase) and r.name in hand}))

@@ -183,12 +183,24 @@ def describe(finding: k.Finding) -> str:
     return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
 
 
+def warn_unsettled(output: Output, compiled: k.Compiled, what: str, node: m.Node) -> None:
+    """A compiled base that leaves inputs unsettled deserves a word at compile time."""
+    findings = compiled.findings
+    if findings:
+        output.warn("rules-unsettled", f"{what} leaves {len(findings)} input configuration(s) unsettled, e.g. "
+                    f"{describe(findings[0])}; `specc rules` lists them", node.span)
+
+
 def generate(program: m.Program, output: Output, robot: str = "") -> list[k.Compiled]:
     compiled_all = []
     bases = sorted((i for i in program.items if isinstance(i, m.RuleBase)), key=lambda b: b.name)
+    # An executive's own bases only decide where they apply: the generated controller completes them.
+    joined = {ref.text for e in program.items if isinstance(e, m.Executive) for ref in e.rules}
     for base in bases:
         compiled = k.compile_base(k.normalise(base))
         compiled_all.append(compiled)
+        if base.name not in joined:
+            warn_unsettled(output, compiled, f"rule base '{base.name}'", base)
         view = DecisionView(compiled, base.span.file)
         output.add(BACKEND, f"rules/{python_name(base.name)}.py", render("rules/decision.py.j2", view=view))
     if bases:
