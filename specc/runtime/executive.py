@@ -15,7 +15,9 @@ The task level asks for *services* by name with a unique id (RQST EXEC) and may 
 
 Every input (a task request, a module reply, a timer) runs one *cycle*: the event, then a new
 start authorisation for every WAIT activity. Replies that modules send during a cycle queue up
-for the next one, so a cycle never re-enters itself.
+for the next one, so a cycle never re-enters itself. The seed's executive also wakes up
+periodically while activities wait (§3.8.2); here nothing a WAIT depends on (the controller
+sees only the service, the event and the group states) changes between events, so it need not.
 
 What the controller is told: START for every authorisation asked; for an exec service, INTERM
 when its intermediate reply arrives (its group is held from then on), then END, ZOMBIE or ABORT;
