@@ -126,7 +126,12 @@ def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group],
         if not local:
             actions.append(_call("sendAbortRequest", group, names))
             must_wait_for_abort.append(running)
-        rules.append(_rule(f"{service}_interrupts_{group.name}", _and(*start, *none_waited, running), *actions))
+        # Interrupt only along with the answer that goes with it (OK once the module interrupts by
+        # itself, WAIT while an abort is under way): a hand-written rule answering otherwise where
+        # it applies (REFUSE, WAIT) leaves running services alone.
+        answer = _is("status", "WAIT" if not local else "OK")
+        rules.append(_rule(f"{service}_interrupts_{group.name}", _and(*start, *none_waited, running, answer),
+                           *actions))
     if must_wait_for_abort:
         rules.append(_rule(f"{service}_waits_for_abort", _and(*start, *none_waited, _or(*must_wait_for_abort)),
                            _restrict("status", "WAIT")))

@@ -112,7 +112,8 @@ def reduce(graph: IncompatibilityGraph) -> tuple[tuple[str, ...], ...]:
     taken: set[str] = set()
     macros: list[tuple[str, ...]] = []
     while True:
-        candidates = [tuple(s for s in c if s not in taken) for c in cliques]
+        # Cliques are sets: list their members in declaration order, or ties follow string hashing.
+        candidates = [tuple(sorted((s for s in c if s not in taken), key=order.__getitem__)) for c in cliques]
         candidates = [c for c in candidates if c]
         if not candidates:
             break

@@ -35,15 +35,17 @@ def executive_spec(program: m.Program, controller: Controller) -> rx.ExecutiveSp
         module, request = service.request.parts
         kind = next(r for r in modules[module].requests if r.name == request).kind or "exec"
         timeout = service.timeout or m.Timeouts()
-        linked = {a.target for a in graph.arcs if a.source == service.name} | {
-            a.source for a in graph.arcs if a.target == service.name}
+        targets = {a.target for a in graph.arcs if a.source == service.name}
+        linked = targets | {a.source for a in graph.arcs if a.target == service.name}
+        group = next((g.services for g in controller.groups if service.name in g.services), ())
         services[service.name] = rx.ServiceSpec(
             name=service.name, module=module, request=request, kind=kind,
             args={a.name: value_of(a.value) for a in service.args},
             input=service.input.text if service.input else None,
             output=service.output.text if service.output else None,
             start_timeout=seconds(timeout.start), interm_timeout=seconds(timeout.interm),
-            final_timeout=seconds(timeout.final), conflicts=frozenset(linked))
+            final_timeout=seconds(timeout.final), conflicts=frozenset(linked), targets=frozenset(targets),
+            group=frozenset(group))
     reflexes = tuple(rx.ReflexSpec(
         name=reflex.name or f"reflex{number + 1}", trigger=reflex.trigger, source=reflex.source.text,
         op=reflex.comparison.op if reflex.comparison else None,

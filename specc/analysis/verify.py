@@ -92,11 +92,13 @@ class ModelModule:
     """A module as its clients see it: what `specc.runtime.functional.Module` does on a request
     or an abort, with the activities' own endings left to the explorer."""
 
-    def __init__(self, name: str, requests: Mapping[str, RequestSpec], registry: ModelRegistry):
+    def __init__(self, name: str, requests: Mapping[str, RequestSpec], registry: ModelRegistry,
+                 codes: tuple[str, ...] = ()):
         self.name = name
+        self.codes = codes  # the report codes reflexes look for: activities may end with them too
         self.requests = requests
         self.registry = registry
-        self.spec = described(requests)  # what the executive reads: no request takes an input here
+        self.spec = SimpleNamespace(requests=requests)  # what the executive reads (no request takes an input)
         self.activities: dict[int, ModelActivity] = {}
         self.zombies: set[int] = set()
         self.reply_listeners: list[Callable[[Reply], None]] = []
@@ -146,7 +148,8 @@ class ModelModule:
         return rqst_id
 
     def interrupt(self, activity: ModelActivity, cause: str) -> None:
-        activity.cause = cause
+        if activity.state != "INTER":  # an activity already being interrupted keeps its first cause
+            activity.cause = cause
         if activity.state == "INIT":
             self.finish(activity, Status.INTERRUPTED, cause)
         elif activity.state == "EXEC":
@@ -179,7 +182,9 @@ class ModelModule:
     def endings(self, activity: ModelActivity) -> list[tuple[str, Callable[[], None]]]:
         """What the activity itself may do next."""
         if activity.state == "EXEC":
-            return [("ends", functools.partial(self.finish, activity, Status.END, "OK")),
+            reported = [(f"ends with {code}", functools.partial(self.finish, activity, Status.END, code))
+                        for code in self.codes]
+            return [("ends", functools.partial(self.finish, activity, Status.END, "OK")), *reported,
                     ("fails", functools.partial(self.finish, activity, Status.FINAL_ERROR, "FAILED")),
                     ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         if activity.state == "INTER":
@@ -188,20 +193,11 @@ class ModelModule:
         return []
 
 
-@functools.cache
-def _described(requests: tuple[str, ...]) -> SimpleNamespace:
-    return SimpleNamespace(requests={n: SimpleNamespace(input_type=None) for n in requests})
-
-
-def described(requests: Mapping[str, RequestSpec]) -> SimpleNamespace:
-    return _described(tuple(requests))
-
-
 class ModelRegistry:
-    def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]]):
+    def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]], codes: tuple[str, ...] = ()):
         self.kernel = ModelKernel()
         self._ids = itertools.count(1)
-        self.modules = {name: ModelModule(name, requests, self) for name, requests in modules.items()}
+        self.modules = {name: ModelModule(name, requests, self, codes) for name, requests in modules.items()}
 
     def new_id(self) -> int:
         return next(self._ids)
@@ -273,7 +269,8 @@ class Explorer:
 
     # -- states: a world is rebuilt from its canonical key before each step (cheaper than copying it)
     def initial(self) -> World:
-        registry = ModelRegistry(self.modules)
+        codes = tuple(sorted({str(r.value) for r in self.spec.reflexes if r.op is not None} - {"OK"}))
+        registry = ModelRegistry(self.modules, codes)
         executive = rx.Executive(self.spec, self.decide, registry)  # type: ignore[arg-type]
         world = World(executive, registry)
         executive.observers.append(functools.partial(_check_exclusion, world, self.arcs))
@@ -282,7 +279,7 @@ class Explorer:
     def key(self, world: World) -> Key:
         """The world's state, canonical: activities numbered by age, module activities by owner."""
         executive = world.executive
-        ordered = sorted(executive.activities.values(), key=lambda a: abs(a.id))
+        ordered = list(executive.activities.values())  # in the order they were listed: by age
         ranks = {a.id: rank for rank, a in enumerate(ordered)}
         owners = {(a.service.module, a.module_id): rank for rank, a in enumerate(ordered)}
         timers: dict[int, list[str]] = {}
@@ -299,7 +296,8 @@ class Explorer:
         activities = tuple((a.service.name, str(a.state), a.holds_group, a.answered, a.abort_sent,
                             tuple(sorted(timers.get(rank, ()))))
                            for rank, a in enumerate(ordered))
-        zombies = tuple(sorted((module, ranks[a.id]) for module, a in executive.zombies.items()))
+        zombies = tuple(sorted((module, ranks[a.id]) for module, listed in executive.zombies.items()
+                               for a in listed))
         return (activities, tuple(modules), tuple(executive.groups.values()), zombies, executive.error is not None)
 
     def world(self, key: Key) -> World:
@@ -335,7 +333,8 @@ class Explorer:
             if activity.module_id is None and activity.state is not rx.Phase.WAIT:
                 activity.module_id = registry.new_id()  # its module has forgotten it
         executive.groups = dict(zip(self.spec.groups, groups, strict=True))
-        executive.zombies = {module: made[rank] for module, rank in zombies}
+        for module, rank in zombies:
+            executive.zombies.setdefault(module, []).append(made[rank])
         executive.error = "ERROR" if error else None
         world.next_id = len(made) + 1
         return world

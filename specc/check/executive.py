@@ -135,7 +135,11 @@ def check_reflex(ctx: Context, reflex: m.Reflex, services: dict[str, m.Service])
     for action in reflex.actions:
         target = action.target
         if action.verb == "request":
-            resolve_request(ctx, target)
+            request = resolve_request(ctx, target)
+            if request is not None and request.inputs:
+                ctx.report("reflex-needs-input", f"a reflex sends '{target.text}' without input, but it takes "
+                           f"{', '.join(i.name for i in request.inputs)}: start a service that provides them instead",
+                           target.span)
         elif target.text not in services:
             ctx.unknown("undefined-service", "service", target.text, services, target.span,
                         f" (reflexes '{action.verb}' executive services)")

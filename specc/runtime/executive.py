@@ -106,6 +106,8 @@ class ServiceSpec:
     interm_timeout: float | None = None  # s from the request to its intermediate reply
     final_timeout: float | None = None  # s from the request to its final reply
     conflicts: frozenset[str] = frozenset()  # services it has an arc to, or from
+    targets: frozenset[str] = frozenset()  # services it has an arc to (interrupts or waits for)
+    group: frozenset[str] = frozenset()  # the services of its group (whose state holds one of them)
 
     @property
     def control(self) -> bool:
@@ -217,12 +219,13 @@ class Executive:
         self.context = Context(registry, world)
         self.activities: dict[int, Activity] = {}  # the activity list, by task-level id
         self.groups: dict[str, str] = dict.fromkeys(spec.groups, IDLE)  # the controller's state
-        self.zombies: dict[str, Activity] = {}  # module -> its ZOMBIE activity: requests refused
+        self.zombies: dict[str, list[Activity]] = {}  # module -> its ZOMBIE activities: requests refused
         self.error: str | None = None  # the general ERROR state (§3.4.2): why
         self.messages: deque[Message] = deque(maxlen=HISTORY)  # the latest ones; listeners get them all
         self.listeners: list[Callable[[Message], None]] = []
         self.observers: list[Callable[[Activity, Phase, Phase], None]] = []
         self.reflex_replies: list[Reply] = []  # replies to requests sent by reflexes
+        self.incidents: list[str] = []  # exceptions raised by listeners and observers
         # With `measure`: each cycle's duration, without the time modules spend handling what it
         # sends them (in-process here, they are other processes on the robot).
         self.cycle_durations: list[float] | None = [] if measure else None
@@ -267,6 +270,9 @@ class Executive:
         module = self.registry.modules[module_name]
         spec = module.spec.requests[request]
         replies: list[Reply] = []
+        if self.error is not None or self.zombies.get(module_name):
+            return "REFUSED"
+        self._post(self._interrupted_by, module_name, request)
         module.submit(request, _as_input(spec.input_type, value), replies.append)
         reply = replies[-1] if replies else None
         if reply is None or not reply.final:
@@ -313,8 +319,8 @@ class Executive:
         if service is None:
             self._tell("REPLY", name, ident, "BAD-SERVICE", f"the executive offers no service '{name}'")
             return
-        if ident in self.activities:
-            self._tell("REPLY", name, ident, "BAD-ID", f"id {ident} is already in use")
+        if ident in self.activities:  # a REPLY would be a second final reply for the live request
+            self._tell("WARNING", name, ident, "BAD-ID", f"id {ident} is already in use: request ignored")
             return
         activity = Activity(ident, service, self.kernel.now)
         self.activities[ident] = activity
@@ -367,14 +373,21 @@ class Executive:
         if self.error is not None:
             self._end(activity, "REFUSED", f"the executive is in its ERROR state: {self.error}")
             return
-        zombie = self.zombies.get(service.module)
-        if zombie is not None:
+        zombies = self.zombies.get(service.module)
+        if zombies:
             self._end(activity, "REFUSED", f"module {service.module} is frozen by ZOMBIE service "
-                                           f"{zombie.service.name} (id {zombie.id}): interrupt it first")
+                                           f"{zombies[0].service.name} (id {zombies[0].id}): interrupt it first")
             return
-        if any(other.state is Phase.INIT and not other.service.control and other.service.name in service.conflicts
-               for other in self.activities.values() if other is not activity):
-            return  # a conflicting activity is about to hold its group: ask again next cycle
+        for other in self.activities.values():
+            if other is activity or other.service.control:
+                continue
+            if other.state is Phase.INIT and other.service.name in service.conflicts:
+                return  # a conflicting activity is about to hold its group: ask again next cycle
+            if other.state in (Phase.INIT, Phase.EXEC, Phase.INTER) and other.service.name in service.group \
+                    and other.service.name not in service.targets:
+                # Its group's state names one running service: a mate the rules would not interrupt
+                # (two instances of a service that does not exclude itself) must end first.
+                return
         status = self._control(service.name, "START")
         if status == "OK":
             self._move(activity, Phase.INIT)
@@ -466,7 +479,7 @@ class Executive:
             return
         if reply.status is Status.ZOMBIE and reply.report.code != "MODULE_FROZEN":
             self._move(activity, Phase.ZOMBIE)
-            self.zombies[service.module] = activity
+            self.zombies.setdefault(service.module, []).append(activity)
             activity.abort_sent = False  # an abort sent before it froze is spent: a new one releases it
             if activity.holds_group and self.error is None and self._control(service.name, "ZOMBIE") == "ERROR":
                 self._fatal(f"the controller rejected the ZOMBIE of {service.name}")
@@ -512,14 +525,16 @@ class Executive:
         """REPLY ABORT: only news for a ZOMBIE, whose module it unfreezes (§3.4.1)."""
         if activity.state is not Phase.ZOMBIE or reply.status is not Status.END:
             return
-        self.zombies.pop(activity.service.module, None)
+        self._forget_zombie(activity)
         self._release(activity)
         self._end(activity, "ZOMBIE", "ended after ZOMBIE and its interruption")
 
     def _module_reply_seen(self, reply: Reply) -> None:
-        if reply.request != "abort":
-            self._post(self._reflexes, "reply" if reply.final else "interm", f"{reply.module}.{reply.request}",
-                       reply)
+        if reply.request == "abort":
+            return
+        frozen = reply.status is Status.ZOMBIE and reply.report.code != "MODULE_FROZEN"
+        trigger = "warning" if frozen else "reply" if reply.final else "interm"
+        self._post(self._reflexes, trigger, f"{reply.module}.{reply.request}", reply)
 
     # ------------------------------------------------------------ the resource controller
     def _control(self, service: str, event: str) -> str:
@@ -569,9 +584,25 @@ class Executive:
                 for verb, target in reflex.actions:
                     self._reflex_action(verb, target)
 
+    def _interrupted_by(self, module_name: str, request: str) -> None:
+        """The executive is about to send `request` itself: the activities of that module it
+        excludes will be interrupted by the module, which the executive decides here (INTER)."""
+        requests = self.registry.modules[module_name].spec.requests
+        sent = requests.get(request)
+        for activity in list(self.activities.values()):
+            service = activity.service
+            if service.module != module_name or service.control or activity.state not in (Phase.INIT, Phase.EXEC):
+                continue
+            own = requests.get(service.request)
+            if sent is not None and own is not None and sent.conflicts_with(own):
+                if activity.state is Phase.EXEC and activity.holds_group and self.error is None:
+                    self._control(service.name, "ABORT")
+                self._move(activity, Phase.INTER)
+
     def _reflex_action(self, verb: str, target: str) -> None:
         if verb == "request":
             module_name, _, request = target.partition(".")
+            self._interrupted_by(module_name, request)
             self._to_module(self.registry.modules[module_name].submit, request, None, self.reflex_replies.append)
         elif verb == "start":
             self._on_request(target, next(self._internal_ids))
@@ -588,7 +619,7 @@ class Executive:
             raise TransitionError(f"{activity.service.name} (id {activity.id}): no arc {source} -> {target}")
         activity.state = target
         for observer in self.observers:
-            observer(activity, source, target)
+            self._guarded(observer, activity, source, target)
 
     def _answer(self, activity: Activity, result: Any, detail: str = "") -> None:
         if not activity.answered:
@@ -602,14 +633,27 @@ class Executive:
             timer.cancel()
         self._move(activity, Phase.ETHER)
         self.activities.pop(activity.id, None)
-        if self.zombies.get(activity.service.module) is activity:
-            del self.zombies[activity.service.module]
+        self._forget_zombie(activity)
+
+    def _forget_zombie(self, activity: Activity) -> None:
+        zombies = self.zombies.get(activity.service.module)
+        if zombies and activity in zombies:
+            zombies.remove(activity)
+            if not zombies:
+                del self.zombies[activity.service.module]
 
     def _tell(self, kind: str, service: str, ident: int, result: Any, detail: str = "") -> None:
         message = Message(kind, service, ident, result, detail, self.kernel.now)
         self.messages.append(message)
         for listener in self.listeners:
-            listener(message)
+            self._guarded(listener, message)
+
+    def _guarded(self, callback: Callable[..., Any], *args: Any) -> None:
+        """A listener's or observer's bug is recorded, not allowed to leave the lists half updated."""
+        try:
+            callback(*args)
+        except Exception as exc:
+            self.incidents.append(f"{getattr(callback, '__name__', callback)!s}: {type(exc).__name__}: {exc}")
 
 
 def _as_input(input_type: Any, value: Any) -> Any:

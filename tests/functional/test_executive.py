@@ -80,7 +80,7 @@ def test_unknown_service_and_reused_id_are_answered_at_once(shop: Shop) -> None:
     shop.ask("FLY", 1)
     shop.ask("FREE", 2, LONG)
     shop.ask("FREE", 2)
-    assert shop.facts() == [("REPLY", 1, "BAD-SERVICE"), ("REPLY", 2, "BAD-ID")]
+    assert shop.facts() == [("REPLY", 1, "BAD-SERVICE"), ("WARNING", "FREE", 2, "BAD-ID")]
 
 
 def test_a_waiting_service_starts_when_what_it_waits_for_ends(shop: Shop) -> None:
@@ -194,7 +194,7 @@ def test_reflexes_start_services_and_send_requests(shop: Shop) -> None:
     assert len(started) == 1 and started[0].kind == "REPLY" and started[0].id < 0
     shop.ask("FREE", 2, "exec,zombie")
     shop.run(0.1)
-    assert [r.request for r in shop.executive.reflex_replies] == ["Set"]
+    assert [(r.request, r.status) for r in shop.executive.reflex_replies] == [("Get", rt.Status.END)]
 
 
 def test_parameters_and_output_functions(shop: Shop) -> None:

@@ -28,6 +28,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "B": rt.ServiceSpec(
         name='B',
@@ -41,6 +43,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('B',)),
+        targets=frozenset(('B',)),
+        group=frozenset(('B',)),
     ),
     "C": rt.ServiceSpec(
         name='C',
@@ -54,6 +58,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('E',)),
+        targets=frozenset(('E',)),
+        group=frozenset(()),
     ),
     "D": rt.ServiceSpec(
         name='D',
@@ -67,6 +73,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('D', 'E', 'F')),
+        targets=frozenset(('D', 'E', 'F')),
+        group=frozenset(('D', 'E', 'F')),
     ),
     "E": rt.ServiceSpec(
         name='E',
@@ -80,6 +88,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('C', 'D', 'E', 'F')),
+        targets=frozenset(('D', 'E', 'F')),
+        group=frozenset(('D', 'E', 'F')),
     ),
     "F": rt.ServiceSpec(
         name='F',
@@ -93,6 +103,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('D', 'E', 'F')),
+        targets=frozenset(('D', 'E', 'F')),
+        group=frozenset(('D', 'E', 'F')),
     ),
     "G": rt.ServiceSpec(
         name='G',
@@ -106,6 +118,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('G', 'H', 'I')),
+        targets=frozenset(('G', 'H', 'I')),
+        group=frozenset(('G',)),
     ),
     "H": rt.ServiceSpec(
         name='H',
@@ -119,6 +133,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('G', 'H', 'I')),
+        targets=frozenset(('H', 'I')),
+        group=frozenset(('H', 'I')),
     ),
     "I": rt.ServiceSpec(
         name='I',
@@ -132,6 +148,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('G', 'H', 'I', 'J')),
+        targets=frozenset(('H', 'I', 'J')),
+        group=frozenset(('H', 'I')),
     ),
     "J": rt.ServiceSpec(
         name='J',
@@ -145,6 +163,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('I', 'J')),
+        targets=frozenset(('J',)),
+        group=frozenset(('J',)),
     ),
 }
 

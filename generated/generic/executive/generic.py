@@ -28,6 +28,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('A', 'B', 'C', 'I', 'J')),
+        targets=frozenset(('A', 'B', 'C')),
+        group=frozenset(('A', 'B', 'C')),
     ),
     "B": rt.ServiceSpec(
         name='B',
@@ -41,6 +43,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('A', 'B', 'C', 'I', 'J')),
+        targets=frozenset(('A', 'B', 'C')),
+        group=frozenset(('A', 'B', 'C')),
     ),
     "C": rt.ServiceSpec(
         name='C',
@@ -54,6 +58,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('A', 'B', 'C', 'I', 'J')),
+        targets=frozenset(('A', 'B', 'C')),
+        group=frozenset(('A', 'B', 'C')),
     ),
     "D": rt.ServiceSpec(
         name='D',
@@ -67,6 +73,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "E": rt.ServiceSpec(
         name='E',
@@ -80,6 +88,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('E', 'F', 'G', 'H', 'I', 'J')),
+        targets=frozenset(('E', 'F', 'G')),
+        group=frozenset(('E', 'F', 'G')),
     ),
     "F": rt.ServiceSpec(
         name='F',
@@ -93,6 +103,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('E', 'F', 'G', 'H', 'I', 'J')),
+        targets=frozenset(('E', 'F', 'G')),
+        group=frozenset(('E', 'F', 'G')),
     ),
     "G": rt.ServiceSpec(
         name='G',
@@ -106,6 +118,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('E', 'F', 'G', 'H', 'I', 'J')),
+        targets=frozenset(('E', 'F', 'G')),
+        group=frozenset(('E', 'F', 'G')),
     ),
     "H": rt.ServiceSpec(
         name='H',
@@ -119,6 +133,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(('E', 'F', 'G')),
+        targets=frozenset(('E', 'F', 'G')),
+        group=frozenset(()),
     ),
     "I": rt.ServiceSpec(
         name='I',
@@ -132,6 +148,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(('A', 'B', 'C', 'E', 'F', 'G')),
+        targets=frozenset(('A', 'B', 'C', 'E', 'F', 'G')),
+        group=frozenset(()),
     ),
     "J": rt.ServiceSpec(
         name='J',
@@ -145,6 +163,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(('A', 'B', 'C', 'E', 'F', 'G')),
+        targets=frozenset(('A', 'B', 'C', 'E', 'F', 'G')),
+        group=frozenset(()),
     ),
 }
 

@@ -581,54 +581,15 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'A':
                 calls('changeInterState', (a['@ABCstate'],))
                 calls('sendAbortRequest', (a['@ABCstate'],))
-                v = a['@EFGstate']
-                if v == 'E':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_32
-                elif v == 'F':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_33
-                elif v == 'G':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_34
-                elif v == 'IDLE':
-                    return _LEAF_35
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                return _node_11(a, calls)
             elif v == 'B':
                 calls('changeInterState', (a['@ABCstate'],))
                 calls('sendAbortRequest', (a['@ABCstate'],))
-                v = a['@EFGstate']
-                if v == 'E':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_36
-                elif v == 'F':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_37
-                elif v == 'G':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_38
-                elif v == 'IDLE':
-                    return _LEAF_39
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                return _node_12(a, calls)
             elif v == 'C':
                 calls('changeInterState', (a['@ABCstate'],))
                 calls('sendAbortRequest', (a['@ABCstate'],))
-                v = a['@EFGstate']
-                if v == 'E':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_40
-                elif v == 'F':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_41
-                elif v == 'G':
-                    calls('changeInterState', (a['@EFGstate'],))
-                    return _LEAF_42
-                elif v == 'IDLE':
-                    return _LEAF_43
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                return _node_13(a, calls)
             elif v == 'IDLE':
                 return _node_16(a, calls)
             else:

@@ -28,6 +28,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "SET-DYNAMIC": rt.ServiceSpec(
         name='SET-DYNAMIC',
@@ -41,6 +43,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "AUTOBOX-OFF": rt.ServiceSpec(
         name='AUTOBOX-OFF',
@@ -54,6 +58,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "SET-BOX": rt.ServiceSpec(
         name='SET-BOX',
@@ -67,6 +73,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "READ-MODEL": rt.ServiceSpec(
         name='READ-MODEL',
@@ -80,6 +88,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=30.0,
         conflicts=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
+        targets=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
+        group=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
     ),
     "INIT-MODEL": rt.ServiceSpec(
         name='INIT-MODEL',
@@ -93,6 +103,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(('READ-OBST', 'SEARCH-OBJ')),
+        targets=frozenset(('READ-OBST', 'SEARCH-OBJ')),
+        group=frozenset(()),
     ),
     "READ-OBST": rt.ServiceSpec(
         name='READ-OBST',
@@ -106,6 +118,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=30.0,
         conflicts=frozenset(('INIT-MODEL', 'READ-OBST', 'SEARCH-OBJ')),
+        targets=frozenset(('READ-OBST', 'SEARCH-OBJ')),
+        group=frozenset(('READ-OBST', 'SEARCH-OBJ')),
     ),
     "EXEC-TRAJ-GOAL": rt.ServiceSpec(
         name='EXEC-TRAJ-GOAL',
@@ -119,6 +133,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=120.0,
         conflicts=frozenset(('ARM-OBJ', 'CALC-OBJ', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
+        targets=frozenset(('ARM-OBJ', 'CALC-OBJ', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
+        group=frozenset(('EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
     ),
     "EXEC-TRAJ-OBJ": rt.ServiceSpec(
         name='EXEC-TRAJ-OBJ',
@@ -132,6 +148,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=120.0,
         conflicts=frozenset(('CALC-GOAL', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
+        targets=frozenset(('EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
+        group=frozenset(('EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ')),
     ),
     "CALC-TRAJ-GOAL": rt.ServiceSpec(
         name='CALC-TRAJ-GOAL',
@@ -145,6 +163,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=30.0,
         conflicts=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
+        targets=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
+        group=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
     ),
     "CALC-TRAJ-OBJ": rt.ServiceSpec(
         name='CALC-TRAJ-OBJ',
@@ -158,6 +178,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=30.0,
         conflicts=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'READ-MODEL')),
+        targets=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'READ-MODEL')),
+        group=frozenset(('CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'READ-MODEL')),
     ),
     "ARM-OBJ": rt.ServiceSpec(
         name='ARM-OBJ',
@@ -171,6 +193,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('ARM-BACK', 'ARM-OBJ', 'EXEC-TRAJ-GOAL')),
+        targets=frozenset(('ARM-BACK', 'ARM-OBJ', 'EXEC-TRAJ-GOAL')),
+        group=frozenset(('ARM-BACK', 'ARM-OBJ')),
     ),
     "ARM-BACK": rt.ServiceSpec(
         name='ARM-BACK',
@@ -184,6 +208,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('ARM-BACK', 'ARM-OBJ')),
+        targets=frozenset(('ARM-BACK', 'ARM-OBJ')),
+        group=frozenset(('ARM-BACK', 'ARM-OBJ')),
     ),
     "OPEN-GRIP": rt.ServiceSpec(
         name='OPEN-GRIP',
@@ -197,6 +223,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "CLOSE-GRIP": rt.ServiceSpec(
         name='CLOSE-GRIP',
@@ -210,6 +238,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "TURN-CAMERA": rt.ServiceSpec(
         name='TURN-CAMERA',
@@ -223,6 +253,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "TAKE-IMAGE": rt.ServiceSpec(
         name='TAKE-IMAGE',
@@ -236,6 +268,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(('SEARCH-OBJ',)),
+        targets=frozenset(('SEARCH-OBJ',)),
+        group=frozenset(()),
     ),
     "SEARCH-OBJ": rt.ServiceSpec(
         name='SEARCH-OBJ',
@@ -249,6 +283,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=30.0,
         conflicts=frozenset(('INIT-MODEL', 'READ-OBST', 'SEARCH-OBJ', 'TAKE-IMAGE')),
+        targets=frozenset(('READ-OBST', 'SEARCH-OBJ')),
+        group=frozenset(('READ-OBST', 'SEARCH-OBJ')),
     ),
     "GET-NEAR-OBJ": rt.ServiceSpec(
         name='GET-NEAR-OBJ',
@@ -262,6 +298,8 @@ SERVICES = {
         interm_timeout=None,
         final_timeout=5.0,
         conflicts=frozenset(()),
+        targets=frozenset(()),
+        group=frozenset(()),
     ),
     "CALC-GOAL": rt.ServiceSpec(
         name='CALC-GOAL',
@@ -275,6 +313,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=60.0,
         conflicts=frozenset(('CALC-GOAL', 'EXEC-TRAJ-OBJ')),
+        targets=frozenset(('CALC-GOAL', 'EXEC-TRAJ-OBJ')),
+        group=frozenset(('CALC-GOAL',)),
     ),
     "CALC-OBJ": rt.ServiceSpec(
         name='CALC-OBJ',
@@ -288,6 +328,8 @@ SERVICES = {
         interm_timeout=1.0,
         final_timeout=30.0,
         conflicts=frozenset(('CALC-OBJ', 'EXEC-TRAJ-GOAL')),
+        targets=frozenset(('CALC-OBJ', 'EXEC-TRAJ-GOAL')),
+        group=frozenset(('CALC-OBJ',)),
     ),
 }
 

@@ -1268,26 +1268,26 @@ _LEAF_1246 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_
 _LEAF_1247 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'READ-MODEL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'IDLE', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1248 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1249 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1250 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1251 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1252 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1253 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1254 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1255 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1256 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1257 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1250 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1251 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1252 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1253 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1254 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1255 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1256 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1257 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1258 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1259 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1260 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1261 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1262 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1263 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1264 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1265 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1266 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1267 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1268 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
-_LEAF_1269 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1262 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1263 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'READ-OBST', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1264 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1265 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1266 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1267 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1268 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
+_LEAF_1269 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1270 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1271 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'IDLE', 'READ_OBST_SEARCH_OBJstate': 'IDLE', 'ExecTrajState': 'EXEC-TRAJ-GOAL', 'ARM_OBJ_ARM_BACKstate': 'IDLE', 'CALC_GOALstate': 'IDLE', 'CALC_OBJstate': 'IDLE'}), (), (), None)
 _LEAF_1272 = Decision(MappingProxyType({'status': 'WAIT', 'READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate': 'CALC-TRAJ-GOAL', 'READ_OBST_SEARCH_OBJstate': 'SEARCH-OBJ', 'ExecTrajState': 'IDLE', 'ARM_OBJ_ARM_BACKstate': 'ARM-BACK', 'CALC_GOALstate': 'CALC-GOAL', 'CALC_OBJstate': 'IDLE'}), (), (), None)
@@ -1671,7 +1671,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_761(a, calls)
+                                return _node_755(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_10(a, calls)
@@ -1680,7 +1680,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_762(a, calls)
+                                return _node_756(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_41(a, calls)
@@ -1689,7 +1689,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_763(a, calls)
+                                return _node_757(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_72(a, calls)
@@ -1702,7 +1702,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_764(a, calls)
+                                return _node_758(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_13(a, calls)
@@ -1711,7 +1711,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_765(a, calls)
+                                return _node_759(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_44(a, calls)
@@ -1720,7 +1720,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_766(a, calls)
+                                return _node_760(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_75(a, calls)
@@ -1733,13 +1733,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'CALC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_767(a, calls)
+                        return _node_761(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_776(a, calls)
+                                return _node_765(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_104(a, calls)
@@ -1748,7 +1748,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_777(a, calls)
+                                return _node_766(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_135(a, calls)
@@ -1757,7 +1757,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_778(a, calls)
+                                return _node_767(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_166(a, calls)
@@ -1770,7 +1770,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_779(a, calls)
+                                return _node_768(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_107(a, calls)
@@ -1779,7 +1779,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_780(a, calls)
+                                return _node_769(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_138(a, calls)
@@ -1788,7 +1788,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_781(a, calls)
+                                return _node_770(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_169(a, calls)
@@ -1801,23 +1801,39 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'CALC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_782(a, calls)
+                        return _node_771(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_792(a, calls)
+                        v = a['@READ_OBST_SEARCH_OBJstate']
+                        if v == 'READ-OBST':
+                            return _node_775(a, calls)
+                        elif v == 'SEARCH-OBJ':
+                            return _node_776(a, calls)
+                        elif v == 'IDLE':
+                            return _node_777(a, calls)
+                        else:
+                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     elif v == 'IDLE':
-                        return _node_802(a, calls)
+                        v = a['@READ_OBST_SEARCH_OBJstate']
+                        if v == 'READ-OBST':
+                            return _node_778(a, calls)
+                        elif v == 'SEARCH-OBJ':
+                            return _node_779(a, calls)
+                        elif v == 'IDLE':
+                            return _node_780(a, calls)
+                        else:
+                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_812(a, calls)
+                        return _node_781(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_821(a, calls)
+                                return _node_785(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_292(a, calls)
@@ -1826,7 +1842,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_822(a, calls)
+                                return _node_786(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_323(a, calls)
@@ -1835,7 +1851,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_823(a, calls)
+                                return _node_787(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_354(a, calls)
@@ -1848,7 +1864,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_824(a, calls)
+                                return _node_788(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_295(a, calls)
@@ -1857,7 +1873,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_825(a, calls)
+                                return _node_789(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_326(a, calls)
@@ -1866,7 +1882,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_826(a, calls)
+                                return _node_790(a, calls)
                             elif v == 'IDLE':
                                 calls('changeInterState', (a['@ExecTrajState'],))
                                 return _node_357(a, calls)
@@ -1883,25 +1899,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'READ-MODEL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_827(a, calls)
+                        return _node_791(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_831(a, calls)
+                            return _node_795(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_832(a, calls)
+                            return _node_796(a, calls)
                         elif v == 'IDLE':
-                            return _node_833(a, calls)
+                            return _node_797(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_834(a, calls)
+                            return _node_798(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_835(a, calls)
+                            return _node_799(a, calls)
                         elif v == 'IDLE':
-                            return _node_836(a, calls)
+                            return _node_800(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     else:
@@ -1909,25 +1925,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'CALC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_837(a, calls)
+                        return _node_801(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_841(a, calls)
+                            return _node_805(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_842(a, calls)
+                            return _node_806(a, calls)
                         elif v == 'IDLE':
-                            return _node_843(a, calls)
+                            return _node_807(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_844(a, calls)
+                            return _node_808(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_845(a, calls)
+                            return _node_809(a, calls)
                         elif v == 'IDLE':
-                            return _node_846(a, calls)
+                            return _node_810(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     else:
@@ -1935,25 +1951,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'CALC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_847(a, calls)
+                        return _node_811(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_851(a, calls)
+                            return _node_815(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_852(a, calls)
+                            return _node_816(a, calls)
                         elif v == 'IDLE':
-                            return _node_853(a, calls)
+                            return _node_817(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_854(a, calls)
+                            return _node_818(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_855(a, calls)
+                            return _node_819(a, calls)
                         elif v == 'IDLE':
-                            return _node_856(a, calls)
+                            return _node_820(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     else:
@@ -1961,25 +1977,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_857(a, calls)
+                        return _node_821(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_861(a, calls)
+                            return _node_825(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_862(a, calls)
+                            return _node_826(a, calls)
                         elif v == 'IDLE':
-                            return _node_863(a, calls)
+                            return _node_827(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_864(a, calls)
+                            return _node_828(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_865(a, calls)
+                            return _node_829(a, calls)
                         elif v == 'IDLE':
-                            return _node_866(a, calls)
+                            return _node_830(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     else:
@@ -1991,13 +2007,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'READ-MODEL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_867(a, calls)
+                        return _node_831(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_871(a, calls)
+                                return _node_835(a, calls)
                             elif v == 'IDLE':
                                 return _node_30(a, calls)
                             else:
@@ -2005,7 +2021,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_872(a, calls)
+                                return _node_836(a, calls)
                             elif v == 'IDLE':
                                 return _node_61(a, calls)
                             else:
@@ -2013,7 +2029,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_873(a, calls)
+                                return _node_837(a, calls)
                             elif v == 'IDLE':
                                 return _node_92(a, calls)
                             else:
@@ -2025,7 +2041,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_874(a, calls)
+                                return _node_838(a, calls)
                             elif v == 'IDLE':
                                 return _node_33(a, calls)
                             else:
@@ -2033,7 +2049,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_875(a, calls)
+                                return _node_839(a, calls)
                             elif v == 'IDLE':
                                 return _node_64(a, calls)
                             else:
@@ -2041,7 +2057,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_876(a, calls)
+                                return _node_840(a, calls)
                             elif v == 'IDLE':
                                 return _node_95(a, calls)
                             else:
@@ -2053,13 +2069,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'CALC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_877(a, calls)
+                        return _node_841(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_880(a, calls)
+                                return _node_844(a, calls)
                             elif v == 'IDLE':
                                 return _node_124(a, calls)
                             else:
@@ -2067,7 +2083,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_881(a, calls)
+                                return _node_845(a, calls)
                             elif v == 'IDLE':
                                 return _node_155(a, calls)
                             else:
@@ -2093,7 +2109,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_882(a, calls)
+                                return _node_846(a, calls)
                             elif v == 'IDLE':
                                 return _node_127(a, calls)
                             else:
@@ -2101,7 +2117,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_883(a, calls)
+                                return _node_847(a, calls)
                             elif v == 'IDLE':
                                 return _node_158(a, calls)
                             else:
@@ -2127,25 +2143,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'CALC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_884(a, calls)
+                        return _node_848(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_888(a, calls)
+                            return _node_852(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_889(a, calls)
+                            return _node_853(a, calls)
                         elif v == 'IDLE':
-                            return _node_890(a, calls)
+                            return _node_854(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
-                            return _node_891(a, calls)
+                            return _node_855(a, calls)
                         elif v == 'SEARCH-OBJ':
-                            return _node_892(a, calls)
+                            return _node_856(a, calls)
                         elif v == 'IDLE':
-                            return _node_893(a, calls)
+                            return _node_857(a, calls)
                         else:
                             raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                     else:
@@ -2153,13 +2169,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_894(a, calls)
+                        return _node_858(a, calls)
                     elif v == 'ARM-BACK':
                         v = a['@READ_OBST_SEARCH_OBJstate']
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_897(a, calls)
+                                return _node_861(a, calls)
                             elif v == 'IDLE':
                                 return _node_312(a, calls)
                             else:
@@ -2167,7 +2183,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_898(a, calls)
+                                return _node_862(a, calls)
                             elif v == 'IDLE':
                                 return _node_343(a, calls)
                             else:
@@ -2193,7 +2209,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'READ-OBST':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_899(a, calls)
+                                return _node_863(a, calls)
                             elif v == 'IDLE':
                                 return _node_315(a, calls)
                             else:
@@ -2201,7 +2217,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'SEARCH-OBJ':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_900(a, calls)
+                                return _node_864(a, calls)
                             elif v == 'IDLE':
                                 return _node_346(a, calls)
                             else:
@@ -2233,41 +2249,41 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'READ-MODEL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_901(a, calls)
+                    return _node_865(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_902(a, calls)
+                    return _node_866(a, calls)
                 elif v == 'IDLE':
-                    return _node_903(a, calls)
+                    return _node_867(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-GOAL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_904(a, calls)
+                    return _node_868(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_905(a, calls)
+                    return _node_869(a, calls)
                 elif v == 'IDLE':
-                    return _node_906(a, calls)
+                    return _node_870(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_907(a, calls)
+                    return _node_871(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_908(a, calls)
+                    return _node_872(a, calls)
                 elif v == 'IDLE':
-                    return _node_909(a, calls)
+                    return _node_873(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_910(a, calls)
+                    return _node_874(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_911(a, calls)
+                    return _node_875(a, calls)
                 elif v == 'IDLE':
-                    return _node_912(a, calls)
+                    return _node_876(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             else:
@@ -2277,47 +2293,47 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'READ-MODEL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_913(a, calls)
+                    return _node_877(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_902(a, calls)
+                    return _node_866(a, calls)
                 elif v == 'IDLE':
-                    return _node_914(a, calls)
+                    return _node_878(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-GOAL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_915(a, calls)
+                    return _node_879(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_905(a, calls)
+                    return _node_869(a, calls)
                 elif v == 'IDLE':
-                    return _node_916(a, calls)
+                    return _node_880(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_917(a, calls)
+                    return _node_881(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_908(a, calls)
+                    return _node_872(a, calls)
                 elif v == 'IDLE':
-                    return _node_918(a, calls)
+                    return _node_882(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_919(a, calls)
+                    return _node_883(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_911(a, calls)
+                    return _node_875(a, calls)
                 elif v == 'IDLE':
-                    return _node_920(a, calls)
+                    return _node_884(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_921(a, calls)
+            return _node_885(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'EXEC-TRAJ-OBJ':
@@ -2328,48 +2344,48 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_903(a, calls)
+                    return _node_867(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_922(a, calls)
+                    return _node_886(a, calls)
                 elif v == 'IDLE':
-                    return _node_913(a, calls)
+                    return _node_877(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-GOAL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_906(a, calls)
+                    return _node_870(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_923(a, calls)
+                    return _node_887(a, calls)
                 elif v == 'IDLE':
-                    return _node_915(a, calls)
+                    return _node_879(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_909(a, calls)
+                    return _node_873(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_924(a, calls)
+                    return _node_888(a, calls)
                 elif v == 'IDLE':
-                    return _node_917(a, calls)
+                    return _node_881(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_912(a, calls)
+                    return _node_876(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
                     calls('changeInterState', (a['@ExecTrajState'],))
-                    return _node_925(a, calls)
+                    return _node_889(a, calls)
                 elif v == 'IDLE':
-                    return _node_919(a, calls)
+                    return _node_883(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             else:
@@ -2379,41 +2395,41 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'READ-MODEL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_901(a, calls)
+                    return _node_865(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_902(a, calls)
+                    return _node_866(a, calls)
                 elif v == 'IDLE':
-                    return _node_922(a, calls)
+                    return _node_886(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-GOAL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_904(a, calls)
+                    return _node_868(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_905(a, calls)
+                    return _node_869(a, calls)
                 elif v == 'IDLE':
-                    return _node_923(a, calls)
+                    return _node_887(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_907(a, calls)
+                    return _node_871(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_908(a, calls)
+                    return _node_872(a, calls)
                 elif v == 'IDLE':
-                    return _node_924(a, calls)
+                    return _node_888(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_910(a, calls)
+                    return _node_874(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_911(a, calls)
+                    return _node_875(a, calls)
                 elif v == 'IDLE':
-                    return _node_925(a, calls)
+                    return _node_889(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             else:
@@ -2423,47 +2439,47 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'READ-MODEL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_901(a, calls)
+                    return _node_865(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_913(a, calls)
+                    return _node_877(a, calls)
                 elif v == 'IDLE':
-                    return _node_914(a, calls)
+                    return _node_878(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-GOAL':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_904(a, calls)
+                    return _node_868(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_915(a, calls)
+                    return _node_879(a, calls)
                 elif v == 'IDLE':
-                    return _node_916(a, calls)
+                    return _node_880(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_907(a, calls)
+                    return _node_871(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_917(a, calls)
+                    return _node_881(a, calls)
                 elif v == 'IDLE':
-                    return _node_918(a, calls)
+                    return _node_882(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
-                    return _node_910(a, calls)
+                    return _node_874(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_919(a, calls)
+                    return _node_883(a, calls)
                 elif v == 'IDLE':
-                    return _node_920(a, calls)
+                    return _node_884(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_926(a, calls)
+            return _node_890(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'CALC-TRAJ-GOAL':
@@ -2473,33 +2489,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'READ-MODEL':
                 v = a['@READ_OBST_SEARCH_OBJstate']
                 if v == 'READ-OBST':
-                    return _node_927(a, calls)
+                    return _node_891(a, calls)
                 elif v == 'SEARCH-OBJ':
                     v = a['@ExecTrajState']
                     if v == 'EXEC-TRAJ-GOAL':
-                        return _node_934(a, calls)
+                        return _node_895(a, calls)
                     elif v == 'EXEC-TRAJ-OBJ':
-                        return _node_939(a, calls)
+                        return _node_896(a, calls)
                     elif v == 'IDLE':
-                        return _node_940(a, calls)
+                        return _node_897(a, calls)
                     else:
                         raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ExecTrajState']
                     if v == 'EXEC-TRAJ-GOAL':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            return _node_758(a, calls)
-                        elif v == 'ARM-BACK':
-                            return _node_941(a, calls)
-                        elif v == 'IDLE':
-                            return _node_943(a, calls)
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                        return _node_898(a, calls)
                     elif v == 'EXEC-TRAJ-OBJ':
-                        return _node_945(a, calls)
+                        return _node_899(a, calls)
                     elif v == 'IDLE':
-                        return _node_946(a, calls)
+                        return _node_900(a, calls)
                     else:
                         raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
                 else:
@@ -2509,39 +2517,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@READ_OBST_SEARCH_OBJstate']
                 if v == 'READ-OBST':
-                    return _node_947(a, calls)
+                    return _node_901(a, calls)
                 elif v == 'SEARCH-OBJ':
                     v = a['@ExecTrajState']
                     if v == 'EXEC-TRAJ-GOAL':
-                        return _node_949(a, calls)
+                        return _node_904(a, calls)
                     elif v == 'EXEC-TRAJ-OBJ':
-                        return _node_950(a, calls)
+                        return _node_905(a, calls)
                     elif v == 'IDLE':
-                        return _node_951(a, calls)
+                        return _node_906(a, calls)
                     else:
                         raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ExecTrajState']
                     if v == 'EXEC-TRAJ-GOAL':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            return _node_789(a, calls)
-                        elif v == 'ARM-BACK':
-                            return _node_799(a, calls)
-                        elif v == 'IDLE':
-                            return _node_809(a, calls)
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                        return _node_907(a, calls)
                     elif v == 'EXEC-TRAJ-OBJ':
-                        return _node_952(a, calls)
+                        return _node_908(a, calls)
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_887(a, calls)
+                            return _node_851(a, calls)
                         elif v == 'ARM-BACK':
-                            return _node_890(a, calls)
+                            return _node_854(a, calls)
                         elif v == 'IDLE':
-                            return _node_893(a, calls)
+                            return _node_857(a, calls)
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -2577,7 +2577,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_953(a, calls)
+            return _node_909(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'CALC-TRAJ-OBJ':
@@ -2589,45 +2589,49 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                     calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _node_903(a, calls)
+                    return _node_867(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_954(a, calls)
+                    return _node_910(a, calls)
                 elif v == 'IDLE':
                     v = a['@READ_OBST_SEARCH_OBJstate']
                     if v == 'READ-OBST':
-                        return _node_933(a, calls)
+                        return _node_894(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_940(a, calls)
+                        return _node_897(a, calls)
                     elif v == 'IDLE':
-                        return _node_946(a, calls)
+                        return _node_900(a, calls)
                     else:
                         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-GOAL':
-                calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                     calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _node_906(a, calls)
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _node_870(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_923(a, calls)
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _node_887(a, calls)
                 elif v == 'IDLE':
-                    return _node_915(a, calls)
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _node_879(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'CALC-TRAJ-OBJ':
-                calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
                 v = a['@ExecTrajState']
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                     calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _node_909(a, calls)
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _node_873(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_924(a, calls)
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _node_888(a, calls)
                 elif v == 'IDLE':
-                    return _node_917(a, calls)
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _node_881(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             elif v == 'IDLE':
@@ -2635,11 +2639,11 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                     calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _node_912(a, calls)
+                    return _node_876(a, calls)
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_925(a, calls)
+                    return _node_889(a, calls)
                 elif v == 'IDLE':
-                    return _node_919(a, calls)
+                    return _node_883(a, calls)
                 else:
                     raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
             else:
@@ -2669,7 +2673,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_955(a, calls)
+            return _node_911(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'ARM-OBJ':
@@ -2679,173 +2683,51 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'EXEC-TRAJ-GOAL':
                 calls('changeInterState', ('EXEC-TRAJ-GOAL',))
                 calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-                if v == 'READ-MODEL':
-                    v = a['@ARM_OBJ_ARM_BACKstate']
-                    if v == 'ARM-OBJ':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_751(a, calls)
-                    elif v == 'ARM-BACK':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        v = a['@READ_OBST_SEARCH_OBJstate']
-                        if v == 'READ-OBST':
-                            return _node_928(a, calls)
-                        elif v == 'SEARCH-OBJ':
-                            return _node_935(a, calls)
-                        elif v == 'IDLE':
-                            return _node_941(a, calls)
-                        else:
-                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@READ_OBST_SEARCH_OBJstate']
-                        if v == 'READ-OBST':
-                            return _node_930(a, calls)
-                        elif v == 'SEARCH-OBJ':
-                            return _node_937(a, calls)
-                        elif v == 'IDLE':
-                            return _node_943(a, calls)
-                        else:
-                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                elif v == 'CALC-TRAJ-GOAL':
-                    v = a['@ARM_OBJ_ARM_BACKstate']
-                    if v == 'ARM-OBJ':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_767(a, calls)
-                    elif v == 'ARM-BACK':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        v = a['@READ_OBST_SEARCH_OBJstate']
-                        if v == 'READ-OBST':
-                            return _node_956(a, calls)
-                        elif v == 'SEARCH-OBJ':
-                            return _node_958(a, calls)
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                return _node_778(a, calls)
-                            elif v == 'IDLE':
-                                return _node_960(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@READ_OBST_SEARCH_OBJstate']
-                        if v == 'READ-OBST':
-                            return _node_961(a, calls)
-                        elif v == 'SEARCH-OBJ':
-                            return _node_963(a, calls)
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                return _node_781(a, calls)
-                            elif v == 'IDLE':
-                                return _node_965(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                elif v == 'CALC-TRAJ-OBJ':
-                    v = a['@ARM_OBJ_ARM_BACKstate']
-                    if v == 'ARM-OBJ':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_782(a, calls)
-                    elif v == 'ARM-BACK':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_792(a, calls)
-                    elif v == 'IDLE':
-                        return _node_802(a, calls)
-                    else:
-                        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                elif v == 'IDLE':
-                    v = a['@ARM_OBJ_ARM_BACKstate']
-                    if v == 'ARM-OBJ':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_812(a, calls)
-                    elif v == 'ARM-BACK':
-                        calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        v = a['@READ_OBST_SEARCH_OBJstate']
-                        if v == 'READ-OBST':
-                            return _node_966(a, calls)
-                        elif v == 'SEARCH-OBJ':
-                            return _node_968(a, calls)
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                return _node_823(a, calls)
-                            elif v == 'IDLE':
-                                return _node_970(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@READ_OBST_SEARCH_OBJstate']
-                        if v == 'READ-OBST':
-                            return _node_971(a, calls)
-                        elif v == 'SEARCH-OBJ':
-                            return _node_973(a, calls)
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                return _node_826(a, calls)
-                            elif v == 'IDLE':
-                                return _node_975(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                return _node_912(a, calls)
             elif v == 'EXEC-TRAJ-OBJ':
                 v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
                 if v == 'READ-MODEL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_976(a, calls)
+                        return _node_917(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_977(a, calls)
+                        return _node_918(a, calls)
                     elif v == 'IDLE':
-                        return _node_979(a, calls)
+                        return _node_920(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'CALC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_980(a, calls)
+                        return _node_921(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_981(a, calls)
+                        return _node_922(a, calls)
                     elif v == 'IDLE':
-                        return _node_983(a, calls)
+                        return _node_924(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'CALC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_984(a, calls)
+                        return _node_925(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_985(a, calls)
+                        return _node_926(a, calls)
                     elif v == 'IDLE':
-                        return _node_987(a, calls)
+                        return _node_928(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_988(a, calls)
+                        return _node_929(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_989(a, calls)
+                        return _node_930(a, calls)
                     elif v == 'IDLE':
-                        return _node_991(a, calls)
+                        return _node_932(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -2856,44 +2738,44 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_992(a, calls)
+                        return _node_933(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_993(a, calls)
+                        return _node_934(a, calls)
                     elif v == 'IDLE':
-                        return _node_995(a, calls)
+                        return _node_936(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'CALC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_996(a, calls)
+                        return _node_937(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_997(a, calls)
+                        return _node_938(a, calls)
                     elif v == 'IDLE':
-                        return _node_999(a, calls)
+                        return _node_940(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'CALC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_1000(a, calls)
+                        return _node_941(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1001(a, calls)
+                        return _node_942(a, calls)
                     elif v == 'IDLE':
-                        return _node_1003(a, calls)
+                        return _node_944(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_1004(a, calls)
+                        return _node_945(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1005(a, calls)
+                        return _node_946(a, calls)
                     elif v == 'IDLE':
-                        return _node_1007(a, calls)
+                        return _node_948(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -2907,31 +2789,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1008(a, calls)
+                        return _node_949(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1009(a, calls)
+                        return _node_950(a, calls)
                     elif v == 'IDLE':
-                        return _node_1010(a, calls)
+                        return _node_951(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1011(a, calls)
+                        return _node_952(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1012(a, calls)
+                        return _node_953(a, calls)
                     elif v == 'IDLE':
-                        return _node_976(a, calls)
+                        return _node_917(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1013(a, calls)
+                        return _node_954(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1014(a, calls)
+                        return _node_955(a, calls)
                     elif v == 'IDLE':
-                        return _node_992(a, calls)
+                        return _node_933(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -2941,31 +2823,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1015(a, calls)
+                        return _node_956(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1016(a, calls)
+                        return _node_957(a, calls)
                     elif v == 'IDLE':
-                        return _node_1017(a, calls)
+                        return _node_958(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1018(a, calls)
+                        return _node_959(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1019(a, calls)
+                        return _node_960(a, calls)
                     elif v == 'IDLE':
-                        return _node_980(a, calls)
+                        return _node_921(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1020(a, calls)
+                        return _node_961(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1021(a, calls)
+                        return _node_962(a, calls)
                     elif v == 'IDLE':
-                        return _node_996(a, calls)
+                        return _node_937(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -2975,31 +2857,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1022(a, calls)
+                        return _node_963(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1023(a, calls)
+                        return _node_964(a, calls)
                     elif v == 'IDLE':
-                        return _node_1024(a, calls)
+                        return _node_965(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1025(a, calls)
+                        return _node_966(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1026(a, calls)
+                        return _node_967(a, calls)
                     elif v == 'IDLE':
-                        return _node_984(a, calls)
+                        return _node_925(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1027(a, calls)
+                        return _node_968(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1028(a, calls)
+                        return _node_969(a, calls)
                     elif v == 'IDLE':
-                        return _node_1000(a, calls)
+                        return _node_941(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3009,31 +2891,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1029(a, calls)
+                        return _node_970(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1030(a, calls)
+                        return _node_971(a, calls)
                     elif v == 'IDLE':
-                        return _node_1031(a, calls)
+                        return _node_972(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1032(a, calls)
+                        return _node_973(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1033(a, calls)
+                        return _node_974(a, calls)
                     elif v == 'IDLE':
-                        return _node_988(a, calls)
+                        return _node_929(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1034(a, calls)
+                        return _node_975(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1035(a, calls)
+                        return _node_976(a, calls)
                     elif v == 'IDLE':
-                        return _node_1004(a, calls)
+                        return _node_945(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3047,31 +2929,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1036(a, calls)
+                        return _node_977(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1009(a, calls)
+                        return _node_950(a, calls)
                     elif v == 'IDLE':
-                        return _node_1037(a, calls)
+                        return _node_978(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_979(a, calls)
+                        return _node_920(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1012(a, calls)
+                        return _node_953(a, calls)
                     elif v == 'IDLE':
-                        return _node_1038(a, calls)
+                        return _node_979(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_995(a, calls)
+                        return _node_936(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1014(a, calls)
+                        return _node_955(a, calls)
                     elif v == 'IDLE':
-                        return _node_1039(a, calls)
+                        return _node_980(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3081,31 +2963,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1040(a, calls)
+                        return _node_981(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1016(a, calls)
+                        return _node_957(a, calls)
                     elif v == 'IDLE':
-                        return _node_1041(a, calls)
+                        return _node_982(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_983(a, calls)
+                        return _node_924(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1019(a, calls)
+                        return _node_960(a, calls)
                     elif v == 'IDLE':
-                        return _node_1042(a, calls)
+                        return _node_983(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_999(a, calls)
+                        return _node_940(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1021(a, calls)
+                        return _node_962(a, calls)
                     elif v == 'IDLE':
-                        return _node_1043(a, calls)
+                        return _node_984(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3115,31 +2997,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1044(a, calls)
+                        return _node_985(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1023(a, calls)
+                        return _node_964(a, calls)
                     elif v == 'IDLE':
-                        return _node_1045(a, calls)
+                        return _node_986(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_987(a, calls)
+                        return _node_928(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1026(a, calls)
+                        return _node_967(a, calls)
                     elif v == 'IDLE':
-                        return _node_1046(a, calls)
+                        return _node_987(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1003(a, calls)
+                        return _node_944(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1028(a, calls)
+                        return _node_969(a, calls)
                     elif v == 'IDLE':
-                        return _node_1047(a, calls)
+                        return _node_988(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3149,31 +3031,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1048(a, calls)
+                        return _node_989(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1030(a, calls)
+                        return _node_971(a, calls)
                     elif v == 'IDLE':
-                        return _node_1049(a, calls)
+                        return _node_990(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_991(a, calls)
+                        return _node_932(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1033(a, calls)
+                        return _node_974(a, calls)
                     elif v == 'IDLE':
-                        return _node_1050(a, calls)
+                        return _node_991(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1007(a, calls)
+                        return _node_948(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1035(a, calls)
+                        return _node_976(a, calls)
                     elif v == 'IDLE':
-                        return _node_1051(a, calls)
+                        return _node_992(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3181,7 +3063,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_1052(a, calls)
+            return _node_993(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'ARM-BACK':
@@ -3196,29 +3078,29 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         return _node_751(a, calls)
                     elif v == 'ARM-BACK':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_1053(a, calls)
+                        return _node_994(a, calls)
                     elif v == 'IDLE':
-                        return _node_1036(a, calls)
+                        return _node_977(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_827(a, calls)
+                        return _node_791(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_977(a, calls)
+                        return _node_918(a, calls)
                     elif v == 'IDLE':
-                        return _node_979(a, calls)
+                        return _node_920(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_867(a, calls)
+                        return _node_831(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_993(a, calls)
+                        return _node_934(a, calls)
                     elif v == 'IDLE':
-                        return _node_995(a, calls)
+                        return _node_936(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3228,32 +3110,32 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_767(a, calls)
+                        return _node_761(a, calls)
                     elif v == 'ARM-BACK':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_1054(a, calls)
+                        return _node_995(a, calls)
                     elif v == 'IDLE':
-                        return _node_1040(a, calls)
+                        return _node_981(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_837(a, calls)
+                        return _node_801(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_981(a, calls)
+                        return _node_922(a, calls)
                     elif v == 'IDLE':
-                        return _node_983(a, calls)
+                        return _node_924(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_877(a, calls)
+                        return _node_841(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_997(a, calls)
+                        return _node_938(a, calls)
                     elif v == 'IDLE':
-                        return _node_999(a, calls)
+                        return _node_940(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3263,32 +3145,32 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_782(a, calls)
+                        return _node_771(a, calls)
                     elif v == 'ARM-BACK':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_1055(a, calls)
+                        return _node_996(a, calls)
                     elif v == 'IDLE':
-                        return _node_1044(a, calls)
+                        return _node_985(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_847(a, calls)
+                        return _node_811(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_985(a, calls)
+                        return _node_926(a, calls)
                     elif v == 'IDLE':
-                        return _node_987(a, calls)
+                        return _node_928(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_884(a, calls)
+                        return _node_848(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1001(a, calls)
+                        return _node_942(a, calls)
                     elif v == 'IDLE':
-                        return _node_1003(a, calls)
+                        return _node_944(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3298,32 +3180,32 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_812(a, calls)
+                        return _node_781(a, calls)
                     elif v == 'ARM-BACK':
                         calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-                        return _node_1056(a, calls)
+                        return _node_997(a, calls)
                     elif v == 'IDLE':
-                        return _node_1048(a, calls)
+                        return _node_989(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_857(a, calls)
+                        return _node_821(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_989(a, calls)
+                        return _node_930(a, calls)
                     elif v == 'IDLE':
-                        return _node_991(a, calls)
+                        return _node_932(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_894(a, calls)
+                        return _node_858(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1005(a, calls)
+                        return _node_946(a, calls)
                     elif v == 'IDLE':
-                        return _node_1007(a, calls)
+                        return _node_948(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3337,31 +3219,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1008(a, calls)
+                        return _node_949(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1009(a, calls)
+                        return _node_950(a, calls)
                     elif v == 'IDLE':
-                        return _node_1053(a, calls)
+                        return _node_994(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1011(a, calls)
+                        return _node_952(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1012(a, calls)
+                        return _node_953(a, calls)
                     elif v == 'IDLE':
-                        return _node_978(a, calls)
+                        return _node_919(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1013(a, calls)
+                        return _node_954(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1014(a, calls)
+                        return _node_955(a, calls)
                     elif v == 'IDLE':
-                        return _node_994(a, calls)
+                        return _node_935(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3371,31 +3253,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1015(a, calls)
+                        return _node_956(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1016(a, calls)
+                        return _node_957(a, calls)
                     elif v == 'IDLE':
-                        return _node_1054(a, calls)
+                        return _node_995(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1018(a, calls)
+                        return _node_959(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1019(a, calls)
+                        return _node_960(a, calls)
                     elif v == 'IDLE':
-                        return _node_982(a, calls)
+                        return _node_923(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1020(a, calls)
+                        return _node_961(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1021(a, calls)
+                        return _node_962(a, calls)
                     elif v == 'IDLE':
-                        return _node_998(a, calls)
+                        return _node_939(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3405,31 +3287,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1022(a, calls)
+                        return _node_963(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1023(a, calls)
+                        return _node_964(a, calls)
                     elif v == 'IDLE':
-                        return _node_1055(a, calls)
+                        return _node_996(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1025(a, calls)
+                        return _node_966(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1026(a, calls)
+                        return _node_967(a, calls)
                     elif v == 'IDLE':
-                        return _node_986(a, calls)
+                        return _node_927(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1027(a, calls)
+                        return _node_968(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1028(a, calls)
+                        return _node_969(a, calls)
                     elif v == 'IDLE':
-                        return _node_1002(a, calls)
+                        return _node_943(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3439,31 +3321,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1029(a, calls)
+                        return _node_970(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1030(a, calls)
+                        return _node_971(a, calls)
                     elif v == 'IDLE':
-                        return _node_1056(a, calls)
+                        return _node_997(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1032(a, calls)
+                        return _node_973(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1033(a, calls)
+                        return _node_974(a, calls)
                     elif v == 'IDLE':
-                        return _node_990(a, calls)
+                        return _node_931(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1034(a, calls)
+                        return _node_975(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1035(a, calls)
+                        return _node_976(a, calls)
                     elif v == 'IDLE':
-                        return _node_1006(a, calls)
+                        return _node_947(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3477,31 +3359,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1008(a, calls)
+                        return _node_949(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1036(a, calls)
+                        return _node_977(a, calls)
                     elif v == 'IDLE':
-                        return _node_1037(a, calls)
+                        return _node_978(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1011(a, calls)
+                        return _node_952(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_979(a, calls)
+                        return _node_920(a, calls)
                     elif v == 'IDLE':
-                        return _node_1038(a, calls)
+                        return _node_979(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1013(a, calls)
+                        return _node_954(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_995(a, calls)
+                        return _node_936(a, calls)
                     elif v == 'IDLE':
-                        return _node_1039(a, calls)
+                        return _node_980(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3511,31 +3393,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1015(a, calls)
+                        return _node_956(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1040(a, calls)
+                        return _node_981(a, calls)
                     elif v == 'IDLE':
-                        return _node_1041(a, calls)
+                        return _node_982(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1018(a, calls)
+                        return _node_959(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_983(a, calls)
+                        return _node_924(a, calls)
                     elif v == 'IDLE':
-                        return _node_1042(a, calls)
+                        return _node_983(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1020(a, calls)
+                        return _node_961(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_999(a, calls)
+                        return _node_940(a, calls)
                     elif v == 'IDLE':
-                        return _node_1043(a, calls)
+                        return _node_984(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3545,31 +3427,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1022(a, calls)
+                        return _node_963(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1044(a, calls)
+                        return _node_985(a, calls)
                     elif v == 'IDLE':
-                        return _node_1045(a, calls)
+                        return _node_986(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1025(a, calls)
+                        return _node_966(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_987(a, calls)
+                        return _node_928(a, calls)
                     elif v == 'IDLE':
-                        return _node_1046(a, calls)
+                        return _node_987(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1027(a, calls)
+                        return _node_968(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1003(a, calls)
+                        return _node_944(a, calls)
                     elif v == 'IDLE':
-                        return _node_1047(a, calls)
+                        return _node_988(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3579,31 +3461,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'EXEC-TRAJ-GOAL':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1029(a, calls)
+                        return _node_970(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1048(a, calls)
+                        return _node_989(a, calls)
                     elif v == 'IDLE':
-                        return _node_1049(a, calls)
+                        return _node_990(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1032(a, calls)
+                        return _node_973(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_991(a, calls)
+                        return _node_932(a, calls)
                     elif v == 'IDLE':
-                        return _node_1050(a, calls)
+                        return _node_991(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@ARM_OBJ_ARM_BACKstate']
                     if v == 'ARM-OBJ':
-                        return _node_1034(a, calls)
+                        return _node_975(a, calls)
                     elif v == 'ARM-BACK':
-                        return _node_1007(a, calls)
+                        return _node_948(a, calls)
                     elif v == 'IDLE':
-                        return _node_1051(a, calls)
+                        return _node_992(a, calls)
                     else:
                         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                 else:
@@ -3611,7 +3493,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_1057(a, calls)
+            return _node_998(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'TAKE-IMAGE':
@@ -3625,7 +3507,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_4(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_934(a, calls)
+                        return _node_895(a, calls)
                     elif v == 'IDLE':
                         return _node_66(a, calls)
                     else:
@@ -3635,7 +3517,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_14(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_939(a, calls)
+                        return _node_896(a, calls)
                     elif v == 'IDLE':
                         return _node_76(a, calls)
                     else:
@@ -3645,7 +3527,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_24(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_940(a, calls)
+                        return _node_897(a, calls)
                     elif v == 'IDLE':
                         return _node_86(a, calls)
                     else:
@@ -3659,15 +3541,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_98(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            return _node_771(a, calls)
-                        elif v == 'ARM-BACK':
-                            return _node_958(a, calls)
-                        elif v == 'IDLE':
-                            return _node_963(a, calls)
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                        return _node_914(a, calls)
                     elif v == 'IDLE':
                         return _node_160(a, calls)
                     else:
@@ -3677,7 +3551,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_108(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_1058(a, calls)
+                        return _node_999(a, calls)
                     elif v == 'IDLE':
                         return _node_170(a, calls)
                     else:
@@ -3689,11 +3563,11 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_879(a, calls)
+                            return _node_843(a, calls)
                         elif v == 'ARM-BACK':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_881(a, calls)
+                                return _node_845(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3707,7 +3581,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_883(a, calls)
+                                return _node_847(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3733,7 +3607,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_192(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_949(a, calls)
+                        return _node_904(a, calls)
                     elif v == 'IDLE':
                         return _node_254(a, calls)
                     else:
@@ -3743,7 +3617,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_202(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_950(a, calls)
+                        return _node_905(a, calls)
                     elif v == 'IDLE':
                         return _node_264(a, calls)
                     else:
@@ -3753,7 +3627,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_212(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_951(a, calls)
+                        return _node_906(a, calls)
                     elif v == 'IDLE':
                         return _node_274(a, calls)
                     else:
@@ -3767,15 +3641,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_286(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            return _node_816(a, calls)
-                        elif v == 'ARM-BACK':
-                            return _node_968(a, calls)
-                        elif v == 'IDLE':
-                            return _node_973(a, calls)
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                        return _node_916(a, calls)
                     elif v == 'IDLE':
                         return _node_348(a, calls)
                     else:
@@ -3785,7 +3651,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         return _node_296(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_1059(a, calls)
+                        return _node_1000(a, calls)
                     elif v == 'IDLE':
                         return _node_358(a, calls)
                     else:
@@ -3797,11 +3663,11 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_896(a, calls)
+                            return _node_860(a, calls)
                         elif v == 'ARM-BACK':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_898(a, calls)
+                                return _node_862(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3815,7 +3681,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_900(a, calls)
+                                return _node_864(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3849,7 +3715,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'READ-MODEL':
                 v = a['@READ_OBST_SEARCH_OBJstate']
                 if v == 'READ-OBST':
-                    return _node_927(a, calls)
+                    return _node_891(a, calls)
                 elif v == 'SEARCH-OBJ':
                     return _node_746(a, calls)
                 elif v == 'IDLE':
@@ -3861,25 +3727,17 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'READ-OBST':
                     v = a['@ExecTrajState']
                     if v == 'EXEC-TRAJ-GOAL':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            return _node_768(a, calls)
-                        elif v == 'ARM-BACK':
-                            return _node_956(a, calls)
-                        elif v == 'IDLE':
-                            return _node_961(a, calls)
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                        return _node_913(a, calls)
                     elif v == 'EXEC-TRAJ-OBJ':
-                        return _node_1060(a, calls)
+                        return _node_1001(a, calls)
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_878(a, calls)
+                            return _node_842(a, calls)
                         elif v == 'ARM-BACK':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_880(a, calls)
+                                return _node_844(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3893,7 +3751,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_882(a, calls)
+                                return _node_846(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3917,7 +3775,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['@READ_OBST_SEARCH_OBJstate']
                 if v == 'READ-OBST':
-                    return _node_947(a, calls)
+                    return _node_901(a, calls)
                 elif v == 'SEARCH-OBJ':
                     return _node_748(a, calls)
                 elif v == 'IDLE':
@@ -3929,25 +3787,17 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 if v == 'READ-OBST':
                     v = a['@ExecTrajState']
                     if v == 'EXEC-TRAJ-GOAL':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            return _node_813(a, calls)
-                        elif v == 'ARM-BACK':
-                            return _node_966(a, calls)
-                        elif v == 'IDLE':
-                            return _node_971(a, calls)
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                        return _node_915(a, calls)
                     elif v == 'EXEC-TRAJ-OBJ':
-                        return _node_1061(a, calls)
+                        return _node_1002(a, calls)
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_895(a, calls)
+                            return _node_859(a, calls)
                         elif v == 'ARM-BACK':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_897(a, calls)
+                                return _node_861(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -3961,7 +3811,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         elif v == 'IDLE':
                             v = a['@CALC_OBJstate']
                             if v == 'CALC-OBJ':
-                                return _node_899(a, calls)
+                                return _node_863(a, calls)
                             elif v == 'IDLE':
                                 v = a['@CALC_GOALstate']
                                 if v == 'CALC-GOAL':
@@ -4265,7 +4115,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_1062(a, calls)
+            return _node_1003(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'CALC-GOAL':
@@ -4282,27 +4132,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1063(a, calls)
+                                return _node_1004(a, calls)
                             elif v == 'IDLE':
-                                return _node_1064(a, calls)
+                                return _node_1005(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1065(a, calls)
+                                return _node_1006(a, calls)
                             elif v == 'IDLE':
-                                return _node_1066(a, calls)
+                                return _node_1007(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1067(a, calls)
+                                return _node_1008(a, calls)
                             elif v == 'IDLE':
-                                return _node_1068(a, calls)
+                                return _node_1009(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4313,27 +4163,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1069(a, calls)
+                                return _node_1010(a, calls)
                             elif v == 'IDLE':
-                                return _node_1070(a, calls)
+                                return _node_1011(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1071(a, calls)
+                                return _node_1012(a, calls)
                             elif v == 'IDLE':
-                                return _node_1072(a, calls)
+                                return _node_1013(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1073(a, calls)
+                                return _node_1014(a, calls)
                             elif v == 'IDLE':
-                                return _node_1074(a, calls)
+                                return _node_1015(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4344,27 +4194,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1075(a, calls)
+                                return _node_1016(a, calls)
                             elif v == 'IDLE':
-                                return _node_1076(a, calls)
+                                return _node_1017(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1077(a, calls)
+                                return _node_1018(a, calls)
                             elif v == 'IDLE':
-                                return _node_1078(a, calls)
+                                return _node_1019(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1079(a, calls)
+                                return _node_1020(a, calls)
                             elif v == 'IDLE':
-                                return _node_1080(a, calls)
+                                return _node_1021(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4372,7 +4222,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     else:
                         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                 elif v == 'EXEC-TRAJ-OBJ':
-                    return _node_954(a, calls)
+                    return _node_910(a, calls)
                 elif v == 'IDLE':
                     v = a['@READ_OBST_SEARCH_OBJstate']
                     if v == 'READ-OBST':
@@ -4381,27 +4231,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1081(a, calls)
+                                return _node_1022(a, calls)
                             elif v == 'IDLE':
-                                return _node_1082(a, calls)
+                                return _node_1023(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1083(a, calls)
+                                return _node_1024(a, calls)
                             elif v == 'IDLE':
-                                return _node_1084(a, calls)
+                                return _node_1025(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1085(a, calls)
+                                return _node_1026(a, calls)
                             elif v == 'IDLE':
-                                return _node_1086(a, calls)
+                                return _node_1027(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4412,27 +4262,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1087(a, calls)
+                                return _node_1028(a, calls)
                             elif v == 'IDLE':
-                                return _node_1088(a, calls)
+                                return _node_1029(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1089(a, calls)
+                                return _node_1030(a, calls)
                             elif v == 'IDLE':
-                                return _node_1090(a, calls)
+                                return _node_1031(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1091(a, calls)
+                                return _node_1032(a, calls)
                             elif v == 'IDLE':
-                                return _node_1092(a, calls)
+                                return _node_1033(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4443,27 +4293,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1093(a, calls)
+                                return _node_1034(a, calls)
                             elif v == 'IDLE':
-                                return _node_1094(a, calls)
+                                return _node_1035(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1095(a, calls)
+                                return _node_1036(a, calls)
                             elif v == 'IDLE':
-                                return _node_1096(a, calls)
+                                return _node_1037(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1097(a, calls)
+                                return _node_1038(a, calls)
                             elif v == 'IDLE':
-                                return _node_1098(a, calls)
+                                return _node_1039(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4482,27 +4332,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1099(a, calls)
+                                return _node_1040(a, calls)
                             elif v == 'IDLE':
-                                return _node_1100(a, calls)
+                                return _node_1041(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1101(a, calls)
+                                return _node_1042(a, calls)
                             elif v == 'IDLE':
-                                return _node_1102(a, calls)
+                                return _node_1043(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1103(a, calls)
+                                return _node_1044(a, calls)
                             elif v == 'IDLE':
-                                return _node_1104(a, calls)
+                                return _node_1045(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4513,27 +4363,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1105(a, calls)
+                                return _node_1046(a, calls)
                             elif v == 'IDLE':
-                                return _node_1106(a, calls)
+                                return _node_1047(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1107(a, calls)
+                                return _node_1048(a, calls)
                             elif v == 'IDLE':
-                                return _node_1108(a, calls)
+                                return _node_1049(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1109(a, calls)
+                                return _node_1050(a, calls)
                             elif v == 'IDLE':
-                                return _node_1110(a, calls)
+                                return _node_1051(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4544,27 +4394,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1111(a, calls)
+                                return _node_1052(a, calls)
                             elif v == 'IDLE':
-                                return _node_1112(a, calls)
+                                return _node_1053(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1113(a, calls)
+                                return _node_1054(a, calls)
                             elif v == 'IDLE':
-                                return _node_1114(a, calls)
+                                return _node_1055(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1115(a, calls)
+                                return _node_1056(a, calls)
                             elif v == 'IDLE':
-                                return _node_1116(a, calls)
+                                return _node_1057(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4574,17 +4424,17 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@READ_OBST_SEARCH_OBJstate']
                     if v == 'READ-OBST':
-                        return _node_1060(a, calls)
+                        return _node_1001(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_1058(a, calls)
+                        return _node_999(a, calls)
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_840(a, calls)
+                            return _node_804(a, calls)
                         elif v == 'ARM-BACK':
-                            return _node_843(a, calls)
+                            return _node_807(a, calls)
                         elif v == 'IDLE':
-                            return _node_846(a, calls)
+                            return _node_810(a, calls)
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -4597,27 +4447,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1117(a, calls)
+                                return _node_1058(a, calls)
                             elif v == 'IDLE':
-                                return _node_1118(a, calls)
+                                return _node_1059(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1119(a, calls)
+                                return _node_1060(a, calls)
                             elif v == 'IDLE':
-                                return _node_1120(a, calls)
+                                return _node_1061(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1121(a, calls)
+                                return _node_1062(a, calls)
                             elif v == 'IDLE':
-                                return _node_1122(a, calls)
+                                return _node_1063(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4628,27 +4478,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1123(a, calls)
+                                return _node_1064(a, calls)
                             elif v == 'IDLE':
-                                return _node_1124(a, calls)
+                                return _node_1065(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1125(a, calls)
+                                return _node_1066(a, calls)
                             elif v == 'IDLE':
-                                return _node_1126(a, calls)
+                                return _node_1067(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1127(a, calls)
+                                return _node_1068(a, calls)
                             elif v == 'IDLE':
-                                return _node_1128(a, calls)
+                                return _node_1069(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4659,27 +4509,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1129(a, calls)
+                                return _node_1070(a, calls)
                             elif v == 'IDLE':
-                                return _node_1130(a, calls)
+                                return _node_1071(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1131(a, calls)
+                                return _node_1072(a, calls)
                             elif v == 'IDLE':
-                                return _node_1132(a, calls)
+                                return _node_1073(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1133(a, calls)
+                                return _node_1074(a, calls)
                             elif v == 'IDLE':
-                                return _node_1134(a, calls)
+                                return _node_1075(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4698,27 +4548,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1135(a, calls)
+                                return _node_1076(a, calls)
                             elif v == 'IDLE':
-                                return _node_1136(a, calls)
+                                return _node_1077(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1137(a, calls)
+                                return _node_1078(a, calls)
                             elif v == 'IDLE':
-                                return _node_1138(a, calls)
+                                return _node_1079(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1139(a, calls)
+                                return _node_1080(a, calls)
                             elif v == 'IDLE':
-                                return _node_1140(a, calls)
+                                return _node_1081(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4729,27 +4579,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1141(a, calls)
+                                return _node_1082(a, calls)
                             elif v == 'IDLE':
-                                return _node_1142(a, calls)
+                                return _node_1083(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1143(a, calls)
+                                return _node_1084(a, calls)
                             elif v == 'IDLE':
-                                return _node_1144(a, calls)
+                                return _node_1085(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1145(a, calls)
+                                return _node_1086(a, calls)
                             elif v == 'IDLE':
-                                return _node_1146(a, calls)
+                                return _node_1087(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4760,27 +4610,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1147(a, calls)
+                                return _node_1088(a, calls)
                             elif v == 'IDLE':
-                                return _node_1148(a, calls)
+                                return _node_1089(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1149(a, calls)
+                                return _node_1090(a, calls)
                             elif v == 'IDLE':
-                                return _node_1150(a, calls)
+                                return _node_1091(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1151(a, calls)
+                                return _node_1092(a, calls)
                             elif v == 'IDLE':
-                                return _node_1152(a, calls)
+                                return _node_1093(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4790,11 +4640,11 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@READ_OBST_SEARCH_OBJstate']
                     if v == 'READ-OBST':
-                        return _node_948(a, calls)
+                        return _node_903(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_950(a, calls)
+                        return _node_905(a, calls)
                     elif v == 'IDLE':
-                        return _node_952(a, calls)
+                        return _node_908(a, calls)
                     else:
                         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
                 elif v == 'IDLE':
@@ -4805,27 +4655,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1153(a, calls)
+                                return _node_1094(a, calls)
                             elif v == 'IDLE':
-                                return _node_1154(a, calls)
+                                return _node_1095(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1155(a, calls)
+                                return _node_1096(a, calls)
                             elif v == 'IDLE':
-                                return _node_1156(a, calls)
+                                return _node_1097(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1157(a, calls)
+                                return _node_1098(a, calls)
                             elif v == 'IDLE':
-                                return _node_1158(a, calls)
+                                return _node_1099(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4836,27 +4686,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1159(a, calls)
+                                return _node_1100(a, calls)
                             elif v == 'IDLE':
-                                return _node_1160(a, calls)
+                                return _node_1101(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1161(a, calls)
+                                return _node_1102(a, calls)
                             elif v == 'IDLE':
-                                return _node_1162(a, calls)
+                                return _node_1103(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1163(a, calls)
+                                return _node_1104(a, calls)
                             elif v == 'IDLE':
-                                return _node_1164(a, calls)
+                                return _node_1105(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4867,27 +4717,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1165(a, calls)
+                                return _node_1106(a, calls)
                             elif v == 'IDLE':
-                                return _node_1166(a, calls)
+                                return _node_1107(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1167(a, calls)
+                                return _node_1108(a, calls)
                             elif v == 'IDLE':
-                                return _node_1168(a, calls)
+                                return _node_1109(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1169(a, calls)
+                                return _node_1110(a, calls)
                             elif v == 'IDLE':
-                                return _node_1170(a, calls)
+                                return _node_1111(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4906,27 +4756,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1171(a, calls)
+                                return _node_1112(a, calls)
                             elif v == 'IDLE':
-                                return _node_1172(a, calls)
+                                return _node_1113(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1173(a, calls)
+                                return _node_1114(a, calls)
                             elif v == 'IDLE':
-                                return _node_1174(a, calls)
+                                return _node_1115(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1175(a, calls)
+                                return _node_1116(a, calls)
                             elif v == 'IDLE':
-                                return _node_1176(a, calls)
+                                return _node_1117(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4937,27 +4787,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1177(a, calls)
+                                return _node_1118(a, calls)
                             elif v == 'IDLE':
-                                return _node_1178(a, calls)
+                                return _node_1119(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1179(a, calls)
+                                return _node_1120(a, calls)
                             elif v == 'IDLE':
-                                return _node_1180(a, calls)
+                                return _node_1121(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1181(a, calls)
+                                return _node_1122(a, calls)
                             elif v == 'IDLE':
-                                return _node_1182(a, calls)
+                                return _node_1123(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4968,27 +4818,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1183(a, calls)
+                                return _node_1124(a, calls)
                             elif v == 'IDLE':
-                                return _node_1184(a, calls)
+                                return _node_1125(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1185(a, calls)
+                                return _node_1126(a, calls)
                             elif v == 'IDLE':
-                                return _node_1186(a, calls)
+                                return _node_1127(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1187(a, calls)
+                                return _node_1128(a, calls)
                             elif v == 'IDLE':
-                                return _node_1188(a, calls)
+                                return _node_1129(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4998,17 +4848,17 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'EXEC-TRAJ-OBJ':
                     v = a['@READ_OBST_SEARCH_OBJstate']
                     if v == 'READ-OBST':
-                        return _node_1061(a, calls)
+                        return _node_1002(a, calls)
                     elif v == 'SEARCH-OBJ':
-                        return _node_1059(a, calls)
+                        return _node_1000(a, calls)
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            return _node_860(a, calls)
+                            return _node_824(a, calls)
                         elif v == 'ARM-BACK':
-                            return _node_863(a, calls)
+                            return _node_827(a, calls)
                         elif v == 'IDLE':
-                            return _node_866(a, calls)
+                            return _node_830(a, calls)
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -5021,27 +4871,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1189(a, calls)
+                                return _node_1130(a, calls)
                             elif v == 'IDLE':
-                                return _node_1190(a, calls)
+                                return _node_1131(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1191(a, calls)
+                                return _node_1132(a, calls)
                             elif v == 'IDLE':
-                                return _node_1192(a, calls)
+                                return _node_1133(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1193(a, calls)
+                                return _node_1134(a, calls)
                             elif v == 'IDLE':
-                                return _node_1194(a, calls)
+                                return _node_1135(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5052,27 +4902,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1195(a, calls)
+                                return _node_1136(a, calls)
                             elif v == 'IDLE':
-                                return _node_1196(a, calls)
+                                return _node_1137(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1197(a, calls)
+                                return _node_1138(a, calls)
                             elif v == 'IDLE':
-                                return _node_1198(a, calls)
+                                return _node_1139(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1199(a, calls)
+                                return _node_1140(a, calls)
                             elif v == 'IDLE':
-                                return _node_1200(a, calls)
+                                return _node_1141(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5083,27 +4933,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1201(a, calls)
+                                return _node_1142(a, calls)
                             elif v == 'IDLE':
-                                return _node_1202(a, calls)
+                                return _node_1143(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1203(a, calls)
+                                return _node_1144(a, calls)
                             elif v == 'IDLE':
-                                return _node_1204(a, calls)
+                                return _node_1145(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                return _node_1205(a, calls)
+                                return _node_1146(a, calls)
                             elif v == 'IDLE':
-                                return _node_1206(a, calls)
+                                return _node_1147(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5133,7 +4983,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1063(a, calls)
+                                return _node_1004(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5147,7 +4997,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1065(a, calls)
+                                return _node_1006(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5161,7 +5011,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1067(a, calls)
+                                return _node_1008(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5179,7 +5029,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1069(a, calls)
+                                return _node_1010(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5193,7 +5043,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1071(a, calls)
+                                return _node_1012(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5207,7 +5057,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1073(a, calls)
+                                return _node_1014(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5225,7 +5075,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1075(a, calls)
+                                return _node_1016(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5239,7 +5089,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1077(a, calls)
+                                return _node_1018(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5253,7 +5103,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1079(a, calls)
+                                return _node_1020(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5275,7 +5125,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1207(a, calls)
+                                return _node_1148(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5289,7 +5139,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1208(a, calls)
+                                return _node_1149(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5303,7 +5153,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1209(a, calls)
+                                return _node_1150(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5321,7 +5171,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1210(a, calls)
+                                return _node_1151(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5335,7 +5185,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1211(a, calls)
+                                return _node_1152(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5349,7 +5199,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1212(a, calls)
+                                return _node_1153(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5367,7 +5217,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1213(a, calls)
+                                return _node_1154(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5381,7 +5231,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1214(a, calls)
+                                return _node_1155(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5395,7 +5245,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1215(a, calls)
+                                return _node_1156(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5417,7 +5267,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1081(a, calls)
+                                return _node_1022(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5431,7 +5281,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1083(a, calls)
+                                return _node_1024(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5445,7 +5295,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1085(a, calls)
+                                return _node_1026(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5463,7 +5313,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1087(a, calls)
+                                return _node_1028(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5477,7 +5327,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1089(a, calls)
+                                return _node_1030(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5491,7 +5341,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1091(a, calls)
+                                return _node_1032(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5509,7 +5359,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1093(a, calls)
+                                return _node_1034(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5523,7 +5373,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1095(a, calls)
+                                return _node_1036(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5537,7 +5387,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1097(a, calls)
+                                return _node_1038(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5563,7 +5413,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1099(a, calls)
+                                return _node_1040(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5577,7 +5427,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1101(a, calls)
+                                return _node_1042(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5591,7 +5441,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1103(a, calls)
+                                return _node_1044(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5609,7 +5459,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1105(a, calls)
+                                return _node_1046(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5623,7 +5473,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1107(a, calls)
+                                return _node_1048(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5637,7 +5487,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1109(a, calls)
+                                return _node_1050(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5655,7 +5505,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1111(a, calls)
+                                return _node_1052(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5669,7 +5519,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1113(a, calls)
+                                return _node_1054(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5683,7 +5533,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1115(a, calls)
+                                return _node_1056(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5705,7 +5555,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1216(a, calls)
+                                return _node_1157(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5719,7 +5569,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1217(a, calls)
+                                return _node_1158(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5733,7 +5583,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1218(a, calls)
+                                return _node_1159(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5751,7 +5601,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1219(a, calls)
+                                return _node_1160(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5765,7 +5615,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1220(a, calls)
+                                return _node_1161(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5779,7 +5629,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1221(a, calls)
+                                return _node_1162(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5797,7 +5647,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1222(a, calls)
+                                return _node_1163(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5811,7 +5661,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1223(a, calls)
+                                return _node_1164(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5825,7 +5675,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1224(a, calls)
+                                return _node_1165(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5847,7 +5697,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1117(a, calls)
+                                return _node_1058(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5861,7 +5711,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1119(a, calls)
+                                return _node_1060(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5875,7 +5725,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1121(a, calls)
+                                return _node_1062(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5893,7 +5743,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1123(a, calls)
+                                return _node_1064(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5907,7 +5757,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1125(a, calls)
+                                return _node_1066(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5921,7 +5771,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1127(a, calls)
+                                return _node_1068(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5939,7 +5789,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1129(a, calls)
+                                return _node_1070(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -5953,7 +5803,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1131(a, calls)
+                                return _node_1072(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -5967,7 +5817,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1133(a, calls)
+                                return _node_1074(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5993,7 +5843,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1135(a, calls)
+                                return _node_1076(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6007,7 +5857,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1137(a, calls)
+                                return _node_1078(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6021,7 +5871,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1139(a, calls)
+                                return _node_1080(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6039,7 +5889,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1141(a, calls)
+                                return _node_1082(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6053,7 +5903,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1143(a, calls)
+                                return _node_1084(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6067,7 +5917,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1145(a, calls)
+                                return _node_1086(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6085,7 +5935,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1147(a, calls)
+                                return _node_1088(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6099,7 +5949,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1149(a, calls)
+                                return _node_1090(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6113,7 +5963,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1151(a, calls)
+                                return _node_1092(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6135,7 +5985,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1225(a, calls)
+                                return _node_1166(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6149,7 +5999,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1226(a, calls)
+                                return _node_1167(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6163,7 +6013,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1227(a, calls)
+                                return _node_1168(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6181,7 +6031,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1228(a, calls)
+                                return _node_1169(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6195,7 +6045,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1229(a, calls)
+                                return _node_1170(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6209,7 +6059,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1230(a, calls)
+                                return _node_1171(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6227,7 +6077,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1231(a, calls)
+                                return _node_1172(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6241,7 +6091,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1232(a, calls)
+                                return _node_1173(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6255,7 +6105,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1233(a, calls)
+                                return _node_1174(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6277,7 +6127,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1153(a, calls)
+                                return _node_1094(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6291,7 +6141,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1155(a, calls)
+                                return _node_1096(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6305,7 +6155,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1157(a, calls)
+                                return _node_1098(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6323,7 +6173,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1159(a, calls)
+                                return _node_1100(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6337,7 +6187,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1161(a, calls)
+                                return _node_1102(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6351,7 +6201,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1163(a, calls)
+                                return _node_1104(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6369,7 +6219,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1165(a, calls)
+                                return _node_1106(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6383,7 +6233,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1167(a, calls)
+                                return _node_1108(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6397,7 +6247,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1169(a, calls)
+                                return _node_1110(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6423,7 +6273,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1171(a, calls)
+                                return _node_1112(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6437,7 +6287,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1173(a, calls)
+                                return _node_1114(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6451,7 +6301,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1175(a, calls)
+                                return _node_1116(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6469,7 +6319,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1177(a, calls)
+                                return _node_1118(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6483,7 +6333,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1179(a, calls)
+                                return _node_1120(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6497,7 +6347,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1181(a, calls)
+                                return _node_1122(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6515,7 +6365,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1183(a, calls)
+                                return _node_1124(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6529,7 +6379,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1185(a, calls)
+                                return _node_1126(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6543,7 +6393,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1187(a, calls)
+                                return _node_1128(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6565,7 +6415,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1234(a, calls)
+                                return _node_1175(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6579,7 +6429,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1235(a, calls)
+                                return _node_1176(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6593,7 +6443,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1236(a, calls)
+                                return _node_1177(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6611,7 +6461,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1237(a, calls)
+                                return _node_1178(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6625,7 +6475,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1238(a, calls)
+                                return _node_1179(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6639,7 +6489,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1239(a, calls)
+                                return _node_1180(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6657,7 +6507,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1240(a, calls)
+                                return _node_1181(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6671,7 +6521,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1241(a, calls)
+                                return _node_1182(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6685,7 +6535,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1242(a, calls)
+                                return _node_1183(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6707,7 +6557,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1189(a, calls)
+                                return _node_1130(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6721,7 +6571,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1191(a, calls)
+                                return _node_1132(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6735,7 +6585,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1193(a, calls)
+                                return _node_1134(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6753,7 +6603,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1195(a, calls)
+                                return _node_1136(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6767,7 +6617,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1197(a, calls)
+                                return _node_1138(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6781,7 +6631,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1199(a, calls)
+                                return _node_1140(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6799,7 +6649,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1201(a, calls)
+                                return _node_1142(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6813,7 +6663,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1203(a, calls)
+                                return _node_1144(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6827,7 +6677,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1205(a, calls)
+                                return _node_1146(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6849,25 +6699,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1064(a, calls)
+                                return _node_1005(a, calls)
                             elif v == 'IDLE':
-                                return _node_1243(a, calls)
+                                return _node_1184(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1066(a, calls)
+                                return _node_1007(a, calls)
                             elif v == 'IDLE':
-                                return _node_1244(a, calls)
+                                return _node_1185(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1068(a, calls)
+                                return _node_1009(a, calls)
                             elif v == 'IDLE':
-                                return _node_1245(a, calls)
+                                return _node_1186(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6877,25 +6727,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1070(a, calls)
+                                return _node_1011(a, calls)
                             elif v == 'IDLE':
-                                return _node_1246(a, calls)
+                                return _node_1187(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1072(a, calls)
+                                return _node_1013(a, calls)
                             elif v == 'IDLE':
-                                return _node_1247(a, calls)
+                                return _node_1188(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1074(a, calls)
+                                return _node_1015(a, calls)
                             elif v == 'IDLE':
-                                return _node_1248(a, calls)
+                                return _node_1189(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6905,25 +6755,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1076(a, calls)
+                                return _node_1017(a, calls)
                             elif v == 'IDLE':
-                                return _node_1249(a, calls)
+                                return _node_1190(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1078(a, calls)
+                                return _node_1019(a, calls)
                             elif v == 'IDLE':
-                                return _node_1250(a, calls)
+                                return _node_1191(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1080(a, calls)
+                                return _node_1021(a, calls)
                             elif v == 'IDLE':
-                                return _node_1251(a, calls)
+                                return _node_1192(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6945,7 +6795,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1252(a, calls)
+                                return _node_1193(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -6959,7 +6809,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1253(a, calls)
+                                return _node_1194(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -6973,7 +6823,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1254(a, calls)
+                                return _node_1195(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6991,7 +6841,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1255(a, calls)
+                                return _node_1196(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7005,7 +6855,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1256(a, calls)
+                                return _node_1197(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7019,7 +6869,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1257(a, calls)
+                                return _node_1198(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7037,7 +6887,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1258(a, calls)
+                                return _node_1199(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7051,7 +6901,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1259(a, calls)
+                                return _node_1200(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7065,7 +6915,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1260(a, calls)
+                                return _node_1201(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7079,25 +6929,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1082(a, calls)
+                                return _node_1023(a, calls)
                             elif v == 'IDLE':
-                                return _node_1261(a, calls)
+                                return _node_1202(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1084(a, calls)
+                                return _node_1025(a, calls)
                             elif v == 'IDLE':
-                                return _node_1262(a, calls)
+                                return _node_1203(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1086(a, calls)
+                                return _node_1027(a, calls)
                             elif v == 'IDLE':
-                                return _node_1263(a, calls)
+                                return _node_1204(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7107,25 +6957,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1088(a, calls)
+                                return _node_1029(a, calls)
                             elif v == 'IDLE':
-                                return _node_1264(a, calls)
+                                return _node_1205(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1090(a, calls)
+                                return _node_1031(a, calls)
                             elif v == 'IDLE':
-                                return _node_1265(a, calls)
+                                return _node_1206(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1092(a, calls)
+                                return _node_1033(a, calls)
                             elif v == 'IDLE':
-                                return _node_1266(a, calls)
+                                return _node_1207(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7135,25 +6985,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1094(a, calls)
+                                return _node_1035(a, calls)
                             elif v == 'IDLE':
-                                return _node_1267(a, calls)
+                                return _node_1208(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1096(a, calls)
+                                return _node_1037(a, calls)
                             elif v == 'IDLE':
-                                return _node_1268(a, calls)
+                                return _node_1209(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1098(a, calls)
+                                return _node_1039(a, calls)
                             elif v == 'IDLE':
-                                return _node_1269(a, calls)
+                                return _node_1210(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7171,25 +7021,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1100(a, calls)
+                                return _node_1041(a, calls)
                             elif v == 'IDLE':
-                                return _node_1270(a, calls)
+                                return _node_1211(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1102(a, calls)
+                                return _node_1043(a, calls)
                             elif v == 'IDLE':
-                                return _node_1271(a, calls)
+                                return _node_1212(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1104(a, calls)
+                                return _node_1045(a, calls)
                             elif v == 'IDLE':
-                                return _node_1272(a, calls)
+                                return _node_1213(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7199,25 +7049,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1106(a, calls)
+                                return _node_1047(a, calls)
                             elif v == 'IDLE':
-                                return _node_1273(a, calls)
+                                return _node_1214(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1108(a, calls)
+                                return _node_1049(a, calls)
                             elif v == 'IDLE':
-                                return _node_1274(a, calls)
+                                return _node_1215(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1110(a, calls)
+                                return _node_1051(a, calls)
                             elif v == 'IDLE':
-                                return _node_1275(a, calls)
+                                return _node_1216(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7227,25 +7077,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1112(a, calls)
+                                return _node_1053(a, calls)
                             elif v == 'IDLE':
-                                return _node_1276(a, calls)
+                                return _node_1217(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1114(a, calls)
+                                return _node_1055(a, calls)
                             elif v == 'IDLE':
-                                return _node_1277(a, calls)
+                                return _node_1218(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1116(a, calls)
+                                return _node_1057(a, calls)
                             elif v == 'IDLE':
-                                return _node_1278(a, calls)
+                                return _node_1219(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7267,7 +7117,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1279(a, calls)
+                                return _node_1220(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7281,7 +7131,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1280(a, calls)
+                                return _node_1221(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7295,7 +7145,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1281(a, calls)
+                                return _node_1222(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7313,7 +7163,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1282(a, calls)
+                                return _node_1223(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7327,7 +7177,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1283(a, calls)
+                                return _node_1224(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7341,7 +7191,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1284(a, calls)
+                                return _node_1225(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7359,7 +7209,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1285(a, calls)
+                                return _node_1226(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7373,7 +7223,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1286(a, calls)
+                                return _node_1227(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7387,7 +7237,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1287(a, calls)
+                                return _node_1228(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7401,25 +7251,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1118(a, calls)
+                                return _node_1059(a, calls)
                             elif v == 'IDLE':
-                                return _node_1288(a, calls)
+                                return _node_1229(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1120(a, calls)
+                                return _node_1061(a, calls)
                             elif v == 'IDLE':
-                                return _node_1289(a, calls)
+                                return _node_1230(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1122(a, calls)
+                                return _node_1063(a, calls)
                             elif v == 'IDLE':
-                                return _node_1290(a, calls)
+                                return _node_1231(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7429,25 +7279,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1124(a, calls)
+                                return _node_1065(a, calls)
                             elif v == 'IDLE':
-                                return _node_1291(a, calls)
+                                return _node_1232(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1126(a, calls)
+                                return _node_1067(a, calls)
                             elif v == 'IDLE':
-                                return _node_1292(a, calls)
+                                return _node_1233(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1128(a, calls)
+                                return _node_1069(a, calls)
                             elif v == 'IDLE':
-                                return _node_1293(a, calls)
+                                return _node_1234(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7457,25 +7307,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1130(a, calls)
+                                return _node_1071(a, calls)
                             elif v == 'IDLE':
-                                return _node_1294(a, calls)
+                                return _node_1235(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1132(a, calls)
+                                return _node_1073(a, calls)
                             elif v == 'IDLE':
-                                return _node_1295(a, calls)
+                                return _node_1236(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1134(a, calls)
+                                return _node_1075(a, calls)
                             elif v == 'IDLE':
-                                return _node_1296(a, calls)
+                                return _node_1237(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7493,25 +7343,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1136(a, calls)
+                                return _node_1077(a, calls)
                             elif v == 'IDLE':
-                                return _node_1297(a, calls)
+                                return _node_1238(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1138(a, calls)
+                                return _node_1079(a, calls)
                             elif v == 'IDLE':
-                                return _node_1298(a, calls)
+                                return _node_1239(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1140(a, calls)
+                                return _node_1081(a, calls)
                             elif v == 'IDLE':
-                                return _node_1299(a, calls)
+                                return _node_1240(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7521,25 +7371,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1142(a, calls)
+                                return _node_1083(a, calls)
                             elif v == 'IDLE':
-                                return _node_1300(a, calls)
+                                return _node_1241(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1144(a, calls)
+                                return _node_1085(a, calls)
                             elif v == 'IDLE':
-                                return _node_1301(a, calls)
+                                return _node_1242(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1146(a, calls)
+                                return _node_1087(a, calls)
                             elif v == 'IDLE':
-                                return _node_1302(a, calls)
+                                return _node_1243(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7549,25 +7399,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1148(a, calls)
+                                return _node_1089(a, calls)
                             elif v == 'IDLE':
-                                return _node_1303(a, calls)
+                                return _node_1244(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1150(a, calls)
+                                return _node_1091(a, calls)
                             elif v == 'IDLE':
-                                return _node_1304(a, calls)
+                                return _node_1245(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1152(a, calls)
+                                return _node_1093(a, calls)
                             elif v == 'IDLE':
-                                return _node_1305(a, calls)
+                                return _node_1246(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7589,7 +7439,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1306(a, calls)
+                                return _node_1247(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7603,7 +7453,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1307(a, calls)
+                                return _node_1248(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7617,7 +7467,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1308(a, calls)
+                                return _node_1249(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7635,7 +7485,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1309(a, calls)
+                                return _node_1250(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7649,7 +7499,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1310(a, calls)
+                                return _node_1251(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7663,7 +7513,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1311(a, calls)
+                                return _node_1252(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7681,7 +7531,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1312(a, calls)
+                                return _node_1253(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7695,7 +7545,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1313(a, calls)
+                                return _node_1254(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7709,7 +7559,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1314(a, calls)
+                                return _node_1255(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7723,25 +7573,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1154(a, calls)
+                                return _node_1095(a, calls)
                             elif v == 'IDLE':
-                                return _node_1315(a, calls)
+                                return _node_1256(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1156(a, calls)
+                                return _node_1097(a, calls)
                             elif v == 'IDLE':
-                                return _node_1316(a, calls)
+                                return _node_1257(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1158(a, calls)
+                                return _node_1099(a, calls)
                             elif v == 'IDLE':
-                                return _node_1317(a, calls)
+                                return _node_1258(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7751,25 +7601,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1160(a, calls)
+                                return _node_1101(a, calls)
                             elif v == 'IDLE':
-                                return _node_1318(a, calls)
+                                return _node_1259(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1162(a, calls)
+                                return _node_1103(a, calls)
                             elif v == 'IDLE':
-                                return _node_1319(a, calls)
+                                return _node_1260(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1164(a, calls)
+                                return _node_1105(a, calls)
                             elif v == 'IDLE':
-                                return _node_1320(a, calls)
+                                return _node_1261(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7779,25 +7629,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1166(a, calls)
+                                return _node_1107(a, calls)
                             elif v == 'IDLE':
-                                return _node_1321(a, calls)
+                                return _node_1262(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1168(a, calls)
+                                return _node_1109(a, calls)
                             elif v == 'IDLE':
-                                return _node_1322(a, calls)
+                                return _node_1263(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1170(a, calls)
+                                return _node_1111(a, calls)
                             elif v == 'IDLE':
-                                return _node_1323(a, calls)
+                                return _node_1264(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7815,25 +7665,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1172(a, calls)
+                                return _node_1113(a, calls)
                             elif v == 'IDLE':
-                                return _node_1324(a, calls)
+                                return _node_1265(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1174(a, calls)
+                                return _node_1115(a, calls)
                             elif v == 'IDLE':
-                                return _node_1325(a, calls)
+                                return _node_1266(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1176(a, calls)
+                                return _node_1117(a, calls)
                             elif v == 'IDLE':
-                                return _node_1326(a, calls)
+                                return _node_1267(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7843,25 +7693,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1178(a, calls)
+                                return _node_1119(a, calls)
                             elif v == 'IDLE':
-                                return _node_1327(a, calls)
+                                return _node_1268(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1180(a, calls)
+                                return _node_1121(a, calls)
                             elif v == 'IDLE':
-                                return _node_1328(a, calls)
+                                return _node_1269(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1182(a, calls)
+                                return _node_1123(a, calls)
                             elif v == 'IDLE':
-                                return _node_1329(a, calls)
+                                return _node_1270(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7871,25 +7721,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1184(a, calls)
+                                return _node_1125(a, calls)
                             elif v == 'IDLE':
-                                return _node_1330(a, calls)
+                                return _node_1271(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1186(a, calls)
+                                return _node_1127(a, calls)
                             elif v == 'IDLE':
-                                return _node_1331(a, calls)
+                                return _node_1272(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1188(a, calls)
+                                return _node_1129(a, calls)
                             elif v == 'IDLE':
-                                return _node_1332(a, calls)
+                                return _node_1273(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7911,7 +7761,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1333(a, calls)
+                                return _node_1274(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7925,7 +7775,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1334(a, calls)
+                                return _node_1275(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7939,7 +7789,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1335(a, calls)
+                                return _node_1276(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -7957,7 +7807,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1336(a, calls)
+                                return _node_1277(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -7971,7 +7821,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1337(a, calls)
+                                return _node_1278(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -7985,7 +7835,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1338(a, calls)
+                                return _node_1279(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -8003,7 +7853,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1339(a, calls)
+                                return _node_1280(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
@@ -8017,7 +7867,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1340(a, calls)
+                                return _node_1281(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
@@ -8031,7 +7881,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                                 else:
                                     raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
                             elif v == 'IDLE':
-                                return _node_1341(a, calls)
+                                return _node_1282(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -8045,25 +7895,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1190(a, calls)
+                                return _node_1131(a, calls)
                             elif v == 'IDLE':
-                                return _node_1342(a, calls)
+                                return _node_1283(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1192(a, calls)
+                                return _node_1133(a, calls)
                             elif v == 'IDLE':
-                                return _node_1343(a, calls)
+                                return _node_1284(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1194(a, calls)
+                                return _node_1135(a, calls)
                             elif v == 'IDLE':
-                                return _node_1344(a, calls)
+                                return _node_1285(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -8073,25 +7923,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1196(a, calls)
+                                return _node_1137(a, calls)
                             elif v == 'IDLE':
-                                return _node_1345(a, calls)
+                                return _node_1286(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1198(a, calls)
+                                return _node_1139(a, calls)
                             elif v == 'IDLE':
-                                return _node_1346(a, calls)
+                                return _node_1287(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1200(a, calls)
+                                return _node_1141(a, calls)
                             elif v == 'IDLE':
-                                return _node_1347(a, calls)
+                                return _node_1288(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -8101,25 +7951,25 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                         if v == 'ARM-OBJ':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1202(a, calls)
+                                return _node_1143(a, calls)
                             elif v == 'IDLE':
-                                return _node_1348(a, calls)
+                                return _node_1289(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1204(a, calls)
+                                return _node_1145(a, calls)
                             elif v == 'IDLE':
-                                return _node_1349(a, calls)
+                                return _node_1290(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
-                                return _node_1206(a, calls)
+                                return _node_1147(a, calls)
                             elif v == 'IDLE':
-                                return _node_1350(a, calls)
+                                return _node_1291(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -8131,7 +7981,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_1351(a, calls)
+            return _node_1292(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'CALC-OBJ':
@@ -8141,397 +7991,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'EXEC-TRAJ-GOAL':
                 calls('changeInterState', (a['@ExecTrajState'],))
                 calls('sendAbortRequest', (a['@ExecTrajState'],))
-                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-                if v == 'READ-MODEL':
-                    v = a['@READ_OBST_SEARCH_OBJstate']
-                    if v == 'READ-OBST':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_753(a, calls)
-                            elif v == 'IDLE':
-                                return _node_754(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_761(a, calls)
-                            elif v == 'IDLE':
-                                return _node_929(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_764(a, calls)
-                            elif v == 'IDLE':
-                                return _node_931(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'SEARCH-OBJ':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_756(a, calls)
-                            elif v == 'IDLE':
-                                return _node_757(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_762(a, calls)
-                            elif v == 'IDLE':
-                                return _node_936(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_765(a, calls)
-                            elif v == 'IDLE':
-                                return _node_938(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_759(a, calls)
-                            elif v == 'IDLE':
-                                return _node_760(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_763(a, calls)
-                            elif v == 'IDLE':
-                                return _node_942(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_766(a, calls)
-                            elif v == 'IDLE':
-                                return _node_944(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                elif v == 'CALC-TRAJ-GOAL':
-                    v = a['@READ_OBST_SEARCH_OBJstate']
-                    if v == 'READ-OBST':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_769(a, calls)
-                            elif v == 'IDLE':
-                                return _node_770(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_776(a, calls)
-                            elif v == 'IDLE':
-                                return _node_957(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_779(a, calls)
-                            elif v == 'IDLE':
-                                return _node_962(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'SEARCH-OBJ':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_772(a, calls)
-                            elif v == 'IDLE':
-                                return _node_773(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_777(a, calls)
-                            elif v == 'IDLE':
-                                return _node_959(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_780(a, calls)
-                            elif v == 'IDLE':
-                                return _node_964(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_774(a, calls)
-                            elif v == 'IDLE':
-                                return _node_775(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_778(a, calls)
-                            elif v == 'IDLE':
-                                return _node_960(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_781(a, calls)
-                            elif v == 'IDLE':
-                                return _node_965(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                elif v == 'CALC-TRAJ-OBJ':
-                    v = a['@READ_OBST_SEARCH_OBJstate']
-                    if v == 'READ-OBST':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_784(a, calls)
-                            elif v == 'IDLE':
-                                return _node_785(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_794(a, calls)
-                            elif v == 'IDLE':
-                                return _node_795(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_804(a, calls)
-                            elif v == 'IDLE':
-                                return _node_805(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'SEARCH-OBJ':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_787(a, calls)
-                            elif v == 'IDLE':
-                                return _node_788(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_797(a, calls)
-                            elif v == 'IDLE':
-                                return _node_798(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_807(a, calls)
-                            elif v == 'IDLE':
-                                return _node_808(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_790(a, calls)
-                            elif v == 'IDLE':
-                                return _node_791(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_800(a, calls)
-                            elif v == 'IDLE':
-                                return _node_801(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_810(a, calls)
-                            elif v == 'IDLE':
-                                return _node_811(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                elif v == 'IDLE':
-                    v = a['@READ_OBST_SEARCH_OBJstate']
-                    if v == 'READ-OBST':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_814(a, calls)
-                            elif v == 'IDLE':
-                                return _node_815(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_821(a, calls)
-                            elif v == 'IDLE':
-                                return _node_967(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_824(a, calls)
-                            elif v == 'IDLE':
-                                return _node_972(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'SEARCH-OBJ':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_817(a, calls)
-                            elif v == 'IDLE':
-                                return _node_818(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_822(a, calls)
-                            elif v == 'IDLE':
-                                return _node_969(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_825(a, calls)
-                            elif v == 'IDLE':
-                                return _node_974(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    elif v == 'IDLE':
-                        v = a['@ARM_OBJ_ARM_BACKstate']
-                        if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_819(a, calls)
-                            elif v == 'IDLE':
-                                return _node_820(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_823(a, calls)
-                            elif v == 'IDLE':
-                                return _node_970(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                calls('changeInterState', (a['@CALC_OBJstate'],))
-                                return _node_826(a, calls)
-                            elif v == 'IDLE':
-                                return _node_975(a, calls)
-                            else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-                        else:
-                            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-                    else:
-                        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-                else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                return _node_912(a, calls)
             elif v == 'EXEC-TRAJ-OBJ':
                 v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
                 if v == 'READ-MODEL':
@@ -11471,7 +10931,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_1352(a, calls)
+            return _node_1293(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     else:
@@ -19432,9 +18892,9 @@ def _node_751(a: Any, calls: Calls) -> Decision:
     if v == 'READ-OBST':
         return _node_752(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_755(a, calls)
+        return _node_753(a, calls)
     elif v == 'IDLE':
-        return _node_758(a, calls)
+        return _node_754(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
@@ -19442,94 +18902,70 @@ def _node_751(a: Any, calls: Calls) -> Decision:
 def _node_752(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
-        return _node_753(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_864
+        elif v == 'IDLE':
+            return _LEAF_865
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_754(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_866
+        elif v == 'IDLE':
+            return _LEAF_867
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
 def _node_753(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_864
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_868
+        elif v == 'IDLE':
+            return _LEAF_869
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_865
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_870
+        elif v == 'IDLE':
+            return _LEAF_871
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
 def _node_754(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_866
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_872
+        elif v == 'IDLE':
+            return _LEAF_873
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_867
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_874
+        elif v == 'IDLE':
+            return _LEAF_875
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
 def _node_755(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_756(a, calls)
-    elif v == 'IDLE':
-        return _node_757(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_756(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_868
-    elif v == 'IDLE':
-        return _LEAF_869
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_757(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_870
-    elif v == 'IDLE':
-        return _LEAF_871
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_758(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_759(a, calls)
-    elif v == 'IDLE':
-        return _node_760(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_759(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_872
-    elif v == 'IDLE':
-        return _LEAF_873
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_760(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_874
-    elif v == 'IDLE':
-        return _LEAF_875
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_761(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_876
@@ -19539,7 +18975,7 @@ def _node_761(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_762(a: Any, calls: Calls) -> Decision:
+def _node_756(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_878
@@ -19549,7 +18985,7 @@ def _node_762(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_763(a: Any, calls: Calls) -> Decision:
+def _node_757(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_880
@@ -19559,7 +18995,7 @@ def _node_763(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_764(a: Any, calls: Calls) -> Decision:
+def _node_758(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_882
@@ -19569,7 +19005,7 @@ def _node_764(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_765(a: Any, calls: Calls) -> Decision:
+def _node_759(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_884
@@ -19579,7 +19015,7 @@ def _node_765(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_766(a: Any, calls: Calls) -> Decision:
+def _node_760(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_886
@@ -19589,105 +19025,85 @@ def _node_766(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_767(a: Any, calls: Calls) -> Decision:
+def _node_761(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_768(a, calls)
+        return _node_762(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_771(a, calls)
+        return _node_763(a, calls)
     elif v == 'IDLE':
-        v = a['@CALC_OBJstate']
-        if v == 'CALC-OBJ':
-            return _node_774(a, calls)
-        elif v == 'IDLE':
-            return _node_775(a, calls)
-        else:
-            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        return _node_764(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_768(a: Any, calls: Calls) -> Decision:
+def _node_762(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
-        return _node_769(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_888
+        elif v == 'IDLE':
+            return _LEAF_889
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_770(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_890
+        elif v == 'IDLE':
+            return _LEAF_891
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_769(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_888
-    elif v == 'IDLE':
-        return _LEAF_889
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_770(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_890
-    elif v == 'IDLE':
-        return _LEAF_891
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_771(a: Any, calls: Calls) -> Decision:
+def _node_763(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
-        return _node_772(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_892
+        elif v == 'IDLE':
+            return _LEAF_893
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_773(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_894
+        elif v == 'IDLE':
+            return _LEAF_895
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_772(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_892
+def _node_764(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_896
+        elif v == 'IDLE':
+            return _LEAF_897
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_893
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_898
+        elif v == 'IDLE':
+            return _LEAF_899
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_773(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_894
-    elif v == 'IDLE':
-        return _LEAF_895
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_774(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_896
-    elif v == 'IDLE':
-        return _LEAF_897
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_775(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_898
-    elif v == 'IDLE':
-        return _LEAF_899
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_776(a: Any, calls: Calls) -> Decision:
+def _node_765(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_900
@@ -19697,7 +19113,7 @@ def _node_776(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_777(a: Any, calls: Calls) -> Decision:
+def _node_766(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_902
@@ -19707,7 +19123,7 @@ def _node_777(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_778(a: Any, calls: Calls) -> Decision:
+def _node_767(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_904
@@ -19717,7 +19133,7 @@ def _node_778(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_779(a: Any, calls: Calls) -> Decision:
+def _node_768(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_906
@@ -19727,7 +19143,7 @@ def _node_779(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_780(a: Any, calls: Calls) -> Decision:
+def _node_769(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_908
@@ -19737,7 +19153,7 @@ def _node_780(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_781(a: Any, calls: Calls) -> Decision:
+def _node_770(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_910
@@ -19747,411 +19163,295 @@ def _node_781(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_782(a: Any, calls: Calls) -> Decision:
+def _node_771(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_783(a, calls)
+        return _node_772(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_786(a, calls)
+        return _node_773(a, calls)
     elif v == 'IDLE':
-        return _node_789(a, calls)
+        return _node_774(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+
+
+def _node_772(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_912
+        elif v == 'IDLE':
+            return _LEAF_913
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_914
+        elif v == 'IDLE':
+            return _LEAF_915
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_773(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_916
+        elif v == 'IDLE':
+            return _LEAF_917
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_918
+        elif v == 'IDLE':
+            return _LEAF_919
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_774(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_920
+        elif v == 'IDLE':
+            return _LEAF_921
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_922
+        elif v == 'IDLE':
+            return _LEAF_923
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_775(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_924
+        elif v == 'IDLE':
+            return _LEAF_925
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_926
+        elif v == 'IDLE':
+            return _LEAF_927
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_776(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_928
+        elif v == 'IDLE':
+            return _LEAF_929
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_930
+        elif v == 'IDLE':
+            return _LEAF_931
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_777(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_932
+        elif v == 'IDLE':
+            return _LEAF_933
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_934
+        elif v == 'IDLE':
+            return _LEAF_935
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_778(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_936
+        elif v == 'IDLE':
+            return _LEAF_937
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_938
+        elif v == 'IDLE':
+            return _LEAF_939
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_779(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_940
+        elif v == 'IDLE':
+            return _LEAF_941
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_942
+        elif v == 'IDLE':
+            return _LEAF_943
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_780(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_944
+        elif v == 'IDLE':
+            return _LEAF_945
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_946
+        elif v == 'IDLE':
+            return _LEAF_947
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_781(a: Any, calls: Calls) -> Decision:
+    v = a['@READ_OBST_SEARCH_OBJstate']
+    if v == 'READ-OBST':
+        return _node_782(a, calls)
+    elif v == 'SEARCH-OBJ':
+        return _node_783(a, calls)
+    elif v == 'IDLE':
+        return _node_784(a, calls)
+    else:
+        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+
+
+def _node_782(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_948
+        elif v == 'IDLE':
+            return _LEAF_949
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_950
+        elif v == 'IDLE':
+            return _LEAF_951
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
 def _node_783(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
-        return _node_784(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_952
+        elif v == 'IDLE':
+            return _LEAF_953
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_785(a, calls)
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_954
+        elif v == 'IDLE':
+            return _LEAF_955
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
 def _node_784(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_912
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_956
+        elif v == 'IDLE':
+            return _LEAF_957
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_913
+        v = a['@CALC_GOALstate']
+        if v == 'CALC-GOAL':
+            return _LEAF_958
+        elif v == 'IDLE':
+            return _LEAF_959
+        else:
+            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
 def _node_785(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_914
-    elif v == 'IDLE':
-        return _LEAF_915
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_786(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_787(a, calls)
-    elif v == 'IDLE':
-        return _node_788(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_787(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_916
-    elif v == 'IDLE':
-        return _LEAF_917
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_788(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_918
-    elif v == 'IDLE':
-        return _LEAF_919
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_789(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_790(a, calls)
-    elif v == 'IDLE':
-        return _node_791(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_790(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_920
-    elif v == 'IDLE':
-        return _LEAF_921
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_791(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_922
-    elif v == 'IDLE':
-        return _LEAF_923
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_792(a: Any, calls: Calls) -> Decision:
-    v = a['@READ_OBST_SEARCH_OBJstate']
-    if v == 'READ-OBST':
-        return _node_793(a, calls)
-    elif v == 'SEARCH-OBJ':
-        return _node_796(a, calls)
-    elif v == 'IDLE':
-        return _node_799(a, calls)
-    else:
-        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-
-
-def _node_793(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_794(a, calls)
-    elif v == 'IDLE':
-        return _node_795(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_794(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_924
-    elif v == 'IDLE':
-        return _LEAF_925
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_795(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_926
-    elif v == 'IDLE':
-        return _LEAF_927
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_796(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_797(a, calls)
-    elif v == 'IDLE':
-        return _node_798(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_797(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_928
-    elif v == 'IDLE':
-        return _LEAF_929
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_798(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_930
-    elif v == 'IDLE':
-        return _LEAF_931
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_799(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_800(a, calls)
-    elif v == 'IDLE':
-        return _node_801(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_800(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_932
-    elif v == 'IDLE':
-        return _LEAF_933
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_801(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_934
-    elif v == 'IDLE':
-        return _LEAF_935
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_802(a: Any, calls: Calls) -> Decision:
-    v = a['@READ_OBST_SEARCH_OBJstate']
-    if v == 'READ-OBST':
-        return _node_803(a, calls)
-    elif v == 'SEARCH-OBJ':
-        return _node_806(a, calls)
-    elif v == 'IDLE':
-        return _node_809(a, calls)
-    else:
-        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-
-
-def _node_803(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_804(a, calls)
-    elif v == 'IDLE':
-        return _node_805(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_804(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_936
-    elif v == 'IDLE':
-        return _LEAF_937
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_805(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_938
-    elif v == 'IDLE':
-        return _LEAF_939
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_806(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_807(a, calls)
-    elif v == 'IDLE':
-        return _node_808(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_807(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_940
-    elif v == 'IDLE':
-        return _LEAF_941
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_808(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_942
-    elif v == 'IDLE':
-        return _LEAF_943
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_809(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_810(a, calls)
-    elif v == 'IDLE':
-        return _node_811(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_810(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_944
-    elif v == 'IDLE':
-        return _LEAF_945
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_811(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_946
-    elif v == 'IDLE':
-        return _LEAF_947
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_812(a: Any, calls: Calls) -> Decision:
-    v = a['@READ_OBST_SEARCH_OBJstate']
-    if v == 'READ-OBST':
-        return _node_813(a, calls)
-    elif v == 'SEARCH-OBJ':
-        return _node_816(a, calls)
-    elif v == 'IDLE':
-        v = a['@CALC_OBJstate']
-        if v == 'CALC-OBJ':
-            return _node_819(a, calls)
-        elif v == 'IDLE':
-            return _node_820(a, calls)
-        else:
-            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-
-
-def _node_813(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_814(a, calls)
-    elif v == 'IDLE':
-        return _node_815(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_814(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_948
-    elif v == 'IDLE':
-        return _LEAF_949
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_815(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_950
-    elif v == 'IDLE':
-        return _LEAF_951
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_816(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_817(a, calls)
-    elif v == 'IDLE':
-        return _node_818(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_817(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_952
-    elif v == 'IDLE':
-        return _LEAF_953
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_818(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_954
-    elif v == 'IDLE':
-        return _LEAF_955
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_819(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_956
-    elif v == 'IDLE':
-        return _LEAF_957
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_820(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_958
-    elif v == 'IDLE':
-        return _LEAF_959
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_821(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_960
@@ -20161,7 +19461,7 @@ def _node_821(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_822(a: Any, calls: Calls) -> Decision:
+def _node_786(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_962
@@ -20171,7 +19471,7 @@ def _node_822(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_823(a: Any, calls: Calls) -> Decision:
+def _node_787(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_964
@@ -20181,7 +19481,7 @@ def _node_823(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_824(a: Any, calls: Calls) -> Decision:
+def _node_788(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_966
@@ -20191,7 +19491,7 @@ def _node_824(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_825(a: Any, calls: Calls) -> Decision:
+def _node_789(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_968
@@ -20201,7 +19501,7 @@ def _node_825(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_826(a: Any, calls: Calls) -> Decision:
+def _node_790(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_970
@@ -20211,19 +19511,19 @@ def _node_826(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_827(a: Any, calls: Calls) -> Decision:
+def _node_791(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_828(a, calls)
+        return _node_792(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_829(a, calls)
+        return _node_793(a, calls)
     elif v == 'IDLE':
-        return _node_830(a, calls)
+        return _node_794(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_828(a: Any, calls: Calls) -> Decision:
+def _node_792(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20245,7 +19545,7 @@ def _node_828(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_829(a: Any, calls: Calls) -> Decision:
+def _node_793(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20267,7 +19567,7 @@ def _node_829(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_830(a: Any, calls: Calls) -> Decision:
+def _node_794(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20289,7 +19589,7 @@ def _node_830(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_831(a: Any, calls: Calls) -> Decision:
+def _node_795(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20311,7 +19611,7 @@ def _node_831(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_832(a: Any, calls: Calls) -> Decision:
+def _node_796(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20333,7 +19633,7 @@ def _node_832(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_833(a: Any, calls: Calls) -> Decision:
+def _node_797(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20355,7 +19655,7 @@ def _node_833(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_834(a: Any, calls: Calls) -> Decision:
+def _node_798(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20377,7 +19677,7 @@ def _node_834(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_835(a: Any, calls: Calls) -> Decision:
+def _node_799(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20399,7 +19699,7 @@ def _node_835(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_836(a: Any, calls: Calls) -> Decision:
+def _node_800(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20421,19 +19721,19 @@ def _node_836(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_837(a: Any, calls: Calls) -> Decision:
+def _node_801(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_838(a, calls)
+        return _node_802(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_839(a, calls)
+        return _node_803(a, calls)
     elif v == 'IDLE':
-        return _node_840(a, calls)
+        return _node_804(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_838(a: Any, calls: Calls) -> Decision:
+def _node_802(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20455,7 +19755,7 @@ def _node_838(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_839(a: Any, calls: Calls) -> Decision:
+def _node_803(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20477,7 +19777,7 @@ def _node_839(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_840(a: Any, calls: Calls) -> Decision:
+def _node_804(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20499,7 +19799,7 @@ def _node_840(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_841(a: Any, calls: Calls) -> Decision:
+def _node_805(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20521,7 +19821,7 @@ def _node_841(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_842(a: Any, calls: Calls) -> Decision:
+def _node_806(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20543,7 +19843,7 @@ def _node_842(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_843(a: Any, calls: Calls) -> Decision:
+def _node_807(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20565,7 +19865,7 @@ def _node_843(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_844(a: Any, calls: Calls) -> Decision:
+def _node_808(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20587,7 +19887,7 @@ def _node_844(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_845(a: Any, calls: Calls) -> Decision:
+def _node_809(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20609,7 +19909,7 @@ def _node_845(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_846(a: Any, calls: Calls) -> Decision:
+def _node_810(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20631,19 +19931,19 @@ def _node_846(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_847(a: Any, calls: Calls) -> Decision:
+def _node_811(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_848(a, calls)
+        return _node_812(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_849(a, calls)
+        return _node_813(a, calls)
     elif v == 'IDLE':
-        return _node_850(a, calls)
+        return _node_814(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_848(a: Any, calls: Calls) -> Decision:
+def _node_812(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20665,7 +19965,7 @@ def _node_848(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_849(a: Any, calls: Calls) -> Decision:
+def _node_813(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20687,7 +19987,7 @@ def _node_849(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_850(a: Any, calls: Calls) -> Decision:
+def _node_814(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20709,7 +20009,7 @@ def _node_850(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_851(a: Any, calls: Calls) -> Decision:
+def _node_815(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20731,7 +20031,7 @@ def _node_851(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_852(a: Any, calls: Calls) -> Decision:
+def _node_816(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20753,7 +20053,7 @@ def _node_852(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_853(a: Any, calls: Calls) -> Decision:
+def _node_817(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20775,7 +20075,7 @@ def _node_853(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_854(a: Any, calls: Calls) -> Decision:
+def _node_818(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20797,7 +20097,7 @@ def _node_854(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_855(a: Any, calls: Calls) -> Decision:
+def _node_819(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20819,7 +20119,7 @@ def _node_855(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_856(a: Any, calls: Calls) -> Decision:
+def _node_820(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20841,19 +20141,19 @@ def _node_856(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_857(a: Any, calls: Calls) -> Decision:
+def _node_821(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_858(a, calls)
+        return _node_822(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_859(a, calls)
+        return _node_823(a, calls)
     elif v == 'IDLE':
-        return _node_860(a, calls)
+        return _node_824(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_858(a: Any, calls: Calls) -> Decision:
+def _node_822(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20875,7 +20175,7 @@ def _node_858(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_859(a: Any, calls: Calls) -> Decision:
+def _node_823(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20897,7 +20197,7 @@ def _node_859(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_860(a: Any, calls: Calls) -> Decision:
+def _node_824(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20919,7 +20219,7 @@ def _node_860(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_861(a: Any, calls: Calls) -> Decision:
+def _node_825(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20941,7 +20241,7 @@ def _node_861(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_862(a: Any, calls: Calls) -> Decision:
+def _node_826(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20963,7 +20263,7 @@ def _node_862(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_863(a: Any, calls: Calls) -> Decision:
+def _node_827(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -20985,7 +20285,7 @@ def _node_863(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_864(a: Any, calls: Calls) -> Decision:
+def _node_828(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21007,7 +20307,7 @@ def _node_864(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_865(a: Any, calls: Calls) -> Decision:
+def _node_829(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21029,7 +20329,7 @@ def _node_865(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_866(a: Any, calls: Calls) -> Decision:
+def _node_830(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21051,19 +20351,19 @@ def _node_866(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_867(a: Any, calls: Calls) -> Decision:
+def _node_831(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_868(a, calls)
+        return _node_832(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_869(a, calls)
+        return _node_833(a, calls)
     elif v == 'IDLE':
-        return _node_870(a, calls)
+        return _node_834(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_868(a: Any, calls: Calls) -> Decision:
+def _node_832(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21085,7 +20385,7 @@ def _node_868(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_869(a: Any, calls: Calls) -> Decision:
+def _node_833(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21107,7 +20407,7 @@ def _node_869(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_870(a: Any, calls: Calls) -> Decision:
+def _node_834(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21129,7 +20429,7 @@ def _node_870(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_871(a: Any, calls: Calls) -> Decision:
+def _node_835(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1128
@@ -21139,7 +20439,7 @@ def _node_871(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_872(a: Any, calls: Calls) -> Decision:
+def _node_836(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1130
@@ -21149,7 +20449,7 @@ def _node_872(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_873(a: Any, calls: Calls) -> Decision:
+def _node_837(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1132
@@ -21159,7 +20459,7 @@ def _node_873(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_874(a: Any, calls: Calls) -> Decision:
+def _node_838(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1134
@@ -21169,7 +20469,7 @@ def _node_874(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_875(a: Any, calls: Calls) -> Decision:
+def _node_839(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1136
@@ -21179,7 +20479,7 @@ def _node_875(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_876(a: Any, calls: Calls) -> Decision:
+def _node_840(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1138
@@ -21189,12 +20489,12 @@ def _node_876(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_877(a: Any, calls: Calls) -> Decision:
+def _node_841(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_878(a, calls)
+        return _node_842(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_879(a, calls)
+        return _node_843(a, calls)
     elif v == 'IDLE':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
@@ -21219,7 +20519,7 @@ def _node_877(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_878(a: Any, calls: Calls) -> Decision:
+def _node_842(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21241,7 +20541,7 @@ def _node_878(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_879(a: Any, calls: Calls) -> Decision:
+def _node_843(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21263,7 +20563,7 @@ def _node_879(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_880(a: Any, calls: Calls) -> Decision:
+def _node_844(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1152
@@ -21273,7 +20573,7 @@ def _node_880(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_881(a: Any, calls: Calls) -> Decision:
+def _node_845(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1154
@@ -21283,7 +20583,7 @@ def _node_881(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_882(a: Any, calls: Calls) -> Decision:
+def _node_846(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1158
@@ -21293,7 +20593,7 @@ def _node_882(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_883(a: Any, calls: Calls) -> Decision:
+def _node_847(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1160
@@ -21303,19 +20603,19 @@ def _node_883(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_884(a: Any, calls: Calls) -> Decision:
+def _node_848(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_885(a, calls)
+        return _node_849(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_886(a, calls)
+        return _node_850(a, calls)
     elif v == 'IDLE':
-        return _node_887(a, calls)
+        return _node_851(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_885(a: Any, calls: Calls) -> Decision:
+def _node_849(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21337,7 +20637,7 @@ def _node_885(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_886(a: Any, calls: Calls) -> Decision:
+def _node_850(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21359,7 +20659,7 @@ def _node_886(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_887(a: Any, calls: Calls) -> Decision:
+def _node_851(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21381,7 +20681,7 @@ def _node_887(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_888(a: Any, calls: Calls) -> Decision:
+def _node_852(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21403,7 +20703,7 @@ def _node_888(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_889(a: Any, calls: Calls) -> Decision:
+def _node_853(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21425,7 +20725,7 @@ def _node_889(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_890(a: Any, calls: Calls) -> Decision:
+def _node_854(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21447,7 +20747,7 @@ def _node_890(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_891(a: Any, calls: Calls) -> Decision:
+def _node_855(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21469,7 +20769,7 @@ def _node_891(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_892(a: Any, calls: Calls) -> Decision:
+def _node_856(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21491,7 +20791,7 @@ def _node_892(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_893(a: Any, calls: Calls) -> Decision:
+def _node_857(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21513,12 +20813,12 @@ def _node_893(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_894(a: Any, calls: Calls) -> Decision:
+def _node_858(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_895(a, calls)
+        return _node_859(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_896(a, calls)
+        return _node_860(a, calls)
     elif v == 'IDLE':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
@@ -21543,7 +20843,7 @@ def _node_894(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_895(a: Any, calls: Calls) -> Decision:
+def _node_859(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21565,7 +20865,7 @@ def _node_895(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_896(a: Any, calls: Calls) -> Decision:
+def _node_860(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         v = a['@CALC_GOALstate']
@@ -21587,7 +20887,7 @@ def _node_896(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_897(a: Any, calls: Calls) -> Decision:
+def _node_861(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1212
@@ -21597,7 +20897,7 @@ def _node_897(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_898(a: Any, calls: Calls) -> Decision:
+def _node_862(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1214
@@ -21607,7 +20907,7 @@ def _node_898(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_899(a: Any, calls: Calls) -> Decision:
+def _node_863(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1218
@@ -21617,7 +20917,7 @@ def _node_899(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_900(a: Any, calls: Calls) -> Decision:
+def _node_864(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_GOALstate']
     if v == 'CALC-GOAL':
         return _LEAF_1220
@@ -21627,7 +20927,7 @@ def _node_900(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
 
 
-def _node_901(a: Any, calls: Calls) -> Decision:
+def _node_865(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_380(a, calls)
@@ -21639,7 +20939,7 @@ def _node_901(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_902(a: Any, calls: Calls) -> Decision:
+def _node_866(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_390(a, calls)
@@ -21651,7 +20951,7 @@ def _node_902(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_903(a: Any, calls: Calls) -> Decision:
+def _node_867(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_4(a, calls)
@@ -21663,7 +20963,7 @@ def _node_903(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_904(a: Any, calls: Calls) -> Decision:
+def _node_868(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_471(a, calls)
@@ -21675,7 +20975,7 @@ def _node_904(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_905(a: Any, calls: Calls) -> Decision:
+def _node_869(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_481(a, calls)
@@ -21687,7 +20987,7 @@ def _node_905(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_906(a: Any, calls: Calls) -> Decision:
+def _node_870(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_98(a, calls)
@@ -21699,7 +20999,7 @@ def _node_906(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_907(a: Any, calls: Calls) -> Decision:
+def _node_871(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_562(a, calls)
@@ -21711,7 +21011,7 @@ def _node_907(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_908(a: Any, calls: Calls) -> Decision:
+def _node_872(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_572(a, calls)
@@ -21723,7 +21023,7 @@ def _node_908(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_909(a: Any, calls: Calls) -> Decision:
+def _node_873(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_192(a, calls)
@@ -21735,7 +21035,7 @@ def _node_909(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_910(a: Any, calls: Calls) -> Decision:
+def _node_874(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_653(a, calls)
@@ -21747,7 +21047,7 @@ def _node_910(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_911(a: Any, calls: Calls) -> Decision:
+def _node_875(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_663(a, calls)
@@ -21759,7 +21059,7 @@ def _node_911(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_912(a: Any, calls: Calls) -> Decision:
+def _node_876(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_286(a, calls)
@@ -21771,7 +21071,7 @@ def _node_912(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_913(a: Any, calls: Calls) -> Decision:
+def _node_877(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_24(a, calls)
@@ -21783,7 +21083,7 @@ def _node_913(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_914(a: Any, calls: Calls) -> Decision:
+def _node_878(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_400(a, calls)
@@ -21795,7 +21095,7 @@ def _node_914(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_915(a: Any, calls: Calls) -> Decision:
+def _node_879(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_118(a, calls)
@@ -21807,7 +21107,7 @@ def _node_915(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_916(a: Any, calls: Calls) -> Decision:
+def _node_880(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_491(a, calls)
@@ -21819,7 +21119,7 @@ def _node_916(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_917(a: Any, calls: Calls) -> Decision:
+def _node_881(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_212(a, calls)
@@ -21831,7 +21131,7 @@ def _node_917(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_918(a: Any, calls: Calls) -> Decision:
+def _node_882(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_582(a, calls)
@@ -21843,7 +21143,7 @@ def _node_918(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_919(a: Any, calls: Calls) -> Decision:
+def _node_883(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_306(a, calls)
@@ -21855,7 +21155,7 @@ def _node_919(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_920(a: Any, calls: Calls) -> Decision:
+def _node_884(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_673(a, calls)
@@ -21867,53 +21167,53 @@ def _node_920(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_921(a: Any, calls: Calls) -> Decision:
+def _node_885(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_903(a, calls)
+            return _node_867(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_902(a, calls)
+            return _node_866(a, calls)
         elif v == 'IDLE':
-            return _node_914(a, calls)
+            return _node_878(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     elif v == 'CALC-TRAJ-GOAL':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_906(a, calls)
+            return _node_870(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_905(a, calls)
+            return _node_869(a, calls)
         elif v == 'IDLE':
-            return _node_916(a, calls)
+            return _node_880(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     elif v == 'CALC-TRAJ-OBJ':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_909(a, calls)
+            return _node_873(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_908(a, calls)
+            return _node_872(a, calls)
         elif v == 'IDLE':
-            return _node_918(a, calls)
+            return _node_882(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     elif v == 'IDLE':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_912(a, calls)
+            return _node_876(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_911(a, calls)
+            return _node_875(a, calls)
         elif v == 'IDLE':
-            return _node_920(a, calls)
+            return _node_884(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     else:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_922(a: Any, calls: Calls) -> Decision:
+def _node_886(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_14(a, calls)
@@ -21925,7 +21225,7 @@ def _node_922(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_923(a: Any, calls: Calls) -> Decision:
+def _node_887(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_108(a, calls)
@@ -21937,7 +21237,7 @@ def _node_923(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_924(a: Any, calls: Calls) -> Decision:
+def _node_888(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_202(a, calls)
@@ -21949,7 +21249,7 @@ def _node_924(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_925(a: Any, calls: Calls) -> Decision:
+def _node_889(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_296(a, calls)
@@ -21961,132 +21261,120 @@ def _node_925(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_926(a: Any, calls: Calls) -> Decision:
+def _node_890(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_901(a, calls)
+            return _node_865(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_922(a, calls)
+            return _node_886(a, calls)
         elif v == 'IDLE':
-            return _node_914(a, calls)
+            return _node_878(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     elif v == 'CALC-TRAJ-GOAL':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_904(a, calls)
+            return _node_868(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_923(a, calls)
+            return _node_887(a, calls)
         elif v == 'IDLE':
-            return _node_916(a, calls)
+            return _node_880(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     elif v == 'CALC-TRAJ-OBJ':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_907(a, calls)
+            return _node_871(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_924(a, calls)
+            return _node_888(a, calls)
         elif v == 'IDLE':
-            return _node_918(a, calls)
+            return _node_882(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     elif v == 'IDLE':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
-            return _node_910(a, calls)
+            return _node_874(a, calls)
         elif v == 'EXEC-TRAJ-OBJ':
-            return _node_925(a, calls)
+            return _node_889(a, calls)
         elif v == 'IDLE':
-            return _node_920(a, calls)
+            return _node_884(a, calls)
         else:
             raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
     else:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_927(a: Any, calls: Calls) -> Decision:
+def _node_891(a: Any, calls: Calls) -> Decision:
     v = a['@ExecTrajState']
     if v == 'EXEC-TRAJ-GOAL':
-        v = a['@ARM_OBJ_ARM_BACKstate']
-        if v == 'ARM-OBJ':
-            return _node_752(a, calls)
-        elif v == 'ARM-BACK':
-            return _node_928(a, calls)
-        elif v == 'IDLE':
-            return _node_930(a, calls)
-        else:
-            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+        return _node_892(a, calls)
     elif v == 'EXEC-TRAJ-OBJ':
-        return _node_932(a, calls)
+        return _node_893(a, calls)
     elif v == 'IDLE':
-        return _node_933(a, calls)
+        return _node_894(a, calls)
     else:
         raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
 
 
-def _node_928(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_761(a, calls)
-    elif v == 'IDLE':
-        return _node_929(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_929(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1224
-    elif v == 'IDLE':
-        return _LEAF_1225
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_930(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_764(a, calls)
-    elif v == 'IDLE':
-        return _node_931(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_931(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1226
-    elif v == 'IDLE':
-        return _LEAF_1227
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_932(a: Any, calls: Calls) -> Decision:
+def _node_892(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_828(a, calls)
+        return _node_752(a, calls)
     elif v == 'ARM-BACK':
-        return _node_831(a, calls)
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_755(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1224
+            elif v == 'IDLE':
+                return _LEAF_1225
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_834(a, calls)
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_758(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1226
+            elif v == 'IDLE':
+                return _LEAF_1227
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_933(a: Any, calls: Calls) -> Decision:
+def _node_893(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_868(a, calls)
+        return _node_792(a, calls)
+    elif v == 'ARM-BACK':
+        return _node_795(a, calls)
+    elif v == 'IDLE':
+        return _node_798(a, calls)
+    else:
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+
+
+def _node_894(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_832(a, calls)
     elif v == 'ARM-BACK':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
-            return _node_871(a, calls)
+            return _node_835(a, calls)
         elif v == 'IDLE':
             v = a['@CALC_GOALstate']
             if v == 'CALC-GOAL':
@@ -22100,7 +21388,7 @@ def _node_933(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
-            return _node_874(a, calls)
+            return _node_838(a, calls)
         elif v == 'IDLE':
             v = a['@CALC_GOALstate']
             if v == 'CALC-GOAL':
@@ -22115,78 +21403,62 @@ def _node_933(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_934(a: Any, calls: Calls) -> Decision:
+def _node_895(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_755(a, calls)
-    elif v == 'ARM-BACK':
-        return _node_935(a, calls)
-    elif v == 'IDLE':
-        return _node_937(a, calls)
-    else:
-        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-
-
-def _node_935(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_762(a, calls)
-    elif v == 'IDLE':
-        return _node_936(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_936(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1232
-    elif v == 'IDLE':
-        return _LEAF_1233
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_937(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_765(a, calls)
-    elif v == 'IDLE':
-        return _node_938(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_938(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1234
-    elif v == 'IDLE':
-        return _LEAF_1235
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_939(a: Any, calls: Calls) -> Decision:
-    v = a['@ARM_OBJ_ARM_BACKstate']
-    if v == 'ARM-OBJ':
-        return _node_829(a, calls)
-    elif v == 'ARM-BACK':
-        return _node_832(a, calls)
-    elif v == 'IDLE':
-        return _node_835(a, calls)
-    else:
-        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-
-
-def _node_940(a: Any, calls: Calls) -> Decision:
-    v = a['@ARM_OBJ_ARM_BACKstate']
-    if v == 'ARM-OBJ':
-        return _node_869(a, calls)
+        return _node_753(a, calls)
     elif v == 'ARM-BACK':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
-            return _node_872(a, calls)
+            return _node_756(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1232
+            elif v == 'IDLE':
+                return _LEAF_1233
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_759(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1234
+            elif v == 'IDLE':
+                return _LEAF_1235
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+
+
+def _node_896(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_793(a, calls)
+    elif v == 'ARM-BACK':
+        return _node_796(a, calls)
+    elif v == 'IDLE':
+        return _node_799(a, calls)
+    else:
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+
+
+def _node_897(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_833(a, calls)
+    elif v == 'ARM-BACK':
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_836(a, calls)
         elif v == 'IDLE':
             v = a['@CALC_GOALstate']
             if v == 'CALC-GOAL':
@@ -22200,7 +21472,7 @@ def _node_940(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
-            return _node_875(a, calls)
+            return _node_839(a, calls)
         elif v == 'IDLE':
             v = a['@CALC_GOALstate']
             if v == 'CALC-GOAL':
@@ -22215,66 +21487,62 @@ def _node_940(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_941(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_763(a, calls)
-    elif v == 'IDLE':
-        return _node_942(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_942(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1240
-    elif v == 'IDLE':
-        return _LEAF_1241
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_943(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_766(a, calls)
-    elif v == 'IDLE':
-        return _node_944(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_944(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1242
-    elif v == 'IDLE':
-        return _LEAF_1243
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_945(a: Any, calls: Calls) -> Decision:
+def _node_898(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_830(a, calls)
+        return _node_754(a, calls)
     elif v == 'ARM-BACK':
-        return _node_833(a, calls)
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_757(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1240
+            elif v == 'IDLE':
+                return _LEAF_1241
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_836(a, calls)
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_760(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1242
+            elif v == 'IDLE':
+                return _LEAF_1243
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_946(a: Any, calls: Calls) -> Decision:
+def _node_899(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_870(a, calls)
+        return _node_794(a, calls)
+    elif v == 'ARM-BACK':
+        return _node_797(a, calls)
+    elif v == 'IDLE':
+        return _node_800(a, calls)
+    else:
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+
+
+def _node_900(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_834(a, calls)
     elif v == 'ARM-BACK':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
-            return _node_873(a, calls)
+            return _node_837(a, calls)
         elif v == 'IDLE':
             v = a['@CALC_GOALstate']
             if v == 'CALC-GOAL':
@@ -22288,7 +21556,7 @@ def _node_946(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         v = a['@CALC_OBJstate']
         if v == 'CALC-OBJ':
-            return _node_876(a, calls)
+            return _node_840(a, calls)
         elif v == 'IDLE':
             v = a['@CALC_GOALstate']
             if v == 'CALC-GOAL':
@@ -22303,83 +21571,75 @@ def _node_946(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_947(a: Any, calls: Calls) -> Decision:
+def _node_901(a: Any, calls: Calls) -> Decision:
     v = a['@ExecTrajState']
     if v == 'EXEC-TRAJ-GOAL':
-        v = a['@ARM_OBJ_ARM_BACKstate']
-        if v == 'ARM-OBJ':
-            return _node_783(a, calls)
-        elif v == 'ARM-BACK':
-            return _node_793(a, calls)
-        elif v == 'IDLE':
-            return _node_803(a, calls)
-        else:
-            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+        return _node_902(a, calls)
     elif v == 'EXEC-TRAJ-OBJ':
-        return _node_948(a, calls)
+        return _node_903(a, calls)
     elif v == 'IDLE':
         v = a['@ARM_OBJ_ARM_BACKstate']
         if v == 'ARM-OBJ':
-            return _node_885(a, calls)
+            return _node_849(a, calls)
         elif v == 'ARM-BACK':
-            return _node_888(a, calls)
+            return _node_852(a, calls)
         elif v == 'IDLE':
-            return _node_891(a, calls)
+            return _node_855(a, calls)
         else:
             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
     else:
         raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
 
 
-def _node_948(a: Any, calls: Calls) -> Decision:
+def _node_902(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_848(a, calls)
+        return _node_772(a, calls)
     elif v == 'ARM-BACK':
-        return _node_851(a, calls)
+        return _node_775(a, calls)
     elif v == 'IDLE':
-        return _node_854(a, calls)
+        return _node_778(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_949(a: Any, calls: Calls) -> Decision:
+def _node_903(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_786(a, calls)
+        return _node_812(a, calls)
     elif v == 'ARM-BACK':
-        return _node_796(a, calls)
+        return _node_815(a, calls)
     elif v == 'IDLE':
-        return _node_806(a, calls)
+        return _node_818(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_950(a: Any, calls: Calls) -> Decision:
+def _node_904(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_849(a, calls)
+        return _node_773(a, calls)
     elif v == 'ARM-BACK':
-        return _node_852(a, calls)
+        return _node_776(a, calls)
     elif v == 'IDLE':
-        return _node_855(a, calls)
+        return _node_779(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_951(a: Any, calls: Calls) -> Decision:
+def _node_905(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_886(a, calls)
+        return _node_813(a, calls)
     elif v == 'ARM-BACK':
-        return _node_889(a, calls)
+        return _node_816(a, calls)
     elif v == 'IDLE':
-        return _node_892(a, calls)
+        return _node_819(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_952(a: Any, calls: Calls) -> Decision:
+def _node_906(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
         return _node_850(a, calls)
@@ -22391,7 +21651,31 @@ def _node_952(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_953(a: Any, calls: Calls) -> Decision:
+def _node_907(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_774(a, calls)
+    elif v == 'ARM-BACK':
+        return _node_777(a, calls)
+    elif v == 'IDLE':
+        return _node_780(a, calls)
+    else:
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+
+
+def _node_908(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_814(a, calls)
+    elif v == 'ARM-BACK':
+        return _node_817(a, calls)
+    elif v == 'IDLE':
+        return _node_820(a, calls)
+    else:
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+
+
+def _node_909(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         return _node_379(a, calls)
@@ -22405,19 +21689,19 @@ def _node_953(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_954(a: Any, calls: Calls) -> Decision:
+def _node_910(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
-        return _node_932(a, calls)
+        return _node_893(a, calls)
     elif v == 'SEARCH-OBJ':
-        return _node_939(a, calls)
+        return _node_896(a, calls)
     elif v == 'IDLE':
-        return _node_945(a, calls)
+        return _node_899(a, calls)
     else:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_955(a: Any, calls: Calls) -> Decision:
+def _node_911(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         return _node_379(a, calls)
@@ -22431,207 +21715,261 @@ def _node_955(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_956(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_776(a, calls)
+def _node_912(a: Any, calls: Calls) -> Decision:
+    v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+    if v == 'READ-MODEL':
+        v = a['@READ_OBST_SEARCH_OBJstate']
+        if v == 'READ-OBST':
+            return _node_892(a, calls)
+        elif v == 'SEARCH-OBJ':
+            return _node_895(a, calls)
+        elif v == 'IDLE':
+            return _node_898(a, calls)
+        else:
+            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+    elif v == 'CALC-TRAJ-GOAL':
+        v = a['@READ_OBST_SEARCH_OBJstate']
+        if v == 'READ-OBST':
+            return _node_913(a, calls)
+        elif v == 'SEARCH-OBJ':
+            return _node_914(a, calls)
+        elif v == 'IDLE':
+            v = a['@ARM_OBJ_ARM_BACKstate']
+            if v == 'ARM-OBJ':
+                return _node_764(a, calls)
+            elif v == 'ARM-BACK':
+                v = a['@CALC_OBJstate']
+                if v == 'CALC-OBJ':
+                    return _node_767(a, calls)
+                elif v == 'IDLE':
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _LEAF_1256
+                    elif v == 'IDLE':
+                        return _LEAF_1257
+                    else:
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['@CALC_OBJstate']
+                if v == 'CALC-OBJ':
+                    return _node_770(a, calls)
+                elif v == 'IDLE':
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _LEAF_1258
+                    elif v == 'IDLE':
+                        return _LEAF_1259
+                    else:
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+    elif v == 'CALC-TRAJ-OBJ':
+        v = a['@READ_OBST_SEARCH_OBJstate']
+        if v == 'READ-OBST':
+            return _node_902(a, calls)
+        elif v == 'SEARCH-OBJ':
+            return _node_904(a, calls)
+        elif v == 'IDLE':
+            return _node_907(a, calls)
+        else:
+            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_957(a, calls)
+        v = a['@READ_OBST_SEARCH_OBJstate']
+        if v == 'READ-OBST':
+            return _node_915(a, calls)
+        elif v == 'SEARCH-OBJ':
+            return _node_916(a, calls)
+        elif v == 'IDLE':
+            v = a['@ARM_OBJ_ARM_BACKstate']
+            if v == 'ARM-OBJ':
+                return _node_784(a, calls)
+            elif v == 'ARM-BACK':
+                v = a['@CALC_OBJstate']
+                if v == 'CALC-OBJ':
+                    return _node_787(a, calls)
+                elif v == 'IDLE':
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _LEAF_1268
+                    elif v == 'IDLE':
+                        return _LEAF_1269
+                    else:
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['@CALC_OBJstate']
+                if v == 'CALC-OBJ':
+                    return _node_790(a, calls)
+                elif v == 'IDLE':
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _LEAF_1270
+                    elif v == 'IDLE':
+                        return _LEAF_1271
+                    else:
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_957(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1248
+def _node_913(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_762(a, calls)
+    elif v == 'ARM-BACK':
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_765(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1248
+            elif v == 'IDLE':
+                return _LEAF_1249
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_1249
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_768(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1250
+            elif v == 'IDLE':
+                return _LEAF_1251
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_958(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_777(a, calls)
+def _node_914(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_763(a, calls)
+    elif v == 'ARM-BACK':
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_766(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1252
+            elif v == 'IDLE':
+                return _LEAF_1253
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _node_959(a, calls)
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_769(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1254
+            elif v == 'IDLE':
+                return _LEAF_1255
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_959(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1250
+def _node_915(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_782(a, calls)
+    elif v == 'ARM-BACK':
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_785(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1260
+            elif v == 'IDLE':
+                return _LEAF_1261
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_1251
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_788(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1262
+            elif v == 'IDLE':
+                return _LEAF_1263
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_960(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1252
+def _node_916(a: Any, calls: Calls) -> Decision:
+    v = a['@ARM_OBJ_ARM_BACKstate']
+    if v == 'ARM-OBJ':
+        return _node_783(a, calls)
+    elif v == 'ARM-BACK':
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_786(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1264
+            elif v == 'IDLE':
+                return _LEAF_1265
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_1253
+        v = a['@CALC_OBJstate']
+        if v == 'CALC-OBJ':
+            return _node_789(a, calls)
+        elif v == 'IDLE':
+            v = a['@CALC_GOALstate']
+            if v == 'CALC-GOAL':
+                return _LEAF_1266
+            elif v == 'IDLE':
+                return _LEAF_1267
+            else:
+                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_961(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_779(a, calls)
-    elif v == 'IDLE':
-        return _node_962(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_962(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1254
-    elif v == 'IDLE':
-        return _LEAF_1255
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_963(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_780(a, calls)
-    elif v == 'IDLE':
-        return _node_964(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_964(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1256
-    elif v == 'IDLE':
-        return _LEAF_1257
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_965(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1258
-    elif v == 'IDLE':
-        return _LEAF_1259
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_966(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_821(a, calls)
-    elif v == 'IDLE':
-        return _node_967(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_967(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1260
-    elif v == 'IDLE':
-        return _LEAF_1261
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_968(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_822(a, calls)
-    elif v == 'IDLE':
-        return _node_969(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_969(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1262
-    elif v == 'IDLE':
-        return _LEAF_1263
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_970(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1264
-    elif v == 'IDLE':
-        return _LEAF_1265
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_971(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_824(a, calls)
-    elif v == 'IDLE':
-        return _node_972(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_972(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1266
-    elif v == 'IDLE':
-        return _LEAF_1267
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_973(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_OBJstate']
-    if v == 'CALC-OBJ':
-        return _node_825(a, calls)
-    elif v == 'IDLE':
-        return _node_974(a, calls)
-    else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-
-
-def _node_974(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1268
-    elif v == 'IDLE':
-        return _LEAF_1269
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_975(a: Any, calls: Calls) -> Decision:
-    v = a['@CALC_GOALstate']
-    if v == 'CALC-GOAL':
-        return _LEAF_1270
-    elif v == 'IDLE':
-        return _LEAF_1271
-    else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-
-
-def _node_976(a: Any, calls: Calls) -> Decision:
+def _node_917(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_15(a, calls)
@@ -22643,12 +21981,12 @@ def _node_976(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_977(a: Any, calls: Calls) -> Decision:
+def _node_918(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_978(a, calls)
+    return _node_919(a, calls)
 
 
-def _node_978(a: Any, calls: Calls) -> Decision:
+def _node_919(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_18(a, calls)
@@ -22660,7 +21998,7 @@ def _node_978(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_979(a: Any, calls: Calls) -> Decision:
+def _node_920(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_21(a, calls)
@@ -22672,7 +22010,7 @@ def _node_979(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_980(a: Any, calls: Calls) -> Decision:
+def _node_921(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_109(a, calls)
@@ -22684,12 +22022,12 @@ def _node_980(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_981(a: Any, calls: Calls) -> Decision:
+def _node_922(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_982(a, calls)
+    return _node_923(a, calls)
 
 
-def _node_982(a: Any, calls: Calls) -> Decision:
+def _node_923(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_112(a, calls)
@@ -22701,7 +22039,7 @@ def _node_982(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_983(a: Any, calls: Calls) -> Decision:
+def _node_924(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_115(a, calls)
@@ -22713,7 +22051,7 @@ def _node_983(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_984(a: Any, calls: Calls) -> Decision:
+def _node_925(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_203(a, calls)
@@ -22725,12 +22063,12 @@ def _node_984(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_985(a: Any, calls: Calls) -> Decision:
+def _node_926(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_986(a, calls)
+    return _node_927(a, calls)
 
 
-def _node_986(a: Any, calls: Calls) -> Decision:
+def _node_927(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_206(a, calls)
@@ -22742,7 +22080,7 @@ def _node_986(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_987(a: Any, calls: Calls) -> Decision:
+def _node_928(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_209(a, calls)
@@ -22754,7 +22092,7 @@ def _node_987(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_988(a: Any, calls: Calls) -> Decision:
+def _node_929(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_297(a, calls)
@@ -22766,12 +22104,12 @@ def _node_988(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_989(a: Any, calls: Calls) -> Decision:
+def _node_930(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_990(a, calls)
+    return _node_931(a, calls)
 
 
-def _node_990(a: Any, calls: Calls) -> Decision:
+def _node_931(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_300(a, calls)
@@ -22783,7 +22121,7 @@ def _node_990(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_991(a: Any, calls: Calls) -> Decision:
+def _node_932(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_303(a, calls)
@@ -22795,7 +22133,7 @@ def _node_991(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_992(a: Any, calls: Calls) -> Decision:
+def _node_933(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_25(a, calls)
@@ -22807,12 +22145,12 @@ def _node_992(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_993(a: Any, calls: Calls) -> Decision:
+def _node_934(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_994(a, calls)
+    return _node_935(a, calls)
 
 
-def _node_994(a: Any, calls: Calls) -> Decision:
+def _node_935(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_28(a, calls)
@@ -22824,7 +22162,7 @@ def _node_994(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_995(a: Any, calls: Calls) -> Decision:
+def _node_936(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_31(a, calls)
@@ -22836,7 +22174,7 @@ def _node_995(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_996(a: Any, calls: Calls) -> Decision:
+def _node_937(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_119(a, calls)
@@ -22848,12 +22186,12 @@ def _node_996(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_997(a: Any, calls: Calls) -> Decision:
+def _node_938(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_998(a, calls)
+    return _node_939(a, calls)
 
 
-def _node_998(a: Any, calls: Calls) -> Decision:
+def _node_939(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_122(a, calls)
@@ -22865,7 +22203,7 @@ def _node_998(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_999(a: Any, calls: Calls) -> Decision:
+def _node_940(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_125(a, calls)
@@ -22877,7 +22215,7 @@ def _node_999(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1000(a: Any, calls: Calls) -> Decision:
+def _node_941(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_213(a, calls)
@@ -22889,12 +22227,12 @@ def _node_1000(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1001(a: Any, calls: Calls) -> Decision:
+def _node_942(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_1002(a, calls)
+    return _node_943(a, calls)
 
 
-def _node_1002(a: Any, calls: Calls) -> Decision:
+def _node_943(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_216(a, calls)
@@ -22906,7 +22244,7 @@ def _node_1002(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1003(a: Any, calls: Calls) -> Decision:
+def _node_944(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_219(a, calls)
@@ -22918,7 +22256,7 @@ def _node_1003(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1004(a: Any, calls: Calls) -> Decision:
+def _node_945(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_307(a, calls)
@@ -22930,12 +22268,12 @@ def _node_1004(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1005(a: Any, calls: Calls) -> Decision:
+def _node_946(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ARM_OBJ_ARM_BACKstate'],))
-    return _node_1006(a, calls)
+    return _node_947(a, calls)
 
 
-def _node_1006(a: Any, calls: Calls) -> Decision:
+def _node_947(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_310(a, calls)
@@ -22947,7 +22285,7 @@ def _node_1006(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1007(a: Any, calls: Calls) -> Decision:
+def _node_948(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_313(a, calls)
@@ -22959,7 +22297,7 @@ def _node_1007(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1008(a: Any, calls: Calls) -> Decision:
+def _node_949(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_381(a, calls)
@@ -22971,7 +22309,7 @@ def _node_1008(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1009(a: Any, calls: Calls) -> Decision:
+def _node_950(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_384(a, calls)
@@ -22983,7 +22321,7 @@ def _node_1009(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1010(a: Any, calls: Calls) -> Decision:
+def _node_951(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_5(a, calls)
@@ -22995,7 +22333,7 @@ def _node_1010(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1011(a: Any, calls: Calls) -> Decision:
+def _node_952(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_391(a, calls)
@@ -23007,7 +22345,7 @@ def _node_1011(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1012(a: Any, calls: Calls) -> Decision:
+def _node_953(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_394(a, calls)
@@ -23019,7 +22357,7 @@ def _node_1012(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1013(a: Any, calls: Calls) -> Decision:
+def _node_954(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_401(a, calls)
@@ -23031,7 +22369,7 @@ def _node_1013(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1014(a: Any, calls: Calls) -> Decision:
+def _node_955(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_404(a, calls)
@@ -23043,7 +22381,7 @@ def _node_1014(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1015(a: Any, calls: Calls) -> Decision:
+def _node_956(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_472(a, calls)
@@ -23055,7 +22393,7 @@ def _node_1015(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1016(a: Any, calls: Calls) -> Decision:
+def _node_957(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_475(a, calls)
@@ -23067,7 +22405,7 @@ def _node_1016(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1017(a: Any, calls: Calls) -> Decision:
+def _node_958(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_99(a, calls)
@@ -23079,7 +22417,7 @@ def _node_1017(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1018(a: Any, calls: Calls) -> Decision:
+def _node_959(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_482(a, calls)
@@ -23091,7 +22429,7 @@ def _node_1018(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1019(a: Any, calls: Calls) -> Decision:
+def _node_960(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_485(a, calls)
@@ -23103,7 +22441,7 @@ def _node_1019(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1020(a: Any, calls: Calls) -> Decision:
+def _node_961(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_492(a, calls)
@@ -23115,7 +22453,7 @@ def _node_1020(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1021(a: Any, calls: Calls) -> Decision:
+def _node_962(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_495(a, calls)
@@ -23127,7 +22465,7 @@ def _node_1021(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1022(a: Any, calls: Calls) -> Decision:
+def _node_963(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_563(a, calls)
@@ -23139,7 +22477,7 @@ def _node_1022(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1023(a: Any, calls: Calls) -> Decision:
+def _node_964(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_566(a, calls)
@@ -23151,7 +22489,7 @@ def _node_1023(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1024(a: Any, calls: Calls) -> Decision:
+def _node_965(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_193(a, calls)
@@ -23163,7 +22501,7 @@ def _node_1024(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1025(a: Any, calls: Calls) -> Decision:
+def _node_966(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_573(a, calls)
@@ -23175,7 +22513,7 @@ def _node_1025(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1026(a: Any, calls: Calls) -> Decision:
+def _node_967(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_576(a, calls)
@@ -23187,7 +22525,7 @@ def _node_1026(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1027(a: Any, calls: Calls) -> Decision:
+def _node_968(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_583(a, calls)
@@ -23199,7 +22537,7 @@ def _node_1027(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1028(a: Any, calls: Calls) -> Decision:
+def _node_969(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_586(a, calls)
@@ -23211,7 +22549,7 @@ def _node_1028(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1029(a: Any, calls: Calls) -> Decision:
+def _node_970(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_654(a, calls)
@@ -23223,7 +22561,7 @@ def _node_1029(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1030(a: Any, calls: Calls) -> Decision:
+def _node_971(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_657(a, calls)
@@ -23235,7 +22573,7 @@ def _node_1030(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1031(a: Any, calls: Calls) -> Decision:
+def _node_972(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_287(a, calls)
@@ -23247,7 +22585,7 @@ def _node_1031(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1032(a: Any, calls: Calls) -> Decision:
+def _node_973(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_664(a, calls)
@@ -23259,7 +22597,7 @@ def _node_1032(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1033(a: Any, calls: Calls) -> Decision:
+def _node_974(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_667(a, calls)
@@ -23271,7 +22609,7 @@ def _node_1033(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1034(a: Any, calls: Calls) -> Decision:
+def _node_975(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_674(a, calls)
@@ -23283,7 +22621,7 @@ def _node_1034(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1035(a: Any, calls: Calls) -> Decision:
+def _node_976(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_677(a, calls)
@@ -23295,7 +22633,7 @@ def _node_1035(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1036(a: Any, calls: Calls) -> Decision:
+def _node_977(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_11(a, calls)
@@ -23307,7 +22645,7 @@ def _node_1036(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1037(a: Any, calls: Calls) -> Decision:
+def _node_978(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_387(a, calls)
@@ -23319,7 +22657,7 @@ def _node_1037(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1038(a: Any, calls: Calls) -> Decision:
+def _node_979(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_397(a, calls)
@@ -23331,7 +22669,7 @@ def _node_1038(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1039(a: Any, calls: Calls) -> Decision:
+def _node_980(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_407(a, calls)
@@ -23343,7 +22681,7 @@ def _node_1039(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1040(a: Any, calls: Calls) -> Decision:
+def _node_981(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_105(a, calls)
@@ -23355,7 +22693,7 @@ def _node_1040(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1041(a: Any, calls: Calls) -> Decision:
+def _node_982(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_478(a, calls)
@@ -23367,7 +22705,7 @@ def _node_1041(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1042(a: Any, calls: Calls) -> Decision:
+def _node_983(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_488(a, calls)
@@ -23379,7 +22717,7 @@ def _node_1042(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1043(a: Any, calls: Calls) -> Decision:
+def _node_984(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_498(a, calls)
@@ -23391,7 +22729,7 @@ def _node_1043(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1044(a: Any, calls: Calls) -> Decision:
+def _node_985(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_199(a, calls)
@@ -23403,7 +22741,7 @@ def _node_1044(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1045(a: Any, calls: Calls) -> Decision:
+def _node_986(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_569(a, calls)
@@ -23415,7 +22753,7 @@ def _node_1045(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1046(a: Any, calls: Calls) -> Decision:
+def _node_987(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_579(a, calls)
@@ -23427,7 +22765,7 @@ def _node_1046(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1047(a: Any, calls: Calls) -> Decision:
+def _node_988(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_589(a, calls)
@@ -23439,7 +22777,7 @@ def _node_1047(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1048(a: Any, calls: Calls) -> Decision:
+def _node_989(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_293(a, calls)
@@ -23451,7 +22789,7 @@ def _node_1048(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1049(a: Any, calls: Calls) -> Decision:
+def _node_990(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_660(a, calls)
@@ -23463,7 +22801,7 @@ def _node_1049(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1050(a: Any, calls: Calls) -> Decision:
+def _node_991(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_670(a, calls)
@@ -23475,7 +22813,7 @@ def _node_1050(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1051(a: Any, calls: Calls) -> Decision:
+def _node_992(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_680(a, calls)
@@ -23487,38 +22825,38 @@ def _node_1051(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1052(a: Any, calls: Calls) -> Decision:
+def _node_993(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1010(a, calls)
+                return _node_951(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1009(a, calls)
+                return _node_950(a, calls)
             elif v == 'IDLE':
-                return _node_1037(a, calls)
+                return _node_978(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_976(a, calls)
+                return _node_917(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1012(a, calls)
+                return _node_953(a, calls)
             elif v == 'IDLE':
-                return _node_1038(a, calls)
+                return _node_979(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_992(a, calls)
+                return _node_933(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1014(a, calls)
+                return _node_955(a, calls)
             elif v == 'IDLE':
-                return _node_1039(a, calls)
+                return _node_980(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23528,31 +22866,31 @@ def _node_1052(a: Any, calls: Calls) -> Decision:
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1017(a, calls)
+                return _node_958(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1016(a, calls)
+                return _node_957(a, calls)
             elif v == 'IDLE':
-                return _node_1041(a, calls)
+                return _node_982(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_980(a, calls)
+                return _node_921(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1019(a, calls)
+                return _node_960(a, calls)
             elif v == 'IDLE':
-                return _node_1042(a, calls)
+                return _node_983(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_996(a, calls)
+                return _node_937(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1021(a, calls)
+                return _node_962(a, calls)
             elif v == 'IDLE':
-                return _node_1043(a, calls)
+                return _node_984(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23562,31 +22900,31 @@ def _node_1052(a: Any, calls: Calls) -> Decision:
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1024(a, calls)
+                return _node_965(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1023(a, calls)
+                return _node_964(a, calls)
             elif v == 'IDLE':
-                return _node_1045(a, calls)
+                return _node_986(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_984(a, calls)
+                return _node_925(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1026(a, calls)
+                return _node_967(a, calls)
             elif v == 'IDLE':
-                return _node_1046(a, calls)
+                return _node_987(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1000(a, calls)
+                return _node_941(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1028(a, calls)
+                return _node_969(a, calls)
             elif v == 'IDLE':
-                return _node_1047(a, calls)
+                return _node_988(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23596,31 +22934,31 @@ def _node_1052(a: Any, calls: Calls) -> Decision:
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1031(a, calls)
+                return _node_972(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1030(a, calls)
+                return _node_971(a, calls)
             elif v == 'IDLE':
-                return _node_1049(a, calls)
+                return _node_990(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_988(a, calls)
+                return _node_929(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1033(a, calls)
+                return _node_974(a, calls)
             elif v == 'IDLE':
-                return _node_1050(a, calls)
+                return _node_991(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1004(a, calls)
+                return _node_945(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1035(a, calls)
+                return _node_976(a, calls)
             elif v == 'IDLE':
-                return _node_1051(a, calls)
+                return _node_992(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23629,7 +22967,7 @@ def _node_1052(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_1053(a: Any, calls: Calls) -> Decision:
+def _node_994(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_8(a, calls)
@@ -23641,7 +22979,7 @@ def _node_1053(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1054(a: Any, calls: Calls) -> Decision:
+def _node_995(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_102(a, calls)
@@ -23653,7 +22991,7 @@ def _node_1054(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1055(a: Any, calls: Calls) -> Decision:
+def _node_996(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_196(a, calls)
@@ -23665,7 +23003,7 @@ def _node_1055(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1056(a: Any, calls: Calls) -> Decision:
+def _node_997(a: Any, calls: Calls) -> Decision:
     v = a['@READ_OBST_SEARCH_OBJstate']
     if v == 'READ-OBST':
         return _node_290(a, calls)
@@ -23677,38 +23015,38 @@ def _node_1056(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
 
 
-def _node_1057(a: Any, calls: Calls) -> Decision:
+def _node_998(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1008(a, calls)
+                return _node_949(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1053(a, calls)
+                return _node_994(a, calls)
             elif v == 'IDLE':
-                return _node_1037(a, calls)
+                return _node_978(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1011(a, calls)
+                return _node_952(a, calls)
             elif v == 'ARM-BACK':
-                return _node_978(a, calls)
+                return _node_919(a, calls)
             elif v == 'IDLE':
-                return _node_1038(a, calls)
+                return _node_979(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1013(a, calls)
+                return _node_954(a, calls)
             elif v == 'ARM-BACK':
-                return _node_994(a, calls)
+                return _node_935(a, calls)
             elif v == 'IDLE':
-                return _node_1039(a, calls)
+                return _node_980(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23718,31 +23056,31 @@ def _node_1057(a: Any, calls: Calls) -> Decision:
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1015(a, calls)
+                return _node_956(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1054(a, calls)
+                return _node_995(a, calls)
             elif v == 'IDLE':
-                return _node_1041(a, calls)
+                return _node_982(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1018(a, calls)
+                return _node_959(a, calls)
             elif v == 'ARM-BACK':
-                return _node_982(a, calls)
+                return _node_923(a, calls)
             elif v == 'IDLE':
-                return _node_1042(a, calls)
+                return _node_983(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1020(a, calls)
+                return _node_961(a, calls)
             elif v == 'ARM-BACK':
-                return _node_998(a, calls)
+                return _node_939(a, calls)
             elif v == 'IDLE':
-                return _node_1043(a, calls)
+                return _node_984(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23752,31 +23090,31 @@ def _node_1057(a: Any, calls: Calls) -> Decision:
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1022(a, calls)
+                return _node_963(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1055(a, calls)
+                return _node_996(a, calls)
             elif v == 'IDLE':
-                return _node_1045(a, calls)
+                return _node_986(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1025(a, calls)
+                return _node_966(a, calls)
             elif v == 'ARM-BACK':
-                return _node_986(a, calls)
+                return _node_927(a, calls)
             elif v == 'IDLE':
-                return _node_1046(a, calls)
+                return _node_987(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1027(a, calls)
+                return _node_968(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1002(a, calls)
+                return _node_943(a, calls)
             elif v == 'IDLE':
-                return _node_1047(a, calls)
+                return _node_988(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23786,31 +23124,31 @@ def _node_1057(a: Any, calls: Calls) -> Decision:
         if v == 'EXEC-TRAJ-GOAL':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1029(a, calls)
+                return _node_970(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1056(a, calls)
+                return _node_997(a, calls)
             elif v == 'IDLE':
-                return _node_1049(a, calls)
+                return _node_990(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1032(a, calls)
+                return _node_973(a, calls)
             elif v == 'ARM-BACK':
-                return _node_990(a, calls)
+                return _node_931(a, calls)
             elif v == 'IDLE':
-                return _node_1050(a, calls)
+                return _node_991(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['@ARM_OBJ_ARM_BACKstate']
             if v == 'ARM-OBJ':
-                return _node_1034(a, calls)
+                return _node_975(a, calls)
             elif v == 'ARM-BACK':
-                return _node_1006(a, calls)
+                return _node_947(a, calls)
             elif v == 'IDLE':
-                return _node_1051(a, calls)
+                return _node_992(a, calls)
             else:
                 raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
         else:
@@ -23819,55 +23157,55 @@ def _node_1057(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_1058(a: Any, calls: Calls) -> Decision:
+def _node_999(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_839(a, calls)
+        return _node_803(a, calls)
     elif v == 'ARM-BACK':
-        return _node_842(a, calls)
+        return _node_806(a, calls)
     elif v == 'IDLE':
-        return _node_845(a, calls)
+        return _node_809(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_1059(a: Any, calls: Calls) -> Decision:
+def _node_1000(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_859(a, calls)
+        return _node_823(a, calls)
     elif v == 'ARM-BACK':
-        return _node_862(a, calls)
+        return _node_826(a, calls)
     elif v == 'IDLE':
-        return _node_865(a, calls)
+        return _node_829(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_1060(a: Any, calls: Calls) -> Decision:
+def _node_1001(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_838(a, calls)
+        return _node_802(a, calls)
     elif v == 'ARM-BACK':
-        return _node_841(a, calls)
+        return _node_805(a, calls)
     elif v == 'IDLE':
-        return _node_844(a, calls)
+        return _node_808(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_1061(a: Any, calls: Calls) -> Decision:
+def _node_1002(a: Any, calls: Calls) -> Decision:
     v = a['@ARM_OBJ_ARM_BACKstate']
     if v == 'ARM-OBJ':
-        return _node_858(a, calls)
+        return _node_822(a, calls)
     elif v == 'ARM-BACK':
-        return _node_861(a, calls)
+        return _node_825(a, calls)
     elif v == 'IDLE':
-        return _node_864(a, calls)
+        return _node_828(a, calls)
     else:
         raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
 
 
-def _node_1062(a: Any, calls: Calls) -> Decision:
+def _node_1003(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
@@ -24009,7 +23347,7 @@ def _node_1062(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_1063(a: Any, calls: Calls) -> Decision:
+def _node_1004(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_0
@@ -24019,7 +23357,7 @@ def _node_1063(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1064(a: Any, calls: Calls) -> Decision:
+def _node_1005(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_1
@@ -24029,7 +23367,7 @@ def _node_1064(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1065(a: Any, calls: Calls) -> Decision:
+def _node_1006(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_4
@@ -24039,7 +23377,7 @@ def _node_1065(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1066(a: Any, calls: Calls) -> Decision:
+def _node_1007(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_5
@@ -24049,7 +23387,7 @@ def _node_1066(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1067(a: Any, calls: Calls) -> Decision:
+def _node_1008(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_8
@@ -24059,7 +23397,7 @@ def _node_1067(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1068(a: Any, calls: Calls) -> Decision:
+def _node_1009(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_9
@@ -24069,7 +23407,7 @@ def _node_1068(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1069(a: Any, calls: Calls) -> Decision:
+def _node_1010(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_36
@@ -24079,7 +23417,7 @@ def _node_1069(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1070(a: Any, calls: Calls) -> Decision:
+def _node_1011(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_37
@@ -24089,7 +23427,7 @@ def _node_1070(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1071(a: Any, calls: Calls) -> Decision:
+def _node_1012(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_40
@@ -24099,7 +23437,7 @@ def _node_1071(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1072(a: Any, calls: Calls) -> Decision:
+def _node_1013(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_41
@@ -24109,7 +23447,7 @@ def _node_1072(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1073(a: Any, calls: Calls) -> Decision:
+def _node_1014(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_44
@@ -24119,7 +23457,7 @@ def _node_1073(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1074(a: Any, calls: Calls) -> Decision:
+def _node_1015(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_45
@@ -24129,7 +23467,7 @@ def _node_1074(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1075(a: Any, calls: Calls) -> Decision:
+def _node_1016(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_72
@@ -24139,7 +23477,7 @@ def _node_1075(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1076(a: Any, calls: Calls) -> Decision:
+def _node_1017(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_73
@@ -24149,7 +23487,7 @@ def _node_1076(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1077(a: Any, calls: Calls) -> Decision:
+def _node_1018(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_76
@@ -24159,7 +23497,7 @@ def _node_1077(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1078(a: Any, calls: Calls) -> Decision:
+def _node_1019(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_77
@@ -24169,7 +23507,7 @@ def _node_1078(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1079(a: Any, calls: Calls) -> Decision:
+def _node_1020(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_80
@@ -24179,7 +23517,7 @@ def _node_1079(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1080(a: Any, calls: Calls) -> Decision:
+def _node_1021(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_81
@@ -24189,7 +23527,7 @@ def _node_1080(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1081(a: Any, calls: Calls) -> Decision:
+def _node_1022(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_24
@@ -24199,7 +23537,7 @@ def _node_1081(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1082(a: Any, calls: Calls) -> Decision:
+def _node_1023(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_25
@@ -24209,7 +23547,7 @@ def _node_1082(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1083(a: Any, calls: Calls) -> Decision:
+def _node_1024(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_28
@@ -24219,7 +23557,7 @@ def _node_1083(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1084(a: Any, calls: Calls) -> Decision:
+def _node_1025(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_29
@@ -24229,7 +23567,7 @@ def _node_1084(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1085(a: Any, calls: Calls) -> Decision:
+def _node_1026(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_32
@@ -24239,7 +23577,7 @@ def _node_1085(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1086(a: Any, calls: Calls) -> Decision:
+def _node_1027(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_33
@@ -24249,7 +23587,7 @@ def _node_1086(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1087(a: Any, calls: Calls) -> Decision:
+def _node_1028(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_60
@@ -24259,7 +23597,7 @@ def _node_1087(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1088(a: Any, calls: Calls) -> Decision:
+def _node_1029(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_61
@@ -24269,7 +23607,7 @@ def _node_1088(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1089(a: Any, calls: Calls) -> Decision:
+def _node_1030(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_64
@@ -24279,7 +23617,7 @@ def _node_1089(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1090(a: Any, calls: Calls) -> Decision:
+def _node_1031(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_65
@@ -24289,7 +23627,7 @@ def _node_1090(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1091(a: Any, calls: Calls) -> Decision:
+def _node_1032(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_68
@@ -24299,7 +23637,7 @@ def _node_1091(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1092(a: Any, calls: Calls) -> Decision:
+def _node_1033(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_69
@@ -24309,7 +23647,7 @@ def _node_1092(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1093(a: Any, calls: Calls) -> Decision:
+def _node_1034(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_96
@@ -24319,7 +23657,7 @@ def _node_1093(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1094(a: Any, calls: Calls) -> Decision:
+def _node_1035(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_97
@@ -24329,7 +23667,7 @@ def _node_1094(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1095(a: Any, calls: Calls) -> Decision:
+def _node_1036(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_100
@@ -24339,7 +23677,7 @@ def _node_1095(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1096(a: Any, calls: Calls) -> Decision:
+def _node_1037(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_101
@@ -24349,7 +23687,7 @@ def _node_1096(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1097(a: Any, calls: Calls) -> Decision:
+def _node_1038(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_104
@@ -24359,7 +23697,7 @@ def _node_1097(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1098(a: Any, calls: Calls) -> Decision:
+def _node_1039(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_105
@@ -24369,7 +23707,7 @@ def _node_1098(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1099(a: Any, calls: Calls) -> Decision:
+def _node_1040(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_108
@@ -24379,7 +23717,7 @@ def _node_1099(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1100(a: Any, calls: Calls) -> Decision:
+def _node_1041(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_109
@@ -24389,7 +23727,7 @@ def _node_1100(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1101(a: Any, calls: Calls) -> Decision:
+def _node_1042(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_112
@@ -24399,7 +23737,7 @@ def _node_1101(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1102(a: Any, calls: Calls) -> Decision:
+def _node_1043(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_113
@@ -24409,7 +23747,7 @@ def _node_1102(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1103(a: Any, calls: Calls) -> Decision:
+def _node_1044(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_116
@@ -24419,7 +23757,7 @@ def _node_1103(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1104(a: Any, calls: Calls) -> Decision:
+def _node_1045(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_117
@@ -24429,7 +23767,7 @@ def _node_1104(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1105(a: Any, calls: Calls) -> Decision:
+def _node_1046(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_144
@@ -24439,7 +23777,7 @@ def _node_1105(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1106(a: Any, calls: Calls) -> Decision:
+def _node_1047(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_145
@@ -24449,7 +23787,7 @@ def _node_1106(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1107(a: Any, calls: Calls) -> Decision:
+def _node_1048(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_148
@@ -24459,7 +23797,7 @@ def _node_1107(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1108(a: Any, calls: Calls) -> Decision:
+def _node_1049(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_149
@@ -24469,7 +23807,7 @@ def _node_1108(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1109(a: Any, calls: Calls) -> Decision:
+def _node_1050(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_152
@@ -24479,7 +23817,7 @@ def _node_1109(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1110(a: Any, calls: Calls) -> Decision:
+def _node_1051(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_153
@@ -24489,7 +23827,7 @@ def _node_1110(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1111(a: Any, calls: Calls) -> Decision:
+def _node_1052(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_180
@@ -24499,7 +23837,7 @@ def _node_1111(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1112(a: Any, calls: Calls) -> Decision:
+def _node_1053(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_181
@@ -24509,7 +23847,7 @@ def _node_1112(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1113(a: Any, calls: Calls) -> Decision:
+def _node_1054(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_184
@@ -24519,7 +23857,7 @@ def _node_1113(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1114(a: Any, calls: Calls) -> Decision:
+def _node_1055(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_185
@@ -24529,7 +23867,7 @@ def _node_1114(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1115(a: Any, calls: Calls) -> Decision:
+def _node_1056(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_188
@@ -24539,7 +23877,7 @@ def _node_1115(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1116(a: Any, calls: Calls) -> Decision:
+def _node_1057(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_189
@@ -24549,7 +23887,7 @@ def _node_1116(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1117(a: Any, calls: Calls) -> Decision:
+def _node_1058(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_132
@@ -24559,7 +23897,7 @@ def _node_1117(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1118(a: Any, calls: Calls) -> Decision:
+def _node_1059(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_133
@@ -24569,7 +23907,7 @@ def _node_1118(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1119(a: Any, calls: Calls) -> Decision:
+def _node_1060(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_136
@@ -24579,7 +23917,7 @@ def _node_1119(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1120(a: Any, calls: Calls) -> Decision:
+def _node_1061(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_137
@@ -24589,7 +23927,7 @@ def _node_1120(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1121(a: Any, calls: Calls) -> Decision:
+def _node_1062(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_140
@@ -24599,7 +23937,7 @@ def _node_1121(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1122(a: Any, calls: Calls) -> Decision:
+def _node_1063(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_141
@@ -24609,7 +23947,7 @@ def _node_1122(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1123(a: Any, calls: Calls) -> Decision:
+def _node_1064(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_168
@@ -24619,7 +23957,7 @@ def _node_1123(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1124(a: Any, calls: Calls) -> Decision:
+def _node_1065(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_169
@@ -24629,7 +23967,7 @@ def _node_1124(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1125(a: Any, calls: Calls) -> Decision:
+def _node_1066(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_172
@@ -24639,7 +23977,7 @@ def _node_1125(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1126(a: Any, calls: Calls) -> Decision:
+def _node_1067(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_173
@@ -24649,7 +23987,7 @@ def _node_1126(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1127(a: Any, calls: Calls) -> Decision:
+def _node_1068(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_176
@@ -24659,7 +23997,7 @@ def _node_1127(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1128(a: Any, calls: Calls) -> Decision:
+def _node_1069(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_177
@@ -24669,7 +24007,7 @@ def _node_1128(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1129(a: Any, calls: Calls) -> Decision:
+def _node_1070(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_204
@@ -24679,7 +24017,7 @@ def _node_1129(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1130(a: Any, calls: Calls) -> Decision:
+def _node_1071(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_205
@@ -24689,7 +24027,7 @@ def _node_1130(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1131(a: Any, calls: Calls) -> Decision:
+def _node_1072(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_208
@@ -24699,7 +24037,7 @@ def _node_1131(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1132(a: Any, calls: Calls) -> Decision:
+def _node_1073(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_209
@@ -24709,7 +24047,7 @@ def _node_1132(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1133(a: Any, calls: Calls) -> Decision:
+def _node_1074(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_212
@@ -24719,7 +24057,7 @@ def _node_1133(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1134(a: Any, calls: Calls) -> Decision:
+def _node_1075(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_213
@@ -24729,7 +24067,7 @@ def _node_1134(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1135(a: Any, calls: Calls) -> Decision:
+def _node_1076(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_216
@@ -24739,7 +24077,7 @@ def _node_1135(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1136(a: Any, calls: Calls) -> Decision:
+def _node_1077(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_217
@@ -24749,7 +24087,7 @@ def _node_1136(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1137(a: Any, calls: Calls) -> Decision:
+def _node_1078(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_220
@@ -24759,7 +24097,7 @@ def _node_1137(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1138(a: Any, calls: Calls) -> Decision:
+def _node_1079(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_221
@@ -24769,7 +24107,7 @@ def _node_1138(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1139(a: Any, calls: Calls) -> Decision:
+def _node_1080(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_224
@@ -24779,7 +24117,7 @@ def _node_1139(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1140(a: Any, calls: Calls) -> Decision:
+def _node_1081(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_225
@@ -24789,7 +24127,7 @@ def _node_1140(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1141(a: Any, calls: Calls) -> Decision:
+def _node_1082(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_252
@@ -24799,7 +24137,7 @@ def _node_1141(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1142(a: Any, calls: Calls) -> Decision:
+def _node_1083(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_253
@@ -24809,7 +24147,7 @@ def _node_1142(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1143(a: Any, calls: Calls) -> Decision:
+def _node_1084(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_256
@@ -24819,7 +24157,7 @@ def _node_1143(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1144(a: Any, calls: Calls) -> Decision:
+def _node_1085(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_257
@@ -24829,7 +24167,7 @@ def _node_1144(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1145(a: Any, calls: Calls) -> Decision:
+def _node_1086(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_260
@@ -24839,7 +24177,7 @@ def _node_1145(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1146(a: Any, calls: Calls) -> Decision:
+def _node_1087(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_261
@@ -24849,7 +24187,7 @@ def _node_1146(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1147(a: Any, calls: Calls) -> Decision:
+def _node_1088(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_288
@@ -24859,7 +24197,7 @@ def _node_1147(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1148(a: Any, calls: Calls) -> Decision:
+def _node_1089(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_289
@@ -24869,7 +24207,7 @@ def _node_1148(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1149(a: Any, calls: Calls) -> Decision:
+def _node_1090(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_292
@@ -24879,7 +24217,7 @@ def _node_1149(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1150(a: Any, calls: Calls) -> Decision:
+def _node_1091(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_293
@@ -24889,7 +24227,7 @@ def _node_1150(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1151(a: Any, calls: Calls) -> Decision:
+def _node_1092(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_296
@@ -24899,7 +24237,7 @@ def _node_1151(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1152(a: Any, calls: Calls) -> Decision:
+def _node_1093(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_297
@@ -24909,7 +24247,7 @@ def _node_1152(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1153(a: Any, calls: Calls) -> Decision:
+def _node_1094(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_240
@@ -24919,7 +24257,7 @@ def _node_1153(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1154(a: Any, calls: Calls) -> Decision:
+def _node_1095(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_241
@@ -24929,7 +24267,7 @@ def _node_1154(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1155(a: Any, calls: Calls) -> Decision:
+def _node_1096(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_244
@@ -24939,7 +24277,7 @@ def _node_1155(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1156(a: Any, calls: Calls) -> Decision:
+def _node_1097(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_245
@@ -24949,7 +24287,7 @@ def _node_1156(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1157(a: Any, calls: Calls) -> Decision:
+def _node_1098(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_248
@@ -24959,7 +24297,7 @@ def _node_1157(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1158(a: Any, calls: Calls) -> Decision:
+def _node_1099(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_249
@@ -24969,7 +24307,7 @@ def _node_1158(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1159(a: Any, calls: Calls) -> Decision:
+def _node_1100(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_276
@@ -24979,7 +24317,7 @@ def _node_1159(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1160(a: Any, calls: Calls) -> Decision:
+def _node_1101(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_277
@@ -24989,7 +24327,7 @@ def _node_1160(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1161(a: Any, calls: Calls) -> Decision:
+def _node_1102(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_280
@@ -24999,7 +24337,7 @@ def _node_1161(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1162(a: Any, calls: Calls) -> Decision:
+def _node_1103(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_281
@@ -25009,7 +24347,7 @@ def _node_1162(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1163(a: Any, calls: Calls) -> Decision:
+def _node_1104(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_284
@@ -25019,7 +24357,7 @@ def _node_1163(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1164(a: Any, calls: Calls) -> Decision:
+def _node_1105(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_285
@@ -25029,7 +24367,7 @@ def _node_1164(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1165(a: Any, calls: Calls) -> Decision:
+def _node_1106(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_312
@@ -25039,7 +24377,7 @@ def _node_1165(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1166(a: Any, calls: Calls) -> Decision:
+def _node_1107(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_313
@@ -25049,7 +24387,7 @@ def _node_1166(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1167(a: Any, calls: Calls) -> Decision:
+def _node_1108(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_316
@@ -25059,7 +24397,7 @@ def _node_1167(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1168(a: Any, calls: Calls) -> Decision:
+def _node_1109(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_317
@@ -25069,7 +24407,7 @@ def _node_1168(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1169(a: Any, calls: Calls) -> Decision:
+def _node_1110(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_320
@@ -25079,7 +24417,7 @@ def _node_1169(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1170(a: Any, calls: Calls) -> Decision:
+def _node_1111(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_321
@@ -25089,7 +24427,7 @@ def _node_1170(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1171(a: Any, calls: Calls) -> Decision:
+def _node_1112(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_324
@@ -25099,7 +24437,7 @@ def _node_1171(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1172(a: Any, calls: Calls) -> Decision:
+def _node_1113(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_325
@@ -25109,7 +24447,7 @@ def _node_1172(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1173(a: Any, calls: Calls) -> Decision:
+def _node_1114(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_328
@@ -25119,7 +24457,7 @@ def _node_1173(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1174(a: Any, calls: Calls) -> Decision:
+def _node_1115(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_329
@@ -25129,7 +24467,7 @@ def _node_1174(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1175(a: Any, calls: Calls) -> Decision:
+def _node_1116(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_332
@@ -25139,7 +24477,7 @@ def _node_1175(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1176(a: Any, calls: Calls) -> Decision:
+def _node_1117(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_333
@@ -25149,7 +24487,7 @@ def _node_1176(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1177(a: Any, calls: Calls) -> Decision:
+def _node_1118(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_360
@@ -25159,7 +24497,7 @@ def _node_1177(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1178(a: Any, calls: Calls) -> Decision:
+def _node_1119(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_361
@@ -25169,7 +24507,7 @@ def _node_1178(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1179(a: Any, calls: Calls) -> Decision:
+def _node_1120(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_364
@@ -25179,7 +24517,7 @@ def _node_1179(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1180(a: Any, calls: Calls) -> Decision:
+def _node_1121(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_365
@@ -25189,7 +24527,7 @@ def _node_1180(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1181(a: Any, calls: Calls) -> Decision:
+def _node_1122(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_368
@@ -25199,7 +24537,7 @@ def _node_1181(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1182(a: Any, calls: Calls) -> Decision:
+def _node_1123(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_369
@@ -25209,7 +24547,7 @@ def _node_1182(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1183(a: Any, calls: Calls) -> Decision:
+def _node_1124(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_396
@@ -25219,7 +24557,7 @@ def _node_1183(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1184(a: Any, calls: Calls) -> Decision:
+def _node_1125(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_397
@@ -25229,7 +24567,7 @@ def _node_1184(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1185(a: Any, calls: Calls) -> Decision:
+def _node_1126(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_400
@@ -25239,7 +24577,7 @@ def _node_1185(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1186(a: Any, calls: Calls) -> Decision:
+def _node_1127(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_401
@@ -25249,7 +24587,7 @@ def _node_1186(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1187(a: Any, calls: Calls) -> Decision:
+def _node_1128(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_404
@@ -25259,7 +24597,7 @@ def _node_1187(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1188(a: Any, calls: Calls) -> Decision:
+def _node_1129(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_405
@@ -25269,7 +24607,7 @@ def _node_1188(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1189(a: Any, calls: Calls) -> Decision:
+def _node_1130(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_348
@@ -25279,7 +24617,7 @@ def _node_1189(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1190(a: Any, calls: Calls) -> Decision:
+def _node_1131(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_349
@@ -25289,7 +24627,7 @@ def _node_1190(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1191(a: Any, calls: Calls) -> Decision:
+def _node_1132(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_352
@@ -25299,7 +24637,7 @@ def _node_1191(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1192(a: Any, calls: Calls) -> Decision:
+def _node_1133(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_353
@@ -25309,7 +24647,7 @@ def _node_1192(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1193(a: Any, calls: Calls) -> Decision:
+def _node_1134(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_356
@@ -25319,7 +24657,7 @@ def _node_1193(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1194(a: Any, calls: Calls) -> Decision:
+def _node_1135(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_357
@@ -25329,7 +24667,7 @@ def _node_1194(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1195(a: Any, calls: Calls) -> Decision:
+def _node_1136(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_384
@@ -25339,7 +24677,7 @@ def _node_1195(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1196(a: Any, calls: Calls) -> Decision:
+def _node_1137(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_385
@@ -25349,7 +24687,7 @@ def _node_1196(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1197(a: Any, calls: Calls) -> Decision:
+def _node_1138(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_388
@@ -25359,7 +24697,7 @@ def _node_1197(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1198(a: Any, calls: Calls) -> Decision:
+def _node_1139(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_389
@@ -25369,7 +24707,7 @@ def _node_1198(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1199(a: Any, calls: Calls) -> Decision:
+def _node_1140(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_392
@@ -25379,7 +24717,7 @@ def _node_1199(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1200(a: Any, calls: Calls) -> Decision:
+def _node_1141(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_393
@@ -25389,7 +24727,7 @@ def _node_1200(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1201(a: Any, calls: Calls) -> Decision:
+def _node_1142(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_420
@@ -25399,7 +24737,7 @@ def _node_1201(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1202(a: Any, calls: Calls) -> Decision:
+def _node_1143(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_421
@@ -25409,7 +24747,7 @@ def _node_1202(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1203(a: Any, calls: Calls) -> Decision:
+def _node_1144(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_424
@@ -25419,7 +24757,7 @@ def _node_1203(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1204(a: Any, calls: Calls) -> Decision:
+def _node_1145(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_425
@@ -25429,7 +24767,7 @@ def _node_1204(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1205(a: Any, calls: Calls) -> Decision:
+def _node_1146(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_428
@@ -25439,7 +24777,7 @@ def _node_1205(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1206(a: Any, calls: Calls) -> Decision:
+def _node_1147(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_429
@@ -25449,7 +24787,7 @@ def _node_1206(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1207(a: Any, calls: Calls) -> Decision:
+def _node_1148(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_12
@@ -25459,7 +24797,7 @@ def _node_1207(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1208(a: Any, calls: Calls) -> Decision:
+def _node_1149(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_16
@@ -25469,7 +24807,7 @@ def _node_1208(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1209(a: Any, calls: Calls) -> Decision:
+def _node_1150(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_20
@@ -25479,7 +24817,7 @@ def _node_1209(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1210(a: Any, calls: Calls) -> Decision:
+def _node_1151(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_48
@@ -25489,7 +24827,7 @@ def _node_1210(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1211(a: Any, calls: Calls) -> Decision:
+def _node_1152(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_52
@@ -25499,7 +24837,7 @@ def _node_1211(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1212(a: Any, calls: Calls) -> Decision:
+def _node_1153(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_56
@@ -25509,7 +24847,7 @@ def _node_1212(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1213(a: Any, calls: Calls) -> Decision:
+def _node_1154(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_84
@@ -25519,7 +24857,7 @@ def _node_1213(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1214(a: Any, calls: Calls) -> Decision:
+def _node_1155(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_88
@@ -25529,7 +24867,7 @@ def _node_1214(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1215(a: Any, calls: Calls) -> Decision:
+def _node_1156(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_92
@@ -25539,7 +24877,7 @@ def _node_1215(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1216(a: Any, calls: Calls) -> Decision:
+def _node_1157(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_120
@@ -25549,7 +24887,7 @@ def _node_1216(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1217(a: Any, calls: Calls) -> Decision:
+def _node_1158(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_124
@@ -25559,7 +24897,7 @@ def _node_1217(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1218(a: Any, calls: Calls) -> Decision:
+def _node_1159(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_128
@@ -25569,7 +24907,7 @@ def _node_1218(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1219(a: Any, calls: Calls) -> Decision:
+def _node_1160(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_156
@@ -25579,7 +24917,7 @@ def _node_1219(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1220(a: Any, calls: Calls) -> Decision:
+def _node_1161(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_160
@@ -25589,7 +24927,7 @@ def _node_1220(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1221(a: Any, calls: Calls) -> Decision:
+def _node_1162(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_164
@@ -25599,7 +24937,7 @@ def _node_1221(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1222(a: Any, calls: Calls) -> Decision:
+def _node_1163(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_192
@@ -25609,7 +24947,7 @@ def _node_1222(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1223(a: Any, calls: Calls) -> Decision:
+def _node_1164(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_196
@@ -25619,7 +24957,7 @@ def _node_1223(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1224(a: Any, calls: Calls) -> Decision:
+def _node_1165(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_200
@@ -25629,7 +24967,7 @@ def _node_1224(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1225(a: Any, calls: Calls) -> Decision:
+def _node_1166(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_228
@@ -25639,7 +24977,7 @@ def _node_1225(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1226(a: Any, calls: Calls) -> Decision:
+def _node_1167(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_232
@@ -25649,7 +24987,7 @@ def _node_1226(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1227(a: Any, calls: Calls) -> Decision:
+def _node_1168(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_236
@@ -25659,7 +24997,7 @@ def _node_1227(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1228(a: Any, calls: Calls) -> Decision:
+def _node_1169(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_264
@@ -25669,7 +25007,7 @@ def _node_1228(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1229(a: Any, calls: Calls) -> Decision:
+def _node_1170(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_268
@@ -25679,7 +25017,7 @@ def _node_1229(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1230(a: Any, calls: Calls) -> Decision:
+def _node_1171(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_272
@@ -25689,7 +25027,7 @@ def _node_1230(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1231(a: Any, calls: Calls) -> Decision:
+def _node_1172(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_300
@@ -25699,7 +25037,7 @@ def _node_1231(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1232(a: Any, calls: Calls) -> Decision:
+def _node_1173(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_304
@@ -25709,7 +25047,7 @@ def _node_1232(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1233(a: Any, calls: Calls) -> Decision:
+def _node_1174(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_308
@@ -25719,7 +25057,7 @@ def _node_1233(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1234(a: Any, calls: Calls) -> Decision:
+def _node_1175(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_336
@@ -25729,7 +25067,7 @@ def _node_1234(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1235(a: Any, calls: Calls) -> Decision:
+def _node_1176(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_340
@@ -25739,7 +25077,7 @@ def _node_1235(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1236(a: Any, calls: Calls) -> Decision:
+def _node_1177(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_344
@@ -25749,7 +25087,7 @@ def _node_1236(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1237(a: Any, calls: Calls) -> Decision:
+def _node_1178(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_372
@@ -25759,7 +25097,7 @@ def _node_1237(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1238(a: Any, calls: Calls) -> Decision:
+def _node_1179(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_376
@@ -25769,7 +25107,7 @@ def _node_1238(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1239(a: Any, calls: Calls) -> Decision:
+def _node_1180(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_380
@@ -25779,7 +25117,7 @@ def _node_1239(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1240(a: Any, calls: Calls) -> Decision:
+def _node_1181(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_408
@@ -25789,7 +25127,7 @@ def _node_1240(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1241(a: Any, calls: Calls) -> Decision:
+def _node_1182(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_412
@@ -25799,7 +25137,7 @@ def _node_1241(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1242(a: Any, calls: Calls) -> Decision:
+def _node_1183(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_416
@@ -25809,7 +25147,7 @@ def _node_1242(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1243(a: Any, calls: Calls) -> Decision:
+def _node_1184(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_433
@@ -25819,7 +25157,7 @@ def _node_1243(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1244(a: Any, calls: Calls) -> Decision:
+def _node_1185(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_437
@@ -25829,7 +25167,7 @@ def _node_1244(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1245(a: Any, calls: Calls) -> Decision:
+def _node_1186(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_441
@@ -25839,7 +25177,7 @@ def _node_1245(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1246(a: Any, calls: Calls) -> Decision:
+def _node_1187(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_469
@@ -25849,7 +25187,7 @@ def _node_1246(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1247(a: Any, calls: Calls) -> Decision:
+def _node_1188(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_473
@@ -25859,7 +25197,7 @@ def _node_1247(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1248(a: Any, calls: Calls) -> Decision:
+def _node_1189(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_477
@@ -25869,7 +25207,7 @@ def _node_1248(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1249(a: Any, calls: Calls) -> Decision:
+def _node_1190(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_505
@@ -25879,7 +25217,7 @@ def _node_1249(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1250(a: Any, calls: Calls) -> Decision:
+def _node_1191(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_509
@@ -25889,7 +25227,7 @@ def _node_1250(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1251(a: Any, calls: Calls) -> Decision:
+def _node_1192(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_513
@@ -25899,7 +25237,7 @@ def _node_1251(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1252(a: Any, calls: Calls) -> Decision:
+def _node_1193(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_445
@@ -25909,7 +25247,7 @@ def _node_1252(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1253(a: Any, calls: Calls) -> Decision:
+def _node_1194(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_449
@@ -25919,7 +25257,7 @@ def _node_1253(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1254(a: Any, calls: Calls) -> Decision:
+def _node_1195(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_453
@@ -25929,7 +25267,7 @@ def _node_1254(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1255(a: Any, calls: Calls) -> Decision:
+def _node_1196(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_481
@@ -25939,7 +25277,7 @@ def _node_1255(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1256(a: Any, calls: Calls) -> Decision:
+def _node_1197(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_485
@@ -25949,7 +25287,7 @@ def _node_1256(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1257(a: Any, calls: Calls) -> Decision:
+def _node_1198(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_489
@@ -25959,7 +25297,7 @@ def _node_1257(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1258(a: Any, calls: Calls) -> Decision:
+def _node_1199(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_517
@@ -25969,7 +25307,7 @@ def _node_1258(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1259(a: Any, calls: Calls) -> Decision:
+def _node_1200(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_521
@@ -25979,7 +25317,7 @@ def _node_1259(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1260(a: Any, calls: Calls) -> Decision:
+def _node_1201(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_525
@@ -25989,7 +25327,7 @@ def _node_1260(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1261(a: Any, calls: Calls) -> Decision:
+def _node_1202(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_457
@@ -25999,7 +25337,7 @@ def _node_1261(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1262(a: Any, calls: Calls) -> Decision:
+def _node_1203(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_461
@@ -26009,7 +25347,7 @@ def _node_1262(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1263(a: Any, calls: Calls) -> Decision:
+def _node_1204(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_465
@@ -26019,7 +25357,7 @@ def _node_1263(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1264(a: Any, calls: Calls) -> Decision:
+def _node_1205(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_493
@@ -26029,7 +25367,7 @@ def _node_1264(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1265(a: Any, calls: Calls) -> Decision:
+def _node_1206(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_497
@@ -26039,7 +25377,7 @@ def _node_1265(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1266(a: Any, calls: Calls) -> Decision:
+def _node_1207(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_501
@@ -26049,7 +25387,7 @@ def _node_1266(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1267(a: Any, calls: Calls) -> Decision:
+def _node_1208(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_529
@@ -26059,7 +25397,7 @@ def _node_1267(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1268(a: Any, calls: Calls) -> Decision:
+def _node_1209(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_533
@@ -26069,7 +25407,7 @@ def _node_1268(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1269(a: Any, calls: Calls) -> Decision:
+def _node_1210(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_537
@@ -26079,7 +25417,7 @@ def _node_1269(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1270(a: Any, calls: Calls) -> Decision:
+def _node_1211(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_541
@@ -26089,7 +25427,7 @@ def _node_1270(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1271(a: Any, calls: Calls) -> Decision:
+def _node_1212(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_545
@@ -26099,7 +25437,7 @@ def _node_1271(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1272(a: Any, calls: Calls) -> Decision:
+def _node_1213(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_549
@@ -26109,7 +25447,7 @@ def _node_1272(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1273(a: Any, calls: Calls) -> Decision:
+def _node_1214(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_577
@@ -26119,7 +25457,7 @@ def _node_1273(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1274(a: Any, calls: Calls) -> Decision:
+def _node_1215(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_581
@@ -26129,7 +25467,7 @@ def _node_1274(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1275(a: Any, calls: Calls) -> Decision:
+def _node_1216(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_585
@@ -26139,7 +25477,7 @@ def _node_1275(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1276(a: Any, calls: Calls) -> Decision:
+def _node_1217(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_613
@@ -26149,7 +25487,7 @@ def _node_1276(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1277(a: Any, calls: Calls) -> Decision:
+def _node_1218(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_617
@@ -26159,7 +25497,7 @@ def _node_1277(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1278(a: Any, calls: Calls) -> Decision:
+def _node_1219(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_621
@@ -26169,7 +25507,7 @@ def _node_1278(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1279(a: Any, calls: Calls) -> Decision:
+def _node_1220(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_553
@@ -26179,7 +25517,7 @@ def _node_1279(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1280(a: Any, calls: Calls) -> Decision:
+def _node_1221(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_557
@@ -26189,7 +25527,7 @@ def _node_1280(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1281(a: Any, calls: Calls) -> Decision:
+def _node_1222(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_561
@@ -26199,7 +25537,7 @@ def _node_1281(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1282(a: Any, calls: Calls) -> Decision:
+def _node_1223(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_589
@@ -26209,7 +25547,7 @@ def _node_1282(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1283(a: Any, calls: Calls) -> Decision:
+def _node_1224(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_593
@@ -26219,7 +25557,7 @@ def _node_1283(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1284(a: Any, calls: Calls) -> Decision:
+def _node_1225(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_597
@@ -26229,7 +25567,7 @@ def _node_1284(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1285(a: Any, calls: Calls) -> Decision:
+def _node_1226(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_625
@@ -26239,7 +25577,7 @@ def _node_1285(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1286(a: Any, calls: Calls) -> Decision:
+def _node_1227(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_629
@@ -26249,7 +25587,7 @@ def _node_1286(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1287(a: Any, calls: Calls) -> Decision:
+def _node_1228(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_633
@@ -26259,7 +25597,7 @@ def _node_1287(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1288(a: Any, calls: Calls) -> Decision:
+def _node_1229(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_565
@@ -26269,7 +25607,7 @@ def _node_1288(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1289(a: Any, calls: Calls) -> Decision:
+def _node_1230(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_569
@@ -26279,7 +25617,7 @@ def _node_1289(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1290(a: Any, calls: Calls) -> Decision:
+def _node_1231(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_573
@@ -26289,7 +25627,7 @@ def _node_1290(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1291(a: Any, calls: Calls) -> Decision:
+def _node_1232(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_601
@@ -26299,7 +25637,7 @@ def _node_1291(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1292(a: Any, calls: Calls) -> Decision:
+def _node_1233(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_605
@@ -26309,7 +25647,7 @@ def _node_1292(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1293(a: Any, calls: Calls) -> Decision:
+def _node_1234(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_609
@@ -26319,7 +25657,7 @@ def _node_1293(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1294(a: Any, calls: Calls) -> Decision:
+def _node_1235(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_637
@@ -26329,7 +25667,7 @@ def _node_1294(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1295(a: Any, calls: Calls) -> Decision:
+def _node_1236(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_641
@@ -26339,7 +25677,7 @@ def _node_1295(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1296(a: Any, calls: Calls) -> Decision:
+def _node_1237(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_645
@@ -26349,7 +25687,7 @@ def _node_1296(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1297(a: Any, calls: Calls) -> Decision:
+def _node_1238(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_649
@@ -26359,7 +25697,7 @@ def _node_1297(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1298(a: Any, calls: Calls) -> Decision:
+def _node_1239(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_653
@@ -26369,7 +25707,7 @@ def _node_1298(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1299(a: Any, calls: Calls) -> Decision:
+def _node_1240(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_657
@@ -26379,7 +25717,7 @@ def _node_1299(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1300(a: Any, calls: Calls) -> Decision:
+def _node_1241(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_685
@@ -26389,7 +25727,7 @@ def _node_1300(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1301(a: Any, calls: Calls) -> Decision:
+def _node_1242(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_689
@@ -26399,7 +25737,7 @@ def _node_1301(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1302(a: Any, calls: Calls) -> Decision:
+def _node_1243(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_693
@@ -26409,7 +25747,7 @@ def _node_1302(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1303(a: Any, calls: Calls) -> Decision:
+def _node_1244(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_721
@@ -26419,7 +25757,7 @@ def _node_1303(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1304(a: Any, calls: Calls) -> Decision:
+def _node_1245(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_725
@@ -26429,7 +25767,7 @@ def _node_1304(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1305(a: Any, calls: Calls) -> Decision:
+def _node_1246(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_729
@@ -26439,7 +25777,7 @@ def _node_1305(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1306(a: Any, calls: Calls) -> Decision:
+def _node_1247(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_661
@@ -26449,7 +25787,7 @@ def _node_1306(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1307(a: Any, calls: Calls) -> Decision:
+def _node_1248(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_665
@@ -26459,7 +25797,7 @@ def _node_1307(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1308(a: Any, calls: Calls) -> Decision:
+def _node_1249(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_669
@@ -26469,7 +25807,7 @@ def _node_1308(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1309(a: Any, calls: Calls) -> Decision:
+def _node_1250(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_697
@@ -26479,7 +25817,7 @@ def _node_1309(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1310(a: Any, calls: Calls) -> Decision:
+def _node_1251(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_701
@@ -26489,7 +25827,7 @@ def _node_1310(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1311(a: Any, calls: Calls) -> Decision:
+def _node_1252(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_705
@@ -26499,7 +25837,7 @@ def _node_1311(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1312(a: Any, calls: Calls) -> Decision:
+def _node_1253(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_733
@@ -26509,7 +25847,7 @@ def _node_1312(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1313(a: Any, calls: Calls) -> Decision:
+def _node_1254(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_737
@@ -26519,7 +25857,7 @@ def _node_1313(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1314(a: Any, calls: Calls) -> Decision:
+def _node_1255(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_741
@@ -26529,7 +25867,7 @@ def _node_1314(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1315(a: Any, calls: Calls) -> Decision:
+def _node_1256(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_673
@@ -26539,7 +25877,7 @@ def _node_1315(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1316(a: Any, calls: Calls) -> Decision:
+def _node_1257(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_677
@@ -26549,7 +25887,7 @@ def _node_1316(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1317(a: Any, calls: Calls) -> Decision:
+def _node_1258(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_681
@@ -26559,7 +25897,7 @@ def _node_1317(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1318(a: Any, calls: Calls) -> Decision:
+def _node_1259(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_709
@@ -26569,7 +25907,7 @@ def _node_1318(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1319(a: Any, calls: Calls) -> Decision:
+def _node_1260(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_713
@@ -26579,7 +25917,7 @@ def _node_1319(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1320(a: Any, calls: Calls) -> Decision:
+def _node_1261(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_717
@@ -26589,7 +25927,7 @@ def _node_1320(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1321(a: Any, calls: Calls) -> Decision:
+def _node_1262(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_745
@@ -26599,7 +25937,7 @@ def _node_1321(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1322(a: Any, calls: Calls) -> Decision:
+def _node_1263(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_749
@@ -26609,7 +25947,7 @@ def _node_1322(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1323(a: Any, calls: Calls) -> Decision:
+def _node_1264(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_753
@@ -26619,7 +25957,7 @@ def _node_1323(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1324(a: Any, calls: Calls) -> Decision:
+def _node_1265(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_757
@@ -26629,7 +25967,7 @@ def _node_1324(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1325(a: Any, calls: Calls) -> Decision:
+def _node_1266(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_761
@@ -26639,7 +25977,7 @@ def _node_1325(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1326(a: Any, calls: Calls) -> Decision:
+def _node_1267(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_765
@@ -26649,7 +25987,7 @@ def _node_1326(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1327(a: Any, calls: Calls) -> Decision:
+def _node_1268(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_793
@@ -26659,7 +25997,7 @@ def _node_1327(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1328(a: Any, calls: Calls) -> Decision:
+def _node_1269(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_797
@@ -26669,7 +26007,7 @@ def _node_1328(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1329(a: Any, calls: Calls) -> Decision:
+def _node_1270(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_801
@@ -26679,7 +26017,7 @@ def _node_1329(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1330(a: Any, calls: Calls) -> Decision:
+def _node_1271(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_829
@@ -26689,7 +26027,7 @@ def _node_1330(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1331(a: Any, calls: Calls) -> Decision:
+def _node_1272(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_833
@@ -26699,7 +26037,7 @@ def _node_1331(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1332(a: Any, calls: Calls) -> Decision:
+def _node_1273(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_837
@@ -26709,7 +26047,7 @@ def _node_1332(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1333(a: Any, calls: Calls) -> Decision:
+def _node_1274(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_769
@@ -26719,7 +26057,7 @@ def _node_1333(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1334(a: Any, calls: Calls) -> Decision:
+def _node_1275(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_773
@@ -26729,7 +26067,7 @@ def _node_1334(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1335(a: Any, calls: Calls) -> Decision:
+def _node_1276(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_777
@@ -26739,7 +26077,7 @@ def _node_1335(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1336(a: Any, calls: Calls) -> Decision:
+def _node_1277(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_805
@@ -26749,7 +26087,7 @@ def _node_1336(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1337(a: Any, calls: Calls) -> Decision:
+def _node_1278(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_809
@@ -26759,7 +26097,7 @@ def _node_1337(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1338(a: Any, calls: Calls) -> Decision:
+def _node_1279(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_813
@@ -26769,7 +26107,7 @@ def _node_1338(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1339(a: Any, calls: Calls) -> Decision:
+def _node_1280(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_841
@@ -26779,7 +26117,7 @@ def _node_1339(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1340(a: Any, calls: Calls) -> Decision:
+def _node_1281(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_845
@@ -26789,7 +26127,7 @@ def _node_1340(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1341(a: Any, calls: Calls) -> Decision:
+def _node_1282(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_849
@@ -26799,7 +26137,7 @@ def _node_1341(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1342(a: Any, calls: Calls) -> Decision:
+def _node_1283(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_781
@@ -26809,7 +26147,7 @@ def _node_1342(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1343(a: Any, calls: Calls) -> Decision:
+def _node_1284(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_785
@@ -26819,7 +26157,7 @@ def _node_1343(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1344(a: Any, calls: Calls) -> Decision:
+def _node_1285(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_789
@@ -26829,7 +26167,7 @@ def _node_1344(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1345(a: Any, calls: Calls) -> Decision:
+def _node_1286(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_817
@@ -26839,7 +26177,7 @@ def _node_1345(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1346(a: Any, calls: Calls) -> Decision:
+def _node_1287(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_821
@@ -26849,7 +26187,7 @@ def _node_1346(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1347(a: Any, calls: Calls) -> Decision:
+def _node_1288(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_825
@@ -26859,7 +26197,7 @@ def _node_1347(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1348(a: Any, calls: Calls) -> Decision:
+def _node_1289(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_853
@@ -26869,7 +26207,7 @@ def _node_1348(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1349(a: Any, calls: Calls) -> Decision:
+def _node_1290(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_857
@@ -26879,7 +26217,7 @@ def _node_1349(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1350(a: Any, calls: Calls) -> Decision:
+def _node_1291(a: Any, calls: Calls) -> Decision:
     v = a['@CALC_OBJstate']
     if v == 'CALC-OBJ':
         return _LEAF_861
@@ -26889,7 +26227,7 @@ def _node_1350(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
 
 
-def _node_1351(a: Any, calls: Calls) -> Decision:
+def _node_1292(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
@@ -26900,25 +26238,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1063(a, calls)
+                        return _node_1004(a, calls)
                     elif v == 'IDLE':
-                        return _node_1243(a, calls)
+                        return _node_1184(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1065(a, calls)
+                        return _node_1006(a, calls)
                     elif v == 'IDLE':
-                        return _node_1244(a, calls)
+                        return _node_1185(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1067(a, calls)
+                        return _node_1008(a, calls)
                     elif v == 'IDLE':
-                        return _node_1245(a, calls)
+                        return _node_1186(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -26928,25 +26266,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1069(a, calls)
+                        return _node_1010(a, calls)
                     elif v == 'IDLE':
-                        return _node_1246(a, calls)
+                        return _node_1187(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1071(a, calls)
+                        return _node_1012(a, calls)
                     elif v == 'IDLE':
-                        return _node_1247(a, calls)
+                        return _node_1188(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1073(a, calls)
+                        return _node_1014(a, calls)
                     elif v == 'IDLE':
-                        return _node_1248(a, calls)
+                        return _node_1189(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -26956,25 +26294,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1075(a, calls)
+                        return _node_1016(a, calls)
                     elif v == 'IDLE':
-                        return _node_1249(a, calls)
+                        return _node_1190(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1077(a, calls)
+                        return _node_1018(a, calls)
                     elif v == 'IDLE':
-                        return _node_1250(a, calls)
+                        return _node_1191(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1079(a, calls)
+                        return _node_1020(a, calls)
                     elif v == 'IDLE':
-                        return _node_1251(a, calls)
+                        return _node_1192(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -26988,25 +26326,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1207(a, calls)
+                        return _node_1148(a, calls)
                     elif v == 'IDLE':
-                        return _node_1252(a, calls)
+                        return _node_1193(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1208(a, calls)
+                        return _node_1149(a, calls)
                     elif v == 'IDLE':
-                        return _node_1253(a, calls)
+                        return _node_1194(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1209(a, calls)
+                        return _node_1150(a, calls)
                     elif v == 'IDLE':
-                        return _node_1254(a, calls)
+                        return _node_1195(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27016,25 +26354,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1210(a, calls)
+                        return _node_1151(a, calls)
                     elif v == 'IDLE':
-                        return _node_1255(a, calls)
+                        return _node_1196(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1211(a, calls)
+                        return _node_1152(a, calls)
                     elif v == 'IDLE':
-                        return _node_1256(a, calls)
+                        return _node_1197(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1212(a, calls)
+                        return _node_1153(a, calls)
                     elif v == 'IDLE':
-                        return _node_1257(a, calls)
+                        return _node_1198(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27044,25 +26382,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1213(a, calls)
+                        return _node_1154(a, calls)
                     elif v == 'IDLE':
-                        return _node_1258(a, calls)
+                        return _node_1199(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1214(a, calls)
+                        return _node_1155(a, calls)
                     elif v == 'IDLE':
-                        return _node_1259(a, calls)
+                        return _node_1200(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1215(a, calls)
+                        return _node_1156(a, calls)
                     elif v == 'IDLE':
-                        return _node_1260(a, calls)
+                        return _node_1201(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27076,25 +26414,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1081(a, calls)
+                        return _node_1022(a, calls)
                     elif v == 'IDLE':
-                        return _node_1261(a, calls)
+                        return _node_1202(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1083(a, calls)
+                        return _node_1024(a, calls)
                     elif v == 'IDLE':
-                        return _node_1262(a, calls)
+                        return _node_1203(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1085(a, calls)
+                        return _node_1026(a, calls)
                     elif v == 'IDLE':
-                        return _node_1263(a, calls)
+                        return _node_1204(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27104,25 +26442,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1087(a, calls)
+                        return _node_1028(a, calls)
                     elif v == 'IDLE':
-                        return _node_1264(a, calls)
+                        return _node_1205(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1089(a, calls)
+                        return _node_1030(a, calls)
                     elif v == 'IDLE':
-                        return _node_1265(a, calls)
+                        return _node_1206(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1091(a, calls)
+                        return _node_1032(a, calls)
                     elif v == 'IDLE':
-                        return _node_1266(a, calls)
+                        return _node_1207(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27132,25 +26470,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1093(a, calls)
+                        return _node_1034(a, calls)
                     elif v == 'IDLE':
-                        return _node_1267(a, calls)
+                        return _node_1208(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1095(a, calls)
+                        return _node_1036(a, calls)
                     elif v == 'IDLE':
-                        return _node_1268(a, calls)
+                        return _node_1209(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1097(a, calls)
+                        return _node_1038(a, calls)
                     elif v == 'IDLE':
-                        return _node_1269(a, calls)
+                        return _node_1210(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27168,25 +26506,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1099(a, calls)
+                        return _node_1040(a, calls)
                     elif v == 'IDLE':
-                        return _node_1270(a, calls)
+                        return _node_1211(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1101(a, calls)
+                        return _node_1042(a, calls)
                     elif v == 'IDLE':
-                        return _node_1271(a, calls)
+                        return _node_1212(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1103(a, calls)
+                        return _node_1044(a, calls)
                     elif v == 'IDLE':
-                        return _node_1272(a, calls)
+                        return _node_1213(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27196,25 +26534,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1105(a, calls)
+                        return _node_1046(a, calls)
                     elif v == 'IDLE':
-                        return _node_1273(a, calls)
+                        return _node_1214(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1107(a, calls)
+                        return _node_1048(a, calls)
                     elif v == 'IDLE':
-                        return _node_1274(a, calls)
+                        return _node_1215(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1109(a, calls)
+                        return _node_1050(a, calls)
                     elif v == 'IDLE':
-                        return _node_1275(a, calls)
+                        return _node_1216(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27224,25 +26562,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1111(a, calls)
+                        return _node_1052(a, calls)
                     elif v == 'IDLE':
-                        return _node_1276(a, calls)
+                        return _node_1217(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1113(a, calls)
+                        return _node_1054(a, calls)
                     elif v == 'IDLE':
-                        return _node_1277(a, calls)
+                        return _node_1218(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1115(a, calls)
+                        return _node_1056(a, calls)
                     elif v == 'IDLE':
-                        return _node_1278(a, calls)
+                        return _node_1219(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27256,25 +26594,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1216(a, calls)
+                        return _node_1157(a, calls)
                     elif v == 'IDLE':
-                        return _node_1279(a, calls)
+                        return _node_1220(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1217(a, calls)
+                        return _node_1158(a, calls)
                     elif v == 'IDLE':
-                        return _node_1280(a, calls)
+                        return _node_1221(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1218(a, calls)
+                        return _node_1159(a, calls)
                     elif v == 'IDLE':
-                        return _node_1281(a, calls)
+                        return _node_1222(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27284,25 +26622,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1219(a, calls)
+                        return _node_1160(a, calls)
                     elif v == 'IDLE':
-                        return _node_1282(a, calls)
+                        return _node_1223(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1220(a, calls)
+                        return _node_1161(a, calls)
                     elif v == 'IDLE':
-                        return _node_1283(a, calls)
+                        return _node_1224(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1221(a, calls)
+                        return _node_1162(a, calls)
                     elif v == 'IDLE':
-                        return _node_1284(a, calls)
+                        return _node_1225(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27312,25 +26650,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1222(a, calls)
+                        return _node_1163(a, calls)
                     elif v == 'IDLE':
-                        return _node_1285(a, calls)
+                        return _node_1226(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1223(a, calls)
+                        return _node_1164(a, calls)
                     elif v == 'IDLE':
-                        return _node_1286(a, calls)
+                        return _node_1227(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1224(a, calls)
+                        return _node_1165(a, calls)
                     elif v == 'IDLE':
-                        return _node_1287(a, calls)
+                        return _node_1228(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27344,25 +26682,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1117(a, calls)
+                        return _node_1058(a, calls)
                     elif v == 'IDLE':
-                        return _node_1288(a, calls)
+                        return _node_1229(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1119(a, calls)
+                        return _node_1060(a, calls)
                     elif v == 'IDLE':
-                        return _node_1289(a, calls)
+                        return _node_1230(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1121(a, calls)
+                        return _node_1062(a, calls)
                     elif v == 'IDLE':
-                        return _node_1290(a, calls)
+                        return _node_1231(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27372,25 +26710,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1123(a, calls)
+                        return _node_1064(a, calls)
                     elif v == 'IDLE':
-                        return _node_1291(a, calls)
+                        return _node_1232(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1125(a, calls)
+                        return _node_1066(a, calls)
                     elif v == 'IDLE':
-                        return _node_1292(a, calls)
+                        return _node_1233(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1127(a, calls)
+                        return _node_1068(a, calls)
                     elif v == 'IDLE':
-                        return _node_1293(a, calls)
+                        return _node_1234(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27400,25 +26738,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1129(a, calls)
+                        return _node_1070(a, calls)
                     elif v == 'IDLE':
-                        return _node_1294(a, calls)
+                        return _node_1235(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1131(a, calls)
+                        return _node_1072(a, calls)
                     elif v == 'IDLE':
-                        return _node_1295(a, calls)
+                        return _node_1236(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1133(a, calls)
+                        return _node_1074(a, calls)
                     elif v == 'IDLE':
-                        return _node_1296(a, calls)
+                        return _node_1237(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27436,25 +26774,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1135(a, calls)
+                        return _node_1076(a, calls)
                     elif v == 'IDLE':
-                        return _node_1297(a, calls)
+                        return _node_1238(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1137(a, calls)
+                        return _node_1078(a, calls)
                     elif v == 'IDLE':
-                        return _node_1298(a, calls)
+                        return _node_1239(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1139(a, calls)
+                        return _node_1080(a, calls)
                     elif v == 'IDLE':
-                        return _node_1299(a, calls)
+                        return _node_1240(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27464,25 +26802,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1141(a, calls)
+                        return _node_1082(a, calls)
                     elif v == 'IDLE':
-                        return _node_1300(a, calls)
+                        return _node_1241(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1143(a, calls)
+                        return _node_1084(a, calls)
                     elif v == 'IDLE':
-                        return _node_1301(a, calls)
+                        return _node_1242(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1145(a, calls)
+                        return _node_1086(a, calls)
                     elif v == 'IDLE':
-                        return _node_1302(a, calls)
+                        return _node_1243(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27492,25 +26830,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1147(a, calls)
+                        return _node_1088(a, calls)
                     elif v == 'IDLE':
-                        return _node_1303(a, calls)
+                        return _node_1244(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1149(a, calls)
+                        return _node_1090(a, calls)
                     elif v == 'IDLE':
-                        return _node_1304(a, calls)
+                        return _node_1245(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1151(a, calls)
+                        return _node_1092(a, calls)
                     elif v == 'IDLE':
-                        return _node_1305(a, calls)
+                        return _node_1246(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27524,25 +26862,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1225(a, calls)
+                        return _node_1166(a, calls)
                     elif v == 'IDLE':
-                        return _node_1306(a, calls)
+                        return _node_1247(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1226(a, calls)
+                        return _node_1167(a, calls)
                     elif v == 'IDLE':
-                        return _node_1307(a, calls)
+                        return _node_1248(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1227(a, calls)
+                        return _node_1168(a, calls)
                     elif v == 'IDLE':
-                        return _node_1308(a, calls)
+                        return _node_1249(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27552,25 +26890,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1228(a, calls)
+                        return _node_1169(a, calls)
                     elif v == 'IDLE':
-                        return _node_1309(a, calls)
+                        return _node_1250(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1229(a, calls)
+                        return _node_1170(a, calls)
                     elif v == 'IDLE':
-                        return _node_1310(a, calls)
+                        return _node_1251(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1230(a, calls)
+                        return _node_1171(a, calls)
                     elif v == 'IDLE':
-                        return _node_1311(a, calls)
+                        return _node_1252(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27580,25 +26918,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1231(a, calls)
+                        return _node_1172(a, calls)
                     elif v == 'IDLE':
-                        return _node_1312(a, calls)
+                        return _node_1253(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1232(a, calls)
+                        return _node_1173(a, calls)
                     elif v == 'IDLE':
-                        return _node_1313(a, calls)
+                        return _node_1254(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1233(a, calls)
+                        return _node_1174(a, calls)
                     elif v == 'IDLE':
-                        return _node_1314(a, calls)
+                        return _node_1255(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27612,25 +26950,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1153(a, calls)
+                        return _node_1094(a, calls)
                     elif v == 'IDLE':
-                        return _node_1315(a, calls)
+                        return _node_1256(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1155(a, calls)
+                        return _node_1096(a, calls)
                     elif v == 'IDLE':
-                        return _node_1316(a, calls)
+                        return _node_1257(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1157(a, calls)
+                        return _node_1098(a, calls)
                     elif v == 'IDLE':
-                        return _node_1317(a, calls)
+                        return _node_1258(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27640,25 +26978,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1159(a, calls)
+                        return _node_1100(a, calls)
                     elif v == 'IDLE':
-                        return _node_1318(a, calls)
+                        return _node_1259(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1161(a, calls)
+                        return _node_1102(a, calls)
                     elif v == 'IDLE':
-                        return _node_1319(a, calls)
+                        return _node_1260(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1163(a, calls)
+                        return _node_1104(a, calls)
                     elif v == 'IDLE':
-                        return _node_1320(a, calls)
+                        return _node_1261(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27668,25 +27006,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1165(a, calls)
+                        return _node_1106(a, calls)
                     elif v == 'IDLE':
-                        return _node_1321(a, calls)
+                        return _node_1262(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1167(a, calls)
+                        return _node_1108(a, calls)
                     elif v == 'IDLE':
-                        return _node_1322(a, calls)
+                        return _node_1263(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1169(a, calls)
+                        return _node_1110(a, calls)
                     elif v == 'IDLE':
-                        return _node_1323(a, calls)
+                        return _node_1264(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27704,25 +27042,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1171(a, calls)
+                        return _node_1112(a, calls)
                     elif v == 'IDLE':
-                        return _node_1324(a, calls)
+                        return _node_1265(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1173(a, calls)
+                        return _node_1114(a, calls)
                     elif v == 'IDLE':
-                        return _node_1325(a, calls)
+                        return _node_1266(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1175(a, calls)
+                        return _node_1116(a, calls)
                     elif v == 'IDLE':
-                        return _node_1326(a, calls)
+                        return _node_1267(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27732,25 +27070,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1177(a, calls)
+                        return _node_1118(a, calls)
                     elif v == 'IDLE':
-                        return _node_1327(a, calls)
+                        return _node_1268(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1179(a, calls)
+                        return _node_1120(a, calls)
                     elif v == 'IDLE':
-                        return _node_1328(a, calls)
+                        return _node_1269(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1181(a, calls)
+                        return _node_1122(a, calls)
                     elif v == 'IDLE':
-                        return _node_1329(a, calls)
+                        return _node_1270(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27760,25 +27098,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1183(a, calls)
+                        return _node_1124(a, calls)
                     elif v == 'IDLE':
-                        return _node_1330(a, calls)
+                        return _node_1271(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1185(a, calls)
+                        return _node_1126(a, calls)
                     elif v == 'IDLE':
-                        return _node_1331(a, calls)
+                        return _node_1272(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1187(a, calls)
+                        return _node_1128(a, calls)
                     elif v == 'IDLE':
-                        return _node_1332(a, calls)
+                        return _node_1273(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27792,25 +27130,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1234(a, calls)
+                        return _node_1175(a, calls)
                     elif v == 'IDLE':
-                        return _node_1333(a, calls)
+                        return _node_1274(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1235(a, calls)
+                        return _node_1176(a, calls)
                     elif v == 'IDLE':
-                        return _node_1334(a, calls)
+                        return _node_1275(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1236(a, calls)
+                        return _node_1177(a, calls)
                     elif v == 'IDLE':
-                        return _node_1335(a, calls)
+                        return _node_1276(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27820,25 +27158,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1237(a, calls)
+                        return _node_1178(a, calls)
                     elif v == 'IDLE':
-                        return _node_1336(a, calls)
+                        return _node_1277(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1238(a, calls)
+                        return _node_1179(a, calls)
                     elif v == 'IDLE':
-                        return _node_1337(a, calls)
+                        return _node_1278(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1239(a, calls)
+                        return _node_1180(a, calls)
                     elif v == 'IDLE':
-                        return _node_1338(a, calls)
+                        return _node_1279(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27848,25 +27186,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1240(a, calls)
+                        return _node_1181(a, calls)
                     elif v == 'IDLE':
-                        return _node_1339(a, calls)
+                        return _node_1280(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1241(a, calls)
+                        return _node_1182(a, calls)
                     elif v == 'IDLE':
-                        return _node_1340(a, calls)
+                        return _node_1281(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1242(a, calls)
+                        return _node_1183(a, calls)
                     elif v == 'IDLE':
-                        return _node_1341(a, calls)
+                        return _node_1282(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27880,25 +27218,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1189(a, calls)
+                        return _node_1130(a, calls)
                     elif v == 'IDLE':
-                        return _node_1342(a, calls)
+                        return _node_1283(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1191(a, calls)
+                        return _node_1132(a, calls)
                     elif v == 'IDLE':
-                        return _node_1343(a, calls)
+                        return _node_1284(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1193(a, calls)
+                        return _node_1134(a, calls)
                     elif v == 'IDLE':
-                        return _node_1344(a, calls)
+                        return _node_1285(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27908,25 +27246,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1195(a, calls)
+                        return _node_1136(a, calls)
                     elif v == 'IDLE':
-                        return _node_1345(a, calls)
+                        return _node_1286(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1197(a, calls)
+                        return _node_1138(a, calls)
                     elif v == 'IDLE':
-                        return _node_1346(a, calls)
+                        return _node_1287(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1199(a, calls)
+                        return _node_1140(a, calls)
                     elif v == 'IDLE':
-                        return _node_1347(a, calls)
+                        return _node_1288(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27936,25 +27274,25 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
                 if v == 'ARM-OBJ':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1201(a, calls)
+                        return _node_1142(a, calls)
                     elif v == 'IDLE':
-                        return _node_1348(a, calls)
+                        return _node_1289(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1203(a, calls)
+                        return _node_1144(a, calls)
                     elif v == 'IDLE':
-                        return _node_1349(a, calls)
+                        return _node_1290(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
                     v = a['@CALC_GOALstate']
                     if v == 'CALC-GOAL':
-                        return _node_1205(a, calls)
+                        return _node_1146(a, calls)
                     elif v == 'IDLE':
-                        return _node_1350(a, calls)
+                        return _node_1291(a, calls)
                     else:
                         raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
@@ -27967,7 +27305,7 @@ def _node_1351(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_1352(a: Any, calls: Calls) -> Decision:
+def _node_1293(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
