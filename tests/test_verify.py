@@ -117,3 +117,79 @@ def test_a_refusing_rule_is_answered_refused_and_keeps_every_property(tmp_path: 
     world = explorer_for(loaded.program, executive).initial()
     world.executive.request("MOVE", 7)
     assert [msg.fact for msg in world.executive.messages] == [("REPLY", 7, "REFUSED")]
+
+
+SHARED = """
+module m {
+  codels: "arm_codels";
+  request R { type: exec; task: T; codel exec: go; }
+  request Q { type: exec; task: T; codel exec: go; }
+  exec_task T { period: 10 ms; }
+}
+executive ex {
+  service S { request: m.R; }
+  service W { request: m.Q; conflicts { S: wait; } }
+}
+"""
+
+
+def test_two_instances_of_a_grouped_service_that_does_not_exclude_itself_stay_safe(tmp_path: Path) -> None:
+    """S runs in several instances, yet W waits for it, so it has a group whose state names one
+    running S: a second S waits for the first rather than drive the controller to ERROR."""
+    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    (tmp_path / "shared.spec").write_text(SHARED)
+    result = run([tmp_path / "shared.spec"], "ex", 2)
+    assert result.ok, result.violations
+    from specc.analysis.verify import explorer_for
+
+    loaded = load([tmp_path / "shared.spec"])
+    assert loaded.program is not None
+    world = explorer_for(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Executive))).initial()
+    world.executive.request("S", 1)
+    world.executive.request("S", 2)
+    assert [str(a.state) for a in world.executive.activities.values()] == ["EXEC", "WAIT"]
+
+
+def test_a_hand_written_refusal_interrupts_nothing(tmp_path: Path) -> None:
+    rule = ('backNotNow: event == "START", service == "MOVE", @GOstate == "GO" ==> restrict status == "REFUSE";'
+            '\n  outputs GOstate: {"GO", "IDLE"};\n  init @GOstate = "IDLE";')
+    spec = robot(tmp_path, rule)[0]
+    spec.write_text(spec.read_text().replace("service MOVE { request: base.Move; }",
+                                             "service MOVE { request: base.Move; conflicts { GO: interrupt; } }"))
+    result = run([spec], "shop", 2)
+    assert result.ok, result.violations
+    from specc.analysis.verify import explorer_for
+
+    loaded = load([spec])
+    assert loaded.program is not None
+    world = explorer_for(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Executive))).initial()
+    world.executive.request("GO", 1)
+    world.executive.request("MOVE", 2)
+    assert [msg.fact for msg in world.executive.messages] == [("REPLY", 2, "REFUSED")]
+    assert [str(a.state) for a in world.executive.activities.values()] == ["EXEC"]  # GO untouched
+
+
+def test_service_groups_do_not_depend_on_string_hashing(tmp_path: Path) -> None:
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "c.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    (tmp_path / "tie.spec").write_text("""
+module m {
+  codels: "c";
+  request R0 { type: exec; task: T; codel exec: go; incompatible_with: R0, R3; }
+  request R1 { type: exec; task: T; codel exec: go; incompatible_with: R1, R3; }
+  request R3 { type: exec; task: T; codel exec: go; incompatible_with: R0, R1, R3; }
+  exec_task T { period: 10 ms; }
+}
+executive ex { service S0 { request: m.R0; } service S1 { request: m.R1; } service S3 { request: m.R3; } }
+""")
+    script = ("import sys; from pathlib import Path; from specc.pipeline import load; from specc.model import nodes"
+              " as m; from specc.analysis.incompat import build_graph, service_groups; p = load([Path(sys.argv[1])])"
+              ".program; e = next(i for i in p.items if isinstance(i, m.Executive)); "
+              "print([g.services for g in service_groups(build_graph(p, e))])")
+    found = {subprocess.run([sys.executable, "-c", script, str(tmp_path / "tie.spec")], capture_output=True,
+                            text=True, env={**os.environ, "PYTHONHASHSEED": str(seed)}, check=True).stdout
+             for seed in range(1, 9)}
+    assert found == {"[('S0', 'S3'), ('S1',)]\n"}

@@ -229,3 +229,38 @@ def test_every_move_follows_an_arc_of_fig_3_3(shop: Shop) -> None:
     arcs = {(a, b) for a, _, b in rx.ARCS}
     assert shop.moves and all((s, t) in arcs for _, _, s, t in shop.moves)
     assert {i for _, i, _, t in shop.moves if t is rx.Phase.ETHER} == {1, 2, 3, 4}
+
+
+def test_an_interruption_the_executive_causes_itself_is_decided_not_an_error(shop: Shop) -> None:
+    shop.ask("MOVE", 1, LONG)
+    shop.run(0.05)
+    assert shop.executive.set_param("RESET-ALL", None) == "OK"  # alpha.Reset excludes MOVE's request
+    shop.run(0.1)
+    assert shop.executive.error is None and shop.facts() == [("REPLY", 1, "INT")]
+    assert shop.path(1)[-3:] == ["EXEC", "INTER", "ETHER"]
+
+
+def test_a_module_stays_frozen_until_every_zombie_is_released(shop: Shop) -> None:
+    shop.ask("FREE", 1, "exec,zombie")
+    shop.ask("FREE", 2, "exec,zombie")
+    shop.run(0.1)
+    shop.executive.interrupt(2)
+    shop.run(0.1)
+    shop.ask("WAITER", 3)
+    shop.run(0.1)
+    assert ("REPLY", 3, "REFUSED") in shop.facts()  # activity 1 still freezes alpha
+    shop.executive.interrupt(1)
+    shop.ask("FREE", 4, "exec")
+    shop.run(0.1)
+    assert ("REPLY", 4, "OK") in shop.facts() and shop.executive.zombies == {}
+
+
+def test_a_listener_that_raises_is_recorded_and_the_executive_goes_on(shop: Shop) -> None:
+    def broken(message: rx.Message) -> None:
+        raise RuntimeError("listener bug")
+
+    shop.executive.listeners.append(broken)
+    shop.ask("FREE", 1, "exec")
+    shop.run(0.1)
+    assert shop.facts() == [("REPLY", 1, "OK")] and shop.executive.activities == {}
+    assert shop.executive.incidents and "listener bug" in shop.executive.incidents[0]
