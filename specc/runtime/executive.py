@@ -254,12 +254,7 @@ class Executive:
         parameter = self._parameter(name)
         if parameter.get is None:
             raise LookupError(f"parameter '{name}' cannot be read (it has no 'get:')")
-        module, _, rest = parameter.get.partition(".")
-        poster, _, path = rest.partition(".")
-        value = self.context.read_poster(f"{module}.{poster}")
-        for part in path.split(".") if path and value is not None else ():
-            value = getattr(value, part)
-        return value
+        return self._read_path(parameter.get)
 
     def set_param(self, name: str, value: Any) -> str:
         """SET-PARAM: write a parameter through its control request; OK or the error code."""
