@@ -221,23 +221,39 @@ def controller_name(executive: m.Executive) -> str:
     return f"{executive.name}_resource_controller"
 
 
-def executive_controller(program: m.Program, executive: m.Executive) -> Controller:
-    """The generated rules of `executive`, joined by its hand-written bases."""
+@dataclass
+class Naming:
+    """An executive's groups, the names its own rule bases give them, and what they got wrong."""
+
+    graph: IncompatibilityGraph
+    groups: list[Group]
+    hand: list[m.RuleBase]
+    names: dict[Group, str]
+    problems: list[Problem]
+
+
+def naming(program: m.Program, executive: m.Executive) -> Naming:
+    """Cheap (no rules normalised or compiled): the executive check reports its problems."""
     graph = build_graph(program, executive)
     groups = service_groups(graph)
     bases = {b.name: b for b in program.items if isinstance(b, m.RuleBase)}
     hand = [bases[ref.text] for ref in executive.rules if ref.text in bases]
-    problems: list[Problem] = []
     names: dict[Group, str] = {}
+    problems: list[Problem] = []
     for base in hand:
         problems += name_groups(base, graph, groups, names)
-    generated = k.normalise(controller_rules(controller_name(executive), graph, groups, names))
-    if problems:
-        return Controller(executive, graph, groups, names, generated, problems)
-    merged = generated
-    for base in hand:
-        merged = take_over(merged, k.normalise(base), groups, names)
-    return Controller(executive, graph, groups, names, merged, problems)
+    return Naming(graph, groups, hand, names, problems)
+
+
+def executive_controller(program: m.Program, executive: m.Executive) -> Controller:
+    """The generated rules of `executive`, joined by its hand-written bases."""
+    named = naming(program, executive)
+    graph, groups, names = named.graph, named.groups, named.names
+    merged = k.normalise(controller_rules(controller_name(executive), graph, groups, names))
+    if not named.problems:
+        for base in named.hand:
+            merged = take_over(merged, k.normalise(base), groups, names)
+    return Controller(executive, graph, groups, names, merged, named.problems)
 
 
 def name_groups(base: m.RuleBase, graph: IncompatibilityGraph, groups: list[Group],
@@ -315,16 +331,3 @@ def take_over(generated: k.Base, hand: k.Base, groups: list[Group], names: Mappi
         attributes.setdefault(name, attribute)
     return k.Base(generated.name, attributes, tuple(rules), generated.source)
 
-
-def hand_rule_problems(program: m.Program, executive: m.Executive) -> list[Problem]:
-    """What `executive_controller` would reject in the executive's own rule bases (cheap: no rules
-    are normalised or compiled)."""
-    graph = build_graph(program, executive)
-    groups = service_groups(graph)
-    bases = {b.name: b for b in program.items if isinstance(b, m.RuleBase)}
-    names: dict[Group, str] = {}
-    problems: list[Problem] = []
-    for ref in executive.rules:
-        if ref.text in bases:
-            problems += name_groups(bases[ref.text], graph, groups, names)
-    return problems

@@ -157,18 +157,6 @@ class Unfolded:
     steps: list[Step]
     initial: tuple[int, ...]
 
-    def enabled(self, marking: tuple[int, ...]) -> list[int]:
-        return [i for i, step in enumerate(self.steps) if all(marking[s] >= w for s, w in step.pre)]
-
-    def fire(self, marking: tuple[int, ...], index: int) -> tuple[int, ...]:
-        step = self.steps[index]
-        after = list(marking)
-        for slot, weight in step.pre:
-            after[slot] -= weight
-        for slot, weight in step.post:
-            after[slot] += weight
-        return tuple(after)
-
     def describe(self, marking: tuple[int, ...]) -> str:
         parts = []
         for (place, colour), count in zip(self.slots, marking, strict=True):

@@ -499,11 +499,6 @@ def _timer_label(timer: ModelTimer) -> str:
     return which
 
 
-def _timer_key(timer: ModelTimer, ranks: Mapping[int, int]) -> tuple[Any, ...]:
-    activity, which = _timer_parts(timer)
-    return (ranks.get(activity.id, -1) if isinstance(activity, rx.Activity) else -1, which)
-
-
 def _check_exclusion(world: World, arcs: set[tuple[str, str]], activity: rx.Activity, source: rx.Phase,
                      target: rx.Phase) -> None:
     if target is not rx.Phase.EXEC:

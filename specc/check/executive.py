@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from specc.analysis.controller import hand_rule_problems
+from specc.analysis.controller import naming
 from specc.check.codels import python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
@@ -85,11 +85,10 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                        "executive's codels (it prepares the result for the task level); only modules write posters",
                        service.output.span)
         for io in (service.input, service.output):
-            if io is None:
+            if io is None or (io is service.output and len(io.parts) >= 2):  # reported just above
                 continue
             if len(io.parts) >= 2:
-                if io is service.input:
-                    resolve_poster(ctx, io)
+                resolve_poster(ctx, io)
             elif functions is None:
                 ctx.report("missing-property",
                            f"'{io.text}' is a function: give the executive 'codels: \"python.module\";'", io.span)
@@ -121,7 +120,7 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                            parameter.set.span)
     for reflex in executive.reflexes:
         check_reflex(ctx, reflex, services)
-    for problem in hand_rule_problems(ctx.program, executive):
+    for problem in naming(ctx.program, executive).problems:
         ctx.report(problem.code, problem.message, problem.node.span)
 
 

@@ -268,7 +268,7 @@ class Executive:
         if self.error is not None or self.zombies.get(module_name):
             return "REFUSED"
         self._post(self._interrupted_by, module_name, request)
-        module.submit(request, _as_input(spec.input_type, value), replies.append)
+        module.submit(request, _as_input(spec.input_type, value, parameter.set), replies.append)
         reply = replies[-1] if replies else None
         if reply is None or not reply.final:
             return "ERROR"
@@ -280,9 +280,6 @@ class Executive:
             known = ", ".join(sorted(self.spec.parameters)) or "none"
             raise LookupError(f"executive '{self.spec.name}' has no parameter '{name}' (it has: {known})")
         return parameter
-
-    def live(self) -> list[Activity]:
-        return list(self.activities.values())
 
     # ------------------------------------------------------------ cycles
     def _post(self, handler: Callable[..., None], *args: Any) -> None:
@@ -339,14 +336,9 @@ class Executive:
                 found = self._read_path(service.input)
             else:
                 found = getattr(self.codels, service.input)(self.context)
-            if isinstance(found, Mapping):
-                values.update(found)
-            elif input_type is not None and isinstance(found, input_type):
+            if input_type is not None and isinstance(found, input_type):
                 return found
-            elif len(fields := tuple(getattr(input_type, "__specc_fields__", ()))) == 1:
-                values[fields[0][0]] = found
-            else:
-                raise TypeError(f"'{service.input}' gave {type(found).__name__}; give a dict of the inputs")
+            values.update(_input_fields(input_type, found, service.input))
         if input_type is None:
             return None
         built = build_record(input_type, values)
@@ -651,15 +643,23 @@ class Executive:
             self.incidents.append(f"{getattr(callback, '__name__', callback)!s}: {type(exc).__name__}: {exc}")
 
 
-def _as_input(input_type: Any, value: Any) -> Any:
-    if input_type is None or isinstance(value, input_type):
-        return value
+def _input_fields(input_type: Any, value: Any, origin: str) -> Mapping[str, Any]:
+    """The request input fields `value` gives: a mapping of them, or the value of the only one."""
     if isinstance(value, Mapping):
-        return build_record(input_type, value)
+        return value
     fields: tuple[Any, ...] = tuple(getattr(input_type, "__specc_fields__", ()))
     if len(fields) == 1:
-        return build_record(input_type, {fields[0][0]: value})
-    return value
+        return {fields[0][0]: value}
+    raise TypeError(f"'{origin}' gave {type(value).__name__}; give a dict of the request's inputs")
+
+
+def _as_input(input_type: Any, value: Any, origin: str) -> Any:
+    if input_type is None or isinstance(value, input_type):
+        return value
+    try:
+        return build_record(input_type, _input_fields(input_type, value, origin))
+    except TypeError:
+        return value  # the module refuses it with BAD_INPUT, which SET-PARAM returns
 
 
 def load_codels(spec: ExecutiveSpec, codels: Any = None) -> Any:
