@@ -27,7 +27,9 @@ def default_dynamic(ctx):
 
 def room_box(ctx):
     """SET-BOX: the planner's environment bounds, from the world file's [room] table."""
-    room = tomllib.loads(pathlib.Path(ctx.world).read_text()).get("room", {})
+    if "room" not in ctx.vars:  # the world file does not change while the robot runs: read it once
+        ctx.vars["room"] = tomllib.loads(pathlib.Path(ctx.world).read_text()).get("room", {})
+    room = ctx.vars["room"]
     return {
         "box": {
             "xmin": 0.0,
