@@ -205,14 +205,40 @@ def verify(paths: PathsArg,
            = None,
            requests: Annotated[int, typer.Option(min=1, help="Requests the task level may have outstanding "
                                                  "at once (the bound of the exploration).")] = 2,
-           max_states: Annotated[int, typer.Option(min=1, help="Stop after this many states.")] = 500_000
+           max_states: Annotated[int, typer.Option(min=1, help="Stop after this many states.")] = 500_000,
+           goal: Annotated[Optional[list[str]], typer.Option(
+               help="Verify the procedures instead: the goal posted, e.g. '!(COLLECT-OBJECTS 2)' (repeatable).")]
+           = None,
+           fact: Annotated[Optional[list[str]], typer.Option(help="A fact the database starts with (repeatable).")]
+           = None,
+           fail: Annotated[Optional[list[str]], typer.Option(
+               help="A service whose answer may be a failure (repeatable; 'all' for every one); by default "
+                    "services succeed (§4.5: first the intrinsic correctness).")] = None,
+           reach: Annotated[Optional[list[str]], typer.Option(
+               help="Can these hold together? 'KA:LINE [?(condition)]; KA:LINE ...' (repeatable).")] = None,
+           procedures: Annotated[Optional[str], typer.Option(help="Which procedures, when there are several.")]
+           = None,
+           pnml: Annotated[Optional[Path], typer.Option(help="Also write the net as ISO 15909 PNML.")] = None,
+           strict: Annotated[bool, typer.Option(help="Exit 1 when there is any finding.")] = False,
+           steps: Annotated[int, typer.Option(min=1, help="Trace steps shown per finding (the last ones).")] = 12,
            ) -> None:
     """Explore every state the executive can reach and prove or refute, with a shortest
     counterexample: exclusion of incompatible services, exactly one final reply per request,
     no starvation in WAIT without a start timeout, no general ERROR state.
 
+    With --goal, verify the procedures instead (seed 000 §4.4-4.5): the KAs the goal reaches are
+    translated into a coloured Petri net whose whole state space is explored; deadlocks,
+    unbounded places, statements that never run or never succeed, endless cycles and --reach
+    queries are reported with the firing sequence that shows them, in KA lines.
+
     Example: specc verify examples/generic --executive generic
+
+    Example: specc verify examples/hilare --goal '!(COLLECT-OBJECTS 1)' --fail ARM-OBJ
     """
+    if goal:
+        verify_procedures(paths, goal, fact or [], fail or [], reach or [], procedures, max_states, pnml, strict,
+                          steps)
+        return
     from rich.status import Status
 
     from specc.analysis import kheops
@@ -238,6 +264,84 @@ def verify(paths: PathsArg,
     if not result.complete:
         err.print(f"warning: stopped at {max_states} states; raise --max-states to explore them all", markup=False)
     raise typer.Exit(0 if result.ok else 1)
+
+
+def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], failing: list[str], reach: list[str],
+                      name: str | None, max_states: int, pnml: Path | None, strict: bool, steps: int) -> None:
+    from rich.status import Status
+
+    from specc.analysis import petri
+    from specc.analysis.prs_net import TranslationError
+    from specc.analysis.prs_verify import analyse, parse_query, translate
+    from specc.runtime import procedures as rp
+
+    loaded = load(paths)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    blocks = {p.name: p for p in loaded.program.items if isinstance(p, m.Procedures)}
+    chosen = blocks.get(name) if name else next(iter(blocks.values()), None)
+    if chosen is None or (name is None and len(blocks) > 1):
+        what = f"no procedures '{name}'" if name else "no procedures block" if not blocks else \
+            f"several procedures ({', '.join(sorted(blocks))}); pick one with --procedures"
+        err.print(f"error: {what}", markup=False)
+        raise typer.Exit(1)
+    try:
+        posted = [rp.parse_goal(g) for g in goals]
+        initial = [rp.parse_fact(f) for f in facts]
+        queries = [parse_query(q) for q in reach]
+    except ValueError as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(1) from None
+    started = time.perf_counter()
+    try:
+        translation = translate(loaded.program, chosen, posted, initial, ["*" if f == "all" else f for f in failing])
+    except TranslationError as exc:
+        for diagnostic in exc.diagnostics:
+            err.print(render(diagnostic, loaded.sources), markup=False)
+        raise typer.Exit(1) from None
+    net = translation.net
+    out.print(f"net of {', '.join(translation.kas)}: {len(net.places)} places, {len(net.transitions)} transitions",
+              markup=False)
+    if pnml is not None:
+        try:
+            pnml.write_text(petri.to_pnml(net), encoding="utf-8")
+        except OSError as exc:
+            err.print(f"error: cannot write '{pnml}': {exc}", markup=False)
+            raise typer.Exit(1) from None
+        out.print(f"wrote {pnml}", markup=False)
+    with Status("exploring", console=err) as status:
+        try:
+            result = analyse(translation, queries, max_states, lambda n: status.update(f"exploring: {n} states"))
+        except ValueError as exc:
+            err.print(f"error: {exc}", markup=False)
+            raise typer.Exit(1) from None
+    for finding in result.findings:
+        out.print(f"{finding.kind}: {finding.message}", markup=False)
+        print_trace(finding.trace, finding.where, steps)
+    for answer in result.answers:
+        out.print(f"reach {answer.query.text}: {'yes' if answer.reached else 'never'}", markup=False)
+        print_trace(answer.trace, answer.where, steps)
+    if not result.findings:
+        out.print("no finding: no deadlock, no unbounded place, every statement can run and succeed, no endless cycle",
+                  markup=False)
+    out.print(f"{result.states} states in {time.perf_counter() - started:.1f} s; ends: {result.succeeded} with the "
+              f"goal achieved, {result.failed} with it failed", markup=False)
+    if not result.space.complete:
+        err.print(f"warning: stopped at {max_states} states; raise --max-states to explore them all", markup=False)
+    raise typer.Exit(1 if strict and result.findings else 0)
+
+
+def print_trace(trace: list[str], where: list[str], steps: int) -> None:
+    if trace:
+        hidden = len(trace) - steps
+        if hidden > 0:
+            out.print(f"    ... {hidden} earlier step(s)", markup=False)
+        for line in trace[-steps:]:
+            out.print(f"    {line}", markup=False)
+    if where:
+        out.print("  then:", markup=False)
+        for line in where:
+            out.print(f"    {line}", markup=False)
 
 
 @app.command(name="rules")

@@ -265,3 +265,33 @@ def test_compile_warns_about_rule_bases_that_leave_inputs_unsettled(tmp_path: Pa
     listed = specc("rules", str(EXAMPLES / "generic"))
     assert "executive generic: resource controller" in listed.stdout
     assert listed.stdout.count("complete and consistent for every input") == 2
+
+
+def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Path) -> None:
+    pnml = tmp_path / "hilare.pnml"
+    result = specc("verify", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--fail", "ARM-OBJ",
+                   "--reach", "Explore:254; TakeObject:236", "--steps", "3", "--pnml", str(pnml))
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("net of CollectObjects") and f"wrote {pnml}" in lines
+    assert any(line.startswith("no-way-out: Explore, Modelise cycle forever") for line in lines)
+    assert any(line.startswith("reach Explore:254; TakeObject:236: yes") for line in lines)
+    assert "    goal COLLECT-OBJECTS: CollectObjects fails" in lines  # the last of the trace's 3 steps
+    assert pnml.read_text(encoding="utf-8").startswith("<?xml")
+    strict = specc("verify", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--strict")
+    assert strict.returncode == 1 and "endless-cycle: Explore, Modelise" in strict.stdout
+
+
+def test_verify_procedures_rejects_bad_goals_and_unrepresentable_procedures(tmp_path: Path) -> None:
+    garbled = specc("verify", str(EXAMPLES / "hilare"), "--goal", "COLLECT-OBJECTS 1")
+    assert garbled.returncode == 1 and "is not a goal" in garbled.stderr
+    query = specc("verify", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--reach", "Explore:999")
+    assert query.returncode == 1 and "no statement at Explore:999: its statements are on lines" in query.stderr
+    spec = tmp_path / "tasks.spec"
+    spec.write_text("procedures t {\n  predicate closed DOOR(s: {OPEN});\n  predicate GO();\n"
+                    "  ka Go { invocation: !(GO); body { #(DOOR OPEN); } }\n}\n", encoding="utf-8")
+    rejected = specc("verify", str(spec), "--goal", "!(GO)")
+    assert rejected.returncode == 1
+    assert f"{spec}:4:37: error: '#' (preserve/maintain) has no Petri-net equivalent" in rejected.stderr
+    assert "[unsupported-goal]" in rejected.stderr
+    assert "Traceback" not in garbled.stderr + query.stderr + rejected.stderr

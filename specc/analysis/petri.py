@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import gc
 import itertools
+import re
 import xml.etree.ElementTree as ET
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
@@ -26,6 +27,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 BLACK = "*"  # the colour of an uncoloured token
+# A marking is a byte string, one byte per (place, colour): nets translated from procedures have
+# thousands of such slots, mostly empty, and bytes keep a million markings in memory.
+MAX_TOKENS = 255
+_NONZERO = re.compile(b"[^\x00]")
 Binding = Mapping[str, Any]
 Colour = Any
 
@@ -58,6 +63,19 @@ class Transition:
     variables: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
     guard: Callable[[Binding], bool] | None = None
     origin: str = ""
+    # When the variables' values depend on each other, the caller may list the bindings
+    # outright instead of letting every combination of `variables` through `guard`.
+    bindings: tuple[Binding, ...] | None = None
+
+    def each_binding(self) -> Iterable[Binding]:
+        if self.bindings is not None:
+            yield from self.bindings
+            return
+        names = list(self.variables)
+        for values in itertools.product(*(self.variables[n] for n in names)):
+            binding = dict(zip(names, values, strict=True))
+            if self.guard is None or self.guard(binding):
+                yield binding
 
 
 @dataclass(frozen=True)
@@ -69,6 +87,13 @@ class Step:
     pre: tuple[tuple[int, int], ...]  # (slot, tokens taken)
     post: tuple[tuple[int, int], ...]  # (slot, tokens put)
     origin: str
+    # A step standing for several (see `Unfolded.reduced`): the elementary steps, in firing
+    # order, whose pre and post count slots of the unreduced net.
+    parts: tuple[Step, ...] = ()
+
+    @property
+    def elementary(self) -> tuple[Step, ...]:
+        return self.parts or (self,)
 
     def __str__(self) -> str:
         shown = ", ".join(f"{k}={v}" for k, v in self.binding)
@@ -104,7 +129,8 @@ class Net:
 
     def transition(self, name: str, inputs: Iterable[Arc] = (), outputs: Iterable[Arc] = (),
                    variables: Mapping[str, Iterable[Any]] | None = None,
-                   guard: Callable[[Binding], bool] | None = None, origin: str = "") -> str:
+                   guard: Callable[[Binding], bool] | None = None, origin: str = "",
+                   bindings: Iterable[Binding] | None = None) -> str:
         if name in self.transitions:
             raise NetError(f"transition '{name}' is defined twice")
         arcs = (*inputs, *outputs)
@@ -112,7 +138,8 @@ class Net:
             if arc.place not in self.places:
                 raise NetError(f"transition '{name}': no place '{arc.place}'")
         self.transitions[name] = Transition(name, tuple(inputs), tuple(outputs),
-                                            {k: tuple(v) for k, v in (variables or {}).items()}, guard, origin)
+                                            {k: tuple(v) for k, v in (variables or {}).items()}, guard, origin,
+                                            None if bindings is None else tuple(bindings))
         return name
 
     # ------------------------------------------------------------ unfolding
@@ -123,11 +150,7 @@ class Net:
                 slots[(place.name, colour)] = len(slots)
         steps: list[Step] = []
         for transition in self.transitions.values():
-            names = list(transition.variables)
-            for values in itertools.product(*(transition.variables[n] for n in names)):
-                binding = dict(zip(names, values, strict=True))
-                if transition.guard is not None and not transition.guard(binding):
-                    continue
+            for binding in transition.each_binding():
                 pre = self._vector(transition, transition.inputs, binding, slots)
                 post = self._vector(transition, transition.outputs, binding, slots)
                 steps.append(Step(transition.name, tuple(binding.items()), pre, post, transition.origin))
@@ -135,7 +158,9 @@ class Net:
         for place in self.places.values():
             for colour, count in place.initial.items():
                 initial[slots[(place.name, colour)]] = count
-        return Unfolded(self, list(slots), steps, tuple(initial))
+        if any(count > MAX_TOKENS for count in initial):
+            raise NetError(f"an initial marking puts more than {MAX_TOKENS} tokens in one place")
+        return Unfolded(self, list(slots), steps, bytes(initial))
 
     def _vector(self, transition: Transition, arcs: Iterable[Arc], binding: Binding,
                 slots: Mapping[tuple[str, Colour], int]) -> tuple[tuple[int, int], ...]:
@@ -155,9 +180,78 @@ class Unfolded:
     net: Net
     slots: list[tuple[str, Colour]]
     steps: list[Step]
-    initial: tuple[int, ...]
+    initial: bytes
+    # The slots the parts of reduced steps count (the unreduced net's); `slots` when unreduced.
+    original_slots: list[tuple[str, Colour]] | None = None
 
-    def describe(self, marking: tuple[int, ...]) -> str:
+    def reduced(self, protected: Callable[[str], bool] = lambda place: False) -> Unfolded:
+        """The same behaviour over fewer slots and markings.
+
+        First, the slots no firing sequence can ever mark, and the steps needing them, go.
+        Then each slot whose only consumer is a step taking that one token and nothing else is
+        merged away (Berthelot's pre-agglomeration): once the slot is marked that step is
+        enabled and nothing can disable it, so firing it straight after whichever step marked
+        the slot loses no deadlock, no end marking and no cycle; only the marking in between.
+        Places for which `protected` holds keep their slots."""
+        markable = {s for s, n in enumerate(self.initial) if n}
+        steps = list(self.steps)
+        usable: list[Step] = []
+        while True:
+            waiting = []
+            for step in steps:
+                if all(s in markable for s, _ in step.pre):
+                    usable.append(step)
+                    markable.update(s for s, _ in step.post)
+                else:
+                    waiting.append(step)
+            if len(waiting) == len(steps):
+                break
+            steps = waiting
+        alive: dict[int, Step] = dict(enumerate(usable))
+        consumers: dict[int, set[int]] = {}
+        producers: dict[int, set[int]] = {}
+        for i, step in alive.items():
+            for s, _ in step.pre:
+                consumers.setdefault(s, set()).add(i)
+            for s, _ in step.post:
+                producers.setdefault(s, set()).add(i)
+        removed: set[int] = set()
+        for slot in sorted(markable):
+            if self.initial[slot] or protected(self.slots[slot][0]) or len(consumers.get(slot, ())) != 1:
+                continue
+            (t,) = consumers[slot]
+            taker = alive[t]
+            makers = producers.get(slot, set())
+            if taker.pre != ((slot, 1),) or t in makers or not makers:
+                continue
+            if any(dict(alive[h].post).get(slot) != 1 for h in makers):
+                continue
+            for h in makers:
+                maker = alive[h]
+                post = dict(maker.post)
+                del post[slot]
+                for s, n in taker.post:
+                    post[s] = post.get(s, 0) + n
+                fused = Step(maker.transition, maker.binding, maker.pre, tuple(sorted(post.items())), maker.origin,
+                             maker.elementary + taker.elementary)
+                alive[h] = fused
+                for s, _ in taker.post:
+                    producers.setdefault(s, set()).add(h)
+            for s, _ in taker.post:
+                producers[s].discard(t)
+            del alive[t]
+            del consumers[slot]
+            producers.pop(slot, None)
+            removed.add(slot)
+        kept = [s for s in sorted(markable) if s not in removed]
+        renumber = {old: new for new, old in enumerate(kept)}
+        new_steps = [Step(st.transition, st.binding, tuple((renumber[s], n) for s, n in st.pre),
+                          tuple((renumber[s], n) for s, n in st.post), st.origin, st.elementary)
+                     for _, st in sorted(alive.items())]
+        return Unfolded(self.net, [self.slots[s] for s in kept], new_steps, bytes(self.initial[s] for s in kept),
+                        self.original_slots or self.slots)
+
+    def describe(self, marking: bytes) -> str:
         parts = []
         for (place, colour), count in zip(self.slots, marking, strict=True):
             if count:
@@ -175,12 +269,14 @@ class Finding:
     message: str
     trace: list[Step]
     marking: str = ""
+    places: list[str] = field(default_factory=list)  # unbounded: the places that grow
+    loop: list[Step] = field(default_factory=list)  # unbounded: the steps that repeat
 
 
 @dataclass
 class StateSpace:
     unfolded: Unfolded
-    markings: list[tuple[int, ...]]
+    markings: list[bytes]
     edges: list[list[tuple[int, int]]]  # state -> [(step index, next state)]
     parents: list[tuple[int, int] | None]  # state -> (previous state, step index)
     complete: bool
@@ -219,51 +315,12 @@ class StateSpace:
         return {step for out in self.edges for step, _ in out}
 
     def dead_transitions(self) -> list[str]:
-        alive = {self.unfolded.steps[i].transition for i in self.fired()}
+        alive = {part.transition for i in self.fired() for part in self.unfolded.steps[i].elementary}
         return [name for name in self.unfolded.net.transitions if name not in alive]
 
     def components(self) -> list[list[int]]:
-        """Strongly connected components (Tarjan, without recursion)."""
-        index: dict[int, int] = {}
-        low: dict[int, int] = {}
-        on_stack: set[int] = set()
-        stack: list[int] = []
-        found: list[list[int]] = []
-        counter = 0
-        for root in range(len(self.markings)):
-            if root in index:
-                continue
-            work = [(root, 0)]
-            while work:
-                node, position = work.pop()
-                if position == 0:
-                    index[node] = low[node] = counter
-                    counter += 1
-                    stack.append(node)
-                    on_stack.add(node)
-                successors = self.edges[node]
-                for k in range(position, len(successors)):
-                    child = successors[k][1]
-                    if child not in index:
-                        work.append((node, k + 1))
-                        work.append((child, 0))
-                        break
-                    if child in on_stack:
-                        low[node] = min(low[node], index[child])
-                else:
-                    if low[node] == index[node]:
-                        component = []
-                        while True:
-                            member = stack.pop()
-                            on_stack.discard(member)
-                            component.append(member)
-                            if member == node:
-                                break
-                        found.append(component)
-                    if work:
-                        parent = work[-1][0]
-                        low[parent] = min(low[parent], low[node])
-        return found
+        """Strongly connected components of the whole state space."""
+        return strongly_connected(range(len(self.markings)), lambda state: [t for _, t in self.edges[state]])
 
     def terminal_components(self) -> list[list[int]]:
         components = self.components()
@@ -275,6 +332,54 @@ class StateSpace:
         """Markings reachable from every reachable marking: those of the only terminal component."""
         terminal = self.terminal_components()
         return sorted(terminal[0]) if len(terminal) == 1 else []
+
+
+def strongly_connected(nodes: Iterable[int], successors: Callable[[int], Iterable[int]]) -> list[list[int]]:
+    """Strongly connected components of the graph `nodes` induce (Tarjan, without recursion);
+    successors outside `nodes` are ignored."""
+    members = set(nodes)
+    index: dict[int, int] = {}
+    low: dict[int, int] = {}
+    on_stack: set[int] = set()
+    stack: list[int] = []
+    found: list[list[int]] = []
+    counter = 0
+    for root in sorted(members):
+        if root in index:
+            continue
+        work: list[tuple[int, list[int], int]] = [(root, [t for t in successors(root) if t in members], 0)]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children, position = work.pop()
+            for k in range(position, len(children)):
+                child = children[k]
+                if child not in index:
+                    work.append((node, children, k + 1))
+                    index[child] = low[child] = counter
+                    counter += 1
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, [t for t in successors(child) if t in members], 0))
+                    break
+                if child in on_stack:
+                    low[node] = min(low[node], index[child])
+            else:
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    found.append(component)
+                if work:
+                    parent = work[-1][0]
+                    low[parent] = min(low[parent], low[node])
+    return found
 
 
 def explore(net: Net | Unfolded, limit: int = 2_000_000, progress: Callable[[int], None] | None = None
@@ -324,26 +429,33 @@ def _explore(net: Net | Unfolded, limit: int, progress: Callable[[int], None] | 
         (by_slot[step.pre[0][0]] if step.pre else free).append(i)
     rest = [step.pre[1:] for step in steps]
     first = [step.pre[0][1] if step.pre else 0 for step in steps]
-    seen_get, pop = seen.get, queue.popleft
+    seen_get, pop, nonzero = seen.get, queue.popleft, _NONZERO.finditer
     while queue:
         state = pop()
         marking = markings[state]
         out: list[tuple[int, int]] = []
         candidates = list(free)
-        for slot, tokens in enumerate(marking):
-            if tokens:
-                for i in by_slot[slot]:
-                    if tokens >= first[i]:
-                        candidates.append(i)
+        for match in nonzero(marking):
+            slot = match.start()
+            tokens = marking[slot]
+            for i in by_slot[slot]:
+                if tokens >= first[i]:
+                    candidates.append(i)
         for i in candidates:
             for slot, weight in rest[i]:
                 if marking[slot] < weight:
                     break
             else:
-                after = list(marking)
-                for slot, d in delta[i]:
-                    after[slot] += d
-                successor = tuple(after)
+                after = bytearray(marking)
+                try:
+                    for slot, d in delta[i]:
+                        after[slot] += d
+                except ValueError:  # a place would hold more tokens than a byte counts
+                    if not unbounded:
+                        unbounded.append(_overflowing(unfolded, markings, parents, state, i))
+                    complete = False
+                    continue
+                successor = bytes(after)
                 target = seen_get(successor)
                 if target is None:
                     total = totals[state] + gain[i]
@@ -372,8 +484,8 @@ def _explore(net: Net | Unfolded, limit: int, progress: Callable[[int], None] | 
     return StateSpace(unfolded, markings, edges, parents, complete, unbounded)
 
 
-def _covered_ancestor(markings: list[tuple[int, ...]], totals: list[int], parents: list[tuple[int, int] | None],
-                      state: int, successor: tuple[int, ...], total: int) -> int | None:
+def _covered_ancestor(markings: list[bytes], totals: list[int], parents: list[tuple[int, int] | None],
+                      state: int, successor: bytes, total: int) -> int | None:
     """An ancestor of `successor` it covers with strictly more tokens (Karp-Miller)."""
     node: int | None = state
     while node is not None:
@@ -384,16 +496,24 @@ def _covered_ancestor(markings: list[tuple[int, ...]], totals: list[int], parent
     return None
 
 
-def _unbounded(unfolded: Unfolded, markings: list[tuple[int, ...]], parents: list[tuple[int, int] | None],
-               ancestor: int, state: int, step: int, successor: tuple[int, ...]) -> Finding:
+def _overflowing(unfolded: Unfolded, markings: list[bytes], parents: list[tuple[int, int] | None],
+                 state: int, step: int) -> Finding:
+    space = StateSpace(unfolded, markings, [], parents, False, [])
+    full = sorted({unfolded.slots[s][0] for s, _ in unfolded.steps[step].post})
+    return Finding("unbounded", f"place(s) {', '.join(full)} would hold more than {MAX_TOKENS} tokens",
+                   space.trace(state) + [unfolded.steps[step]], unfolded.describe(markings[state]))
+
+
+def _unbounded(unfolded: Unfolded, markings: list[bytes], parents: list[tuple[int, int] | None],
+               ancestor: int, state: int, step: int, successor: bytes) -> Finding:
     space = StateSpace(unfolded, markings, [], parents, False, [])
     before, upto = space.trace(ancestor), space.trace(state) + [unfolded.steps[step]]
     grown = sorted({unfolded.slots[s][0] for s, (a, b) in enumerate(zip(markings[ancestor], successor,
                                                                         strict=True)) if b > a})
     loop = upto[len(before):]
-    return Finding("unbounded", f"place(s) {', '.join(grown)} grow without bound: the sequence "
-                   f"{' ; '.join(str(s) for s in loop)} can repeat forever, adding tokens each time", upto,
-                   unfolded.describe(successor))
+    shown = " ; ".join(part.transition for s in loop for part in s.elementary)
+    return Finding("unbounded", f"place(s) {', '.join(grown)} grow without bound: the sequence {shown} can repeat "
+                   "forever, adding tokens each time", upto, unfolded.describe(successor), grown, loop)
 
 
 @dataclass
@@ -412,7 +532,7 @@ def analyse(net: Net, expected_end: Callable[[Callable[[str], int]], bool] | Non
     unfolded = space.unfolded
     findings: list[Finding] = list(space.unbounded)
 
-    def tokens_of(marking: tuple[int, ...]) -> Callable[[str], int]:
+    def tokens_of(marking: bytes) -> Callable[[str], int]:
         return lambda place: sum(n for (p, _), n in zip(unfolded.slots, marking, strict=True) if p == place)
 
     for state in space.deadlocks() if space.complete else []:

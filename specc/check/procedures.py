@@ -11,6 +11,10 @@ from specc.model.visitor import Visitor
 
 # Heads PRS evaluates itself: connectives, comparisons and arithmetic.
 BUILTIN_HEADS = frozenset("& | ~ < <= > >= = + - * /".split())
+# What `property:` may say of a KA: `meta` (it orders the KAs applicable to the goals it
+# matches), `executive` (it is the executive's request protocol, Fig 4.3: verification models
+# its goal by the executive's services instead of its body).
+KA_PROPERTIES = ("meta", "executive")
 # Unbounded domains: fine for the interpreter, rejected later by the Petri-net translation.
 BUILTIN_DOMAINS = frozenset({"int", "float", "number", "string", "symbol"})
 
@@ -33,6 +37,8 @@ class ProcedureVisitor(Visitor):
     def domain_values(self, domain: m.PDomain) -> tuple[str, ...] | None:
         if isinstance(domain, m.SymbolSet):
             return domain.values
+        if isinstance(domain, m.IntRange):
+            return tuple(str(v) for v in range(domain.low, domain.high + 1))
         declared = self.types.get(domain.name)
         if declared is None:
             return None
@@ -49,6 +55,11 @@ class ProcedureVisitor(Visitor):
                             f"action '{call.head}' takes {len(params)} argument(s), {len(call.args)} given", call.span)
         for arg in call.args:
             self.visit(arg)
+
+    def visit_IntRange(self, node: m.IntRange) -> None:
+        if node.low > node.high:
+            self.ctx.report("empty-domain", f"the range {node.low}..{node.high} is empty; write the lower bound first",
+                            node.span)
 
     def visit_DomainRef(self, node: m.DomainRef) -> None:
         if node.name in BUILTIN_DOMAINS:
@@ -132,6 +143,11 @@ def check(ctx: Context) -> None:
 
 
 def check_ka(ctx: Context, ka: m.KA) -> None:
+    for word in ka.properties:
+        if word not in KA_PROPERTIES:
+            span = word.span if isinstance(word, m.Word) else ka.span
+            ctx.report("unknown-property", f"unknown KA property '{word}'{did_you_mean(word, KA_PROPERTIES)}; "
+                       f"a KA may be {' or '.join(KA_PROPERTIES)}", span)
     if ka.invocation is None:
         ctx.report("missing-invocation", f"KA '{ka.name}' needs 'invocation: !(GOAL ...);' or a fact", ka.span)
     if ka.body is not None and ka.action is not None:

@@ -449,7 +449,15 @@ class DomainRef(Node):
     name: str
 
 
-PDomain = Union[SymbolSet, DomainRef]
+@dataclass(frozen=True, kw_only=True)
+class IntRange(Node):
+    """`low..high`: the bounded integers a Petri-net translation can enumerate (§4.4.10)."""
+
+    low: int
+    high: int
+
+
+PDomain = Union[SymbolSet, IntRange, DomainRef]
 
 
 @dataclass(frozen=True, kw_only=True)

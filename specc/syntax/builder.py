@@ -529,6 +529,10 @@ class Builder(Transformer[Token, Any]):
     def psymset(self, meta: Meta, children: list[Any]) -> m.SymbolSet:
         return m.SymbolSet(values=tuple(str(c) for c in children), span=self.span(meta))
 
+    def prange(self, meta: Meta, children: list[Token]) -> m.IntRange:
+        low, high = children
+        return m.IntRange(low=int(low), high=int(high), span=self.span(meta))
+
     def pdomain_ref(self, meta: Meta, children: list[Token]) -> m.DomainRef:
         return m.DomainRef(name=str(children[0]), span=self.span(meta))
 

@@ -181,6 +181,8 @@ def goal(g: m.Goal | m.SExp) -> str:
 def pdomain(d: m.PDomain) -> str:
     if isinstance(d, m.SymbolSet):
         return "{" + ", ".join(d.values) + "}"
+    if isinstance(d, m.IntRange):
+        return f"{d.low}..{d.high}"
     return d.name
 
 

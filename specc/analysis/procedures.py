@@ -1,0 +1,122 @@
+"""A `procedures` block as the supervisor runs it: the spec's KAs, predicates and primitive
+actions converted to the runtime records of `specc.runtime.procedures`, and the finite domains
+of the predicates' arguments (for the Petri-net translation)."""
+
+from __future__ import annotations
+
+from specc.model import nodes as m
+from specc.runtime import procedures as rp
+
+
+def term(arg: m.SArg) -> rp.Term:
+    if isinstance(arg, (m.LogicVar, m.ProgramVar)):
+        return rp.Var(arg.name)
+    if isinstance(arg, m.Ref):
+        return arg.text
+    if isinstance(arg, (m.Number, m.String)):
+        return arg.value
+    return compound(arg)
+
+
+def compound(expr: m.SExp) -> rp.Compound:
+    return rp.Compound(expr.head, tuple(term(a) for a in expr.args))
+
+
+def goal(node: m.Goal) -> rp.Goal:
+    return rp.Goal(node.op, compound(node.body), node.span.line)
+
+
+def trigger(node: m.Goal | m.SExp) -> rp.Goal | rp.Compound:
+    return goal(node) if isinstance(node, m.Goal) else compound(node)
+
+
+def block(node: m.Block) -> tuple[rp.Statement, ...]:
+    return tuple(statement(s) for s in node.statements)
+
+
+def statement(node: m.Stmt) -> rp.Statement:
+    line = node.span.line
+    if isinstance(node, m.GoalStmt):
+        return rp.Step(goal(node.goal))
+    if isinstance(node, m.IfStmt):
+        orelse = node.orelse
+        otherwise = () if orelse is None else block(orelse) if isinstance(orelse, m.Block) else (statement(orelse),)
+        return rp.If(goal(node.condition), block(node.then), otherwise, line)
+    if isinstance(node, m.WhileStmt):
+        return rp.While(goal(node.condition), block(node.body), line)
+    if isinstance(node, m.ParallelStmt):
+        return rp.Parallel(tuple(block(b) for b in node.branches), line)
+    if isinstance(node, m.ChooseStmt):
+        return rp.Choose(tuple(block(b) for b in node.branches), line)
+    if isinstance(node, m.AssignStmt):
+        return rp.Assign(rp.Var(node.var), term(node.value), line)
+    return rp.Fail(line)
+
+
+def ka(node: m.KA) -> rp.KA:
+    assert node.invocation is not None, "checked: every KA has an invocation"
+    action = None
+    if node.action is not None:
+        result = node.action.result
+        action = rp.Action(compound(node.action.call), rp.Var(result.name) if result else None, node.action.span.line)
+    return rp.KA(
+        name=node.name,
+        invocation=trigger(node.invocation),
+        context=trigger(node.context) if node.context is not None else None,
+        body=block(node.body) if node.body is not None else None,
+        action=action,
+        effects=tuple(goal(e) for e in node.effects),
+        documentation=node.documentation.value if node.documentation else "",
+        properties=node.properties,
+        line=node.span.line,
+    )
+
+
+def predicate_kind(node: m.PredicateDecl) -> str:
+    for kind in ("evaluable", "event", "functional", "closed"):
+        if kind in node.kinds:
+            return kind
+    return "standard"
+
+
+def library(node: m.Procedures) -> rp.Library:
+    return rp.Library(
+        name=node.name,
+        predicates=tuple(rp.Predicate(p.name, predicate_kind(p), len(p.params), p.binding.value if p.binding else "")
+                         for p in node.predicates),
+        primitives=tuple(rp.Primitive(a.name, len(a.params), a.binding.value, a.result is not None)
+                         for a in node.actions),
+        kas=tuple(ka(k) for k in node.kas),
+        source=node.span.file,
+    )
+
+
+def bindings(node: m.Procedures) -> list[str]:
+    """Every Python function the library calls, sorted."""
+    named = [a.binding.value for a in node.actions] + [p.binding.value for p in node.predicates if p.binding]
+    return sorted(set(named))
+
+
+class Domains:
+    """The values each predicate argument may take: a tuple when finite, None when unbounded
+    (`int`, `string`, ... — fine for the interpreter, not for a Petri net)."""
+
+    def __init__(self, node: m.Procedures):
+        self.types = {t.name: t.domain for t in node.types}
+        self.params = {p.name: p.params for p in node.predicates}
+
+    def values(self, domain: m.PDomain, seen: frozenset[str] = frozenset()) -> tuple[str | int, ...] | None:
+        if isinstance(domain, m.SymbolSet):
+            return tuple(int(v) if v.isdigit() else v for v in domain.values)
+        if isinstance(domain, m.IntRange):
+            return tuple(range(domain.low, domain.high + 1))
+        declared = self.types.get(domain.name)
+        if declared is None or domain.name in seen:
+            return None
+        return self.values(declared, seen | {domain.name})
+
+    def argument(self, predicate: str, index: int) -> tuple[str | int, ...] | None:
+        params = self.params.get(predicate)
+        if params is None or index >= len(params):
+            return None
+        return self.values(params[index].domain)

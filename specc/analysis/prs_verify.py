@@ -1,0 +1,375 @@
+"""Verifying procedures (seed 000 §4.5): translate the KAs a posted goal reaches into a coloured
+Petri net, explore its whole state space, and report in the procedures' own terms.
+
+Findings:
+- deadlock: a marking where nothing can fire and a posted goal has no answer yet (a marking
+  where every posted goal has succeeded or failed is the expected end, §4.5);
+- unbounded: a place that grows without bound (unbounded recursion, §4.5);
+- out-of-domain: a value leaves its finite domain (the net would need more colours);
+- never-succeeds: a statement is reached but its arc can never be crossed (a dead transition);
+- unreachable: statements of an invoked KA that can never run; never-invoked: a KA never started;
+- no-way-out: intentions cycle forever and nothing can take them out (a terminal strongly
+  connected component other than the expected end);
+- endless-cycle: intentions may cycle forever while the world keeps answering the same way: every
+  way out of the cycle is a choice of the world (a service's answer, an evaluable predicate), never
+  a step some procedure is ready to take (those must happen eventually: strong fairness).
+Each finding carries the shortest firing sequence to it, one line per step, naming the KA line.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from specc.analysis import petri
+from specc.analysis.controller import executive_controller
+from specc.analysis.prs_net import IDLE, ExecutiveModel, Reading, Service, Translation, Translator
+from specc.analysis.service_list import executive_spec
+from specc.model import nodes as m
+from specc.runtime import procedures as rp
+
+_NONZERO = re.compile(b"[^\x00]")
+
+
+@dataclass
+class Finding:
+    kind: str
+    message: str
+    trace: list[str] = field(default_factory=list)
+    where: list[str] = field(default_factory=list)  # where each intention stands at the end of the trace
+
+
+@dataclass(frozen=True)
+class Clause:
+    """An intention standing at a statement (KA:LINE), where an optional condition holds (a
+    test over the database and that KA's variables)."""
+
+    ka: str
+    line: int
+    condition: rp.Goal | None = None
+
+
+@dataclass(frozen=True)
+class Query:
+    """Can these clauses hold together? Written `KA:LINE [?(condition)]; KA:LINE ...`."""
+
+    text: str
+    clauses: tuple[Clause, ...]
+
+
+@dataclass
+class Answer:
+    query: Query
+    reached: bool
+    trace: list[str] = field(default_factory=list)
+    where: list[str] = field(default_factory=list)
+
+
+def parse_query(text: str) -> Query:
+    clauses = []
+    for part in text.split(";"):
+        head, _, condition = part.strip().partition(" ")
+        ka, _, line = head.partition(":")
+        if not ka or not line.isdigit():
+            raise ValueError(f"'{part.strip()}': write KA:LINE, optionally followed by a test ?(...)")
+        goal = rp.parse_goal(condition) if condition.strip() else None
+        if goal is not None and goal.op != "?":
+            raise ValueError(f"'{condition.strip()}': a query's condition is a test ?(...)")
+        clauses.append(Clause(ka, int(line), goal))
+    return Query(text, tuple(clauses))
+
+
+@dataclass
+class Report:
+    translation: Translation
+    space: petri.StateSpace
+    findings: list[Finding]
+    succeeded: int  # end markings where the posted goals succeeded
+    failed: int  # ... where one failed
+    answers: list[Answer] = field(default_factory=list)
+
+    @property
+    def states(self) -> int:
+        return self.space.states
+
+    def kinds(self) -> list[str]:
+        return [f.kind for f in self.findings]
+
+
+def executive_model(program: m.Program, procedures: m.Procedures, failing: Sequence[str] = ()) -> ExecutiveModel | None:
+    """The services and groups of the executive a system puts under these procedures."""
+    systems = [i for i in program.items if isinstance(i, m.System)
+               and i.supervisor is not None and i.supervisor.text == procedures.name and i.executive is not None]
+    if not systems:
+        return None
+    assert systems[0].executive is not None
+    name = systems[0].executive.text
+    executive = next((i for i in program.items if isinstance(i, m.Executive) and i.name == name), None)
+    if executive is None:
+        return None
+    spec = executive_spec(program, executive_controller(program, executive))
+    group_of = {service: group for group, services in spec.groups.items() for service in services}
+    services = {}
+    for service in spec.services.values():
+        excluded = tuple(sorted((group_of[c], c) for c in service.conflicts if c in group_of))
+        services[service.name] = Service(service.name, group_of.get(service.name), excluded)
+    return ExecutiveModel(services, {g: tuple(s) for g, s in spec.groups.items()}, frozenset(failing))
+
+
+def translate(program: m.Program, procedures: m.Procedures, goals: Sequence[rp.Goal],
+              facts: Sequence[rp.Compound] = (), failing: Sequence[str] = ()) -> Translation:
+    return Translator(procedures, executive_model(program, procedures, failing)).translate(goals, facts)
+
+
+def verify(program: m.Program, procedures: m.Procedures, goals: Sequence[rp.Goal], facts: Sequence[rp.Compound] = (),
+           failing: Sequence[str] = (), queries: Sequence[Query] = (), limit: int = 2_000_000,
+           progress: Callable[[int], None] | None = None) -> Report:
+    translation = translate(program, procedures, goals, facts, failing)
+    return analyse(translation, queries, limit, progress)
+
+
+def query_places(translation: Translation, query: Query) -> dict[Clause, list[str]]:
+    places = {}
+    for clause in query.clauses:
+        found = translation.statements.get((clause.ka, clause.line))
+        if not found:
+            lines = sorted(line for ka, line in translation.statements if ka == clause.ka)
+            known = f"its statements are on lines {', '.join(map(str, lines))}" if lines else \
+                f"KA '{clause.ka}' is not among the KAs the goal reaches ({', '.join(translation.kas)})"
+            raise ValueError(f"no statement at {clause.ka}:{clause.line}: {known}")
+        places[clause] = found
+    return places
+
+
+def analyse(translation: Translation, queries: Sequence[Query] = (), limit: int = 2_000_000,
+            progress: Callable[[int], None] | None = None) -> Report:
+    asked = [query_places(translation, q) for q in queries]
+    watched = {p for places in asked for found in places.values() for p in found}
+    tops = {f"{goal}.{outcome}" for goal, _ in translation.top for outcome in ("SUCC", "FAIL")}
+    unfolded = translation.net.unfold().reduced(
+        lambda place: place in translation.errors or place in tops or place in watched)
+    space = petri.explore(unfolded, limit, progress)
+    reader = Reader(translation, unfolded)
+    findings: list[Finding] = []
+    for finding in space.unbounded:
+        grown = [reader.place(p) for p in finding.places]
+        loop = " ; ".join(reader.trace(finding.loop))
+        findings.append(Finding("unbounded", f"{', '.join(grown)}: tokens pile up without bound (unbounded "
+                                f"recursion?); this sequence can repeat forever, adding tokens each time: {loop}",
+                                reader.trace(finding.trace)))
+    succeeded = failed = 0
+    # Every place some firing marks (the reduction hides the places its fused steps pass by).
+    original = unfolded.original_slots or unfolded.slots
+    marked_places = {unfolded.slots[m.start()][0] for m in _NONZERO.finditer(unfolded.initial)}
+    for i in space.fired():
+        for part in unfolded.steps[i].elementary:
+            marked_places.update(original[s][0] for s, _ in part.post)
+    for error, meaning in translation.errors.items():
+        if error in marked_places:
+            state = next(i for i, mk in enumerate(space.markings) if reader.tokens(mk, error))
+            findings.append(Finding("out-of-domain", meaning + ": give it a wider domain or keep it in range",
+                                    reader.trace(space.trace(state)), reader.where(space.markings[state])))
+    if space.complete:
+        deadlock = None
+        for state in space.deadlocks():
+            marking = space.markings[state]
+
+            def tokens(place: str, marking: bytes = marking) -> int:
+                return reader.tokens(marking, place)
+
+            if translation.answered(tokens):
+                if any(reader.tokens(marking, f"{goal}.FAIL") for goal, _ in translation.top):
+                    failed += 1
+                else:
+                    succeeded += 1
+            elif deadlock is None and not any(reader.tokens(marking, e) for e in translation.errors):
+                deadlock = state
+        if deadlock is not None:
+            findings.append(Finding("deadlock", "nothing can happen any more and the posted goal has no answer",
+                                    reader.trace(space.trace(deadlock)), reader.where(space.markings[deadlock])))
+        findings.extend(_statements(translation, space, reader, marked_places))
+        findings.extend(_cycles(translation, space, reader))
+    answers = [_answer(query, places, space, reader) for query, places in zip(queries, asked, strict=True)]
+    return Report(translation, space, findings, succeeded, failed, answers)
+
+
+def _answer(query: Query, places: dict[Clause, list[str]], space: petri.StateSpace, reader: Reader) -> Answer:
+    for state, marking in enumerate(space.markings):  # breadth-first: the first is the nearest
+        if all(reader.holds(marking, clause, found) for clause, found in places.items()):
+            return Answer(query, True, reader.trace(space.trace(state)), reader.where(marking))
+    return Answer(query, False)
+
+
+class Reader:
+    """Markings and steps told in the procedures' terms."""
+
+    def __init__(self, translation: Translation, unfolded: petri.Unfolded):
+        self.translation = translation
+        self.unfolded = unfolded
+        self.slots_of: dict[str, list[int]] = {}
+        self.index: dict[tuple[str, Any], int] = {}
+        for slot, (place, colour) in enumerate(unfolded.slots):
+            self.slots_of.setdefault(place, []).append(slot)
+            self.index[(place, colour)] = slot
+
+    def tokens(self, marking: bytes, place: str) -> int:
+        return sum(marking[s] for s in self.slots_of.get(place, ()))
+
+    def place(self, place: str) -> str:
+        where = self.translation.where.get(place)
+        return f"{where.ka}:{where.line} {where.what}" if where is not None else place
+
+    def holds(self, marking: bytes, clause: Clause, places: Sequence[str]) -> bool:
+        """Some token at the clause's statement satisfies its condition."""
+        for place in places:
+            where = self.translation.where.get(place)
+            for slot in self.slots_of.get(place, ()):
+                if not marking[slot]:
+                    continue
+                if clause.condition is None:
+                    return True
+                colour = self.unfolded.slots[slot][1]
+                env = {v: c for v, c in zip(where.vars if where else (), colour if isinstance(colour, tuple) else (),
+                                             strict=False) if c != IDLE}
+                if self._test(marking, clause.condition.expr, env):
+                    return True
+        return False
+
+    def _test(self, marking: bytes, expr: rp.Compound, env: dict[str, Any]) -> bool:
+        solver = self.translation.solver
+        assert solver is not None
+        states = {}
+        for key in dict.fromkeys(solver.atoms(expr, env)):
+            for state in solver.db.states(*key):
+                if state.takes and all(self._present(marking, place, colour) for place, colour in state.takes):
+                    states[key] = state
+                    break
+        return bool(solver.solve(expr, env, Reading(states)))
+
+    def _present(self, marking: bytes, place: str, colour: Any) -> bool:
+        slot = self.index.get((place, petri.BLACK if colour == () else colour))
+        return slot is not None and marking[slot] > 0
+
+    def step(self, step: petri.Step) -> str:
+        """One elementary step (the slots it counts are the unreduced net's)."""
+        name = re.sub(r" #\d+$", "", step.transition)
+        shown = []
+        for slot, _ in step.post:
+            place, colour = (self.unfolded.original_slots or self.unfolded.slots)[slot]
+            where = self.translation.where.get(place)
+            if where is not None and where.vars and isinstance(colour, tuple):
+                values = [f"{v}={c}" for v, c in zip(where.vars, colour, strict=False) if c != IDLE]
+                if values:
+                    shown.append(" ".join(values))
+            elif place.endswith(".SUCC") and isinstance(colour, tuple):
+                shown.append(f"answer ({place[:-5]} {' '.join(map(str, colour))})")
+        return name + (f"  [{'; '.join(dict.fromkeys(shown))}]" if shown else "")
+
+    def trace(self, steps: Sequence[petri.Step]) -> list[str]:
+        return [self.step(part) for s in steps for part in s.elementary]
+
+    def where(self, marking: bytes) -> list[str]:
+        found = []
+        for match in _NONZERO.finditer(marking):
+            place, colour = self.unfolded.slots[match.start()]
+            where = self.translation.where.get(place)
+            if where is None:
+                continue
+            values = ""
+            if where.vars and isinstance(colour, tuple):
+                values = " ".join(f"{v}={c}" for v, c in zip(where.vars, colour, strict=False) if c != IDLE)
+            found.append(f"{where.ka}:{where.line} {where.what}" + (f" ({values})" if values else ""))
+        return found
+
+
+def _statements(translation: Translation, space: petri.StateSpace, reader: Reader,
+                marked: set[str]) -> list[Finding]:
+    fired_names = {re.sub(r" #\d+$", "", part.transition) for i in space.fired()
+                   for part in space.unfolded.steps[i].elementary}
+    findings = []
+    for ka in translation.kas:
+        if f"{ka}.INIT" not in marked and f"{ka}.INIT" in translation.net.places:
+            findings.append(Finding("never-invoked", f"KA '{ka}' is never invoked"))
+            continue
+        unreachable = []
+        for (owner, line), places in sorted(translation.statements.items()):
+            if owner != ka:
+                continue
+            text = translation.text.get((owner, line), "")
+            if not any(p in marked for p in places):
+                unreachable.append(f"{line} {text}")
+                continue
+            crossed = translation.successes.get((owner, line))
+            if crossed and not any(name in fired_names for name in crossed):
+                findings.append(Finding("never-succeeds", f"{ka}:{line} {text} is reached but can never succeed "
+                                        "(its success transition is dead): what follows it never runs"))
+        if unreachable:
+            findings.append(Finding("unreachable", f"KA '{ka}': these statements can never run: "
+                                    + "; ".join(unreachable)))
+    return findings
+
+
+def _cycles(translation: Translation, space: petri.StateSpace, reader: Reader) -> list[Finding]:
+    steps = space.unfolded.steps
+    environment = translation.environment
+
+    def name(step_index: int) -> str:
+        return re.sub(r" #\d+$", "", steps[step_index].transition)
+
+    def is_environment(step_index: int) -> bool:
+        return any(part.origin in environment or re.sub(r" #\d+$", "", part.transition) in environment
+                   for part in steps[step_index].elementary)
+
+    found: dict[tuple[frozenset[str], bool], Finding] = {}
+    work = [set(c) for c in space.components() if _cyclic(space, c)]
+    while work:
+        states = work.pop()
+        # A state where some procedure is ready to leave: strong fairness makes it leave.
+        forced = set()
+        for state in states:
+            for step, target in space.edges[state]:
+                if target in states:
+                    continue
+                sibling_stays = any(t in states and name(s) == name(step) for s, t in space.edges[state])
+                if not (is_environment(step) and sibling_stays):
+                    forced.add(state)
+                    break
+        if forced:
+            rest = states - forced
+            work.extend(set(c) for c in petri.strongly_connected(rest, lambda x: [t for _, t in space.edges[x]])
+                        if _cyclic(space, c, rest))
+            continue
+        exits = sorted({" ; ".join(reader.trace([steps[s]])) for x in states for s, t in space.edges[x]
+                        if t not in states})
+        looping = frozenset(name(s) for x in states for s, t in space.edges[x] if t in states)
+        key = (frozenset(_ka_of(n) for n in looping), bool(exits))
+        entry = min(states)
+        if key in found and len(reader.trace(space.trace(entry))) >= len(found[key].trace):
+            continue
+        kas = sorted({_ka_of(n) for n in looping} - {""})
+        if exits:
+            message = (f"{', '.join(kas)} may cycle forever ({len(states)} markings) while the world keeps answering "
+                       f"the same way; the only ways out: {'; '.join(exits)}")
+            kind = "endless-cycle"
+        else:
+            message = f"{', '.join(kas)} cycle forever ({len(states)} markings) and nothing can stop them"
+            kind = "no-way-out"
+        found[key] = Finding(kind, message, reader.trace(space.trace(entry)), reader.where(space.markings[entry]))
+    return sorted(found.values(), key=lambda f: (f.kind, len(f.trace)))
+
+
+def _cyclic(space: petri.StateSpace, component: Sequence[int] | set[int], within: set[int] | None = None) -> bool:
+    members = set(component) if within is None else set(component) & within
+    if len(members) > 1:
+        return True
+    (only,) = members
+    return any(t == only for _, t in space.edges[only])
+
+
+def _ka_of(transition: str) -> str:
+    head = transition.split(" ", 1)[0]
+    return head.split(":", 1)[0] if ":" in head else ""
+
+

@@ -1,0 +1,349 @@
+"""Procedures -> coloured Petri net (seed 000 §4.4) and its analysis (§4.5): small KAs with known
+answers (a deadlock, unbounded recursion, a branch that can never fire), the constructs a net
+cannot represent, and the Hilare 2 task level of §5.4 with the findings of §5.4.1."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from specc.analysis import petri
+from specc.analysis.prs_net import TranslationError
+from specc.analysis.prs_verify import Report, parse_query, translate, verify
+from specc.model import nodes as m
+from specc.pipeline import load
+from specc.runtime import procedures as rp
+from tests.conftest import EXAMPLES
+
+
+def program_of(text: str, folder: Path) -> m.Program:
+    spec = folder / "tasks.spec"
+    spec.write_text(text, encoding="utf-8")
+    loaded = load([spec])
+    assert loaded.program is not None and not loaded.errors, [d.message for d in loaded.errors]
+    return loaded.program
+
+
+def check(text: str, goal: str, folder: Path, **options: object) -> Report:
+    program = program_of(text, folder)
+    block = next(i for i in program.items if isinstance(i, m.Procedures))
+    return verify(program, block, [rp.parse_goal(goal)], **options)  # type: ignore[arg-type]
+
+
+def finding(report: Report, kind: str) -> str:
+    found = [f for f in report.findings if f.kind == kind]
+    assert found, f"no {kind} among {report.kinds()}"
+    return found[0].message
+
+
+DEADLOCK = """
+procedures handshake {
+  predicate closed LEFT-READY();
+  predicate closed RIGHT-READY();
+  predicate MEET();
+  predicate LEFT();
+  predicate RIGHT();
+  ka Meet {
+    invocation: !(MEET);
+    body {
+      parallel {
+        branch { !(LEFT); }
+        branch { !(RIGHT); }
+      }
+    }
+  }
+  ka Left {
+    invocation: !(LEFT);
+    body {
+      ^(RIGHT-READY);
+      =>(LEFT-READY);
+    }
+  }
+  ka Right {
+    invocation: !(RIGHT);
+    body {
+      ^(LEFT-READY);
+      =>(RIGHT-READY);
+    }
+  }
+}
+"""
+
+
+def test_two_kas_each_waiting_for_the_other_deadlock_with_where_each_one_waits(tmp_path: Path) -> None:
+    report = check(DEADLOCK, "!(MEET)", tmp_path)
+    deadlock = report.findings[0]
+    assert deadlock.kind == "deadlock"
+    assert any(w.startswith("Left:20 ^(RIGHT-READY)") for w in deadlock.where), deadlock.where
+    assert any(w.startswith("Right:27 ^(LEFT-READY)") for w in deadlock.where), deadlock.where
+    # the trace is the shortest one: the split, then each KA started
+    assert deadlock.trace[0].startswith("goal MEET") and any("goal RIGHT: start Right" in s for s in deadlock.trace)
+    assert report.succeeded == report.failed == 0
+    # what the deadlock leaves behind: both waits can never be crossed
+    assert "Left:20 ^(RIGHT-READY) is reached but can never succeed" in " ".join(report.findings[i].message
+                                                                               for i in range(len(report.findings)))
+
+
+def test_the_handshake_in_the_right_order_ends_with_the_goal_achieved(tmp_path: Path) -> None:
+    fixed = DEADLOCK.replace("^(RIGHT-READY);\n      =>(LEFT-READY);", "=>(LEFT-READY);\n      ^(RIGHT-READY);")
+    report = check(fixed, "!(MEET)", tmp_path)
+    assert report.findings == [] and report.succeeded >= 1 and report.failed == 0
+
+
+RECURSION = """
+procedures digging {
+  predicate DIG();
+  ka Dig {
+    invocation: !(DIG);
+    body {
+      !(DIG);
+    }
+  }
+}
+"""
+
+
+def test_a_ka_posting_its_own_goal_recurses_without_bound(tmp_path: Path) -> None:
+    report = check(RECURSION, "!(DIG)", tmp_path)
+    message = finding(report, "unbounded")
+    assert message.startswith("Dig:7 waits for !(DIG): tokens pile up without bound")
+    assert "Dig:7 !(DIG) post" in message  # the repeating sequence
+    unbounded = next(f for f in report.findings if f.kind == "unbounded")
+    assert any(step.startswith("Dig:7 !(DIG) post") for step in unbounded.trace), unbounded.trace
+    assert not report.space.complete
+
+
+DEAD_BRANCH = """
+procedures doors {
+  predicate closed DOOR(state: {OPEN, CLOSED});
+  predicate closed INSIDE();
+  predicate GO();
+  ka Go {
+    invocation: !(GO);
+    body {
+      =>(DOOR CLOSED);
+      choose {
+        branch {
+          ?(DOOR OPEN);
+          =>(INSIDE);
+        }
+        branch {
+          ?(DOOR CLOSED);
+        }
+      }
+    }
+  }
+}
+"""
+
+
+def test_a_branch_whose_arc_is_never_true_is_a_dead_transition(tmp_path: Path) -> None:
+    report = check(DEAD_BRANCH, "!(GO)", tmp_path)
+    assert "Go:12 ?(DOOR OPEN) is reached but can never succeed" in finding(report, "never-succeeds")
+    assert "13 =>(INSIDE)" in finding(report, "unreachable")
+    assert report.succeeded >= 1 and report.failed == 0  # the other branch is tried (Fig 4.22)
+
+
+def test_when_every_branch_fails_the_ka_and_its_goal_fail(tmp_path: Path) -> None:
+    report = check(DEAD_BRANCH.replace("?(DOOR CLOSED);\n        }", "?(DOOR OPEN);\n        }"), "!(GO)", tmp_path)
+    assert report.failed >= 1 and report.succeeded == 0
+
+
+SEVERAL_KAS = """
+procedures fetching {
+  predicate closed HAVE(thing: {TOOL});
+  predicate closed SHELF-EMPTY();
+  predicate FETCH(thing: {TOOL});
+  predicate START();
+  ka Start {
+    invocation: !(START);
+    body {
+      =>(SHELF-EMPTY);
+      !(FETCH TOOL);
+    }
+  }
+  ka FromShelf {
+    invocation: !(FETCH $T);
+    context: ?(~ (SHELF-EMPTY));
+    body { =>(HAVE $T); }
+  }
+  ka FromStore {
+    invocation: !(FETCH $T);
+    body { =>(HAVE $T); }
+  }
+}
+"""
+
+
+def test_several_kas_for_one_goal_are_tried_in_turn_before_it_fails(tmp_path: Path) -> None:
+    report = check(SEVERAL_KAS, "!(START)", tmp_path)
+    # FromShelf is tried and given up at once: its body never runs here.
+    assert report.kinds() == ["unreachable"] and "FromShelf" in report.findings[0].message
+    assert report.succeeded >= 1 and report.failed == 0
+    # FromShelf's context is never true here: it is tried, fails, and FromStore achieves the goal.
+    names = {step.transition for i in report.space.fired() for step in report.space.unfolded.steps[i].elementary}
+    assert "goal FETCH: FromShelf fails, try another" in names and "goal FETCH: FromStore succeeds" in names
+    without = SEVERAL_KAS.replace("body { =>(HAVE $T); }\n  }\n}", "body { fail; }\n  }\n}")
+    assert check(without, "!(START)", tmp_path).failed >= 1
+
+
+FACT_INVOKED = """
+procedures alarms {
+  predicate closed ALARM();
+  predicate closed HANDLED();
+  predicate RAISE();
+  ka Raise {
+    invocation: !(RAISE);
+    body {
+      =>(ALARM);
+      ^(HANDLED);
+    }
+  }
+  ka OnAlarm {
+    invocation: (ALARM);
+    body { =>(HANDLED); }
+  }
+}
+"""
+
+
+def test_a_conclusion_invokes_the_kas_waiting_for_that_fact(tmp_path: Path) -> None:
+    report = check(FACT_INVOKED, "!(RAISE)", tmp_path)
+    assert report.findings == [] and report.succeeded >= 1
+    without = FACT_INVOKED.replace("invocation: (ALARM);", "invocation: (HANDLED);")
+    assert "deadlock" in check(without, "!(RAISE)", tmp_path).kinds()
+
+
+@pytest.mark.parametrize("statement, code, column", [
+    ("#(DOOR OPEN);", "unsupported-goal", 7),
+    ("%(DOOR OPEN);", "unsupported-goal", 7),
+    ("?(COUNT $N);", "unbounded-variable", 15),
+])
+def test_constructs_a_net_cannot_represent_are_rejected_where_they_are(tmp_path: Path, statement: str, code: str,
+                                                                       column: int) -> None:
+    text = f"""procedures limits {{
+  predicate closed DOOR(state: {{OPEN, CLOSED}});
+  predicate functional COUNT(n: int);
+  predicate GO();
+  ka Go {{
+    invocation: !(GO);
+    body {{
+      {statement}
+    }}
+  }}
+}}
+"""
+    program = program_of(text, tmp_path)
+    block = next(i for i in program.items if isinstance(i, m.Procedures))
+    with pytest.raises(TranslationError) as raised:
+        translate(program, block, [rp.parse_goal("!(GO)")])
+    (diagnostic,) = raised.value.diagnostics
+    assert diagnostic.code == code
+    assert (diagnostic.span.line, diagnostic.span.column) == (8, column), diagnostic.span
+
+
+def test_a_meta_ka_is_rejected_for_the_goals_it_arbitrates(tmp_path: Path) -> None:
+    text = """procedures choosing {
+  predicate GO();
+  action PREFER() = "tasks_codels.prefer";
+  ka Go { invocation: !(GO); body { fail; } }
+  ka Policy { invocation: !(GO); property: meta; action: (PREFER); }
+}
+"""
+    (tmp_path / "tasks_codels.py").write_text("def prefer(ctx):\n    return ctx.candidates\n", encoding="utf-8")
+    program = program_of(text, tmp_path)
+    block = next(i for i in program.items if isinstance(i, m.Procedures))
+    with pytest.raises(TranslationError) as raised:
+        translate(program, block, [rp.parse_goal("!(GO)")])
+    assert [d.code for d in raised.value.diagnostics] == ["unsupported-meta"]
+    assert raised.value.diagnostics[0].span.line == 5
+
+
+# ---------------------------------------------------------------- Hilare 2, §5.4
+
+
+@pytest.fixture(scope="module")
+def hilare() -> tuple[m.Program, m.Procedures]:
+    loaded = load([EXAMPLES / "hilare"])
+    assert loaded.program is not None
+    return loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Procedures))
+
+
+def test_hilare_no_deadlock_and_an_endless_cycle_when_no_object_is_found(hilare: tuple[m.Program, m.Procedures]
+                                                                         ) -> None:
+    report = verify(*hilare, [rp.parse_goal("!(COLLECT-OBJECTS 1)")])
+    assert report.space.complete and "deadlock" not in report.kinds()
+    assert report.kinds() == ["endless-cycle"]
+    message = report.findings[0].message
+    assert message.startswith("Explore, Modelise may cycle forever")
+    assert "service SEARCH-OBJ answers  [answer (EXEC-COUNT SEARCH-OBJ 1)]" in message  # the only way out
+    assert report.succeeded >= 1 and report.failed == 0  # every end is the goal achieved
+
+
+def test_hilare_the_others_never_stop_once_object_taking_fails(hilare: tuple[m.Program, m.Procedures]) -> None:
+    report = verify(*hilare, [rp.parse_goal("!(COLLECT-OBJECTS 1)")], failing=["ARM-OBJ"])
+    assert "deadlock" not in report.kinds()
+    stuck = next(f for f in report.findings if f.kind == "no-way-out")
+    assert stuck.message.startswith("Explore, Modelise cycle forever") and "nothing can stop them" in stuck.message
+    assert "TakeObject:234 !(EXEC-REQUEST-OK ARM-OBJ) [false]" in stuck.trace
+    assert "goal TAKE-OBJECT: TakeObject fails" in stuck.trace
+    assert not any(w.startswith("TakeObject") for w in stuck.where)
+
+
+def test_hilare_an_exploration_cycle_may_start_while_an_object_waits(hilare: tuple[m.Program, m.Procedures]) -> None:
+    waiting = parse_query("Explore:254; TakeObject:236 ?(& (OBJ-FOUND @I) (> @I (+ @TAKEN 1)))")
+    impossible = parse_query("Explore:254; TakeObject:236 ?(& (OBJ-FOUND @I) (> @I 5))")
+    report = verify(*hilare, [rp.parse_goal("!(COLLECT-OBJECTS 1)")], queries=[waiting, impossible])
+    reached, never = report.answers
+    assert reached.reached and not never.reached
+    assert any(w.startswith("TakeObject:236 !(EXEC-REQUEST-OK ARM-BACK)") for w in reached.where)
+    assert any(w.startswith("Explore:253 while ?(EXECUTION GO): true") for w in reached.where)
+
+
+def test_hilare_services_run_only_when_their_group_allows(hilare: tuple[m.Program, m.Procedures]) -> None:
+    """§5.4.1: EXEC-TRAJ-GOAL never runs while its group holds EXEC-TRAJ-OBJ, nor while ARM-OBJ
+    or CALC-TRAJ-OBJ (groups of Table 5.7) run."""
+    translation = translate(*hilare, [rp.parse_goal("!(COLLECT-OBJECTS 1)")])
+    starts = translation.net.transitions["service EXEC-TRAJ-GOAL starts"]
+    bindings = starts.bindings or ()
+    assert bindings and all("ARM-OBJ" not in b.values() and "CALC-TRAJ-OBJ" not in b.values() for b in bindings)
+    assert {"ExecTrajState", "ARM_OBJ_ARM_BACKstate"} <= {a.place for a in starts.inputs}
+
+
+def test_the_translated_net_exports_to_pnml(hilare: tuple[m.Program, m.Procedures]) -> None:
+    translation = translate(*hilare, [rp.parse_goal("!(COLLECT-OBJECTS 1)")])
+    root = ET.fromstring(petri.to_pnml(translation.net))
+    ns = {"p": petri.PNML}
+    places = root.findall(".//p:place", ns)
+    assert len(places) == len(translation.net.unfold().slots)
+    marked = [p for p in places if p.find("p:initialMarking", ns) is not None]
+    assert any("COLLECT-OBJECTS.POST" in (p.findtext("p:name/p:text", namespaces=ns) or "") for p in marked)
+
+
+# ---------------------------------------------------------------- the net and the interpreter agree
+
+FIXED_HANDSHAKE = DEADLOCK.replace("^(RIGHT-READY);\n      =>(LEFT-READY);", "=>(LEFT-READY);\n      ^(RIGHT-READY);")
+NO_STORE = SEVERAL_KAS.replace("body { =>(HAVE $T); }\n  }\n}", "body { fail; }\n  }\n}")
+NOBODY_LISTENS = FACT_INVOKED.replace("invocation: (ALARM);", "invocation: (HANDLED);")
+
+
+@pytest.mark.parametrize("text, goal", [
+    (DEADLOCK, "!(MEET)"), (FIXED_HANDSHAKE, "!(MEET)"), (DEAD_BRANCH, "!(GO)"), (SEVERAL_KAS, "!(START)"),
+    (NO_STORE, "!(START)"), (FACT_INVOKED, "!(RAISE)"), (NOBODY_LISTENS, "!(RAISE)"),
+])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_interpreter_ends_only_where_the_net_says_it_can(tmp_path: Path, text: str, goal: str, seed: int) -> None:
+    from specc.analysis.procedures import library
+    from specc.runtime.supervisor import Supervisor
+
+    report = check(text, goal, tmp_path)
+    program = program_of(text, tmp_path)
+    supervisor = Supervisor(library(next(i for i in program.items if isinstance(i, m.Procedures))), seed=seed)
+    intention = supervisor.post(goal)
+    supervisor.run()
+    possible = {"succeeded"} if report.succeeded else set()
+    possible |= {"failed"} if report.failed else set()
+    possible |= {"running"} if "deadlock" in report.kinds() else set()
+    assert intention.status in possible, (intention.status, report.kinds(), intention.lines())
