@@ -20,7 +20,10 @@ demo: $(STAMP)
 	$(BIN)/specc compile examples/hilare -o generated
 	$(BIN)/python examples/hilare/run_modules.py
 	$(BIN)/python examples/hilare/run_executive.py
+	$(BIN)/python examples/hilare/run_supervisor.py
 	$(BIN)/specc verify examples/hilare --requests 1
+	$(BIN)/specc verify examples/hilare --goal '!(COLLECT-OBJECTS 1)' --fail ARM-OBJ --steps 4 \
+	    --reach 'Explore:254; TakeObject:236 ?(& (OBJ-FOUND @I) (> @I (+ @TAKEN 1)))'
 
 test: $(STAMP)
 	$(BIN)/ruff check specc tests

@@ -8,7 +8,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 from rich.console import Console
@@ -151,23 +151,37 @@ def fmt(paths: PathsArg,
 def graph(paths: PathsArg,
           incompat: Annotated[bool, typer.Option("--incompat", help="Draw the executive's service "
                                                  "incompatibility graph and its groups.")] = False,
-          output: Annotated[Path, typer.Option("--output", "-o", help="Picture file (PNG, SVG, PDF).")]
-          = Path("incompat.png"),
+          net: Annotated[bool, typer.Option("--net", help="Draw the coloured Petri net the procedures a --goal "
+                                            "reaches translate into (seed 000 §4.4).")] = False,
+          output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Picture file (PNG, SVG, PDF); "
+                                                         "incompat.png or net.png by default.")] = None,
           executive: Annotated[Optional[str], typer.Option(help="Which executive, when there are several.")]
+          = None,
+          goal: Annotated[Optional[list[str]], typer.Option(help="With --net: the goal posted (repeatable).")]
+          = None,
+          ka: Annotated[Optional[str], typer.Option(help="With --net: draw only this KA's places.")] = None,
+          procedures: Annotated[Optional[str], typer.Option(help="Which procedures, when there are several.")]
           = None) -> None:
-    """Draw a picture of the spec; prints the service groups and the controller's state count.
+    """Draw a picture of the spec: the service incompatibility graph (and print the service
+    groups and the controller's state count), or the Petri net of the procedures.
 
     Example: specc graph --incompat examples/hilare -o hilare-incompat.png
+
+    Example: specc graph --net examples/hilare --goal '!(COLLECT-OBJECTS 1)' --ka TakeObject -o take.png
     """
     from specc.analysis.incompat import build_graph, service_groups, state_count
     from specc.pictures import draw_incompatibility_graph
 
-    if not incompat:
-        err.print("error: say what to draw: --incompat", markup=False)
+    if incompat == net:
+        err.print("error: say what to draw: --incompat or --net", markup=False)
         raise typer.Exit(1)
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
+    if net:
+        draw_procedures_net(loaded, procedures, goal or [], ka, output or Path("net.png"))
+        return
+    output = output or Path("incompat.png")
     chosen = choose_executive(loaded.program, executive)
     incompatibility = build_graph(loaded.program, chosen)
     groups = service_groups(incompatibility)
@@ -266,18 +280,36 @@ def verify(paths: PathsArg,
     raise typer.Exit(0 if result.ok else 1)
 
 
-def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], failing: list[str], reach: list[str],
-                      name: str | None, max_states: int, pnml: Path | None, strict: bool, steps: int) -> None:
-    from rich.status import Status
+def draw_procedures_net(loaded: Loaded, name: str | None, goals: list[str], ka: str | None, output: Path) -> None:
+    from specc.pictures import draw_net
 
-    from specc.analysis import petri
+    if not goals:
+        err.print("error: say which goal is posted: --goal '!(GOAL ...)' (the net holds the KAs it reaches)",
+                  markup=False)
+        raise typer.Exit(1)
+    translation = translate_procedures(loaded, name, goals, [], [])
+    if ka is not None and ka not in translation.kas:
+        err.print(f"error: KA '{ka}' is not among the KAs the goal reaches: {', '.join(translation.kas)}",
+                  markup=False)
+        raise typer.Exit(1)
+    only = None if ka is None else (lambda place: place.startswith(f"{ka}."))
+    title = f"procedures {translation.net.name}" + (f": KA {ka}" if ka else "")
+    try:
+        picture = draw_net(translation.net, output, title, translation.where, only=only)
+    except (OSError, ValueError) as exc:
+        err.print(f"error: cannot draw '{output}': {exc}", markup=False)
+        raise typer.Exit(1) from None
+    out.print(f"wrote {picture}", markup=False)
+
+
+def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], facts: list[str],
+                         failing: list[str]) -> Any:
+    """The Petri net of the procedures the user means, for the goals posted; errors end the command."""
     from specc.analysis.prs_net import TranslationError
-    from specc.analysis.prs_verify import analyse, parse_query, translate
+    from specc.analysis.prs_verify import translate
     from specc.runtime import procedures as rp
 
-    loaded = load(paths)
-    if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+    assert loaded.program is not None
     blocks = {p.name: p for p in loaded.program.items if isinstance(p, m.Procedures)}
     chosen = blocks.get(name) if name else next(iter(blocks.values()), None)
     if chosen is None or (name is None and len(blocks) > 1):
@@ -288,17 +320,34 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
     try:
         posted = [rp.parse_goal(g) for g in goals]
         initial = [rp.parse_fact(f) for f in facts]
+    except ValueError as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(1) from None
+    try:
+        return translate(loaded.program, chosen, posted, initial, ["*" if f == "all" else f for f in failing])
+    except TranslationError as exc:
+        for diagnostic in exc.diagnostics:
+            err.print(render(diagnostic, loaded.sources), markup=False)
+        raise typer.Exit(1) from None
+
+
+def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], failing: list[str], reach: list[str],
+                      name: str | None, max_states: int, pnml: Path | None, strict: bool, steps: int) -> None:
+    from rich.status import Status
+
+    from specc.analysis import petri
+    from specc.analysis.prs_verify import analyse, parse_query
+
+    loaded = load(paths)
+    if report(loaded) or loaded.program is None:
+        raise typer.Exit(1)
+    try:
         queries = [parse_query(q) for q in reach]
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None
     started = time.perf_counter()
-    try:
-        translation = translate(loaded.program, chosen, posted, initial, ["*" if f == "all" else f for f in failing])
-    except TranslationError as exc:
-        for diagnostic in exc.diagnostics:
-            err.print(render(diagnostic, loaded.sources), markup=False)
-        raise typer.Exit(1) from None
+    translation = translate_procedures(loaded, name, goals, facts, failing)
     net = translation.net
     out.print(f"net of {', '.join(translation.kas)}: {len(net.places)} places, {len(net.transitions)} transitions",
               markup=False)

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import math
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
+from specc.analysis import petri
 from specc.analysis.incompat import IncompatibilityGraph, service_groups, state_count
 
 GROUP_COLOURS = ("#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c")
@@ -57,3 +61,272 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
     figure.savefig(target, dpi=110, bbox_inches="tight")
     plt.close(figure)
     return target
+
+
+# ---------------------------------------------------------------------------------------- Petri nets
+NET_FORMATS = (".png", ".svg", ".pdf")
+_LABEL_WIDTH = 28  # characters a node label keeps
+_COLUMN = 1.3  # layout units between two layers
+_ROW = 0.8  # layout units between two nodes of a layer
+_RADIUS = 0.2  # a place's circle
+_BAR = (0.07, 0.44)  # a transition's rectangle
+_MAX_INCHES = (40.0, 30.0)
+_UNIT_INCHES = 0.75  # inches per layout unit when the picture fits
+
+
+def draw_net(net: petri.Net, target: Path, title: str, where: Mapping[str, Any] | None = None,
+             marking: Mapping[str, int] | None = None, only: Callable[[str], bool] | None = None) -> Path:
+    """Draw a (coloured) Petri net in layers, left to right, into a PNG, SVG or PDF file.
+
+    Places are circles holding their tokens (a dot for one, a number for more: `marking`,
+    place -> count, or else the initial marking), transitions thin bars, arcs arrows; a place a
+    transition both takes and puts back (a read arc) is one dashed double-headed line, and an
+    arc's weight, when not 1, is written on it. `only` keeps the places it accepts and the
+    transitions touching them (one KA's net: `only=lambda p: p.startswith("KA.")`). `where`,
+    place -> an object with `line` and `what`, puts the statement under the place's name.
+    The same net always makes the same file."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, FancyArrowPatch, Rectangle
+
+    suffix = target.suffix.lower()
+    if suffix not in NET_FORMATS:
+        raise ValueError(f"cannot draw a net into a '{target.suffix or 'suffix-less'}' file: "
+                         f"name it {', '.join('*' + s for s in NET_FORMATS)}")
+    places = [name for name in net.places if only is None or only(name)]
+    if not places:
+        raise ValueError(f"net '{net.name}' has no place to draw")
+    kept = set(places)
+    tokens = {name: (sum(net.places[name].initial.values()) if marking is None else marking.get(name, 0))
+              for name in places}
+    transitions = [t for t in net.transitions.values()
+                   if only is None or any(arc.place in kept for arc in (*t.inputs, *t.outputs))]
+    arcs = _net_arcs(transitions, kept)
+    layer, order = _net_layers(places, transitions, arcs, tokens)
+
+    # Long thin nets (one KA's net is mostly a chain) fold into bands, like lines of text, when
+    # one band would be long and more than three times as wide as high.
+    widest = max(len(nodes) for nodes in order)
+    bands = 1
+    if len(order) > 20 and len(order) * _COLUMN > 3 * (widest + 1) * _ROW:
+        bands = max(1, round(math.sqrt(len(order) * _COLUMN / (1.33 * (widest + 1) * _ROW))))
+    per_band = math.ceil(len(order) / bands)
+    position: dict[Node, tuple[float, float]] = {}
+    top = 0.0
+    for first in range(0, len(order), per_band):
+        chunk = order[first:first + per_band]
+        high = max(len(nodes) for nodes in chunk)
+        for column, nodes in enumerate(chunk):
+            offset = top + (high - len(nodes)) * _ROW / 2
+            for row, node in enumerate(nodes):
+                position[node] = (column * _COLUMN, -(offset + row * _ROW))
+        top += (high + 1) * _ROW
+    span_x = (per_band + 1) * _COLUMN
+    span_y = top
+    unit = min(_UNIT_INCHES, _MAX_INCHES[0] / span_x, _MAX_INCHES[1] / span_y)
+    font = max(2.0, min(7.0, 7.0 * unit / _UNIT_INCHES))
+    # The axes fill the figure under the title at `unit` inches a layout unit: no tight bounding
+    # box to compute (that would draw everything twice).
+    heading = max(6.0, min(11.0, font * 1.6))
+    width, height = span_x * unit, span_y * unit
+    banner = 3.2 * heading / 72 + 0.2
+    figure = plt.figure(figsize=(max(width, 5.0), height + banner))
+    axes = figure.add_axes((0.5 - width / max(width, 5.0) / 2, 0.0, width / max(width, 5.0),
+                            height / (height + banner)))
+    try:
+        shade = _prefix_colours(places)
+        for name in places:
+            x, y = position[("p", name)]
+            circle = Circle((x, y), _RADIUS, facecolor=shade[name], edgecolor="black", linewidth=0.8, zorder=3)
+            axes.add_patch(circle)
+            count = tokens[name]
+            if count == 1:
+                axes.add_patch(Circle((x, y), _RADIUS / 3.5, color="black", zorder=4))
+            elif count:
+                axes.text(x, y, str(count), ha="center", va="center", fontsize=font * 1.2, fontweight="bold",
+                          zorder=4)
+            label = _wrap(_short_place(name))
+            spot = where.get(name) if where is not None else None
+            if spot is not None:
+                label += _wrap(_shorten(f"{getattr(spot, 'line', '?')}: {getattr(spot, 'what', '')}"))
+            axes.text(x, y - _RADIUS - 0.04, "\n".join(label), ha="center", va="top", fontsize=font, zorder=5,
+                      linespacing=1.0)
+        for transition in transitions:
+            x, y = position[("t", transition.name)]
+            thin, tall = _BAR
+            bar = Rectangle((x - thin / 2, y - tall / 2), thin, tall, facecolor="#333333", edgecolor="black",
+                            linewidth=0.5, zorder=3)
+            axes.add_patch(bar)
+            axes.text(x, y + tall / 2 + 0.03, "\n".join(_wrap(_shorten(transition.name))), ha="center",
+                      va="bottom", fontsize=font * 0.85, color="#333333", zorder=5, linespacing=1.0)
+        for (source, sink), (weight, read) in arcs.items():
+            start, end = position[source], position[sink]
+            # Straight to the next layer, bent when skipping layers (not to run over the nodes
+            # between) and more when going back; barely bent on to the next band.
+            step = layer[sink] - layer[source]
+            bend = 0.0 if step == 1 else 0.2 if step > 1 else 0.3
+            if layer[sink] // per_band != layer[source] // per_band:
+                bend = 0.05
+            arrow = FancyArrowPatch(path=_arc_path(source, start, sink, end, bend),
+                                    arrowstyle="<|-|>" if read else "-|>", mutation_scale=4 + font,
+                                    linestyle="--" if read else "-", linewidth=0.7,
+                                    color="#2a6f97" if read else "#555555", zorder=2)
+            axes.add_patch(arrow)
+            if weight != "1":
+                axes.text((start[0] + end[0]) / 2, (start[1] + end[1]) / 2 + 0.06, weight, ha="center",
+                          va="bottom", fontsize=font, color="#8b0000", zorder=5)
+        figure.text(0.5, 1 - 0.4 * heading / 72 / (height + banner),
+                    f"{title}\n{len(places)} places, {len(transitions)} transitions (dashed double arrow: read arc)",
+                    ha="center", va="top", fontsize=heading)
+        axes.set_xlim(-_COLUMN, span_x - _COLUMN)
+        axes.set_ylim(-(span_y - _ROW), _ROW)
+        axes.axis("off")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        stamp: dict[str, Any] = {".png": {"Software": None}, ".svg": {"Date": None},
+                                 ".pdf": {"CreationDate": None}}[suffix]
+        with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "specc"}):
+            figure.savefig(target, dpi=120, metadata=stamp)
+    finally:
+        plt.close(figure)
+    return target
+
+
+Node = tuple[str, str]  # ("p", place) or ("t", transition)
+
+
+def _net_arcs(transitions: Sequence[petri.Transition], kept: set[str]) -> dict[tuple[Node, Node], tuple[str, bool]]:
+    """(source, sink) -> (weight shown, read arc?); a read arc is keyed place -> transition."""
+    arcs: dict[tuple[Node, Node], tuple[str, bool]] = {}
+    for transition in transitions:
+        takes: dict[str, int] = {}
+        puts: dict[str, int] = {}
+        for arc in transition.inputs:
+            takes[arc.place] = takes.get(arc.place, 0) + arc.weight
+        for arc in transition.outputs:
+            puts[arc.place] = puts.get(arc.place, 0) + arc.weight
+        node = ("t", transition.name)
+        for place, weight in takes.items():
+            if place not in kept:
+                continue
+            if place in puts:
+                back = puts[place]
+                arcs[(("p", place), node)] = (str(weight) if weight == back else f"{weight}/{back}", True)
+            else:
+                arcs[(("p", place), node)] = (str(weight), False)
+        for place, weight in puts.items():
+            if place in kept and place not in takes:
+                arcs[(node, ("p", place))] = (str(weight), False)
+    return arcs
+
+
+def _net_layers(places: Sequence[str], transitions: Sequence[petri.Transition],
+                arcs: Mapping[tuple[Node, Node], tuple[str, bool]],
+                tokens: Mapping[str, int]) -> tuple[dict[Node, int], list[list[Node]]]:
+    """A layer for every node (breadth first from the marked places), then each layer's order."""
+    nodes: list[Node] = [("p", p) for p in places] + [("t", t.name) for t in transitions]
+    after: dict[Node, list[Node]] = {n: [] for n in nodes}
+    before: dict[Node, list[Node]] = {n: [] for n in nodes}
+    for source, sink in arcs:
+        after[source].append(sink)
+        before[sink].append(source)
+    layer: dict[Node, int] = {}
+    found: list[Node] = []
+
+    def spread(seeds: list[Node]) -> None:
+        queue = deque(seeds)
+        while queue:
+            node = queue.popleft()
+            for successor in after[node]:
+                if successor not in layer:
+                    layer[successor] = layer[node] + 1
+                    found.append(successor)
+                    queue.append(successor)
+
+    seeds = [("p", p) for p in places if tokens[p]] or [("p", p) for p in places if not before[("p", p)]]
+    seeds = seeds or [("p", places[0])]
+    while True:
+        for seed in seeds:
+            layer[seed] = 0 if seed[0] == "p" else 1
+            found.append(seed)
+        spread(seeds)
+        rest = [n for n in nodes if n not in layer]
+        if not rest:
+            break
+        seeds = [n for n in rest if not before[n]][:1] or [n for n in rest if n[0] == "p"][:1] or rest[:1]
+    used = sorted(set(layer.values()))
+    renumber = {old: new for new, old in enumerate(used)}
+    layer = {n: renumber[k] for n, k in layer.items()}
+    order: list[list[Node]] = [[] for _ in used]
+    for node in found:
+        order[layer[node]].append(node)
+
+    # Barycentre sweeps, down then up, twice: each node goes where its neighbours already are.
+    def place_of(node: Node) -> float:
+        nodes_here = order[layer[node]]
+        return index[node] - (len(nodes_here) - 1) / 2
+
+    index = {n: i for nodes_here in order for i, n in enumerate(nodes_here)}
+    for _ in range(2):
+        for sweep, neighbours in ((range(1, len(order)), before), (range(len(order) - 2, -1, -1), after)):
+            for k in sweep:
+                def key(node: Node, k: int = k, neighbours: dict[Node, list[Node]] = neighbours) -> float:
+                    near = [place_of(n) for n in neighbours[node] if layer[n] != k]
+                    return sum(near) / len(near) if near else place_of(node)
+                order[k] = sorted(order[k], key=key)
+                index.update({n: i for i, n in enumerate(order[k])})
+    return layer, order
+
+
+def _arc_path(source: Node, start: tuple[float, float], sink: Node, end: tuple[float, float], bend: float) -> Any:
+    """A straight or quadratic arc (like matplotlib's arc3) from node to node, cut at their edges.
+
+    Matplotlib can clip an arrow to its end patches itself, but far too slowly for big nets."""
+    from matplotlib.path import Path as Curve
+
+    (x1, y1), (x2, y2) = start, end
+    control = ((x1 + x2) / 2 + bend * (y2 - y1), (y1 + y2) / 2 - bend * (x2 - x1))
+    head = _cut(source, start, control if bend else end)
+    tail = _cut(sink, end, control if bend else start)
+    if not bend:
+        return Curve([head, tail], [Curve.MOVETO, Curve.LINETO])
+    return Curve([head, control, tail], [Curve.MOVETO, Curve.CURVE3, Curve.CURVE3])
+
+
+def _cut(node: Node, centre: tuple[float, float], toward: tuple[float, float]) -> tuple[float, float]:
+    """Where the line from a node's centre toward a point leaves the node's shape."""
+    dx, dy = toward[0] - centre[0], toward[1] - centre[1]
+    length = math.hypot(dx, dy) or 1.0
+    dx, dy = dx / length, dy / length
+    if node[0] == "p":
+        reach = _RADIUS
+    else:
+        reach = min(_BAR[0] / 2 / abs(dx) if dx else math.inf, _BAR[1] / 2 / abs(dy) if dy else math.inf)
+    reach += 0.02
+    return centre[0] + dx * reach, centre[1] + dy * reach
+
+
+def _prefix_colours(places: Sequence[str]) -> dict[str, str]:
+    prefixes = list(dict.fromkeys(p.split(".", 1)[0] for p in places if "." in p))
+    light = {prefix: _lighter(GROUP_COLOURS[i % len(GROUP_COLOURS)]) for i, prefix in enumerate(prefixes)}
+    return {p: light.get(p.split(".", 1)[0], "#ffffff") if "." in p else "#ffffff" for p in places}
+
+
+def _lighter(colour: str) -> str:
+    red, green, blue = (int(colour[i:i + 2], 16) for i in (1, 3, 5))
+    return "#" + "".join(f"{c + (255 - c) * 2 // 3:02x}" for c in (red, green, blue))
+
+
+def _short_place(name: str) -> str:
+    return _shorten(name.split(".", 1)[1] if "." in name and name.split(".", 1)[1] else name)
+
+
+def _shorten(text: str) -> str:
+    return text if len(text) <= _LABEL_WIDTH else text[:_LABEL_WIDTH - 1] + "…"
+
+
+def _wrap(text: str, width: int = 15) -> list[str]:
+    import textwrap
+
+    return textwrap.wrap(text, width, break_long_words=True, break_on_hyphens=False) or [text]

@@ -295,3 +295,18 @@ def test_verify_procedures_rejects_bad_goals_and_unrepresentable_procedures(tmp_
     assert f"{spec}:4:37: error: '#' (preserve/maintain) has no Petri-net equivalent" in rejected.stderr
     assert "[unsupported-goal]" in rejected.stderr
     assert "Traceback" not in garbled.stderr + query.stderr + rejected.stderr
+
+
+def test_graph_draws_the_procedures_net_or_one_ka(tmp_path: Path) -> None:
+    whole = specc("graph", "--net", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "-o",
+                  str(tmp_path / "net.svg"))
+    assert whole.returncode == 0, whole.stderr
+    one = specc("graph", "--net", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--ka", "TakeObject",
+                "-o", str(tmp_path / "take.svg"))
+    assert one.returncode == 0, one.stderr
+    everything, take = ((tmp_path / name).read_text(encoding="utf-8") for name in ("net.svg", "take.svg"))
+    assert "Explore:254" in everything and "Explore:254" not in take and "TakeObject:236" in take
+    unknown = specc("graph", "--net", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--ka", "Nope")
+    assert unknown.returncode == 1 and "KA 'Nope' is not among the KAs the goal reaches" in unknown.stderr
+    goalless = specc("graph", "--net", str(EXAMPLES / "hilare"))
+    assert goalless.returncode == 1 and "--goal" in goalless.stderr and "Traceback" not in goalless.stderr

@@ -113,3 +113,18 @@ def test_the_hilare_demo_scripts_run(script: str) -> None:
     if script == "run_executive.py":
         assert "ERROR state: never" in result.stdout
         assert "EXEC-TRAJ-GOAL -> INT, CALC-TRAJ-OBJ -> OK" in result.stdout  # Fig 5.6, rule 1
+
+
+def test_the_hilare_supervisor_demo_collects_its_objects() -> None:
+    """`make demo` runs the PRS task level (procedures.spec) over the executive and the modules."""
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, str(EXAMPLES / "hilare" / "run_supervisor.py")], capture_output=True,
+                            text=True, timeout=300)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert "Traceback" not in result.stderr
+    assert "outcome: !(COLLECT-OBJECTS 2) succeeded" in result.stdout
+    assert "objects taken: 2 of 2 wanted" in result.stdout
+    assert "(EXECUTION END)" in result.stdout  # TakeObject ends the experiment once @TAKEN = N (§5.4)
+    assert "object 2 on the robot" in result.stdout

@@ -329,8 +329,17 @@ class TaskRunner:
         return self.spec.init is not None or self.spec.permanent is not None
 
     def start(self) -> None:
+        # The init codel runs as the module starts, before it serves any request: a control
+        # request answered at t = 0 must not be undone by an init codel run at the first tick.
+        self.initialise()
         if self.permanent:
             self.schedule()
+
+    def initialise(self) -> None:
+        if not self.initialised and self.spec.init is not None:
+            self.module.call_permanent(self.spec.init)
+            self.module.cycle_done(self.spec.init)
+        self.initialised = True
 
     def schedule(self) -> None:
         """Next tick on the grid delay + k * period: now at the earliest, never twice an instant."""
@@ -349,10 +358,7 @@ class TaskRunner:
         self.last_tick = self.module.kernel.now
         module = self.module
         self.cycles += 1
-        if not self.initialised and self.spec.init is not None:
-            module.call_permanent(self.spec.init)
-            module.cycle_done(self.spec.init)
-        self.initialised = True
+        self.initialise()
         if self.spec.permanent is not None:
             module.call_permanent(self.spec.permanent)
             module.cycle_done(self.spec.permanent)
@@ -397,6 +403,11 @@ class Module:
     def start(self) -> None:
         for runner in self.tasks.values():
             runner.start()
+        # As GenoM creates its posters when the module starts, every poster exists from then on,
+        # holding the initialised SDI: a client reading one before its first update gets that,
+        # not "no poster" (PILO's start codel has AVOID read pilo.Setpoint at once).
+        for name in self.posters:
+            self.update_poster(name)
 
     # -- codel binding
     def function(self, name: str) -> Callable[..., Any]:
