@@ -374,7 +374,8 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
         out.print("no finding: no deadlock, no unbounded place, every statement can run and succeed, no endless cycle",
                   markup=False)
     out.print(f"{result.states} states in {time.perf_counter() - started:.1f} s; ends: {result.succeeded} with the "
-              f"goal achieved, {result.failed} with it failed", markup=False)
+              f"goal achieved, {result.failed} with it failed; {result.bound_summary()}; "
+              f"{'a' if result.home else 'no'} home marking", markup=False)
     if not result.space.complete:
         err.print(f"warning: stopped at {max_states} states; raise --max-states to explore them all", markup=False)
     raise typer.Exit(1 if strict and result.findings else 0)

@@ -142,6 +142,8 @@ procedures doors {
 def test_a_branch_whose_arc_is_never_true_is_a_dead_transition(tmp_path: Path) -> None:
     report = check(DEAD_BRANCH, "!(GO)", tmp_path)
     assert "Go:12 ?(DOOR OPEN) is reached but can never succeed" in finding(report, "never-succeeds")
+    dead = next(f for f in report.findings if f.kind == "never-succeeds")
+    assert dead.trace[-2:] == ["Go:9 =>(DOOR CLOSED)", "Go:10 choose"]  # how the dead arc is reached
     assert "13 =>(INSIDE)" in finding(report, "unreachable")
     assert report.succeeded >= 1 and report.failed == 0  # the other branch is tried (Fig 4.22)
 
@@ -280,6 +282,7 @@ def test_hilare_no_deadlock_and_an_endless_cycle_when_no_object_is_found(hilare:
     assert message.startswith("Explore, Modelise may cycle forever")
     assert "service SEARCH-OBJ answers  [answer (EXEC-COUNT SEARCH-OBJ 1)]" in message  # the only way out
     assert report.succeeded >= 1 and report.failed == 0  # every end is the goal achieved
+    assert report.bound_summary() == "every KA place holds at most 1 token(s)"  # one intention per task
 
 
 def test_hilare_the_others_never_stop_once_object_taking_fails(hilare: tuple[m.Program, m.Procedures]) -> None:

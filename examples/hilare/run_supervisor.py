@@ -103,7 +103,7 @@ def main() -> int:
                                   in sorted(monitor.replies.items(), key=lambda item: str(item[0]))))
     print(f"database: (OBJ-FOUND {found[0] if found else '-'}) (EXECUTION {execution[0] if execution else '-'})")
     print(f"objects taken: {monitor.taken} of {wanted} wanted")
-    print(f"last {TRACE_LINES} of {len(lines)} trace lines:")
+    print(f"last {TRACE_LINES} of {intention.traced} trace lines:")
     for line in lines[-TRACE_LINES:]:
         print(f"  {line}")
     return 0 if intention.status == "succeeded" else 1

@@ -304,11 +304,13 @@ class StateSpace:
         owner = [index[place] for place, _ in self.unfolded.slots]
         best = [0] * len(places)
         for marking in self.markings:
-            totals = [0] * len(places)
-            for slot, count in enumerate(marking):
-                if count:
-                    totals[owner[slot]] += count
-            best = [max(a, b) for a, b in zip(best, totals, strict=True)]
+            totals: dict[int, int] = {}
+            for match in _NONZERO.finditer(marking):
+                place = owner[match.start()]
+                totals[place] = totals.get(place, 0) + marking[match.start()]
+            for place, count in totals.items():
+                if count > best[place]:
+                    best[place] = count
         return dict(zip(places, best, strict=True))
 
     def fired(self) -> set[int]:

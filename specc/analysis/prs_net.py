@@ -787,6 +787,12 @@ class Translator:
 
     def _node(self, ka: rp.KA, suffix: str, carried: Iterable[str], line: int, what: str) -> Node:
         place = f"{ka.name}.{suffix}"
+        if suffix.startswith("L"):
+            # Statements are named by their line; several on one line get a place each.
+            taken = 1
+            while place in self.result.where:
+                taken += 1
+                place = f"{ka.name}.{suffix}#{taken}"
         # The invocation's variables travel to the end (§4.4.3): the answer names the goal.
         node = Node(place, tuple(sorted(set(carried) | self._invocation_vars(ka))))
         self.result.where[place] = Where(ka.name, line, what, node.vars)

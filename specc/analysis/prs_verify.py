@@ -89,6 +89,16 @@ class Report:
     succeeded: int  # end markings where the posted goals succeeded
     failed: int  # ... where one failed
     answers: list[Answer] = field(default_factory=list)
+    bounds: dict[str, int] = field(default_factory=dict)  # KA position -> most tokens it ever holds
+    home: bool = False  # one marking (or cycle) every marking can reach
+
+    def bound_summary(self) -> str:
+        if not self.bounds:
+            return "no KA place is ever marked"
+        most = max(self.bounds.values())
+        crowded = sorted(p for p, n in self.bounds.items() if n == most)
+        shown = ", ".join(crowded[:4]) + (f" and {len(crowded) - 4} more" if len(crowded) > 4 else "")
+        return f"every KA place holds at most {most} token(s)" + (f" (that many: {shown})" if most > 1 else "")
 
     @property
     def states(self) -> int:
@@ -192,7 +202,14 @@ def analyse(translation: Translation, queries: Sequence[Query] = (), limit: int 
         findings.extend(_statements(translation, space, reader, marked_places))
         findings.extend(_cycles(translation, space, reader))
     answers = [_answer(query, places, space, reader) for query, places in zip(queries, asked, strict=True)]
-    return Report(translation, space, findings, succeeded, failed, answers)
+    bounds: dict[str, int] = {}
+    if space.complete:
+        for place, most in space.bounds().items():
+            if place in translation.where and most:
+                shown = reader.place(place)
+                bounds[shown] = max(bounds.get(shown, 0), most)
+    home = space.complete and bool(space.home_markings())
+    return Report(translation, space, findings, succeeded, failed, answers, bounds, home)
 
 
 def _answer(query: Query, places: dict[Clause, list[str]], space: petri.StateSpace, reader: Reader) -> Answer:
@@ -303,12 +320,26 @@ def _statements(translation: Translation, space: petri.StateSpace, reader: Reade
                 continue
             crossed = translation.successes.get((owner, line))
             if crossed and not any(name in fired_names for name in crossed):
+                trace = _first_marking(space, reader, set(places))
                 findings.append(Finding("never-succeeds", f"{ka}:{line} {text} is reached but can never succeed "
-                                        "(its success transition is dead): what follows it never runs"))
+                                        "(its success transition is dead): what follows it never runs", trace))
         if unreachable:
             findings.append(Finding("unreachable", f"KA '{ka}': these statements can never run: "
                                     + "; ".join(unreachable)))
     return findings
+
+
+def _first_marking(space: petri.StateSpace, reader: Reader, places: set[str]) -> list[str]:
+    """The shortest firing sequence that puts a token in one of `places` (which the reduction
+    may have merged into the steps passing by them)."""
+    original = space.unfolded.original_slots or space.unfolded.slots
+    for state, out in enumerate(space.edges):  # breadth-first order: the first found is the nearest
+        for step_index, _ in out:
+            parts = space.unfolded.steps[step_index].elementary
+            for n, part in enumerate(parts):
+                if any(original[s][0] in places for s, _ in part.post):
+                    return reader.trace(space.trace(state)) + [reader.step(p) for p in parts[:n + 1]]
+    return []
 
 
 def _cycles(translation: Translation, space: petri.StateSpace, reader: Reader) -> list[Finding]:

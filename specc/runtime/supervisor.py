@@ -311,6 +311,9 @@ def _discard(facts: list[tuple[Any, ...]], args: tuple[Any, ...]) -> bool:
 # ---------------------------------------------------------------- intentions
 
 
+TRACE_LENGTH = 10_000  # trace entries kept per intention
+
+
 class TraceEntry(NamedTuple):
     time: float  # the kernel's clock, or the number of steps run when there is no kernel
     ka: str  # the KA, or "top" for the posted goal itself
@@ -330,7 +333,9 @@ class Intention:
     ka: KA | None = None  # the fact-invoked KA
     status: str = "running"  # running | succeeded | failed
     bindings: dict[str, Any] = field(default_factory=dict)  # the goal's variables, once it ended
-    trace: list[TraceEntry] = field(default_factory=list)
+    # The latest entries only: a task that cycles for hours must not fill the memory.
+    trace: deque[TraceEntry] = field(default_factory=lambda: deque(maxlen=TRACE_LENGTH))
+    traced: int = 0  # entries ever recorded
 
     def lines(self) -> list[str]:
         return [str(entry) for entry in self.trace]
@@ -604,6 +609,7 @@ class Supervisor:
     def _record(self, frame: _Frame, line: int, text: str) -> None:
         when = self.kernel.now if self.kernel is not None else float(self._steps)
         frame.intention.trace.append(TraceEntry(when, frame.name, line, text))
+        frame.intention.traced += 1
 
     # ------------------------------------------------------------ running KAs
     def _run_top(self, thread: _Thread, frame: _Frame, goal: Goal) -> _Body:

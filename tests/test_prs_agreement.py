@@ -1,0 +1,89 @@
+"""The interpreter and the Petri net agree: for random procedures (tests, conclusions,
+retractions, waits, conditions, choices, parallel branches, subgoals achieved by one or two KAs),
+every way the interpreter ends a posted goal is an end the net can reach, and an intention the
+interpreter leaves blocked is a deadlock the net reports."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from specc.analysis.procedures import library
+from specc.analysis.prs_verify import verify
+from specc.model import nodes as m
+from specc.pipeline import load
+from specc.runtime import procedures as rp
+from specc.runtime.supervisor import Supervisor
+
+SIMPLE = [
+    "=>(P A);", "=>(P B);", "~>(P A);", "=>(Q);", "~>(Q);", "?(P A);", "?(Q);", "?(~ (Q));", "?(P $X);",
+    "=>(R $X);", "fail;", "^(Q);", "^(P B);", "!(SUB);", "!(SUB);",
+]
+
+
+def blocks(depth: int) -> st.SearchStrategy[list[str]]:
+    simple = st.sampled_from(SIMPLE)
+    if depth == 0:
+        return st.lists(simple, min_size=1, max_size=4).map(upto_fail)
+    inner = blocks(depth - 1)
+    test = st.sampled_from(["?(P A)", "?(Q)", "?(~ (Q))"])
+    compound = st.one_of(
+        st.builds(lambda c, t, e: f"if {c} {{ {' '.join(t)} }} else {{ {' '.join(e)} }}", test, inner, inner),
+        st.builds(lambda a, b, f1, f2:
+                  f"choose {{ branch {{ {f1}; {' '.join(a)} }} branch {{ {f2}; {' '.join(b)} }} }}",
+                  inner, inner, test, test),
+        st.builds(lambda a, b: f"parallel {{ branch {{ {' '.join(a)} }} branch {{ {' '.join(b)} }} }}", inner, inner),
+    )
+    return st.lists(st.one_of(simple, simple, compound), min_size=1, max_size=4).map(upto_fail)
+
+
+def upto_fail(statements: list[str]) -> list[str]:
+    """The statements up to the first `fail;` (what follows it would never run: a spec error)."""
+    return statements[:statements.index("fail;") + 1] if "fail;" in statements else statements
+
+
+def spec(main: list[str], sub: list[str], second: list[str] | None) -> str:
+    other = f"\n  ka Sub2 {{ invocation: !(SUB); body {{ {' '.join(second)} }} }}" if second is not None else ""
+    return f"""procedures random {{
+  predicate closed P(v: {{A, B}});
+  predicate closed Q();
+  predicate closed R(v: {{A, B}});
+  predicate GO();
+  predicate SUB();
+  ka Main {{ invocation: !(GO); body {{ {' '.join(main)} }} }}
+  ka Sub {{ invocation: !(SUB); body {{ {' '.join(s for s in sub if s != "!(SUB);") or "=>(Q);"} }} }}{other}
+}}
+"""
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(blocks(2), blocks(1), st.one_of(st.none(), blocks(0)), st.integers(0, 3))
+def test_the_interpreter_ends_only_where_the_net_can(main: list[str], sub: list[str], second: list[str] | None,
+                                                     seed: int) -> None:
+    if second is not None:
+        second = [s for s in second if s != "!(SUB);"]
+        if not second:
+            second = ["fail;"]
+    text = spec(main, sub, second)
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "random.spec"
+        path.write_text(text, encoding="utf-8")
+        loaded = load([path])
+        assert loaded.program is not None and not loaded.errors, [d.message for d in loaded.errors]
+        block = next(i for i in loaded.program.items if isinstance(i, m.Procedures))
+        report = verify(loaded.program, block, [rp.parse_goal("!(GO)")], limit=20_000)
+        assume(report.space.complete)  # a few parallel interleavings explode; they prove nothing more
+        supervisor = Supervisor(library(block), seed=seed)
+        intention = supervisor.post("!(GO)")
+        supervisor.run()
+    possible = set()
+    if report.succeeded:
+        possible.add("succeeded")
+    if report.failed:
+        possible.add("failed")
+    if "deadlock" in report.kinds():
+        possible.add("running")
+    assert intention.status in possible, (text, intention.status, report.kinds(), intention.lines())
