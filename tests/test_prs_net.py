@@ -350,3 +350,22 @@ def test_the_interpreter_ends_only_where_the_net_says_it_can(tmp_path: Path, tex
     possible |= {"failed"} if report.failed else set()
     possible |= {"running"} if "deadlock" in report.kinds() else set()
     assert intention.status in possible, (intention.status, report.kinds(), intention.lines())
+
+
+def test_hilare_fig_4_4_asks_for_a_service_the_executive_does_not_offer(hilare: tuple[m.Program, m.Procedures]
+                                                                        ) -> None:
+    """Fig 4.4's fallback (peristaltic locomotion) is not a service of Hilare's executive: once
+    the normal planner may fail, the net reaches the request the executive would refuse."""
+    assert verify(*hilare, [rp.parse_goal("!(FIND-SUBTRAJ $R)")]).kinds() == ["unreachable"]
+    report = verify(*hilare, [rp.parse_goal("!(FIND-SUBTRAJ $R)")], failing=["CALC-TRAJ-GOAL"])
+    unknown = next(f for f in report.findings if f.kind == "unknown-service")
+    assert "CALC-TRAJ-PERISTALTIC" in unknown.message
+    assert unknown.trace[-1] == "service CALC-TRAJ-PERISTALTIC is not offered"
+
+
+def test_hilare_fig_4_1_counts_displacements_without_bound(hilare: tuple[m.Program, m.Procedures]) -> None:
+    with pytest.raises(TranslationError) as raised:
+        translate(*hilare, [rp.parse_goal("!(GOTO-FAR-POSITION)")])
+    (diagnostic,) = raised.value.diagnostics
+    assert diagnostic.code == "unbounded-variable" and "$I" in diagnostic.message
+    assert diagnostic.span.line == 77  # the context of Fig 4.1: (NUMBER-OF-DISPLACEMENTS $I) is an int

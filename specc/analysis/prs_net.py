@@ -112,7 +112,7 @@ class Translation:
     net: petri.Net
     top: list[tuple[str, tuple[Any, ...]]]  # the posted goals: (goal place prefix, colour)
     environment: set[str] = field(default_factory=set)  # transitions whose choice is the world's
-    errors: dict[str, str] = field(default_factory=dict)  # error place -> what reaching it means
+    errors: dict[str, tuple[str, str]] = field(default_factory=dict)  # error place -> (finding kind, meaning)
     where: dict[str, Where] = field(default_factory=dict)  # place -> KA position
     statements: dict[tuple[str, int], list[str]] = field(default_factory=dict)  # (KA, line) -> its places
     successes: dict[tuple[str, int], list[str]] = field(default_factory=dict)  # (KA, line) -> T transitions
@@ -748,7 +748,7 @@ class Translator:
             if isinstance(statement, rp.Assign):
                 every.add(statement.var.name)
         for var in sorted(every):
-            if var in unbounded and var not in found:
+            if var in unbounded:
                 self._reject(ka, f"variable {var} of KA '{ka.name}' ranges over an unbounded domain (int, string...): "
                              "give the predicate argument it stands for a finite domain, e.g. 0..5 or {A, B}",
                              "unbounded-variable", var=var)
@@ -1003,7 +1003,8 @@ class Translator:
             self.emit.fire(origin, origin, [(source.place, source.colour(env))], [(target.place, target.colour(after))])
         else:
             error = f"{ka.name}.L{line}.OUT-OF-DOMAIN"
-            self.result.errors[error] = f"{ka.name}:{line}: a value leaves its domain"
+            self.result.errors[error] = ("out-of-domain", f"{ka.name}:{line}: a value leaves its domain: give it a "
+                                         "wider domain or keep it in range")
             self.result.where[error] = Where(ka.name, line, "value out of its domain")
             self.emit.fire(f"{origin} [out of domain]", origin, [(source.place, source.colour(env))],
                            [(error, petri.BLACK)])
@@ -1190,15 +1191,8 @@ class Translator:
 
     # ------------------------------------------------------------ goal servers
     def _servers(self) -> None:
-        answers: dict[str, dict[str, dict[tuple[Any, ...], None]]] = {}
-        worklist = list(self.posted)
-        done: set[str] = set()
-        while worklist:
-            head = worklist.pop()
-            if head in done:
-                continue
-            done.add(head)
-            answers[head] = self._server(head, list(self.posted.get(head, {})))
+        """Every posted goal's server, then every poster's receiving of the answers they give."""
+        answers = {head: self._server(head, list(colours)) for head, colours in self.posted.items()}
         for pending in self.pending:
             self._receive(pending, answers.get(pending.goal, {}))
 
@@ -1293,7 +1287,11 @@ class Translator:
             service = self.executive.services.get(name)
             origin = f"service {name}"
             if service is None:
-                # The executive answers BAD-SERVICE; the protocol KA then ends normally.
+                error = f"{head}.UNKNOWN-SERVICE"
+                self.result.errors[error] = ("unknown-service", f"a KA asks the executive for a service it does "
+                                             f"not offer ({', '.join(str(c) for c in colour[:1])}...): it would "
+                                             "answer BAD-SERVICE; declare the service or fix the request")
+                self.emit.fire(f"{origin} is not offered", origin, [(f"{head}.POST", colour)], [(error, petri.BLACK)])
                 continue
             takes: list[tuple[str, Any]] = [(f"{head}.POST", colour)]
             puts: list[tuple[str, Any]] = [(f"{head}.RUN", colour)]

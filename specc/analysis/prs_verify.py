@@ -176,11 +176,11 @@ def analyse(translation: Translation, queries: Sequence[Query] = (), limit: int 
     for i in space.fired():
         for part in unfolded.steps[i].elementary:
             marked_places.update(original[s][0] for s, _ in part.post)
-    for error, meaning in translation.errors.items():
+    for error, (kind, meaning) in translation.errors.items():
         if error in marked_places:
             state = next(i for i, mk in enumerate(space.markings) if reader.tokens(mk, error))
-            findings.append(Finding("out-of-domain", meaning + ": give it a wider domain or keep it in range",
-                                    reader.trace(space.trace(state)), reader.where(space.markings[state])))
+            findings.append(Finding(kind, meaning, reader.trace(space.trace(state)),
+                                    reader.where(space.markings[state])))
     if space.complete:
         deadlock = None
         for state in space.deadlocks():
