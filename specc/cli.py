@@ -325,6 +325,9 @@ def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], fac
         raise typer.Exit(1) from None
     try:
         return translate(loaded.program, chosen, posted, initial, ["*" if f == "all" else f for f in failing])
+    except ValueError as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(1) from None
     except TranslationError as exc:
         for diagnostic in exc.diagnostics:
             err.print(render(diagnostic, loaded.sources), markup=False)

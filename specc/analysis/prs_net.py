@@ -44,6 +44,7 @@ COMPARISONS = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a
 ARITHMETIC = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
               "/": lambda a, b: a // b if b else None}
 Env = dict[str, Any]
+CONSUMED = "\0consumed"  # an Env entry: the event occurrences a solution uses up
 
 
 class Undefined(Exception):
@@ -219,12 +220,13 @@ def _live_statement(statement: rp.Statement, after: set[str]) -> set[str]:
     if isinstance(statement, rp.Assign):
         return (after - {statement.var.name}) | variables(statement.value)
     if isinstance(statement, rp.If):
-        branches = live_before(statement.then, after) | live_before(statement.orelse, after)
-        return (branches - outputs(statement.condition)) | reads(statement.condition)
+        # The T half has the condition's outputs afresh; the F half sees their old values.
+        then = live_before(statement.then, after) - outputs(statement.condition)
+        return then | live_before(statement.orelse, after) | reads(statement.condition)
     if isinstance(statement, rp.While):
         live = after | reads(statement.condition)
         while True:  # the loop head sees what the body needs on its next turn
-            grown = live | live_before(statement.body, live)
+            grown = live | (live_before(statement.body, live) - outputs(statement.condition))
             if grown == live:
                 return live
             live = grown
@@ -270,10 +272,7 @@ def unify_into(pattern: Sequence[Any], values: Sequence[Any], env: Env) -> Env |
             if current == IDLE:
                 out[term.name] = value
             elif value != IDLE and current != value:
-                if term.is_program:
-                    out[term.name] = value
-                else:
-                    return None
+                return None
         else:
             try:
                 constant = evaluate(term, out)
@@ -375,7 +374,6 @@ class Reading:
     """States chosen for the keys a condition looks at, and what the condition found."""
 
     states: dict[tuple[str, tuple[Any, ...]], KeyState]
-    consumed: set[tuple[str, tuple[Any, ...]]] = field(default_factory=set)  # events a wait uses up
     choices: dict[tuple[str, tuple[Any, ...]], bool] = field(default_factory=dict)  # evaluable outcomes
 
 
@@ -392,7 +390,7 @@ class Solver:
         head = expr.head
         if head in ("&", "|", "~"):
             return [k for a in expr.args if isinstance(a, rp.Compound) for k in self.atoms(a, env)]
-        if head in COMPARISONS or head in ARITHMETIC or head == "=" or self.db.kind(head) == "evaluable":
+        if head in COMPARISONS or head in ARITHMETIC or head in ("=", "BOUNDP") or self.db.kind(head) == "evaluable":
             return []
         args = []
         for a in expr.args:
@@ -418,39 +416,41 @@ class Solver:
             for conjunct in args:
                 envs = [e2 for e in envs for e2 in self.solve(_compound(conjunct), e, reading)]
             return envs
-        if head == "|":
-            return [e2 for disjunct in args for e2 in self.solve(_compound(disjunct), env, reading)]
+        if head == "|":  # the interpreter looks at the right side only when the left has no solution
+            found: list[Env] = []
+            for disjunct in args:
+                try:
+                    found.extend(self.solve(_compound(disjunct), env, reading))
+                except Undefined:
+                    if not found:
+                        raise
+            return found
         if head == "~":
             inner = _compound(args[0])
-            if self.db.kind(inner.head) == "standard" and inner.head not in COMPARISONS and inner.head != "=":
+            builtin = inner.head in (*COMPARISONS, "=", "&", "|", "~", "BOUNDP")
+            if self.db.kind(inner.head) == "standard" and not builtin:
                 return self._atom(inner, env, reading, negated=True)
             return [] if self.solve(inner, env, reading) else [env]
         if head in COMPARISONS:
-            try:
-                left, right = (evaluate(a, env) for a in args)
-            except Undefined:
-                return []
-            try:
-                return [env] if COMPARISONS[head](left, right) else []
-            except TypeError:  # a symbol compared with a number
-                return []
+            left, right = (evaluate(a, env) for a in args)  # unbound: Undefined, an error
+            if not isinstance(left, (int, float)) or not isinstance(right, (int, float)):
+                raise Undefined(f"{expr} compares a symbol")
+            return [env] if COMPARISONS[head](left, right) else []
         if head == "=":
             return self._equal(args[0], args[1], env)
+        if head == "BOUNDP":  # §4.4.6: are the arguments bound?
+            return [env] if all(env.get(a.name, IDLE) != IDLE for a in args if isinstance(a, rp.Var)) else []
         if self.db.kind(head) == "evaluable":
+            for a in args:
+                evaluate(a, env)  # an evaluable predicate needs its arguments bound
             return [env] if reading.choices.get((head, tuple(args)), False) else []
         return self._atom(expr, env, reading, negated=False)
 
     def _equal(self, left: Any, right: Any, env: Env) -> list[Env]:
         for var, other in ((left, right), (right, left)):
             if isinstance(var, rp.Var) and env.get(var.name, IDLE) == IDLE:
-                try:
-                    return [{**env, var.name: evaluate(other, env)}]
-                except Undefined:
-                    return []
-        try:
-            return [env] if evaluate(left, env) == evaluate(right, env) else []
-        except Undefined:
-            return []
+                return [{**env, var.name: evaluate(other, env)}]  # both unbound: Undefined
+        return [env] if evaluate(left, env) == evaluate(right, env) else []
 
     def _atom(self, expr: rp.Compound, env: Env, reading: Reading, negated: bool) -> list[Env]:
         kind = self.db.kind(expr.head)
@@ -476,8 +476,8 @@ class Solver:
                 values = key
             extended = unify_into(expr.args, values, env)
             if extended is not None:
-                if kind == "event":
-                    reading.consumed.add((name, key))
+                if kind == "event":  # this solution uses that occurrence up
+                    extended[CONSUMED] = (*extended.get(CONSUMED, ()), (name, key))
                 found.append(extended)
         return found
 
@@ -517,14 +517,14 @@ class Emitter:
             self.colours.setdefault(place, {})[colour] = None
 
     def build(self, net: petri.Net, initial: Mapping[str, Mapping[Any, int]],
-              colours: Mapping[str, Sequence[Any]]) -> dict[str, str]:
-        """Declare every place and transition; returns transition -> statement name."""
+              colours: Mapping[str, Sequence[Any]]) -> None:
+        """Declare every place and transition (a statement's transitions with the same places
+        are numbered: `name #2`)."""
         for place in sorted(set(self.colours) | set(initial) | set(colours)):
             known = dict.fromkeys(colours.get(place, ()))
             known.update(self.colours.get(place, {}))
             known.update(dict.fromkeys(initial.get(place, {})))
             net.place(place, [_colour(c) for c in known], {_colour(c): n for c, n in initial.get(place, {}).items()})
-        statement_of: dict[str, str] = {}
         counts: dict[str, int] = {}
         for key in sorted(self.firings, key=repr):
             name, takes, puts = key
@@ -534,8 +534,7 @@ class Emitter:
             outputs = [petri.Arc(p, colour=_pick(len(takes) + i)) for i, p in enumerate(puts)]
             bindings = [{str(i): _colour(c) for i, c in enumerate(row)} for row in self.firings[key]]
             net.transition(unique, inputs, outputs, bindings=bindings, origin=self.origins[name])
-            statement_of[unique] = name
-        return statement_of
+
 
 
 def _colour(colour: Any) -> Any:
@@ -565,19 +564,20 @@ class Translator:
         self.var_domains: dict[str, dict[str, tuple[Any, ...]]] = {}
         self.result = Translation(petri.Net(procedures.name), [])
         self.triggers: list[tuple[rp.KA, Node]] = []  # fact-invoked KAs and their INIT node
+        self.initial_heads: set[str] = set()  # predicates the database starts with
 
     # ------------------------------------------------------------ entry
     def translate(self, goals: Sequence[rp.Goal], facts: Sequence[rp.Compound]) -> Translation:
         for goal in goals:
-            if goal.op != "!":
-                self._reject(None, f"only achievement goals '!(...)' can be posted, not '{goal}'", "bad-goal")
-        if self.diagnostics:
-            raise TranslationError(self.diagnostics)
+            self._check_posted(goal)
+        self.initial_heads = {f.head for f in facts}
         self._select_kas(goals, facts)
         if self.diagnostics:
             raise TranslationError(self.diagnostics)
         for name in self.translated:
             self._ka(self.kas[name])
+        if self.diagnostics:  # what the statements' translation could not represent
+            raise TranslationError(self.diagnostics)
         for goal in goals:
             posted = tuple(argument(a, {}) for a in goal.expr.args)
             self.posted.setdefault(goal.expr.head, {})[posted] = None
@@ -603,21 +603,41 @@ class Translator:
         self.result.solver = self.solver
         return self.result
 
+    def _check_posted(self, goal: rp.Goal) -> None:
+        """A goal given on the command line: `!(HEAD value ...)` for a goal some KA achieves or a
+        declared predicate, with the right number of arguments, each in its domain."""
+        head, args = goal.expr.head, goal.expr.args
+        if goal.op != "!":
+            raise ValueError(f"only achievement goals '!(...)' can be posted, not '{goal}'")
+        invoked = [k for k in self.library.kas if k.goal_invoked and k.trigger.head == head]
+        if head not in self.predicates and not invoked:
+            raise ValueError(f"no KA achieves '{head}' and no predicate is called so: '{goal}' cannot be posted")
+        arity = self.predicates[head].arity if head in self.predicates else len(invoked[0].trigger.args)
+        if len(args) != arity:
+            raise ValueError(f"'{head}' takes {arity} argument(s), {len(args)} given in '{goal}'")
+        for i, arg in enumerate(args):
+            values = self.domains.argument(head, i)
+            if isinstance(arg, rp.Compound) or (isinstance(arg, rp.Var) and arg.is_program):
+                raise ValueError(f"argument {i + 1} of '{goal}' must be a value or a $variable")
+            if not isinstance(arg, rp.Var) and values is not None and arg not in values:
+                raise ValueError(f"{arg} is not in the domain of argument {i + 1} of '{head}' "
+                                 f"({', '.join(map(str, values))})")
+
     def _initial_fact(self, fact: rp.Compound, initial: dict[str, dict[Any, int]]) -> None:
         name, args = fact.head, tuple(fact.args)
         kind = self.db.kind(name)
         self.db.used.add(name)
         if name not in self.predicates or kind in ("evaluable", "event"):
-            self._reject(None, f"'{fact}' cannot start in the database: declare '{name}' as a closed, functional or "
-                         "standard predicate", "bad-fact")
-            raise TranslationError(self.diagnostics)
+            raise ValueError(f"'{fact}' cannot start in the database: declare '{name}' as a closed, functional or "
+                             "standard predicate")
+        if len(args) != self.predicates[name].arity or any(isinstance(a, (rp.Var, rp.Compound)) for a in args):
+            raise ValueError(f"'{fact}': a fact gives '{name}' {self.predicates[name].arity} value(s)")
         for place, _, marking in self.db.places():
             initial.setdefault(place, dict(marking))
         key = args[:-1] if kind == "functional" else args
         undefined = f"{name}.UNDEF" if kind in ("closed", "functional") else f"{name}.AFF.UNDEF"
         if initial.get(undefined, {}).get(key, 0) != 1:
-            self._reject(None, f"'{fact}' is outside the domain of '{name}' or given twice", "bad-fact")
-            raise TranslationError(self.diagnostics)
+            raise ValueError(f"'{fact}' is outside the domain of '{name}', or given twice")
         initial[undefined][key] = 0
         defined = {"closed": f"{name}.DEF", "functional": f"{name}.DEF"}.get(kind, f"{name}.AFF.DEF")
         colour = key + (args[-1],) if kind == "functional" else key
@@ -625,44 +645,33 @@ class Translator:
 
     # ------------------------------------------------------------ which KAs
     def _select_kas(self, goals: Sequence[rp.Goal], facts: Sequence[rp.Compound]) -> None:
-        """The KAs the posted goals can reach (through the goals and facts their bodies post),
-        each checked against what a net can represent."""
-        heads = [g.expr.head for g in goals]
-        concluded: set[str] = {f.head for f in facts}
-        seen_heads: set[str] = set()
-        while heads:
-            head = heads.pop()
-            if head in seen_heads:
+        """The KAs the posted goals can reach: goal-invoked KAs through the goals bodies post,
+        fact-invoked KAs through the facts they conclude; each checked against what a net can
+        represent."""
+        work = [("goal", g.expr.head) for g in goals] + [("fact", f.head) for f in facts]
+        seen: set[tuple[str, str]] = set()
+        while work:
+            item = work.pop()
+            if item in seen:
                 continue
-            seen_heads.add(head)
+            seen.add(item)
+            kind, head = item
             for ka in self.library.kas:
-                if ka.name in self.translated:
+                if ka.name in self.translated or ka.trigger.head != head or ka.goal_invoked != (kind == "goal"):
                     continue
-                if ka.is_meta and ka.trigger.head == head:
+                if ka.is_meta:
                     self._reject(ka, f"meta KA '{ka.name}' chooses among KAs for '{head}': a Petri net cannot "
                                  "represent meta-level reasoning (§4.4.10); verify without it or drop the property",
                                  "unsupported-meta")
-                    continue
-                if ka.trigger.head != head or ka.is_meta:
                     continue
                 self.translated[ka.name] = None
                 if EXECUTIVE_PROPERTY in ka.properties:
                     self._check_executive_ka(ka)
                     continue
                 self.var_domains[ka.name] = self._infer_domains(ka)
-                posted, facts_concluded = self._posted_heads(ka)
-                heads.extend(posted)
-                concluded |= facts_concluded
-                for fact_ka in self.library.kas:
-                    if not fact_ka.goal_invoked and fact_ka.trigger.head in concluded:
-                        heads.append(fact_ka.trigger.head)
-            for ka in self.library.kas:
-                if not ka.goal_invoked and ka.trigger.head == head and ka.name not in self.translated:
-                    self.translated[ka.name] = None
-                    self.var_domains[ka.name] = self._infer_domains(ka)
-                    posted, facts_concluded = self._posted_heads(ka)
-                    heads.extend(posted)
-                    heads.extend(h for h in facts_concluded)
+                posted, concluded = self._posted_heads(ka)
+                work.extend(("goal", h) for h in posted)
+                work.extend(("fact", h) for h in concluded)
 
     def _posted_heads(self, ka: rp.KA) -> tuple[list[str], set[str]]:
         posted: list[str] = []
@@ -818,8 +827,8 @@ class Translator:
         if not ka.goal_invoked:
             self.triggers.append((ka, init))
             # Nothing waits for the end of a fact-invoked KA (Fig 4.25).
-            self._silent(ka, term, None, f"{ka.name}:{ka.line} ends", drop=True)
-            self._silent(ka, fail, None, f"{ka.name}:{ka.line} fails", drop=True)
+            self._silent(ka, term, None, f"{ka.name}:{ka.line} ends")
+            self._silent(ka, fail, None, f"{ka.name}:{ka.line} fails")
         effects_vars = set().union(*(variables(e) for e in ka.effects)) if ka.effects else set()
         body: tuple[rp.Statement, ...] = ka.body or ()
         end_vars = invocation | effects_vars
@@ -848,7 +857,7 @@ class Translator:
         if not ka.effects:
             self._silent(ka, end, term, f"{ka.name}:{ka.line} ends")
 
-    def _silent(self, ka: rp.KA, source: Node, target: Node | None, origin: str, drop: bool = False) -> None:
+    def _silent(self, ka: rp.KA, source: Node, target: Node | None, origin: str) -> None:
         for env in self._tokens(ka.name, source):
             puts = [] if target is None else [(target.place, target.colour(env))]
             self.emit.fire(origin, origin, [(source.place, source.colour(env))], puts)
@@ -928,6 +937,18 @@ class Translator:
     def _parallel(self, ka: rp.KA, statement: rp.Parallel, source: Node, target: Node, fail: Node,
                   bound: set[str], live_after: set[str]) -> None:
         where = f"{ka.name}:{statement.line}"
+        # Branches share their KA's variables in the interpreter; a token carries its own copy.
+        # The two agree unless a branch gives a value to a variable another branch uses.
+        for i, branch in enumerate(statement.branches):
+            written = _written(branch, bound)
+            for j, other in enumerate(statement.branches):
+                shared = sorted(written & block_vars(other)) if i != j else []
+                if shared:
+                    self._reject(ka, f"branch {i + 1} of this parallel gives {shared[0]} a value that branch {j + 1} "
+                                 "uses: a net gives each branch its own copy of the variables; pass the value "
+                                 "through a fact, or bind it before the split", "shared-variable",
+                                 var=shared[0])
+                    return
         starts, ends = [], []
         for i, branch in enumerate(statement.branches):
             inside = bound | block_vars(branch)
@@ -1025,11 +1046,13 @@ class Translator:
             else:
                 self._achieve(ka, goal, source, target, fail, origin)
 
-    def _reads(self, reading: Reading) -> tuple[list[tuple[str, Any]], list[tuple[str, Any]]]:
+    def _reads(self, reading: Reading, consumed: Sequence[tuple[str, tuple[Any, ...]]]
+               ) -> tuple[list[tuple[str, Any]], list[tuple[str, Any]]]:
+        """The tokens a reading looks at (put back) and the events a solution uses up."""
         takes: list[tuple[str, Any]] = []
         puts: list[tuple[str, Any]] = []
         for (name, key), state in reading.states.items():
-            if self.db.kind(name) == "event" and (name, key) not in reading.consumed:
+            if self.db.kind(name) == "event" and (name, key) not in consumed:
                 continue  # an event nobody used is not looked at
             takes.extend(state.takes)
             puts.extend(state.puts)
@@ -1038,21 +1061,32 @@ class Translator:
     def _test(self, ka: rp.KA, goal: rp.Goal, source: Node, target: Node, fail: Node, origin: str,
               wait: bool = False) -> None:
         if any(self.db.kind(a.head) == "event" for a in _subterms(goal.expr)) and not wait:
-            self._reject(ka, f"'{goal}' tests a basic event; events are waited for with ^(...) (§4.4.2)",
+            self._reject(ka, f"'{goal}' tests a basic event: a net can only wait for one, with ^(...) in a body or "
+                         "as a fact invocation (§4.4.2)",
                          "event-test", line=goal.line, op=goal.op)
             return
         if any(self.db.kind(a.head) == "evaluable" for a in _subterms(goal.expr)):
             self.result.environment.add(f"{origin} [true]")
             self.result.environment.add(f"{origin} [false]")
+        released = outputs(goal)
         for env in self._tokens(ka.name, source):
-            for reading in self.solver.readings(goal.expr, env):
-                solutions = self.solver.solve(goal.expr, env, reading)
-                takes, puts = self._reads(reading)
+            # A program variable the test gives a value to is matched afresh; if the test
+            # fails it keeps its old value (the F exit carries `env`).
+            fresh = {**env, **dict.fromkeys(released, IDLE)}
+            for reading in self.solver.readings(goal.expr, fresh):
+                takes, puts = self._reads(reading, ())
                 entry = [(source.place, source.colour(env)), *takes]
+                try:
+                    solutions = self.solver.solve(goal.expr, fresh, reading)
+                except Undefined:  # an unbound or ill-typed value: the interpreter fails the KA
+                    self.emit.fire(f"{origin} [error]", origin, entry, [*puts, (self.fail_node(ka).place,
+                                                                              self.fail_node(ka).colour(env))])
+                    continue
                 if solutions:
-                    for solution in {target.colour(s): s for s in solutions}.values():
-                        self.emit.fire(f"{origin} [true]", origin, entry,
-                                       [*puts, (target.place, target.colour(solution))])
+                    for solution in solutions:
+                        used, back = self._reads(reading, solution.get(CONSUMED, ()))
+                        self.emit.fire(f"{origin} [true]", origin, [(source.place, source.colour(env)), *used],
+                                       [*back, (target.place, target.colour(solution))])
                 elif not wait:
                     self.emit.fire(f"{origin} [false]", origin, entry, [*puts, (fail.place, fail.colour(env))])
 
@@ -1072,11 +1106,13 @@ class Translator:
             except Undefined:
                 args = None
             entry = (source.place, source.colour(env))
-            if args is None or (IDLE in args and not retract):
-                # §4.4.2: concluding an expression with unbound arguments is an error.
-                self.emit.fire(f"{origin} [unbound]", origin, [entry], [(fail.place, fail.colour(env))])
+            if args is None or (IDLE in args and not retract) or (goal.op == "~>" and negative and
+                                                                 kind in ("closed", "functional")):
+                # §4.4.2: concluding an expression with unbound arguments is an error; retracting a
+                # negation of a closed predicate means nothing (the interpreter fails the KA).
+                self.emit.fire(f"{origin} [error]", origin, [entry], [(fail.place, fail.colour(env))])
                 continue
-            if IDLE in args and not (kind == "functional" and IDLE not in args[:-1]):
+            if IDLE in args:
                 # Fig 4.12: retracting with an unbound argument changes nothing.
                 self.emit.fire(f"{origin} [unbound]", origin, [entry], [(target.place, target.colour(env))])
                 continue
@@ -1186,6 +1222,9 @@ class Translator:
         self.pending.append(PendingReceive(head, waiting, target, fail, origin, goal.expr.args))
 
     def _concluded_somewhere(self, head: str) -> bool:
+        """Can the database ever make `head` true (so that `!` tests it first, §4.4.4)?"""
+        if head in COMPARISONS or head == "BOUNDP" or self.db.kind(head) == "evaluable" or head in self.initial_heads:
+            return True
         return any(goal.op == "=>" and _positive(goal.expr).head == head
                    for name in self.translated for goal in _goals(self.kas[name]))
 
@@ -1287,7 +1326,12 @@ class Translator:
             service = self.executive.services.get(name)
             origin = f"service {name}"
             if service is None:
-                error = f"{head}.UNKNOWN-SERVICE"
+                error = f"{head}.UNKNOWN-SERVICE" if name != IDLE else f"{head}.UNBOUND-SERVICE"
+                if name == IDLE:
+                    self.result.errors[error] = ("unknown-service", "a KA asks the executive for a service named by "
+                                                 "an unbound variable: bind it before the request")
+                    self.emit.fire(f"{origin} is unbound", origin, [(f"{head}.POST", colour)], [(error, petri.BLACK)])
+                    continue
                 self.result.errors[error] = ("unknown-service", f"a KA asks the executive for a service it does "
                                              f"not offer ({', '.join(str(c) for c in colour[:1])}...): it would "
                                              "answer BAD-SERVICE; declare the service or fix the request")
@@ -1327,7 +1371,8 @@ class Translator:
                 for answer in answers.get(outcome, {}):
                     if not compatible(posted, answer):
                         continue
-                    after = unify_into(pending.args, answer, env) if outcome == "SUCC" else env
+                    fresh = {**env, **{a.name: IDLE for a in pending.args if isinstance(a, rp.Var) and a.is_program}}
+                    after = unify_into(pending.args, answer, fresh) if outcome == "SUCC" else env
                     if after is None:
                         continue
                     label = "[true]" if outcome == "SUCC" else "[false]"
@@ -1341,6 +1386,20 @@ def _success(result: Any) -> bool:
     """What a service answers when it worked: OK, or a value its output gives (a number); any
     other symbol is a failure category (TIMEOUT, INT, ERROR, REFUSED, ZOMBIE, a module's report)."""
     return result == "OK" or isinstance(result, int)
+
+
+def _written(block: Sequence[rp.Statement], bound: set[str]) -> set[str]:
+    """The variables a block may give a value to: program variables it assigns or matches, and
+    logic variables unbound before it."""
+    written: set[str] = set()
+    for statement in _statements(block):
+        if isinstance(statement, rp.Assign):
+            written.add(statement.var.name)
+        elif isinstance(statement, rp.Step):
+            written |= outputs(statement.goal)
+        elif isinstance(statement, (rp.If, rp.While)):
+            written |= outputs(statement.condition)
+    return written | {v for v in block_vars(block) if not v.startswith("@") and v not in bound}
 
 
 def _positive(expr: rp.Compound) -> rp.Compound:

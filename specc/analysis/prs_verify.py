@@ -125,12 +125,21 @@ def executive_model(program: m.Program, procedures: m.Procedures, failing: Seque
     for service in spec.services.values():
         excluded = tuple(sorted((group_of[c], c) for c in service.conflicts if c in group_of))
         services[service.name] = Service(service.name, group_of.get(service.name), excluded)
+    unknown = sorted(set(failing) - set(services) - {"*"})
+    if unknown:
+        raise ValueError(f"executive '{name}' offers no service {', '.join(unknown)} (it offers "
+                         f"{', '.join(sorted(services))})")
     return ExecutiveModel(services, {g: tuple(s) for g, s in spec.groups.items()}, frozenset(failing))
 
 
 def translate(program: m.Program, procedures: m.Procedures, goals: Sequence[rp.Goal],
               facts: Sequence[rp.Compound] = (), failing: Sequence[str] = ()) -> Translation:
-    return Translator(procedures, executive_model(program, procedures, failing)).translate(goals, facts)
+    """The Petri net of the KAs the goals reach (ValueError for a goal, fact or service the
+    procedures do not know; TranslationError for what a net cannot represent)."""
+    executive = executive_model(program, procedures, failing)
+    if failing and executive is None:
+        raise ValueError("--fail names services, but no system connects these procedures to an executive")
+    return Translator(procedures, executive).translate(goals, facts)
 
 
 def verify(program: m.Program, procedures: m.Procedures, goals: Sequence[rp.Goal], facts: Sequence[rp.Compound] = (),
@@ -363,7 +372,9 @@ def _cycles(translation: Translation, space: petri.StateSpace, reader: Reader) -
             for step, target in space.edges[state]:
                 if target in states:
                     continue
-                sibling_stays = any(t in states and name(s) == name(step) for s, t in space.edges[state])
+                # Another answer of the same statement keeps the cycle going (the world may give it).
+                sibling_stays = any(t in states and steps[s].origin == steps[step].origin
+                                    for s, t in space.edges[state])
                 if not (is_environment(step) and sibling_stays):
                     forced.add(state)
                     break

@@ -10,7 +10,7 @@ from specc.model import nodes as m
 from specc.model.visitor import Visitor
 
 # Heads PRS evaluates itself: connectives, comparisons and arithmetic.
-BUILTIN_HEADS = frozenset("& | ~ < <= > >= = + - * /".split())
+BUILTIN_HEADS = frozenset("& | ~ < <= > >= = + - * / BOUNDP".split())
 # What `property:` may say of a KA: `meta` (it orders the KAs applicable to the goals it
 # matches), `executive` (it is the executive's request protocol, Fig 4.3: verification models
 # its goal by the executive's services instead of its body).
