@@ -565,6 +565,8 @@ class Translator:
         self.result = Translation(petri.Net(procedures.name), [])
         self.triggers: list[tuple[rp.KA, Node]] = []  # fact-invoked KAs and their INIT node
         self.initial_heads: set[str] = set()  # predicates the database starts with
+        # Where an error in a statement goes: the enclosing parallel branch's failure, or FAIL.
+        self._aborts: list[Node] = []
 
     # ------------------------------------------------------------ entry
     def translate(self, goals: Sequence[rp.Goal], facts: Sequence[rp.Compound]) -> Translation:
@@ -956,19 +958,44 @@ class Translator:
                                      statement.line, f"branch {i + 1} started"))
             ends.append(self._node(ka, f"L{statement.line}.B{i + 1}.END", live_after & inside, statement.line,
                                    f"branch {i + 1} done"))
+        # The first failing branch fails the KA and turns ALIVE into DEAD; DEAD then counts the
+        # branches that end or fail afterwards, and goes once all have: no stale token is left
+        # to answer a later instance.
+        count = len(statement.branches)
+        alive = self._node(ka, f"L{statement.line}.ALIVE", (), statement.line, "parallel branches running")
+        dead = self._node(ka, f"L{statement.line}.DEAD", (), statement.line, "a parallel branch failed")
+        failed = [self._node(ka, f"L{statement.line}.B{i + 1}.FAIL", (), statement.line, f"branch {i + 1} failed")
+                  for i in range(count)]
         for env in self._tokens(ka.name, source):
             self.emit.fire(f"{where} split", f"{where} split", [(source.place, source.colour(env))],
-                           [(s.place, s.colour(env)) for s in starts])
+                           [(s.place, s.colour(env)) for s in starts] + [(alive.place, alive.colour(env))])
         for i, branch in enumerate(statement.branches):
-            self._block(ka, branch, starts[i], ends[i], fail, bound, live_after)
+            self._aborts.append(failed[i])
+            self._block(ka, branch, starts[i], ends[i], failed[i], bound, live_after)
+            self._aborts.pop()
+        for i in range(count):
+            for env in self._tokens(ka.name, failed[i]):
+                self.emit.fire(f"{where} branch {i + 1} fails", f"{where} split",
+                               [(failed[i].place, failed[i].colour(env)), (alive.place, alive.colour(env))],
+                               [(fail.place, fail.colour(env))] + ([(dead.place, dead.colour(env) + (1,))]
+                                                                  if count > 1 else []))
+            for node, what in ((failed[i], "fails"), (ends[i], "ends")):
+                for env in self._tokens(ka.name, node):
+                    for done in range(1, count):
+                        left = [(dead.place, dead.colour(env) + (done + 1,))] if done + 1 < count else []
+                        self.emit.fire(f"{where} branch {i + 1} {what} after a failure", f"{where} split",
+                                       [(node.place, node.colour(env)), (dead.place, dead.colour(env) + (done,))], left)
         for envs in itertools.product(*(list(self._tokens(ka.name, e)) for e in ends)):
+            if len({alive.colour(env) for env in envs}) != 1:
+                continue  # the branches of one instance share its invocation's values
             merged: Env = {}
             for env in envs:
                 for var, value in env.items():
                     if merged.get(var, IDLE) == IDLE:
                         merged[var] = value
-            self.emit.fire(f"{where} join", f"{where} join", [(e.place, e.colour(env)) for e, env in
-                                                               zip(ends, envs, strict=True)],
+            self.emit.fire(f"{where} join", f"{where} join",
+                           [(e.place, e.colour(env)) for e, env in zip(ends, envs, strict=True)]
+                           + [(alive.place, alive.colour(envs[0]))],
                            [(target.place, target.colour(merged))])
 
     def _choose(self, ka: rp.KA, statement: rp.Choose, source: Node, target: Node, fail: Node,
@@ -1079,8 +1106,8 @@ class Translator:
                 try:
                     solutions = self.solver.solve(goal.expr, fresh, reading)
                 except Undefined:  # an unbound or ill-typed value: the interpreter fails the KA
-                    self.emit.fire(f"{origin} [error]", origin, entry, [*puts, (self.fail_node(ka).place,
-                                                                              self.fail_node(ka).colour(env))])
+                    abort = self._aborts[-1] if self._aborts else self.fail_node(ka)
+                    self.emit.fire(f"{origin} [error]", origin, entry, [*puts, (abort.place, abort.colour(env))])
                     continue
                 if solutions:
                     for solution in solutions:
