@@ -154,3 +154,19 @@ def test_branches_sharing_a_variable_are_rejected(tmp_path: Path) -> None:
     with pytest.raises(TranslationError) as rejected:
         verify(loaded.program, block, [rp.parse_goal("!(GO)")])
     assert [d.code for d in rejected.value.diagnostics] == ["shared-variable"]
+
+
+def test_an_event_whose_ka_context_fails_stays_for_a_wait(tmp_path: Path) -> None:
+    extra = "predicate closed ARMED();\n  ka OnPing { invocation: (EV A); context: ?(ARMED); body { =>(Q); } }"
+    spec_file = tmp_path / "cases.spec"
+    spec_file.write_text(outcome_spec("=>(EV A); ^(EV A);", extra), encoding="utf-8")
+    loaded = load([spec_file])
+    assert loaded.program is not None and not loaded.errors, [d.message for d in loaded.errors]
+    block = next(i for i in loaded.program.items if isinstance(i, m.Procedures))
+    report = verify(loaded.program, block, [rp.parse_goal("!(GO)")])
+    assert report.kinds() == ["unreachable"] and "OnPing" in report.findings[0].message  # never armed
+    assert report.succeeded >= 1 and report.failed == 0
+    supervisor = Supervisor(library(block))
+    intention = supervisor.post("!(GO)")
+    supervisor.run()
+    assert intention.status == "succeeded"

@@ -115,9 +115,11 @@ class Translation:
     environment: set[str] = field(default_factory=set)  # transitions whose choice is the world's
     errors: dict[str, tuple[str, str]] = field(default_factory=dict)  # error place -> (finding kind, meaning)
     where: dict[str, Where] = field(default_factory=dict)  # place -> KA position
-    statements: dict[tuple[str, int], list[str]] = field(default_factory=dict)  # (KA, line) -> its places
-    successes: dict[tuple[str, int], list[str]] = field(default_factory=dict)  # (KA, line) -> T transitions
-    text: dict[tuple[str, int], str] = field(default_factory=dict)  # (KA, line) -> the statement
+    # Statements by (KA, line, n-th on the line): the places their token waits in, the names of
+    # the transitions that cross them, and their text.
+    statements: dict[tuple[str, int, int], list[str]] = field(default_factory=dict)
+    successes: dict[tuple[str, int, int], list[str]] = field(default_factory=dict)
+    text: dict[tuple[str, int, int], str] = field(default_factory=dict)
     kas: list[str] = field(default_factory=list)
     domains: dict[str, dict[str, tuple[Any, ...]]] = field(default_factory=dict)  # KA -> var -> values
     solver: Solver | None = None  # evaluates conditions over a marking's database
@@ -567,6 +569,7 @@ class Translator:
         self.initial_heads: set[str] = set()  # predicates the database starts with
         # Where an error in a statement goes: the enclosing parallel branch's failure, or FAIL.
         self._aborts: list[Node] = []
+        self._keys: list[tuple[str, int, int]] = []  # the statements being translated, innermost last
 
     # ------------------------------------------------------------ entry
     def translate(self, goals: Sequence[rp.Goal], facts: Sequence[rp.Compound]) -> Translation:
@@ -840,7 +843,17 @@ class Translator:
                            first.line if first else ka.line, _show(first) if first else "started")
         if ka.context is not None:
             condition = ka.context if isinstance(ka.context, rp.Goal) else rp.Goal("?", ka.context, ka.line)
-            self._test(ka, condition, init, start, fail, f"{ka.name}:{ka.line} context {condition}")
+            otherwise = fail
+            if not ka.goal_invoked and self.db.kind(ka.trigger.head) == "event":
+                # An event invokes only the KAs whose context holds; otherwise it stays for others.
+                otherwise = self._node(ka, "CONTEXT-FALSE", (), ka.line, "not invoked: the event stays")
+                for env in self._tokens(ka.name, otherwise):
+                    args = tuple(argument(a, env, posted=False) for a in ka.trigger.args)
+                    if IDLE not in args:
+                        self.emit.fire(f"{ka.name}:{ka.line} leaves the event", f"{ka.name}:{ka.line} context",
+                                       [(otherwise.place, otherwise.colour(env))],
+                                       [(f"{ka.trigger.head}.EVENT", args)])
+            self._test(ka, condition, init, start, otherwise, f"{ka.name}:{ka.line} context {condition}")
         else:
             self._silent(ka, init, start, f"{ka.name}:{ka.line} starts")
         produced = {ka.action.result.name} if ka.action is not None and ka.action.result is not None else set()
@@ -903,17 +916,32 @@ class Translator:
             self._statement(ka, statement, nodes[i], nodes[i + 1], fail, mentioned, live_after)
             mentioned |= statement_vars(statement)
 
+    def _enter(self, ka: rp.KA, statement: rp.Statement, place: str) -> str:
+        """Register a statement (the n-th on its line) and where its token waits; returns how
+        traces name it: KA:LINE, or KA:LINE#n after the first statement of a line."""
+        line = statement.line
+        n = sum(1 for key in self.result.statements if key[:2] == (ka.name, line))
+        key = (ka.name, line, n)
+        self._keys.append(key)
+        self.result.statements[key] = [place]
+        self.result.text[key] = _show(statement)
+        return f"{ka.name}:{line}" + (f"#{n + 1}" if n else "")
+
     def _statement(self, ka: rp.KA, statement: rp.Statement, source: Node, target: Node, fail: Node,
                    bound: set[str], live_after: set[str]) -> None:
-        key = (ka.name, statement.line)
-        self.result.statements.setdefault(key, []).append(source.place)
-        self.result.text.setdefault(key, _show(statement))
-        where = f"{ka.name}:{statement.line}"
+        where = self._enter(ka, statement, source.place)
+        try:
+            self._statement_body(ka, statement, source, target, fail, bound, live_after, where)
+        finally:
+            self._keys.pop()
+
+    def _statement_body(self, ka: rp.KA, statement: rp.Statement, source: Node, target: Node, fail: Node,
+                        bound: set[str], live_after: set[str], where: str) -> None:
         inside = bound | statement_vars(statement)
         if isinstance(statement, rp.Step):
-            self._step(ka, statement.goal, source, target, fail)
+            self._step(ka, statement.goal, source, target, fail, where)
         elif isinstance(statement, rp.Assign):
-            self._assign(ka, statement, source, target, fail)
+            self._assign(ka, statement, source, target, fail, where)
         elif isinstance(statement, rp.Fail):
             self._silent(ka, source, fail, f"{where} fail")
         elif isinstance(statement, rp.If):
@@ -1022,18 +1050,18 @@ class Translator:
             inside = bound | block_vars(branch)
             chosen = self._node(ka, f"L{statement.line}.B{i + 1}", live_before(branch[1:], live_after) & inside,
                                 first.line, f"branch {i + 1} chosen")
+            label = self._enter(ka, first, trying.place)
             for mask in range(full + 1):
                 if mask & (1 << i):
                     continue
                 tried = Node(trying.place, trying.vars, (mask,))
                 retry = Node(trying.place, trying.vars, (mask | (1 << i),))
-                self._step(ka, first.goal, tried, chosen, retry)
-            self.result.statements.setdefault((ka.name, first.line), []).append(trying.place)
-            self.result.text.setdefault((ka.name, first.line), _show(first))
+                self._step(ka, first.goal, tried, chosen, retry, label)
+            self._keys.pop()
             self._block(ka, branch[1:], chosen, target, fail, inside, live_after)
 
-    def _assign(self, ka: rp.KA, statement: rp.Assign, source: Node, target: Node, fail: Node) -> None:
-        origin = f"{ka.name}:{statement.line} assign {statement.var} = {rp.show(statement.value)}"
+    def _assign(self, ka: rp.KA, statement: rp.Assign, source: Node, target: Node, fail: Node, where: str) -> None:
+        origin = f"{where} assign {statement.var} = {rp.show(statement.value)}"
         domain = self.var_domains[ka.name].get(statement.var.name, ())
         for env in self._tokens(ka.name, source):
             try:
@@ -1057,10 +1085,11 @@ class Translator:
             self.emit.fire(f"{origin} [out of domain]", origin, [(source.place, source.colour(env))],
                            [(error, petri.BLACK)])
 
-    def _step(self, ka: rp.KA, goal: rp.Goal, source: Node, target: Node, fail: Node) -> None:
-        origin = f"{ka.name}:{goal.line} {goal}"
+    def _step(self, ka: rp.KA, goal: rp.Goal, source: Node, target: Node, fail: Node, where: str = "") -> None:
+        origin = f"{where or f'{ka.name}:{goal.line}'} {goal}"
         crossed = [origin] if goal.op in ("=>", "~>") else [f"{origin} [true]", f"{origin} in database [true]"]
-        self.result.successes.setdefault((ka.name, goal.line), []).extend(crossed)
+        if where:  # a statement's (not an effect's)
+            self.result.successes.setdefault(self._keys[-1], []).extend(crossed)
         if goal.op == "?":
             self._test(ka, goal, source, target, fail, origin)
         elif goal.op == "^":
@@ -1229,7 +1258,8 @@ class Translator:
         head = goal.expr.head
         waiting = self._node(ka, f"L{goal.line}.W", source.vars, goal.line, f"waits for {goal}")
         waiting = Node(waiting.place, waiting.vars, source.extra)
-        self.result.statements.setdefault((ka.name, goal.line), []).append(waiting.place)
+        if self._keys:
+            self.result.statements[self._keys[-1]].append(waiting.place)
         testable = self._concluded_somewhere(head)
         posting = source
         if testable:

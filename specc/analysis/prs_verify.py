@@ -152,9 +152,10 @@ def verify(program: m.Program, procedures: m.Procedures, goals: Sequence[rp.Goal
 def query_places(translation: Translation, query: Query) -> dict[Clause, list[str]]:
     places = {}
     for clause in query.clauses:
-        found = translation.statements.get((clause.ka, clause.line))
+        found = [p for (ka, line, _), ps in translation.statements.items() if (ka, line) == (clause.ka, clause.line)
+                 for p in ps]
         if not found:
-            lines = sorted(line for ka, line in translation.statements if ka == clause.ka)
+            lines = sorted({line for ka, line, _ in translation.statements if ka == clause.ka})
             known = f"its statements are on lines {', '.join(map(str, lines))}" if lines else \
                 f"KA '{clause.ka}' is not among the KAs the goal reaches ({', '.join(translation.kas)})"
             raise ValueError(f"no statement at {clause.ka}:{clause.line}: {known}")
@@ -320,14 +321,14 @@ def _statements(translation: Translation, space: petri.StateSpace, reader: Reade
             findings.append(Finding("never-invoked", f"KA '{ka}' is never invoked"))
             continue
         unreachable = []
-        for (owner, line), places in sorted(translation.statements.items()):
+        for (owner, line, n), places in sorted(translation.statements.items()):
             if owner != ka:
                 continue
-            text = translation.text.get((owner, line), "")
+            text = translation.text.get((owner, line, n), "")
             if not any(p in marked for p in places):
                 unreachable.append(f"{line} {text}")
                 continue
-            crossed = translation.successes.get((owner, line))
+            crossed = translation.successes.get((owner, line, n))
             if crossed and not any(name in fired_names for name in crossed):
                 trace = _first_marking(space, reader, set(places))
                 findings.append(Finding("never-succeeds", f"{ka}:{line} {text} is reached but can never succeed "
