@@ -374,8 +374,8 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
         out.print(f"reach {answer.query.text}: {'yes' if answer.reached else 'never'}", markup=False)
         print_trace(answer.trace, answer.where, steps)
     if not result.findings:
-        out.print("no finding: no deadlock, no unbounded place, every statement can run and succeed, no endless cycle",
-                  markup=False)
+        out.print("no finding: no deadlock, no unbounded place, no statement that never runs or never succeeds, "
+                  "no endless cycle", markup=False)
     out.print(f"{result.states} states in {time.perf_counter() - started:.1f} s; ends: {result.succeeded} with the "
               f"goal achieved, {result.failed} with it failed; {result.bound_summary()}; "
               f"{'a' if result.home else 'no'} home marking", markup=False)

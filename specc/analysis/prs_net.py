@@ -9,18 +9,24 @@ What maps to what:
   tests and waits read the database places, conclusions and retractions move their tokens;
 - database predicates (§4.4.2): closed ones DEF/UNDEF, functional ones DEF(key, value)/UNDEF(key),
   standard ones AFF DEF/UNDEF and NEG DEF/UNDEF, basic events one place whose tokens are consumed;
-- a goal `!G` posts a token in POST_G and waits in W for SUCC_G or FAIL_G (§4.4.4); the goal's
-  server tests the database, then starts the KA it invokes, or tries each applicable KA in turn
-  with the tried-branches structure of Fig 4.22/4.28; the same structure models `choose`;
+- a goal `!G` is first tested in the database when anything can make G true (a conclusion, an
+  initial fact, an evaluable or built-in predicate), else posted: a token in POST_G while the
+  poster waits in W for SUCC_G or FAIL_G (§4.4.4); the goal's server starts the KA it invokes, or
+  tries each applicable KA in turn with the tried-branches structure of Fig 4.22/4.28; the same
+  structure models `choose`, whose waits race for the first event;
 - condition nodes (if/while) have a T half and an F half; `parallel` splits and joins (§4.4.5);
-  a branch's failure fails the KA, the others run on (nothing in a net can stop them);
+  the first branch to fail fails the KA, the others run on and are then forgotten; branches may
+  not give a value to a variable another branch uses (each token carries its own copy);
+- an error the interpreter would raise (an unbound or ill-typed value in a test) fails the KA;
 - fact-invoked KAs get a token in INIT when a conclusion matches their invocation (Fig 4.25);
 - the executive: the KA marked `property: executive` is the request protocol (Fig 4.3); its goal
   is modelled by the services it names: a service starts when its group place is IDLE and no
   group holds a service it conflicts with (§5.4.1), then answers (an environment choice);
 - evaluable predicates and primitive actions are environment choices over their results.
 
-Rejected with a diagnostic (§4.4.10): `#` and `%`, meta KAs, variables without a finite domain.
+Rejected with a diagnostic (§4.4.10): `#` and `%`, meta KAs, variables without a finite domain,
+tests of basic events, parallel branches sharing a variable, choices whose branch does not start
+with a goal.
 """
 
 from __future__ import annotations
@@ -878,12 +884,21 @@ class Translator:
             self.emit.fire(origin, origin, [(source.place, source.colour(env))], puts)
 
     def _action(self, ka: rp.KA, start: Node, end: Node) -> None:
-        """A primitive KA (Fig 4.2): its action never fails and answers any value of its result."""
+        """A primitive KA (Fig 4.2): with its arguments bound, its action answers any value of its
+        result (primitives "never fail", §4.4.6); an unbound argument fails the KA."""
         assert ka.action is not None
         origin = f"{ka.name}:{ka.action.line} action {ka.action.call}"
         result = ka.action.result
         self.result.environment.add(origin)
+        fail = self.fail_node(ka)
         for env in self._tokens(ka.name, start):
+            try:
+                for arg in ka.action.call.args:
+                    evaluate(arg, env)
+            except Undefined:
+                self.emit.fire(f"{origin} [unbound]", origin, [(start.place, start.colour(env))],
+                               [(fail.place, fail.colour(env))])
+                continue
             values = self.var_domains[ka.name].get(result.name, ()) if result is not None else (None,)
             for value in values:
                 after = dict(env) if result is None else {**env, result.name: value}
