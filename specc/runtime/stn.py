@@ -1,0 +1,169 @@
+"""Simple temporal networks, the temporal core of the planner (seed 004 §3.2.1.2: IxTeT keeps a
+plan's timepoints in such a network and propagates each new constraint at once).
+
+A network holds timepoints, each at or after the origin, and constraints
+`low <= t(j) - t(i) <= high`. It is kept minimal:
+the distance matrix holds, for every pair, the tightest bound the constraints imply (all-pairs
+shortest paths), updated incrementally in O(n^2) per constraint, so a planner learns at once
+whether a resolver makes its plan inconsistent, and reads any timepoint's window.
+
+Contingent links (`low <= t(end) - t(start) <= high` chosen by nature, not by the plan: a move's
+real duration, a visibility window's instants) make it an STNU. `strongly_controllable` tells
+whether one fixed schedule of the plan's own timepoints works whatever nature chooses, and gives
+it (Vidal & Fargier's reduction: each requirement on a contingent end becomes a tighter one on
+its start).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+ORIGIN = "origin"  # timepoint 0: every date is measured from it
+INF = math.inf
+
+
+class Inconsistent(ValueError):
+    """The constraints cannot all hold (a negative cycle)."""
+
+
+@dataclass(frozen=True)
+class Constraint:
+    first: int
+    second: int
+    low: float  # t(second) - t(first) >= low
+    high: float  # t(second) - t(first) <= high
+
+
+@dataclass(frozen=True)
+class Contingent:
+    start: int
+    end: int
+    low: float
+    high: float
+
+
+class STN:
+    def __init__(self, capacity: int = 16) -> None:
+        self.names: list[str] = []
+        self.index: dict[str, int] = {}
+        self._distance = np.full((capacity, capacity), INF)
+        np.fill_diagonal(self._distance, 0.0)
+        self.constraints: list[Constraint] = []
+        self.contingent: list[Contingent] = []
+        self.point(ORIGIN)
+
+    # ------------------------------------------------------------ building
+    def point(self, name: str) -> int:
+        """The timepoint called `name`, created unconstrained if new."""
+        known = self.index.get(name)
+        if known is not None:
+            return known
+        n = len(self.names)
+        if n == len(self._distance):
+            grown = np.full((2 * n, 2 * n), INF)
+            np.fill_diagonal(grown, 0.0)
+            grown[:n, :n] = self._distance
+            self._distance = grown
+        self.names.append(name)
+        self.index[name] = n
+        if n:  # every timepoint comes at or after the origin
+            self._tighten(n, 0, 0.0)
+        return n
+
+    def add(self, first: str | int, second: str | int, low: float = -INF, high: float = INF) -> None:
+        """Require `low <= t(second) - t(first) <= high`; raises Inconsistent (and changes nothing)
+        when the network cannot take it."""
+        i, j = self._id(first), self._id(second)
+        if low > high:
+            raise Inconsistent(f"{self.names[j]} - {self.names[i]} in [{low}, {high}]: an empty interval")
+        d = self.distances
+        # An edge i -> j of weight w means t(j) - t(i) <= w.
+        if high + d[j, i] < 0 or -low + d[i, j] < 0:
+            raise Inconsistent(f"{self.names[j]} - {self.names[i]} in [{low}, {high}] contradicts "
+                               f"[{-d[j, i]}, {d[i, j]}], which the network already implies")
+        self.constraints.append(Constraint(i, j, low, high))
+        self._tighten(i, j, high)
+        self._tighten(j, i, -low)
+
+    def add_contingent(self, start: str | int, end: str | int, low: float, high: float) -> None:
+        """Nature puts `end` between `low` and `high` after `start` (0 <= low <= high)."""
+        if not 0 <= low <= high < INF:
+            raise ValueError(f"a contingent duration needs 0 <= low <= high < inf, not [{low}, {high}]")
+        i, j = self._id(start), self._id(end)
+        if any(c.end == j for c in self.contingent):
+            raise ValueError(f"'{self.names[j]}' already ends a contingent link")
+        self.add(i, j, low, high)
+        self.constraints.pop()  # a contingent link is not a requirement
+        self.contingent.append(Contingent(i, j, low, high))
+
+    def _tighten(self, i: int, j: int, w: float) -> None:
+        n = len(self.names)
+        d = self._distance[:n, :n]
+        if w >= d[i, j]:
+            return
+        # Every path k -> i -> j -> l may now be shorter.
+        np.minimum(d, d[:, i:i + 1] + w + d[j:j + 1, :], out=d)
+
+    def _id(self, point: str | int) -> int:
+        return point if isinstance(point, int) else self.point(point)
+
+    # ------------------------------------------------------------ reading
+    @property
+    def distances(self) -> np.ndarray:
+        n = len(self.names)
+        return self._distance[:n, :n]
+
+    def bounds(self, first: str | int, second: str | int) -> tuple[float, float]:
+        """The tightest [low, high] the network implies for t(second) - t(first)."""
+        i, j = self._id(first), self._id(second)
+        d = self.distances
+        return float(-d[j, i]), float(d[i, j])
+
+    def window(self, point: str | int) -> tuple[float, float]:
+        """[earliest, latest] date of a timepoint."""
+        return self.bounds(0, point)
+
+    def copy(self) -> STN:
+        other = STN.__new__(STN)
+        other.names = list(self.names)
+        other.index = dict(self.index)
+        other._distance = self._distance.copy()
+        other.constraints = list(self.constraints)
+        other.contingent = list(self.contingent)
+        return other
+
+    def earliest_schedule(self) -> dict[str, float]:
+        """Every timepoint at its earliest date: a consistent schedule of a minimal network."""
+        d = self.distances
+        return {name: float(-d[i, 0]) for i, name in enumerate(self.names)}
+
+    def strongly_controllable(self) -> dict[str, float] | None:
+        """A schedule of the timepoints nature does not choose, valid for every duration of the
+        contingent links, or None when there is none (strong controllability)."""
+        ends = {c.end: c for c in self.contingent}
+        reduced = STN()
+        for name in self.names:
+            if self.index[name] not in ends:
+                reduced.point(name)
+
+        def anchor(point: int) -> tuple[int, float, float]:
+            """An executable timepoint and the range of the point's offset from it."""
+            link = ends.get(point)
+            if link is None:
+                return point, 0.0, 0.0
+            base, low, high = anchor(link.start)
+            return base, low + link.low, high + link.high
+
+        try:
+            for c in self.constraints:
+                (a, a_low, a_high), (b, b_low, b_high) = anchor(c.first), anchor(c.second)
+                # t(second) - t(first) = t(b) - t(a) + (offset_b - offset_a): hold it for the worst offsets.
+                low = c.low - (b_low - a_high) if c.low > -INF else -INF
+                high = c.high - (b_high - a_low) if c.high < INF else INF
+                reduced.add(self.names[a], self.names[b], low, high)
+        except Inconsistent:
+            return None
+        return reduced.earliest_schedule()
