@@ -373,14 +373,19 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
     for answer in result.answers:
         out.print(f"reach {answer.query.text}: {'yes' if answer.reached else 'never'}", markup=False)
         print_trace(answer.trace, answer.where, steps)
+    elapsed = time.perf_counter() - started
+    if not result.space.complete:
+        # Only a growing place is a finding before every marking is known.
+        out.print(f"{result.states} states in {elapsed:.1f} s, and more not explored", markup=False)
+        err.print(f"warning: stopped at {result.states} states: deadlocks, cycles and dead statements are not "
+                  "established; raise --max-states (or post a smaller goal) to explore them all", markup=False)
+        raise typer.Exit(1 if strict else 0)
     if not result.findings:
         out.print("no finding: no deadlock, no unbounded place, no statement that never runs or never succeeds, "
                   "no endless cycle", markup=False)
-    out.print(f"{result.states} states in {time.perf_counter() - started:.1f} s; ends: {result.succeeded} with the "
-              f"goal achieved, {result.failed} with it failed; {result.bound_summary()}; "
-              f"{'a' if result.home else 'no'} home marking", markup=False)
-    if not result.space.complete:
-        err.print(f"warning: stopped at {max_states} states; raise --max-states to explore them all", markup=False)
+    out.print(f"{result.states} states in {elapsed:.1f} s; ends: {result.succeeded} with the goal achieved, "
+              f"{result.failed} with it failed; {result.bound_summary()}; {'a' if result.home else 'no'} home marking",
+              markup=False)
     raise typer.Exit(1 if strict and result.findings else 0)
 
 

@@ -310,3 +310,10 @@ def test_graph_draws_the_procedures_net_or_one_ka(tmp_path: Path) -> None:
     assert unknown.returncode == 1 and "KA 'Nope' is not among the KAs the goal reaches" in unknown.stderr
     goalless = specc("graph", "--net", str(EXAMPLES / "hilare"))
     assert goalless.returncode == 1 and "--goal" in goalless.stderr and "Traceback" not in goalless.stderr
+
+
+def test_verify_procedures_says_when_it_stopped_short() -> None:
+    short = specc("verify", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--max-states", "500")
+    assert short.returncode == 0 and "500 states in" in short.stdout and "more not explored" in short.stdout
+    assert "no finding" not in short.stdout  # nothing is established about what was not explored
+    assert "deadlocks, cycles and dead statements are not established" in short.stderr
