@@ -571,7 +571,6 @@ class Translator:
         self.translated: dict[str, None] = {}
         self.var_domains: dict[str, dict[str, tuple[Any, ...]]] = {}
         self.result = Translation(petri.Net(procedures.name), [])
-        self.triggers: list[tuple[rp.KA, Node]] = []  # fact-invoked KAs and their INIT node
         self.initial_heads: set[str] = set()  # predicates the database starts with
         # Where an error in a statement goes: the enclosing parallel branch's failure, or FAIL.
         self._aborts: list[Node] = []
@@ -836,7 +835,6 @@ class Translator:
         invocation = self._invocation_vars(ka)
         init, term, fail = self.init_node(ka), self.term_node(ka), self.fail_node(ka)
         if not ka.goal_invoked:
-            self.triggers.append((ka, init))
             # Nothing waits for the end of a fact-invoked KA (Fig 4.25).
             self._silent(ka, term, None, f"{ka.name}:{ka.line} ends")
             self._silent(ka, fail, None, f"{ka.name}:{ka.line} fails")
