@@ -8,7 +8,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Annotated, Any, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 from rich.console import Console
@@ -18,6 +18,9 @@ from specc.model import nodes as m
 from specc.model.span import Span
 from specc.pipeline import Loaded, load
 from specc.syntax.printer import format_source
+
+if TYPE_CHECKING:
+    from specc.analysis.prs_net import Translation
 
 app = typer.Typer(
     name="specc",
@@ -303,7 +306,7 @@ def draw_procedures_net(loaded: Loaded, name: str | None, goals: list[str], ka: 
 
 
 def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], facts: list[str],
-                         failing: list[str]) -> Any:
+                         failing: list[str]) -> Translation:
     """The Petri net of the procedures the user means, for the goals posted; errors end the command."""
     from specc.analysis.prs_net import TranslationError
     from specc.analysis.prs_verify import translate

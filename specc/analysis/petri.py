@@ -30,7 +30,7 @@ BLACK = "*"  # the colour of an uncoloured token
 # A marking is a byte string, one byte per (place, colour): nets translated from procedures have
 # thousands of such slots, mostly empty, and bytes keep a million markings in memory.
 MAX_TOKENS = 255
-_NONZERO = re.compile(b"[^\x00]")
+NONZERO = re.compile(b"[^\x00]")  # finds a marking's marked slots
 Binding = Mapping[str, Any]
 Colour = Any
 
@@ -305,7 +305,7 @@ class StateSpace:
         best = [0] * len(places)
         for marking in self.markings:
             totals: dict[int, int] = {}
-            for match in _NONZERO.finditer(marking):
+            for match in NONZERO.finditer(marking):
                 place = owner[match.start()]
                 totals[place] = totals.get(place, 0) + marking[match.start()]
             for place, count in totals.items():
@@ -431,7 +431,7 @@ def _explore(net: Net | Unfolded, limit: int, progress: Callable[[int], None] | 
         (by_slot[step.pre[0][0]] if step.pre else free).append(i)
     rest = [step.pre[1:] for step in steps]
     first = [step.pre[0][1] if step.pre else 0 for step in steps]
-    seen_get, pop, nonzero = seen.get, queue.popleft, _NONZERO.finditer
+    seen_get, pop, nonzero = seen.get, queue.popleft, NONZERO.finditer
     while queue:
         state = pop()
         marking = markings[state]

@@ -91,12 +91,6 @@ def library(node: m.Procedures) -> rp.Library:
     )
 
 
-def bindings(node: m.Procedures) -> list[str]:
-    """Every Python function the library calls, sorted."""
-    named = [a.binding.value for a in node.actions] + [p.binding.value for p in node.predicates if p.binding]
-    return sorted(set(named))
-
-
 class Domains:
     """The values each predicate argument may take: a tuple when finite, None when unbounded
     (`int`, `string`, ... — fine for the interpreter, not for a Petri net)."""

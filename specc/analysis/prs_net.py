@@ -45,10 +45,7 @@ from specc.runtime import procedures as rp
 
 IDLE = "IDLE"
 EXECUTIVE_PROPERTY = "executive"
-COMPARISONS = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
-               ">=": lambda a, b: a >= b}
-ARITHMETIC = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
-              "/": lambda a, b: a // b if b else None}
+COMPARISONS, ARITHMETIC = rp.COMPARISONS, rp.ARITHMETIC
 Env = dict[str, Any]
 CONSUMED = "\0consumed"  # an Env entry: the event occurrences a solution uses up
 
@@ -97,6 +94,11 @@ class Where:
     what: str
     vars: tuple[str, ...] = ()
 
+    def values(self, colour: Any) -> dict[str, Any]:
+        """The bound variables a token of this place carries."""
+        carried = colour if isinstance(colour, tuple) else ()
+        return {v: c for v, c in zip(self.vars, carried, strict=False) if c != IDLE}
+
 
 @dataclass
 class PendingReceive:
@@ -127,8 +129,10 @@ class Translation:
     successes: dict[tuple[str, int, int], list[str]] = field(default_factory=dict)
     text: dict[tuple[str, int, int], str] = field(default_factory=dict)
     kas: list[str] = field(default_factory=list)
-    domains: dict[str, dict[str, tuple[Any, ...]]] = field(default_factory=dict)  # KA -> var -> values
     solver: Solver | None = None  # evaluates conditions over a marking's database
+    # Transition -> the firing it stands for: a statement's firings touching other places are
+    # separate transitions (`name #2`), one firing all the same.
+    firings: dict[str, str] = field(default_factory=dict)
 
     def answered(self, tokens: Callable[[str], int]) -> bool:
         """Every posted goal has its answer (SUCC or FAIL): the expected end of §4.5."""
@@ -250,16 +254,12 @@ def evaluate(term: Any, env: Mapping[str, Any]) -> Any:
             raise Undefined(term.name)
         return value
     if isinstance(term, rp.Compound):
-        operation = ARITHMETIC.get(term.head)
-        if operation is None or len(term.args) != 2:
+        if term.head not in ARITHMETIC:
             raise Undefined(str(term))
-        left, right = (evaluate(a, env) for a in term.args)
-        if not isinstance(left, int) or not isinstance(right, int):
-            raise Undefined(str(term))
-        result = operation(left, right)
-        if result is None:
-            raise Undefined(str(term))
-        return result
+        try:  # as the interpreter computes: its values must stay in the variables' domains
+            return rp.compute(term.head, tuple(evaluate(a, env) for a in term.args))
+        except ValueError:
+            raise Undefined(str(term)) from None
     return term
 
 
@@ -441,9 +441,10 @@ class Solver:
             return [] if self.solve(inner, env, reading) else [env]
         if head in COMPARISONS:
             left, right = (evaluate(a, env) for a in args)  # unbound: Undefined, an error
-            if not isinstance(left, (int, float)) or not isinstance(right, (int, float)):
-                raise Undefined(f"{expr} compares a symbol")
-            return [env] if COMPARISONS[head](left, right) else []
+            try:
+                return [env] if rp.compare(head, left, right) else []
+            except ValueError:
+                raise Undefined(str(expr)) from None
         if head == "=":
             return self._equal(args[0], args[1], env)
         if head == "BOUNDP":  # §4.4.6: are the arguments bound?
@@ -525,15 +526,15 @@ class Emitter:
             self.colours.setdefault(place, {})[colour] = None
 
     def build(self, net: petri.Net, initial: Mapping[str, Mapping[Any, int]],
-              colours: Mapping[str, Sequence[Any]]) -> None:
-        """Declare every place and transition (a statement's transitions with the same places
-        are numbered: `name #2`)."""
+              colours: Mapping[str, Sequence[Any]]) -> dict[str, str]:
+        """Declare every place and transition; returns transition -> firing name."""
         for place in sorted(set(self.colours) | set(initial) | set(colours)):
             known = dict.fromkeys(colours.get(place, ()))
             known.update(self.colours.get(place, {}))
             known.update(dict.fromkeys(initial.get(place, {})))
             net.place(place, [_colour(c) for c in known], {_colour(c): n for c, n in initial.get(place, {}).items()})
         counts: dict[str, int] = {}
+        firings: dict[str, str] = {}
         for key in sorted(self.firings, key=repr):
             name, takes, puts = key
             counts[name] = counts.get(name, 0) + 1
@@ -542,6 +543,8 @@ class Emitter:
             outputs = [petri.Arc(p, colour=_pick(len(takes) + i)) for i, p in enumerate(puts)]
             bindings = [{str(i): _colour(c) for i, c in enumerate(row)} for row in self.firings[key]]
             net.transition(unique, inputs, outputs, bindings=bindings, origin=self.origins[name])
+            firings[unique] = name
+        return firings
 
 
 
@@ -572,6 +575,7 @@ class Translator:
         self.var_domains: dict[str, dict[str, tuple[Any, ...]]] = {}
         self.result = Translation(petri.Net(procedures.name), [])
         self.initial_heads: set[str] = set()  # predicates the database starts with
+        self.concluded: set[str] = set()  # predicates the translated KAs conclude
         # Where an error in a statement goes: the enclosing parallel branch's failure, or FAIL.
         self._aborts: list[Node] = []
         self._keys: list[tuple[str, int, int]] = []  # the statements being translated, innermost last
@@ -607,9 +611,8 @@ class Translator:
                 if group in self.emit.colours:
                     colours[group] = [IDLE, *services]
                     initial[group] = {IDLE: 1}
-        self.emit.build(self.result.net, initial, colours)
+        self.result.firings = self.emit.build(self.result.net, initial, colours)
         self.result.kas = list(self.translated)
-        self.result.domains = self.var_domains
         self.result.solver = self.solver
         return self.result
 
@@ -680,6 +683,7 @@ class Translator:
                     continue
                 self.var_domains[ka.name] = self._infer_domains(ka)
                 posted, concluded = self._posted_heads(ka)
+                self.concluded |= concluded
                 work.extend(("goal", h) for h in posted)
                 work.extend(("fact", h) for h in concluded)
 
@@ -1293,10 +1297,8 @@ class Translator:
 
     def _concluded_somewhere(self, head: str) -> bool:
         """Can the database ever make `head` true (so that `!` tests it first, §4.4.4)?"""
-        if head in COMPARISONS or head == "BOUNDP" or self.db.kind(head) == "evaluable" or head in self.initial_heads:
-            return True
-        return any(goal.op == "=>" and _positive(goal.expr).head == head
-                   for name in self.translated for goal in _goals(self.kas[name]))
+        return (head in COMPARISONS or head == "BOUNDP" or self.db.kind(head) == "evaluable"
+                or head in self.initial_heads or head in self.concluded)
 
     # ------------------------------------------------------------ goal servers
     def _servers(self) -> None:

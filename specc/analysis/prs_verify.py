@@ -18,19 +18,16 @@ Each finding carries the shortest firing sequence to it, one line per step, nami
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from specc.analysis import petri
 from specc.analysis.controller import executive_controller
-from specc.analysis.prs_net import IDLE, ExecutiveModel, Reading, Service, Translation, Translator
+from specc.analysis.prs_net import ExecutiveModel, Reading, Service, Translation, Translator
 from specc.analysis.service_list import executive_spec
 from specc.model import nodes as m
 from specc.runtime import procedures as rp
-
-_NONZERO = re.compile(b"[^\x00]")
 
 
 @dataclass
@@ -182,7 +179,7 @@ def analyse(translation: Translation, queries: Sequence[Query] = (), limit: int 
     succeeded = failed = 0
     # Every place some firing marks (the reduction hides the places its fused steps pass by).
     original = unfolded.original_slots or unfolded.slots
-    marked_places = {unfolded.slots[m.start()][0] for m in _NONZERO.finditer(unfolded.initial)}
+    marked_places = {unfolded.slots[m.start()][0] for m in petri.NONZERO.finditer(unfolded.initial)}
     for i in space.fired():
         for part in unfolded.steps[i].elementary:
             marked_places.update(original[s][0] for s, _ in part.post)
@@ -257,9 +254,7 @@ class Reader:
                     continue
                 if clause.condition is None:
                     return True
-                colour = self.unfolded.slots[slot][1]
-                env = {v: c for v, c in zip(where.vars if where else (), colour if isinstance(colour, tuple) else (),
-                                             strict=False) if c != IDLE}
+                env = where.values(self.unfolded.slots[slot][1]) if where else {}
                 if self._test(marking, clause.condition.expr, env):
                     return True
         return False
@@ -279,17 +274,20 @@ class Reader:
         slot = self.index.get((place, petri.BLACK if colour == () else colour))
         return slot is not None and marking[slot] > 0
 
+    def firing(self, step: petri.Step) -> str:
+        return self.translation.firings.get(step.transition, step.transition)
+
     def step(self, step: petri.Step) -> str:
         """One elementary step (the slots it counts are the unreduced net's)."""
-        name = re.sub(r" #\d+$", "", step.transition)
+        name = self.firing(step)
         shown = []
         for slot, _ in step.post:
             place, colour = (self.unfolded.original_slots or self.unfolded.slots)[slot]
             where = self.translation.where.get(place)
             if where is not None and where.vars and isinstance(colour, tuple):
-                values = [f"{v}={c}" for v, c in zip(where.vars, colour, strict=False) if c != IDLE]
+                values = where.values(colour)
                 if values:
-                    shown.append(" ".join(values))
+                    shown.append(" ".join(f"{v}={c}" for v, c in values.items()))
             elif place.endswith(".SUCC") and isinstance(colour, tuple):
                 shown.append(f"answer ({place[:-5]} {' '.join(map(str, colour))})")
         return name + (f"  [{'; '.join(dict.fromkeys(shown))}]" if shown else "")
@@ -299,22 +297,19 @@ class Reader:
 
     def where(self, marking: bytes) -> list[str]:
         found = []
-        for match in _NONZERO.finditer(marking):
+        for match in petri.NONZERO.finditer(marking):
             place, colour = self.unfolded.slots[match.start()]
             where = self.translation.where.get(place)
             if where is None:
                 continue
-            values = ""
-            if where.vars and isinstance(colour, tuple):
-                values = " ".join(f"{v}={c}" for v, c in zip(where.vars, colour, strict=False) if c != IDLE)
+            values = " ".join(f"{v}={c}" for v, c in where.values(colour).items())
             found.append(f"{where.ka}:{where.line} {where.what}" + (f" ({values})" if values else ""))
         return found
 
 
 def _statements(translation: Translation, space: petri.StateSpace, reader: Reader,
                 marked: set[str]) -> list[Finding]:
-    fired_names = {re.sub(r" #\d+$", "", part.transition) for i in space.fired()
-                   for part in space.unfolded.steps[i].elementary}
+    fired_names = {reader.firing(part) for i in space.fired() for part in space.unfolded.steps[i].elementary}
     findings = []
     for ka in translation.kas:
         if f"{ka}.INIT" not in marked and f"{ka}.INIT" in translation.net.places:
@@ -357,10 +352,10 @@ def _cycles(translation: Translation, space: petri.StateSpace, reader: Reader) -
     environment = translation.environment
 
     def name(step_index: int) -> str:
-        return re.sub(r" #\d+$", "", steps[step_index].transition)
+        return reader.firing(steps[step_index])
 
     def is_environment(step_index: int) -> bool:
-        return any(part.origin in environment or re.sub(r" #\d+$", "", part.transition) in environment
+        return any(part.origin in environment or reader.firing(part) in environment
                    for part in steps[step_index].elementary)
 
     found: dict[tuple[frozenset[str], bool], Finding] = {}

@@ -3,6 +3,7 @@ predicates with the right arity, KA shape, and unreachable statements."""
 
 from __future__ import annotations
 
+from specc.analysis.procedures import Domains
 from specc.check.codels import python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
@@ -23,6 +24,7 @@ class ProcedureVisitor(Visitor):
     def __init__(self, ctx: Context, procedures: m.Procedures):
         self.ctx = ctx
         self.types = {t.name: t for t in procedures.types}
+        self.domains = Domains(procedures)
         self.signatures: dict[str, tuple[m.PParam, ...] | None] = {p.name: p.params for p in procedures.predicates}
         # Primitive actions are called from a KA's `action:` only, in a namespace of their own
         # (Fig. 4.2: goal SEND-REQUEST $REQUEST $ID is achieved by action SEND-REQUEST $REQUEST).
@@ -33,16 +35,6 @@ class ProcedureVisitor(Visitor):
             head = invocation.body if isinstance(invocation, m.Goal) else invocation
             if head is not None and head.head not in self.signatures:
                 self.signatures[head.head] = None
-
-    def domain_values(self, domain: m.PDomain) -> tuple[str, ...] | None:
-        if isinstance(domain, m.SymbolSet):
-            return domain.values
-        if isinstance(domain, m.IntRange):
-            return tuple(str(v) for v in range(domain.low, domain.high + 1))
-        declared = self.types.get(domain.name)
-        if declared is None:
-            return None
-        return self.domain_values(declared.domain) if declared.domain != domain else None
 
     def visit_KAAction(self, node: m.KAAction) -> None:
         call = node.call
@@ -87,7 +79,8 @@ class ProcedureVisitor(Visitor):
                             f"'{node.head}' takes {len(params)} argument(s), {len(node.args)} given", node.span)
             return
         for arg, param in zip(node.args, params, strict=True):
-            values = self.domain_values(param.domain)
+            found = self.domains.values(param.domain)
+            values = None if found is None else tuple(str(v) for v in found)
             shown = arg.text if isinstance(arg, m.Ref) else str(arg.value) if isinstance(arg, m.Number) else None
             if shown is not None and values is not None and shown not in values:
                 self.ctx.report("value-outside-domain",

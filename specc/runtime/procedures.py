@@ -9,6 +9,7 @@ the line of the spec it came from, so traces and failures point back at the KA s
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -176,6 +177,42 @@ class Library:
     primitives: tuple[Primitive, ...] = ()
     kas: tuple[KA, ...] = ()
     source: str = ""  # the spec file, for messages
+
+
+# ---------------------------------------------------------------- built-in arithmetic and comparisons
+# One definition for the interpreter and the Petri-net translation, so both compute alike.
+
+COMPARISONS: dict[str, Callable[[Any, Any], bool]] = {
+    "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}
+ARITHMETIC = ("+", "-", "*", "/")
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def compute(head: str, args: tuple[Any, ...]) -> int | float:
+    """`(+ a b ...)`, `(- a)`, `(- a b ...)`, `(* ...)`, `(/ a b ...)` over numbers; ValueError
+    for anything else or a division by zero."""
+    if not args or not all(_number(a) for a in args):
+        raise ValueError("arithmetic on something that is not a number")
+    if head == "+":
+        return sum(args)
+    if head == "*":
+        return math.prod(args)
+    if head == "-":
+        return -args[0] if len(args) == 1 else args[0] - sum(args[1:])
+    divisor = math.prod(args[1:])
+    if divisor == 0:
+        raise ValueError("division by zero")
+    return args[0] / divisor
+
+
+def compare(head: str, left: Any, right: Any) -> bool:
+    """A comparison between two numbers; ValueError for anything else."""
+    if not _number(left) or not _number(right):
+        raise ValueError(f"{left!r} and {right!r} cannot be compared: comparisons are between numbers")
+    return COMPARISONS[head](left, right)
 
 
 def bindings(library: Library) -> list[str]:

@@ -70,8 +70,6 @@ from __future__ import annotations
 
 import itertools
 import logging
-import math
-import operator
 import random
 from collections import deque
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
@@ -79,6 +77,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from specc.runtime.procedures import (
+    ARITHMETIC,
+    COMPARISONS,
     KA,
     Action,
     Assign,
@@ -95,6 +95,8 @@ from specc.runtime.procedures import (
     Term,
     Var,
     While,
+    compare,
+    compute,
     parse_fact,
     parse_goal,
 )
@@ -104,11 +106,8 @@ if TYPE_CHECKING:
     from specc.runtime.kernel import Kernel
 
 
-_COMPARISONS: dict[str, Callable[[Any, Any], bool]] = {"<": operator.lt, "<=": operator.le, ">": operator.gt,
-                                                        ">=": operator.ge}
-_ARITHMETIC = ("+", "-", "*", "/")
 _CONNECTIVES = ("&", "|", "~")
-_BUILTINS = frozenset((*_COMPARISONS, "=", "BOUNDP"))
+_BUILTINS = frozenset((*COMPARISONS, "=", "BOUNDP"))
 _STORED_KINDS = ("standard", "closed", "functional")
 
 
@@ -132,7 +131,7 @@ def resolve(term: Term, env: Mapping[str, Any]) -> Any:
     if not isinstance(term, Compound):
         return term
     args = tuple(resolve(a, env) for a in term.args)
-    if term.head in _ARITHMETIC and args:
+    if term.head in ARITHMETIC and args:
         return _compute(term, args)
     return Compound(term.head, args)
 
@@ -141,19 +140,10 @@ def _compute(term: Compound, args: tuple[Any, ...]) -> Any:
     unbound = _unbound(args)
     if unbound:
         raise ExecutionError(f"{term}: {unbound[0]} is unbound")
-    if not all(isinstance(a, (int, float)) and not isinstance(a, bool) for a in args):
-        raise ExecutionError(f"{term}: arithmetic on something that is not a number")
-    head = term.head
-    if head == "+":
-        return sum(args)
-    if head == "*":
-        return math.prod(args)
-    if head == "-":
-        return -args[0] if len(args) == 1 else args[0] - sum(args[1:])
     try:
-        return args[0] / math.prod(args[1:])
-    except ZeroDivisionError:
-        raise ExecutionError(f"{term}: division by zero") from None
+        return compute(term.head, args)
+    except ValueError as exc:
+        raise ExecutionError(f"{term}: {exc}") from None
 
 
 def _unbound(values: Iterable[Any]) -> list[Var]:
@@ -187,7 +177,7 @@ def match(pattern: Term, value: Any, env: dict[str, Any]) -> bool:
             return True
         return _same(env[pattern.name], value)
     if isinstance(pattern, Compound):
-        if pattern.head in _ARITHMETIC:
+        if pattern.head in ARITHMETIC:
             return _same(resolve(pattern, env), value)
         return (isinstance(value, Compound) and value.head == pattern.head and len(value.args) == len(pattern.args)
                 and all(match(p, v, env) for p, v in zip(pattern.args, value.args, strict=True)))
@@ -921,17 +911,17 @@ class Supervisor:
                 yield from self._solve(alternative, env, ctx)
         elif head == "~":
             yield from self._solve_not(expr, env, ctx)
-        elif head in _COMPARISONS:
+        elif head in COMPARISONS:
             values = [resolve(a, env) for a in args]
             if len(values) != 2:
                 raise ExecutionError(f"{expr}: a comparison takes two values")
             if _unbound(values):
                 raise ExecutionError(f"{expr}: {_unbound(values)[0]} is unbound")
             try:
-                if _COMPARISONS[head](values[0], values[1]):
+                if compare(head, values[0], values[1]):
                     yield env, ()
-            except TypeError:
-                raise ExecutionError(f"{expr}: {values[0]!r} and {values[1]!r} cannot be compared") from None
+            except ValueError as exc:
+                raise ExecutionError(f"{expr}: {exc}") from None
         elif head == "=":
             solution = self._unify(expr, env)
             if solution is not None:
