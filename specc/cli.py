@@ -405,6 +405,51 @@ def print_trace(trace: list[str], where: list[str], steps: int) -> None:
             out.print(f"    {line}", markup=False)
 
 
+@app.command()
+def plan(paths: PathsArg,
+         problem: Annotated[str, typer.Option(help="The problem (mission) to plan: its name, or a prefix such "
+                                                   "as M1 when --domain says which model.")],
+         domain: Annotated[Optional[str], typer.Option(help="Keep the problems of this domain (or domains whose "
+                                                             "name starts so: model2 takes model2_M1).")] = None,
+         horizon: Annotated[Optional[float], typer.Option(help="End the mission by this many seconds.")] = None,
+         now: Annotated[float, typer.Option(help="Mission time of a replanning: nothing starts before it.")] = 0.0,
+         fact: Annotated[Optional[list[str]], typer.Option(
+             help="A replanning: the current value of an attribute, e.g. 'AT_ROBOT_X() = 2' (repeatable).")] = None,
+         goal: Annotated[Optional[list[int]], typer.Option(
+             help="A replanning: the source line of a goal still to meet (repeatable; default: all).")] = None,
+         picture: Annotated[Optional[Path], typer.Option("--picture", "-o", help="Draw the plan's timeline "
+                                                         "(PNG, SVG, PDF).")] = None,
+         nodes: Annotated[int, typer.Option(min=1, help="Partial plans the search for every goal at once may "
+                                                        "expand (each smaller search gets 2/5 of it).")] = 500,
+         exact: Annotated[bool, typer.Option(help="Durations and schedule by CasADi (else the interval "
+                                                  "enclosures and the temporal network alone).")] = True) -> None:
+    """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
+    checked by the independent validator."""
+    from specc.plan_report import print_result, solve
+
+    loaded = load(paths)
+    if report(loaded):
+        raise typer.Exit(1)
+    assert loaded.program is not None
+    try:
+        outcome = solve(loaded.program, problem, domain, horizon, now, fact or [], goal, nodes, exact)
+    except ValueError as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(1) from None
+    print_result(outcome, out)
+    if picture is not None and outcome.result.plan is not None:
+        from specc.pictures import draw_timeline
+
+        try:
+            written = draw_timeline(outcome.result.plan, outcome.problem, picture)
+        except (OSError, ValueError) as exc:
+            err.print(f"error: cannot draw '{picture}': {exc}", markup=False)
+            raise typer.Exit(1) from None
+        out.print(f"wrote {written}", markup=False)
+    if outcome.result.plan is None or outcome.violations:
+        raise typer.Exit(1)
+
+
 @app.command(name="rules")
 def rules_report(paths: PathsArg,
                  limit: Annotated[int, typer.Option(help="Findings shown per rule base (0: all).")] = 20) -> None:

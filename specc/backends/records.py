@@ -1,0 +1,50 @@
+"""Deterministic Python source for the runtime records a back end writes into a module (the KA
+library of a supervisor, the tasks of a planning domain): `Record(field=value, ...)` with the
+fields left at their default omitted, laid out one item per line when it does not fit."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+WIDTH = 110
+
+
+def literal(value: Any, positional: tuple[type, ...] = (), indent: int = 0, prefix: int = 0) -> str:
+    """Source for `value` on a line indented by `indent` whose first `prefix` characters are
+    taken; records of a `positional` type are written without field names."""
+    flat = _flat(value, positional)
+    if indent + prefix + len(flat) <= WIDTH:
+        return flat
+    pad = " " * (indent + 4)
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        items = [f"{name}={literal(v, positional, indent + 4, len(name) + 1)}" for name, v in _fields(value)]
+        return f"{type(value).__name__}(\n" + "".join(f"{pad}{item},\n" for item in items) + " " * indent + ")"
+    if isinstance(value, tuple) and value:
+        return "(\n" + "".join(f"{pad}{literal(v, positional, indent + 4)},\n" for v in value) + " " * indent + ")"
+    return flat
+
+
+def _fields(record: Any) -> list[tuple[str, Any]]:
+    shown = []
+    for f in dataclasses.fields(record):
+        value = getattr(record, f.name)
+        if f.default is not dataclasses.MISSING and value == f.default:
+            continue
+        shown.append((f.name, value))
+    return shown
+
+
+def _flat(value: Any, positional: tuple[type, ...]) -> str:
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        fields = _fields(value)
+        if isinstance(value, positional):
+            return f"{type(value).__name__}({', '.join(_flat(v, positional) for _, v in fields)})"
+        return f"{type(value).__name__}({', '.join(f'{n}={_flat(v, positional)}' for n, v in fields)})"
+    if isinstance(value, tuple):
+        inner = ", ".join(_flat(v, positional) for v in value)
+        return f"({inner},)" if len(value) == 1 else f"({inner})"
+    if isinstance(value, float) and math.isinf(value):
+        return "INF" if value > 0 else "-INF"  # the module imports INF: repr() would write `inf`
+    return repr(value)

@@ -1,0 +1,106 @@
+"""`specc plan`: find the problem the user means, plan it, check the plan with the independent
+validator and print it all."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from rich.console import Console
+from rich.table import Table
+
+from specc.analysis.planning import domain_model, problem_model
+from specc.model import nodes as m
+from specc.runtime.planner import Planner, PlanResult
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import format_value
+from specc.runtime.planner.replan import Fact, replanning_problem
+from specc.runtime.planner.validate import validate
+
+
+@dataclass
+class Outcome:
+    domain: pm.PlanningDomain
+    problem: pm.Problem
+    result: PlanResult
+    violations: list[str]
+
+
+def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Problem:
+    problems = [p for p in program.items if isinstance(p, m.Problem)]
+    if domain is not None:
+        problems = [p for p in problems if p.domain.text == domain or p.domain.text.startswith(domain)]
+    exact = [p for p in problems if p.name == name]
+    found = exact or [p for p in problems if p.name.startswith(name + "_") or p.name.startswith(name)]
+    if len(found) == 1:
+        return found[0]
+    if not found:
+        known = ", ".join(sorted(p.name for p in problems)) or "none"
+        where = f" for domain '{domain}'" if domain else ""
+        raise ValueError(f"no problem '{name}'{where} (problems: {known})")
+    names = ", ".join(sorted(p.name for p in found))
+    raise ValueError(f"problem '{name}' is ambiguous ({names}); add --domain, e.g. --domain {found[0].domain.text}")
+
+
+def solve(program: m.Program, name: str, domain_name: str | None, horizon: float | None, now: float,
+          facts: list[str], goals: list[int] | None, nodes: int, exact: bool) -> Outcome:
+    chosen = choose_problem(program, name, domain_name)
+    domain = next(d for d in program.items if isinstance(d, m.Domain) and d.name == chosen.domain.text)
+    model = domain_model(program, domain)
+    problem = problem_model(program, chosen)
+    if horizon is not None:
+        if horizon <= 0:
+            raise ValueError(f"--horizon must be positive, not {horizon:g}")
+        problem = pm.with_horizon(problem, horizon)
+    if facts or goals is not None or now:
+        lines = {a.line for a in problem.assertions if a.goal is not None}
+        unknown = sorted(set(goals or ()) - lines)
+        if unknown:
+            raise ValueError(f"no goal on line(s) {', '.join(map(str, unknown))} of {problem.source} "
+                             f"(goal lines: {', '.join(map(str, sorted(lines)))})")
+        problem = replanning_problem(problem, [Fact.parse(f) for f in facts], lines if goals is None else goals, now)
+    result = Planner(model, nodes=nodes, goal_nodes=max(1, nodes * 2 // 5), exact=exact).plan(problem, now=now)
+    violations = []
+    if result.plan is not None:
+        violations = validate(model, problem, result.plan, dropped_lines={g.line for g in result.dropped})
+    return Outcome(model, problem, result, violations)
+
+
+def print_result(outcome: Outcome, out: Console) -> None:
+    result, problem = outcome.result, outcome.problem
+    out.print(f"problem {problem.name} for domain {outcome.domain.name}: "
+              f"{result.nodes} partial plans, {result.seconds:.2f} s", markup=False)
+    goals = Table(title="goals", title_justify="left", show_edge=False)
+    for column in ("", "goal", "why dropped"):
+        goals.add_column(column, overflow="fold")
+    for g in result.goals:
+        goals.add_row("kept" if g.kept else "DROPPED", g.description, g.reason)
+    out.print(goals)
+    if result.plan is None:
+        out.print(f"no plan: {result.reason}", markup=False)
+        return
+    plan = result.plan
+    table = Table(title=f"plan ({len(plan.actions)} actions, {plan.controllability}ly controllable: the dates hold "
+                        "whatever durations nature picks)", title_justify="left", show_edge=False)
+    for column in ("start", "action", "duration", "ends by", "may start", ""):
+        table.add_column(column, justify="right" if column in ("start", "ends by") else "left", no_wrap=True)
+    for a in plan.ordered():
+        low, high = a.duration
+        kind = "contingent" if a.contingent else "controllable"
+        table.add_row(f"{a.dispatch:.2f}", a.text(), f"{low:.2f}-{high:.2f} {kind}",
+                      f"{plan.uncontrolled.get(a.end, (0.0, a.dispatch + high))[1]:.2f}",
+                      f"{a.window[0]:.2f}-{a.window[1]:.2f}", "preemptible" if a.preemptible else "")
+    out.print(table)
+    points = ", ".join(f"{name}={date:.2f}" for name, date in sorted(plan.schedule.items(), key=lambda kv: kv[1])
+                       if "." not in name)
+    out.print(f"mission timepoints: {points}", markup=False)
+    if plan.bindings:
+        out.print("bindings: " + ", ".join(f"{k}={format_value(v)}" for k, v in plan.bindings.items()), markup=False)
+    out.print(f"completes by {plan.makespan:.2f} s at worst", markup=False)
+    for note in result.notes:
+        out.print(f"note: {note}", markup=False)
+    if outcome.violations:
+        out.print("the validator REJECTS this plan (a planner bug):", markup=False)
+        for v in outcome.violations:
+            out.print(f"  {v}", markup=False)
+    else:
+        out.print("validator: the plan is valid for every duration and window instant nature may pick", markup=False)

@@ -1,0 +1,256 @@
+"""The planning model as data: what the back end `planner` generates from a `domain` or a
+`problem` block (seed 004 §3.2.1.2, annex A), and what the planner, the validator and the
+exports read.
+
+Everything is already normalised: includes expanded, macros inlined (their own variables
+renamed `?name#k` for the k-th call), constant sets spelled out, constant arithmetic folded
+(`0.0 - 10.0` is -10.0), the IxTeT dotted operators (`=.`, `-.`) written without their dot, and
+every time an assertion refers to is a named timepoint.
+
+Semantics (shared with docs/planning.md):
+- an attribute instance `A(args)` is a piecewise-constant function of time;
+- `event(A(args): (v1, v2), t)`: A(args) is v1 just before t and v2 from t on;
+- `hold(A(args): v, (t1, t2))`: A(args) is v over [t1, t2] and no event on it happens strictly
+  inside; holds and events of a task must be supported (the value comes from an earlier
+  event, with nothing changing it in between); events of the problem marked `explained` or
+  `contingent` are given and need no support;
+- `contingent` constraints are chosen by nature within their bounds: a plan must hold for
+  every value they may take.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Union
+
+INF = float("inf")
+
+# ---------------------------------------------------------------- expressions
+
+
+@dataclass(frozen=True)
+class Num:
+    value: float
+
+
+@dataclass(frozen=True)
+class Sym:
+    """A symbolic value (a member of a constant set, e.g. STRAIGHT)."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Var:
+    """A `?variable` of a task or of the problem."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Time:
+    """A timepoint."""
+
+    name: str
+
+
+@dataclass(frozen=True)
+class Op:
+    """`+ - * /` (two arguments), `neg` (one), or the functions `max min abs`."""
+
+    op: str
+    args: tuple[Expr, ...]
+
+
+Expr = Union[Num, Sym, Var, Time, Op]
+ARITHMETIC = ("+", "-", "*", "/")
+FUNCTIONS = ("max", "min", "abs")
+
+
+# ---------------------------------------------------------------- domains
+
+
+@dataclass(frozen=True)
+class Interval:
+    low: float
+    high: float
+
+
+@dataclass(frozen=True)
+class Symbols:
+    values: tuple[str, ...]  # sorted
+
+
+Values = Union[Interval, Symbols]
+
+
+# ---------------------------------------------------------------- constraints
+
+
+@dataclass(frozen=True)
+class Member:
+    """`expr in domain`; `contingent` when nature chooses the value."""
+
+    expr: Expr
+    domain: Values
+    contingent: bool = False
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class Relation:
+    """`left op right` with op one of `= != < <= > >=` (`=.` and `==` are `=`)."""
+
+    op: str
+    left: Expr
+    right: Expr
+    contingent: bool = False
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class Implies:
+    """`condition => consequence` (Modele2's distance tables)."""
+
+    condition: Member
+    consequence: Member | Relation
+    line: int = 0
+
+
+Constraint = Union[Member, Relation, Implies]
+
+
+# ---------------------------------------------------------------- assertions
+
+
+@dataclass(frozen=True)
+class GoalMark:
+    priority: float
+    weight: float
+
+
+@dataclass(frozen=True)
+class Event:
+    attribute: str
+    args: tuple[Expr, ...]
+    before: Expr
+    after: Expr
+    time: str
+    kind: str = ""  # "" (planned) | explained | contingent
+    goal: GoalMark | None = None
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class Hold:
+    attribute: str
+    args: tuple[Expr, ...]
+    value: Expr
+    start: str
+    end: str
+    goal: GoalMark | None = None
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class Use:
+    """`use(R(args): amount, (start, end))`: borrows `amount` of a resource over [start, end]."""
+
+    resource: str
+    args: tuple[Expr, ...]
+    amount: Expr
+    start: str
+    end: str
+    goal: GoalMark | None = None  # never set: a use is not a goal (kept for a uniform interface)
+    line: int = 0
+
+
+Assertion = Union[Event, Hold, Use]
+
+
+def subject(a: Assertion) -> str:
+    """The attribute (or resource) an assertion is about."""
+    return a.resource if isinstance(a, Use) else a.attribute
+
+
+# ---------------------------------------------------------------- declarations
+
+
+@dataclass(frozen=True)
+class Attribute:
+    name: str
+    params: tuple[str, ...] = ()
+    param_domains: tuple[Values | None, ...] = ()
+    values: Values | None = None  # the domain of ?value
+
+
+@dataclass(frozen=True)
+class Resource:
+    name: str
+    params: tuple[str, ...] = ()
+    param_domains: tuple[Values | None, ...] = ()
+    capacity: float = 1.0
+
+
+@dataclass(frozen=True)
+class Task:
+    name: str
+    params: tuple[str, ...]
+    start: str = "t_start"
+    end: str = "t_end"
+    timepoints: tuple[str, ...] = ()  # besides start and end
+    variables: tuple[str, ...] = ()  # besides the parameters (macro variables included)
+    assertions: tuple[Assertion, ...] = ()
+    constraints: tuple[Constraint, ...] = ()
+    preemption: str = ""  # latePreemptive | earlyPreemptive | nonPreemptive | preemptive | ""
+    line: int = 0
+
+    @property
+    def preemptible(self) -> bool:
+        """May the executive stop it while it runs (for a replanning)?"""
+        return self.preemption in ("latePreemptive", "preemptive")
+
+
+@dataclass(frozen=True)
+class PlanningDomain:
+    name: str
+    attributes: tuple[Attribute, ...] = ()
+    resources: tuple[Resource, ...] = ()
+    tasks: tuple[Task, ...] = ()
+    source: str = ""
+
+    def attribute(self, name: str) -> Attribute | None:
+        return next((a for a in self.attributes if a.name == name), None)
+
+    def task(self, name: str) -> Task | None:
+        return next((t for t in self.tasks if t.name == name), None)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """The initial partial plan: explained and contingent events, goals with priorities,
+    required assertions and constraints; `t_start` is the mission's time origin."""
+
+    name: str
+    domain: str
+    timepoints: tuple[str, ...] = ()  # besides t_start and t_end
+    variables: tuple[str, ...] = ()
+    assertions: tuple[Assertion, ...] = ()
+    constraints: tuple[Constraint, ...] = ()
+    preemption: str = ""
+    source: str = ""
+    start: str = "t_start"
+    end: str = "t_end"
+
+
+def with_horizon(problem: Problem, seconds: float) -> Problem:
+    """The problem with its mission ending by `seconds` after its start: the bounds written on
+    `t_end - t_start` are cut to it (a lower bound beyond it comes down with it)."""
+    span = Op("-", (Time(problem.end), Time(problem.start)))
+    constraints: list[Constraint] = []
+    for c in problem.constraints:
+        if isinstance(c, Member) and c.expr == span and isinstance(c.domain, Interval):
+            c = Member(span, Interval(min(c.domain.low, seconds), min(c.domain.high, seconds)), c.contingent, c.line)
+        constraints.append(c)
+    constraints.append(Member(span, Interval(0.0, seconds)))
+    return replace(problem, constraints=tuple(constraints))

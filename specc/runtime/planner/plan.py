@@ -1,0 +1,96 @@
+"""What the planner returns: a partially ordered plan with time windows, a dispatchable
+schedule, the goals kept and dropped, or no plan and why (seed 004 §3.2.1.2)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+Value = float | str
+
+
+@dataclass(frozen=True)
+class Action:
+    """One task instance of the plan."""
+
+    id: str  # "MOVE#3": unique in the plan
+    task: str
+    args: tuple[Value, ...]  # the task's parameters, all bound
+    start: str  # names of its timepoints in the plan's schedule
+    end: str
+    dispatch: float  # when the executive starts it
+    duration: tuple[float, float]  # [low, high]: nature picks the real duration in it when contingent
+    contingent: bool
+    preemptible: bool  # may be stopped while it runs (latePreemptive)
+    window: tuple[float, float] = (0.0, 0.0)  # [earliest, latest] start the partial order allows
+    values: tuple[tuple[str, Value], ...] = ()  # the other variables the planner fixed (symbolic ones)
+
+    def text(self) -> str:
+        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+
+
+@dataclass(frozen=True)
+class Link:
+    """A causal link: `producer` gives the value `consumer` needs (assertion descriptions)."""
+
+    producer: str
+    consumer: str
+    attribute: str
+    value: Value
+
+
+@dataclass(frozen=True)
+class GoalOutcome:
+    description: str  # "hold(COMMUNICATION(W1): DONE) at line 37"
+    priority: float
+    line: int
+    kept: bool
+    reason: str = ""  # why it was dropped
+
+
+@dataclass(frozen=True)
+class Plan:
+    domain: str
+    problem: str
+    actions: tuple[Action, ...]
+    # Precedences of the partial order: (timepoint, timepoint, minimal delay).
+    orderings: tuple[tuple[str, str, float], ...]
+    links: tuple[Link, ...]
+    # Every timepoint the plan controls, at its dispatch date; and those nature controls
+    # (contingent action ends, window instants) with their [earliest, latest] dates.
+    schedule: dict[str, float]
+    uncontrolled: dict[str, tuple[float, float]]
+    bindings: dict[str, Value]  # the problem's ?variables
+    controllability: str = "strong"  # the schedule holds for every contingent duration
+    now: float = 0.0  # mission time the plan was made for (a replanning starts later)
+
+    @property
+    def makespan(self) -> float:
+        ends = [self.uncontrolled.get(a.end, (0.0, a.dispatch + a.duration[1]))[1] for a in self.actions]
+        return max(ends, default=self.now)
+
+    def ordered(self) -> list[Action]:
+        return sorted(self.actions, key=lambda a: (a.dispatch, a.id))
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    plan: Plan | None
+    goals: tuple[GoalOutcome, ...] = ()
+    reason: str = ""  # why there is no plan
+    nodes: int = 0  # partial plans the search expanded
+    seconds: float = 0.0
+    notes: tuple[str, ...] = field(default=())
+
+    @property
+    def dropped(self) -> tuple[GoalOutcome, ...]:
+        return tuple(g for g in self.goals if not g.kept)
+
+    @property
+    def ok(self) -> bool:
+        return self.plan is not None
+
+
+def format_value(value: Value) -> str:
+    if isinstance(value, float):
+        return f"{value:g}"
+    return str(value)

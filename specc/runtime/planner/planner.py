@@ -1,0 +1,663 @@
+"""The planner: a problem (an initial partial plan) in, a plan or the reason there is none out.
+
+Goals are kept by priority, as IxTeT does: a goal that cannot be met even alone is dropped at
+once; then the planner looks for a plan meeting every remaining goal; when that fails within its
+budget, it adds the goals one at a time, highest priority first, and drops each goal that cannot
+join those already kept. Every search is bounded by a number of partial plans (not by wall time,
+so that a run is deterministic), so the planner never searches forever on an impossible goal set.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+import time
+from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
+
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.numeric import exact_duration
+from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult
+from specc.runtime.planner.search import (
+    EPS,
+    Assertion,
+    Bindings,
+    Context,
+    DeadEnd,
+    Limits,
+    Node,
+    Term,
+    differences,
+    is_var,
+    same_value,
+)
+from specc.runtime.stn import STN, Inconsistent
+
+INF = math.inf
+
+
+class PlanningInputError(ValueError):
+    """The problem cannot be planned as written (a contingent instant without bounds, a
+    constraint the planner does not handle): one clear message, no plan."""
+
+
+@dataclass(frozen=True)
+class Goal:
+    index: int  # position among the problem's assertions
+    hold: pm.Hold | pm.Event
+    priority: float
+
+    @property
+    def text(self) -> str:
+        a = self.hold
+        args = f"({', '.join(_expr_text(x) for x in a.args)})"
+        value = _expr_text(a.value) if isinstance(a, pm.Hold) else _expr_text(a.after)
+        return f"{a.attribute}{args} = {value} (line {a.line}, priority {self.priority:g})"
+
+
+@dataclass
+class Attempt:
+    node: Node | None
+    nodes: int
+    exhausted: bool  # the whole search space was explored
+    failures: Counter[str] = field(default_factory=Counter)
+
+
+class Planner:
+    def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 500, goal_nodes: int = 300,
+                 exact: bool = True, limits: Limits | None = None) -> None:
+        self.domain = domain
+        self.nodes = nodes  # budget of the search for every goal at once
+        self.goal_nodes = goal_nodes  # budget of each smaller search
+        self.exact = exact  # CasADi durations and schedule (else the interval enclosures and the STN)
+        self.limits = limits or Limits()
+
+    # ------------------------------------------------------------ entry point
+    def plan(self, problem: pm.Problem, now: float = 0.0) -> PlanResult:
+        started = time.perf_counter()
+        try:
+            setup = Setup(self.domain, problem, now, self.limits)
+        except PlanningInputError as error:
+            return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
+        goals = setup.goals
+        total = 0
+        outcomes: dict[int, GoalOutcome] = {}
+
+        def attempt(active: Iterable[Goal], budget: int, discrepancies: bool = True) -> Attempt:
+            nonlocal total
+            result = setup.search(list(active), budget, discrepancies)
+            total += result.nodes
+            return result
+
+        base = attempt([], self.goal_nodes)
+        if base.node is None:
+            why = "no plan satisfies the problem's required assertions and constraints"
+            return PlanResult(None, tuple(GoalOutcome(g.text, g.priority, g.hold.line, False, why) for g in goals),
+                              reason=f"{why}: {explain(base)}", nodes=total, seconds=time.perf_counter() - started)
+        candidates = []
+        for goal in goals:
+            alone = attempt([goal], self.goal_nodes)
+            if alone.node is None and alone.exhausted:
+                outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False,
+                                                   f"impossible even alone: {explain(alone)}")
+            else:
+                candidates.append(goal)
+        # Every goal at once, depth first: when the heuristic leads there, the plan comes in a few
+        # hundred partial plans; when not, the goals are added one by one below.
+        best = attempt(candidates, self.nodes, discrepancies=False) if candidates else base
+        kept = list(candidates) if best.node is not None else []
+        if best.node is None:
+            # Highest priority first; within a priority, in the order the problem lists them.
+            best = base
+            for goal in sorted(candidates, key=lambda g: (-g.priority, g.index)):
+                tried = attempt(kept + [goal], self.goal_nodes)
+                if tried.node is not None:
+                    kept.append(goal)
+                    best = tried
+                else:
+                    higher = ", ".join(g.text for g in kept) or "none"
+                    outcomes[goal.index] = GoalOutcome(
+                        goal.text, goal.priority, goal.hold.line, False,
+                        f"cannot be met together with the goals kept before it ({higher}): {explain(tried)}")
+        for goal in kept:
+            outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, True)
+        assert best.node is not None
+        plan, notes = setup.extract(best.node, self.exact)
+        ordered = tuple(outcomes[g.index] for g in goals)
+        return PlanResult(plan, ordered, nodes=total, seconds=time.perf_counter() - started, notes=notes)
+
+
+def explain(attempt: Attempt) -> str:
+    if attempt.node is not None:
+        return "planned"
+    scope = "every partial plan failed" if attempt.exhausted else f"no plan within {attempt.nodes} partial plans"
+    if not attempt.failures:
+        return scope
+    common = ", ".join(f"{why}" for why, _ in attempt.failures.most_common(2))
+    return f"{scope}; most often: {common}"
+
+
+def _generic(message: str) -> str:
+    """A dead end's message without instance numbers, so that alike failures count together."""
+    return re.sub(r"#\d+", "", message)
+
+
+# ---------------------------------------------------------------- one problem
+
+
+class Setup:
+    """A problem made ready to plan: its goals, the contingent instants and the constraints."""
+
+    def __init__(self, domain: pm.PlanningDomain, problem: pm.Problem, now: float, limits: Limits) -> None:
+        if problem.domain != domain.name:
+            raise PlanningInputError(f"problem '{problem.name}' is written for domain '{problem.domain}', "
+                                     f"not '{domain.name}'")
+        self.domain = domain
+        self.problem = problem
+        self.now = now
+        self.limits = limits
+        self.origin = problem.start
+        self.goals = [Goal(i, a, a.goal.priority) for i, a in enumerate(problem.assertions)
+                      if isinstance(a, (pm.Hold, pm.Event)) and a.goal is not None]
+        for a in problem.assertions:
+            if not isinstance(a, (pm.Hold, pm.Event, pm.Use)):
+                continue
+            if isinstance(a, pm.Event) and a.kind == "" and a.goal is None:
+                continue
+            if pm.subject(a) not in {x.name for x in domain.attributes} | {r.name for r in domain.resources}:
+                raise PlanningInputError(f"line {a.line}: unknown attribute '{pm.subject(a)}' in problem "
+                                         f"'{problem.name}'")
+            declared = domain.attribute(pm.subject(a))
+            # An explained event's former value is history: only what it sets must be a value.
+            values: tuple[pm.Expr, ...] = (a.value,) if isinstance(a, pm.Hold) else () if not isinstance(
+                a, pm.Event) else (a.after,) if a.kind == "explained" else (a.before, a.after)
+            for value in values:
+                if (declared is not None and isinstance(declared.values, pm.Symbols) and isinstance(value, pm.Sym)
+                        and value.name not in declared.values.values):
+                    raise PlanningInputError(
+                        f"line {a.line}: '{value.name}' is not a value of {declared.name} "
+                        f"({', '.join(declared.values.values)}), in problem '{problem.name}'")
+        # Nature's instants: the times of contingent events, bounded from the origin.
+        self.contingent = sorted({a.time for a in problem.assertions
+                                  if isinstance(a, pm.Event) and a.kind == "contingent" and a.time != self.origin})
+        bounds: dict[str, tuple[float, float]] = {p: (-INF, INF) for p in self.contingent}
+        self.requirements: list[tuple[str, str, float, float, int]] = []
+        self.nature_before: set[tuple[str, str]] = set()
+        for c in problem.constraints:
+            if isinstance(c, pm.Implies) or not _temporal(c):
+                if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
+                    continue  # a variable's domain
+                raise PlanningInputError(f"line {c.line}: only temporal constraints and variable domains are "
+                                         "planned in a problem")
+            try:
+                pieces = differences(c, origin=self.origin)
+            except ValueError as error:
+                raise PlanningInputError(f"line {c.line}: {error}") from None
+            for first, second, low, high in pieces:
+                nature = {first, second} <= set(self.contingent) | {self.origin}
+                if nature and first == self.origin and second in bounds:
+                    old = bounds[second]
+                    bounds[second] = (max(old[0], low), min(old[1], high))
+                elif not nature:
+                    self.requirements.append((first, second, low, high, c.line))
+                elif low > 0:
+                    self.nature_before.add((first, second))
+                elif high < 0:
+                    self.nature_before.add((second, first))
+                # Constraints among nature's instants alone describe nature: nothing to plan.
+        for point, (low, high) in bounds.items():
+            if not (-INF < low <= high < INF):
+                raise PlanningInputError(f"contingent instant '{point}' needs bounds from {self.origin} "
+                                         f"(e.g. `({point} - {self.origin}) in [a, b];`)")
+        self.bounds = bounds
+        # A goal's own timepoints (used by no other assertion) leave with it.
+        used_by: dict[str, set[int]] = {}
+        for i, a in enumerate(problem.assertions):
+            for point in _points(a):
+                used_by.setdefault(point, set()).add(i)
+        for point in problem.timepoints:
+            if point not in used_by and point not in bounds:
+                used_by[point] = set()  # no assertion uses it (a goal left out of a replanning)
+        goal_indexes = {g.index for g in self.goals}
+        self.owned = {point: owners for point, owners in used_by.items()
+                      if owners <= goal_indexes and point not in (self.origin, problem.end)}
+        self.capacity = {r.name: r.capacity for r in domain.resources}
+
+    def root(self, active: list[Goal], ctx: Context) -> Node:
+        node = Node(ctx)
+        problem = self.problem
+        active_indexes = {g.index for g in active}
+        dropped_points = {p for p, owners in self.owned.items() if not owners & active_indexes}
+        node.require("origin", self.origin, 0.0, 0.0)
+        node.require(self.origin, problem.end, max(0.0, self.now))
+        for point, (low, high) in self.bounds.items():
+            node.anchor[point] = (self.origin, low, high)
+        for point in problem.timepoints:
+            if point not in self.bounds and point not in dropped_points:
+                node.require(self.origin, point, 0.0)
+                node.require(point, problem.end, 0.0)
+        for first, second, low, high, _line in self.requirements:
+            if first in dropped_points or second in dropped_points:
+                continue
+            node.require(first, second, low, high)
+        for var in problem.variables:
+            node.bindings.declare(var, None)
+        for c in problem.constraints:
+            if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
+                domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
+                          else (c.domain.low, c.domain.high))
+                node.bindings.domain[c.expr.name] = domain
+
+        def term(e: pm.Expr) -> Term:
+            if isinstance(e, pm.Num):
+                return e.value
+            if isinstance(e, pm.Sym):
+                return e.name
+            if isinstance(e, pm.Var):
+                return e.name
+            raise PlanningInputError(f"expressions are not planned in assertions: {e}")
+
+        for i, a in enumerate(problem.assertions):
+            if a.goal is not None and i not in active_indexes:
+                continue
+            if isinstance(a, pm.Event):
+                new = node.add_assertion(kind="event", attribute=a.attribute, args=tuple(term(x) for x in a.args),
+                                         value=term(a.after), before=term(a.before), start=a.time, end=a.time,
+                                         owner="problem", given=a.kind in ("explained", "contingent"), line=a.line,
+                                         goal=a.goal)
+            elif isinstance(a, pm.Hold):
+                new = node.add_assertion(kind="hold", attribute=a.attribute, args=tuple(term(x) for x in a.args),
+                                         value=term(a.value), before=None, start=a.start, end=a.end,
+                                         owner="problem", given=False, line=a.line, goal=a.goal)
+                node.require(a.start, a.end, 0.0)
+            else:
+                new = node.add_assertion(kind="use", attribute=a.resource, args=tuple(term(x) for x in a.args),
+                                         value=term(a.amount), before=None, start=a.start, end=a.end,
+                                         owner="problem", given=True, line=a.line)
+            if not new.given:
+                node.open.add(new.id)
+        return node
+
+    # ------------------------------------------------------------ search
+    def search(self, active: list[Goal], budget: int, discrepancies: bool = True) -> Attempt:
+        ctx = Context(self.domain, self.problem.end, self.origin, self.now, self.limits, self.capacity,
+                      nature_before=self.nature_before)
+        failures: Counter[str] = Counter()
+        try:
+            root = self.root(active, ctx)
+        except DeadEnd as error:
+            failures[_generic(str(error))] += 1
+            return Attempt(None, 1, True, failures)
+        # First a plain depth-first search on a quarter of the budget: the heuristic is usually
+        # right, and the few dead ends met are close to where they were made. Then limited
+        # discrepancy search: plans departing from the heuristic at one choice, then two... so
+        # that a wrong early choice costs one discrepancy, not the exhaustion of everything below
+        # it (depth-first search's thrashing).
+        nodes = 0
+        for allowed in itertools.chain((INF,), itertools.count(1)):
+            stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
+            cut = False  # some branch was left out for lack of discrepancies
+            limit = budget // 4 if allowed == INF and discrepancies else budget
+            while stack:
+                node, resolver, used = stack.pop()
+                if resolver is not None:
+                    node = node.copy()
+                nodes += 1
+                if nodes > limit:
+                    if allowed == INF and discrepancies:
+                        cut = True
+                        break
+                    return Attempt(None, nodes - 1, False, failures)
+                try:
+                    if resolver is not None:
+                        resolver.apply(node)
+                    choice = select(node)
+                except DeadEnd as error:
+                    failures[_generic(str(error))] += 1
+                    continue
+                if choice is None:
+                    return Attempt(node, nodes, False, failures)
+                # Children are pushed so that the heuristic's first choice is popped first.
+                for rank in range(len(choice) - 1, -1, -1):
+                    cost = used + (1 if rank else 0)
+                    if cost > allowed:
+                        cut = True
+                        continue
+                    stack.append((node, choice[rank], cost))  # a pass revisits the last one's: never holds the tree
+            if not cut:
+                return Attempt(None, nodes, True, failures)
+        raise AssertionError("unreachable")
+
+    # ------------------------------------------------------------ output
+    def extract(self, node: Node, exact: bool) -> tuple[Plan, tuple[str, ...]]:
+        notes: list[str] = []
+        durations = dict(node.durations)
+        if exact:
+            for instance_id, spec in node.durations.items():
+                instance = node.instances[instance_id]
+                key = tuple(sorted((local, value) for local in instance.task.params + instance.task.variables
+                                   if (value := node.bindings.value(instance.var(local))) is not None))
+                tight = exact_duration(instance.task, key) if spec.contingent else None
+                if tight is not None and spec.low - 1e-6 <= tight[0] <= tight[1] <= spec.high + 1e-6:
+                    # A duration only nature decides may be a little wider than the solver's optimum.
+                    durations[instance_id] = replace(spec, low=max(spec.low, tight[0] - 1e-6),
+                                                     high=min(spec.high, tight[1] + 1e-6))
+        anchors = dict(node.anchor)
+        for instance_id, spec in durations.items():
+            instance = node.instances[instance_id]
+            if spec.contingent:
+                anchors[instance.end] = (instance.start, spec.low, spec.high)
+        network = STN(max(16, len(node.stn.names)))
+        for name in node.stn.names:
+            if name not in anchors:
+                network.point(name)
+        reduced = []
+        for a, b, low, high in node.original:
+            pa, la, ha = anchors.get(a, (a, 0.0, 0.0))
+            pb, lb, hb = anchors.get(b, (b, 0.0, 0.0))
+            if pa == pb:
+                continue
+            new_low = low - (lb - ha) if low > -INF else -INF
+            new_high = high - (hb - la) if high < INF else INF
+            reduced.append((pa, pb, new_low, new_high))
+            try:
+                network.add(pa, pb, new_low, new_high)
+            except Inconsistent:  # rounding only: the search's network, with its tolerance, took it
+                network.add(pa, pb, new_low - 1e-6 if new_low > -INF else -INF,
+                            new_high + 1e-6 if new_high < INF else INF)
+        for instance_id, spec in durations.items():
+            if not spec.contingent:
+                instance = node.instances[instance_id]
+                network.add(instance.start, instance.end, spec.low, spec.high)
+        schedule = network.earliest_schedule()
+        if exact:
+            optimised = optimise_schedule(network, reduced, schedule)
+            if optimised is None:
+                notes.append("CasADi did not return a schedule; the earliest schedule of the network is used")
+            else:
+                schedule = optimised
+        schedule.pop("origin", None)
+        schedule = {name: max(0.0, date) if abs(date) < 1e-6 else date for name, date in schedule.items()}
+        uncontrolled = {}
+        for point, (anchor, low, high) in anchors.items():
+            uncontrolled[point] = (schedule[anchor] + low, schedule[anchor] + high)
+            schedule.pop(point, None)
+        actions = []
+        for instance in sorted(node.instances.values(), key=lambda i: int(i.id.split("#")[1])):
+            task = instance.task
+            spec = durations[instance.id]
+            args = tuple(_chosen(node.bindings.value(instance.var(p))) for p in task.params)
+            values = tuple((v, _chosen(node.bindings.value(instance.var(v)))) for v in task.variables
+                           if isinstance(node.bindings.value(instance.var(v)), str))
+            actions.append(Action(instance.id, task.name, args, instance.start, instance.end,
+                                  schedule[instance.start], (spec.low, spec.high), spec.contingent,
+                                  task.preemptible, network.window(instance.start), values))
+        names = {i.start: i.id for i in node.instances.values()} | {i.end: i.id for i in node.instances.values()}
+        orderings = sorted({(a, b, low) for a, b, low, _ in node.original
+                            if low > -INF and a in names and b in names and names[a] != names[b]})
+        links = tuple(Link(_where(node.assertions[k.producer], node), _where(node.assertions[k.consumer], node),
+                           node.assertions[k.consumer].attribute,
+                           _chosen(node.bindings.value(node.assertions[k.producer].value)))
+                      for k in node.links if node.assertions[k.producer].owner != node.assertions[k.consumer].owner)
+        bindings = {v: _some_value(node.bindings, v) for v in self.problem.variables}
+        plan = Plan(self.domain.name, self.problem.name, tuple(actions), tuple(orderings), links, schedule,
+                    uncontrolled, bindings, "strong", self.now)
+        return plan, tuple(notes)
+
+
+def _chosen(value: Term | None) -> float | str:
+    if value is None:
+        return "?"
+    return value
+
+
+def _some_value(bindings: Bindings, var: str) -> float | str:
+    """The variable's value, or one its domain allows when no assertion of the plan uses it (the
+    initial facts of a dropped goal)."""
+    value = bindings.value(var)
+    if value is not None:
+        return value
+    domain = bindings.domain[bindings.root(var)]
+    if isinstance(domain, frozenset):
+        return min(domain)
+    if isinstance(domain, tuple):
+        return min(max(0.0, domain[0]), domain[1])
+    return 0.0
+
+
+def _where(a: Assertion, node: Node) -> str:
+    return f"{a.owner}: {a.text(node.bindings)}"
+
+
+def optimise_schedule(network: STN, reduced: list[tuple[str, str, float, float]],
+                      earliest: dict[str, float]) -> dict[str, float] | None:
+    """The dispatch dates, by CasADi: every requirement (already rewritten for nature's worst
+    case) as a linear constraint, and the earliest completion as the objective (the sum of the
+    dates, which the earliest date of every timepoint minimises). The result is checked against
+    the network; None when the solver fails or strays."""
+    import casadi
+
+    points = [name for name in network.names if name != "origin"]
+    opti = casadi.Opti()
+    x = opti.variable(len(points))
+    index = {name: i for i, name in enumerate(points)}
+
+    def date(name: str) -> casadi.MX | float:
+        return 0.0 if name == "origin" else x[index[name]]
+
+    for a, b, low, high in reduced:
+        if low > -INF:
+            opti.subject_to(date(b) - date(a) >= low)
+        if high < INF:
+            opti.subject_to(date(b) - date(a) <= high)
+    opti.subject_to(x >= 0)
+    opti.minimize(casadi.sum1(x))
+    opti.set_initial(x, [earliest[p] for p in points])
+    opti.solver("ipopt", {"print_time": False}, {"print_level": 0, "sb": "yes", "max_iter": 500, "tol": 1e-10})
+    try:
+        solution = opti.solve()
+    except RuntimeError:
+        return None
+    values = [float(v) for v in casadi.DM(solution.value(x)).full().ravel()]
+    result = {"origin": 0.0}
+    for name, value in zip(points, values, strict=False):
+        low, high = network.window(name)
+        if not (low - 1e-4 <= value <= high + 1e-4):
+            return None
+        # Snap onto the network's window so that the dates satisfy it exactly.
+        result[name] = min(max(value, low), high)
+    for a, b, low, high in reduced:
+        gap = result[b] - result[a]
+        if gap < low - 1e-4 or gap > high + 1e-4:
+            return None
+    return result
+
+
+# ---------------------------------------------------------------- resolvers and flaw choice
+
+
+@dataclass(frozen=True)
+class Resolver:
+    kind: str  # link | insert | order | apart | bind
+    need: int = -1
+    producer: int = -1
+    task: pm.Task | None = None
+    index: int = -1
+    first: str = ""
+    second: str = ""
+    gap: float = 0.0
+    terms: tuple[Term, Term] = ("", "")
+
+    def apply(self, node: Node) -> None:
+        if self.kind == "link":
+            node.link(node.assertions[self.producer], node.assertions[self.need])
+        elif self.kind == "insert":
+            assert self.task is not None
+            instance = node.insert(self.task)
+            mine = [a for a in node.assertions if a.owner == instance.id and a.kind == "event"]
+            event = self.task.assertions[self.index]
+            assert isinstance(event, pm.Event)
+            producer = next(a for a in mine if a.line == event.line and a.attribute == event.attribute)
+            node.link(producer, node.assertions[self.need])
+        elif self.kind == "order":
+            node.require(self.first, self.second, self.gap)
+        elif self.kind == "apart":
+            node.bindings.keep_apart(*self.terms)
+        elif self.kind == "bind":
+            node.bound(node.bindings.unify(*self.terms))
+
+
+def select(node: Node) -> list[Resolver] | None:
+    """The resolvers of the flaw to solve next (forced ones are applied on the way), or None
+    when the plan has no flaw left: it is a solution."""
+    while True:
+        best: list[Resolver] | None = None
+        forced = False
+        for link, event in list(node.threats()):
+            resolvers = threat_resolvers(node, link.producer, link.consumer, event)
+            if not resolvers:
+                producer = node.assertions[link.producer]
+                consumer = node.assertions[link.consumer]
+                raise DeadEnd(f"{event.text(node.bindings)} of {event.owner} may come while {consumer.owner} "
+                              f"needs the {consumer.attribute} value {producer.owner} gives it")
+            if len(resolvers) == 1:
+                # Constraints only tighten: a threat with one resolver left keeps just that one.
+                resolvers[0].apply(node)
+                forced = True
+            elif best is None or len(resolvers) < len(best):
+                best = resolvers
+        if forced:
+            continue
+        for a, b in node.resource_conflicts():
+            resolvers = [r for r in (Resolver("order", first=a.end, second=b.start),
+                                     Resolver("order", first=b.end, second=a.start))
+                         if node.allows(r.first, r.second, 0.0)]
+            if not resolvers:
+                raise DeadEnd(f"{a.owner} and {b.owner} need more {a.attribute} than there is")
+            if len(resolvers) == 1:
+                resolvers[0].apply(node)
+                forced = True
+                break
+            if best is None or len(resolvers) < len(best):
+                best = resolvers
+        if forced:
+            continue
+        if best is not None:
+            return best
+        picked = pick_need(node)
+        if picked is None:
+            return unbound(node)
+        need, resolvers = picked
+        if not resolvers:
+            raise DeadEnd(f"nothing can give {need.text(node.bindings)} to {need.owner}")
+        if len(resolvers) == 1:
+            resolvers[0].apply(node)
+            continue
+        return resolvers
+
+
+def threat_resolvers(node: Node, producer_id: int, consumer_id: int, event: Assertion) -> list[Resolver]:
+    producer, consumer = node.assertions[producer_id], node.assertions[consumer_id]
+    gap = EPS if consumer.kind == "event" else 0.0
+    options = []
+    before = Resolver("order", first=event.start, second=producer.start, gap=EPS)
+    after = Resolver("order", first=consumer.end, second=event.start, gap=gap)
+    for r in (before, after):
+        if node.surely_before(r.first, r.second, r.gap):
+            return [r]  # already so (nature promises it): nothing to choose
+        if node.allows(r.first, r.second, r.gap):
+            options.append(r)
+    # The order that delays the schedule least first (the minimal-shift rule of scheduling).
+    options.sort(key=lambda r: -(node.bounds(r.first, r.second)[1] - r.gap))
+    for x, y in zip(event.args, consumer.args, strict=False):
+        rx, ry = node.bindings.resolve(x), node.bindings.resolve(y)
+        if (is_var(rx) or is_var(ry)) and rx != ry and node.bindings.possibly_equal(x, y):
+            options.append(Resolver("apart", terms=(x, y)))
+    return options
+
+
+def pick_need(node: Node) -> tuple[Assertion, list[Resolver]] | None:
+    """The open condition to solve next, with its resolvers: the newest task's first (to bind its
+    arguments early), the one with the fewest resolvers among them (a pan-tilt unit's tilt that
+    only a new pan-tilt move gives goes before its pan, which the same move should give too);
+    then the problem's required assertions; then its goals, those that may come earliest first."""
+    if not node.open:
+        return None
+    mine = [node.assertions[i] for i in node.open if node.assertions[i].owner != "problem"]
+    if mine:
+        newest = max(int(a.owner.split("#")[1]) for a in mine)
+        best: tuple[Assertion, list[Resolver]] | None = None
+        for need in sorted((a for a in mine if int(a.owner.split("#")[1]) == newest), key=lambda a: a.id):
+            resolvers = need_resolvers(node, need)
+            if best is None or len(resolvers) < len(best[1]):
+                best = (need, resolvers)
+            if len(resolvers) <= 1:
+                break
+        return best
+
+    def order(a: Assertion) -> tuple[float, float, float, int]:
+        if a.goal is None:
+            return (0.0, 0.0, 0.0, a.id)
+        return (1.0, node.bounds("origin", a.start)[0], a.goal.priority, a.id)
+    need = min((node.assertions[i] for i in node.open), key=order)
+    return need, need_resolvers(node, need)
+
+
+def need_resolvers(node: Node, need: Assertion) -> list[Resolver]:
+    siblings = {node.assertions[k.producer].owner for k in node.links
+                if node.assertions[k.consumer].owner == need.owner and need.owner != "problem"} - {"problem"}
+    existing = node.producers(need)
+    existing.sort(key=lambda e: (e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id))
+    options = [Resolver("link", need=need.id, producer=e.id) for e in existing]
+    options += [Resolver("insert", need=need.id, task=task, index=index) for task, index in node.insertions(need)]
+    return options
+
+
+def unbound(node: Node) -> list[Resolver] | None:
+    """A parameter still free once every condition is met gets a value from its domain."""
+    for instance in node.instances.values():
+        for local in instance.task.params:
+            var = instance.var(local)
+            if node.bindings.value(var) is not None:
+                continue
+            domain = node.bindings.domain[node.bindings.root(var)]
+            values: list[Term]
+            if isinstance(domain, frozenset):
+                values = sorted(domain)
+            elif isinstance(domain, tuple):
+                values = []
+                for v in (0.0, domain[0], domain[1]):
+                    if domain[0] <= v <= domain[1] and abs(v) < INF:
+                        values.append(v)
+                        break
+            else:
+                values = []
+            if not values:
+                raise DeadEnd(f"{var} has no value to take")
+            return [Resolver("bind", terms=(var, v)) for v in values]
+    return None
+
+
+def _temporal(c: pm.Constraint) -> bool:
+    from specc.runtime.planner.search import _temporal as temporal
+
+    return temporal(c)
+
+
+def _points(a: pm.Assertion) -> tuple[str, ...]:
+    if isinstance(a, pm.Event):
+        return (a.time,)
+    return (a.start, a.end)
+
+
+def _expr_text(e: pm.Expr) -> str:
+    if isinstance(e, pm.Num):
+        return f"{e.value:g}"
+    if isinstance(e, (pm.Sym, pm.Var, pm.Time)):
+        return e.name
+    return f"{e.op}({', '.join(_expr_text(a) for a in e.args)})"
+
+
+__all__ = ["Planner", "PlanningInputError", "same_value"]

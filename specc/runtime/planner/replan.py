@@ -1,0 +1,100 @@
+"""Replanning from the current state (seed 004 §3.2.2.3: FTplan sends IxTeT the current state
+as hold/event facts, the goals still to meet and the mission time; IxTeT builds its initial
+plan from them, not from its own, possibly wrong, idea of the past).
+
+The new problem keeps the mission's time origin (windows and goal deadlines stay where they
+were), replaces the initial values of the attributes the facts mention, keeps only the goals
+named as remaining, and the planner schedules nothing before `now`. Tasks still running are the
+caller's business: a non-preemptive one (nonPreemptive, earlyPreemptive) is let finish and its
+outcome sent as facts; a preemptible one (latePreemptive) is stopped first.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, replace
+
+from specc.runtime.planner import model as pm
+
+Value = float | str
+
+
+@dataclass(frozen=True)
+class Fact:
+    """`attribute(args) = value` now."""
+
+    attribute: str
+    args: tuple[Value, ...]
+    value: Value
+
+    @classmethod
+    def parse(cls, text: str) -> Fact:
+        """`AT_ROBOT_X() = 2.5`, `PICTURE(OBJ1, 0, 0) = DONE`."""
+        head, sep, value = text.partition("=")
+        name, paren, rest = head.strip().partition("(")
+        if not sep or not paren or not rest.rstrip().endswith(")") or not name.strip():
+            raise ValueError(f"'{text}' is not a fact: write ATTRIBUTE(args) = value")
+        args = tuple(_value(a) for a in rest.rstrip()[:-1].split(",") if a.strip())
+        return cls(name.strip(), args, _value(value))
+
+
+def _value(text: str) -> Value:
+    text = text.strip()
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def _expr(value: Value) -> pm.Expr:
+    return pm.Num(float(value)) if isinstance(value, (int, float)) else pm.Sym(value)
+
+
+def _matches(event: pm.Event, fact: Fact) -> bool:
+    if event.attribute != fact.attribute or len(event.args) != len(fact.args):
+        return False
+    for arg, value in zip(event.args, fact.args, strict=False):
+        if isinstance(arg, pm.Var):
+            continue  # the problem leaves it open: the fact decides it
+        if arg != _expr(value):
+            return False
+    return True
+
+
+def replanning_problem(problem: pm.Problem, facts: Iterable[Fact], remaining_goals: Iterable[int],
+                       now: float) -> pm.Problem:
+    """The problem FTplan sends at `now`: `facts` as the initial values, only the goals whose
+    source lines are in `remaining_goals`."""
+    facts = list(facts)
+    remaining = set(remaining_goals)
+    assertions: list[pm.Assertion] = []
+    for a in problem.assertions:
+        if isinstance(a, pm.Event) and a.kind == "explained" and any(_matches(a, f) for f in facts):
+            continue  # the present replaces what the problem said of the start
+        if a.goal is not None and a.line not in remaining:
+            continue
+        assertions.append(a)
+    for fact in facts:
+        value = _expr(fact.value)
+        assertions.append(pm.Event(fact.attribute, tuple(_expr(x) for x in fact.args), value, value,
+                                   problem.start, kind="explained"))
+    # The timepoints of the goals left out go with them, and so do the constraints on them.
+    used = {point for a in assertions for point in ((a.time,) if isinstance(a, pm.Event) else (a.start, a.end))}
+    gone = {point for point in problem.timepoints if point not in used}
+    constraints = tuple(c for c in problem.constraints if not _times(c) & gone)
+    return replace(problem, name=f"{problem.name}@{now:g}", assertions=tuple(assertions), constraints=constraints,
+                   timepoints=tuple(p for p in problem.timepoints if p not in gone))
+
+
+def _times(c: pm.Constraint | pm.Expr) -> set[str]:
+    if isinstance(c, pm.Time):
+        return {c.name}
+    if isinstance(c, pm.Op):
+        return set().union(*(_times(a) for a in c.args))
+    if isinstance(c, pm.Member):
+        return _times(c.expr)
+    if isinstance(c, pm.Relation):
+        return _times(c.left) | _times(c.right)
+    if isinstance(c, pm.Implies):
+        return _times(c.condition) | _times(c.consequence)
+    return set()

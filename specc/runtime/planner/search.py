@@ -1,0 +1,688 @@
+"""Plan-space search over partial plans, as IxTeT does (seed 004 §3.2.1.2, Fig 3.6).
+
+A partial plan holds task instances, their assertions, causal links, variable bindings and a
+temporal network. Its flaws are open conditions (a hold, or the value an event changes, with
+nothing yet giving it), threats (an event that may change a value while a link protects it)
+and resource conflicts. Resolvers link an existing event, insert a task, order two timepoints
+or keep two arguments apart; the flaw with the fewest resolvers is solved first, and a flaw
+with a single resolver is solved at once.
+
+The temporal network is kept in its strongly controllable form: a timepoint nature decides (a
+contingent task end, a visibility window's instant) is never scheduled itself; every constraint
+on it is rewritten on the timepoint it hangs from, for its worst offset (Vidal & Fargier). So
+the network is consistent exactly when one schedule of the plan's own timepoints works for every
+duration nature may pick, and each resolver is checked against that at once.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.numeric import DurationSpec, Empty, duration_of, is_number
+from specc.runtime.stn import STN, Inconsistent
+
+INF = math.inf
+EPS = 0.01  # seconds between two events that must not be simultaneous (IxTeT's strict precedence)
+TOLERANCE = 1e-6
+SURELY = 10 * TOLERANCE  # a bound this close counts as met: the network loosens each constraint by TOLERANCE
+Term = float | str  # a value, or a variable when the string holds a '?'
+
+
+class DeadEnd(Exception):
+    """This partial plan has no completion."""
+
+
+def is_var(term: Term) -> bool:
+    return isinstance(term, str) and "?" in term
+
+
+def same_value(a: Term, b: Term) -> bool:
+    if is_number(a) and is_number(b):
+        return abs(float(a) - float(b)) <= TOLERANCE
+    return a == b
+
+
+# ---------------------------------------------------------------- bindings
+
+
+class Bindings:
+    """Variables of the plan in codesignation classes, each with a domain (symbols or an
+    interval); `apart` pairs must never codesignate."""
+
+    def __init__(self) -> None:
+        self.parent: dict[str, str] = {}
+        self.domain: dict[str, frozenset[str] | tuple[float, float] | None] = {}
+        self.apart: list[tuple[Term, Term]] = []
+
+    def copy(self) -> Bindings:
+        other = Bindings.__new__(Bindings)
+        other.parent = dict(self.parent)
+        other.domain = dict(self.domain)
+        other.apart = list(self.apart)
+        return other
+
+    def declare(self, var: str, domain: frozenset[str] | tuple[float, float] | None) -> None:
+        self.parent[var] = var
+        self.domain[var] = domain
+
+    def root(self, var: str) -> str:
+        while self.parent[var] != var:
+            self.parent[var] = self.parent[self.parent[var]]
+            var = self.parent[var]
+        return var
+
+    def resolve(self, term: Term) -> Term:
+        """The term's value when known, else its class's representative."""
+        if not is_var(term):
+            return term
+        assert isinstance(term, str)
+        r = self.root(term)
+        d = self.domain[r]
+        if isinstance(d, frozenset) and len(d) == 1:
+            return next(iter(d))
+        if isinstance(d, tuple) and d[0] == d[1]:
+            return d[0]
+        return r
+
+    def value(self, term: Term) -> Term | None:
+        resolved = self.resolve(term)
+        return None if is_var(resolved) else resolved
+
+    def possibly_equal(self, a: Term, b: Term) -> bool:
+        a, b = self.resolve(a), self.resolve(b)
+        if not is_var(a) and not is_var(b):
+            return same_value(a, b)
+        if is_var(a) and is_var(b) and a == b:
+            return True
+        if any(self._same_pair(a, b, x, y) for x, y in self.apart):
+            return False
+        for var, other in ((a, b), (b, a)):
+            if is_var(var) and not is_var(other):
+                return self._admits(self.domain[str(var)], other)
+        da, db = self.domain[str(a)], self.domain[str(b)]
+        if isinstance(da, frozenset) and isinstance(db, frozenset):
+            return bool(da & db)
+        if isinstance(da, tuple) and isinstance(db, tuple):
+            return max(da[0], db[0]) <= min(da[1], db[1]) + TOLERANCE
+        return da is None or db is None
+
+    def _same_pair(self, a: Term, b: Term, x: Term, y: Term) -> bool:
+        x, y = self.resolve(x), self.resolve(y)
+        return (same_value(a, x) and same_value(b, y)) or (same_value(a, y) and same_value(b, x))
+
+    @staticmethod
+    def _admits(domain: frozenset[str] | tuple[float, float] | None, value: Term) -> bool:
+        if domain is None:
+            return True
+        if isinstance(domain, frozenset):
+            return isinstance(value, str) and value in domain
+        return is_number(value) and domain[0] - TOLERANCE <= float(value) <= domain[1] + TOLERANCE
+
+    def unify(self, a: Term, b: Term) -> list[str]:
+        """Make a and b codesignate; returns the variables that gained a value (raises DeadEnd)."""
+        ra, rb = self.resolve(a), self.resolve(b)
+        if not is_var(ra) and not is_var(rb):
+            if not same_value(ra, rb):
+                raise DeadEnd(f"{ra} is not {rb}")
+            return []
+        if not is_var(ra):
+            ra, rb = rb, ra
+        assert isinstance(ra, str)
+        if is_var(rb):
+            assert isinstance(rb, str)
+            if ra == rb:
+                return []
+            da, db = self.domain[ra], self.domain[rb]
+            merged = self._meet(da, db)
+            self.parent[rb] = ra
+            self.domain[ra] = merged
+        else:
+            if not self._admits(self.domain[ra], rb):
+                raise DeadEnd(f"{rb} is outside the domain of {ra}")
+            self.domain[ra] = frozenset((rb,)) if isinstance(rb, str) else (float(rb), float(rb))
+        for x, y in self.apart:
+            rx, ry = self.resolve(x), self.resolve(y)
+            if (not is_var(rx) and not is_var(ry) and same_value(rx, ry)) or (is_var(rx) and rx == ry):
+                raise DeadEnd(f"{x} and {y} must differ")
+        return [v for v in self.parent if self.root(v) == ra]
+
+    @staticmethod
+    def _meet(da: frozenset[str] | tuple[float, float] | None,
+              db: frozenset[str] | tuple[float, float] | None) -> frozenset[str] | tuple[float, float] | None:
+        if da is None:
+            return db
+        if db is None:
+            return da
+        if isinstance(da, frozenset) and isinstance(db, frozenset):
+            if not da & db:
+                raise DeadEnd("no common value")
+            return da & db
+        if isinstance(da, tuple) and isinstance(db, tuple):
+            low, high = max(da[0], db[0]), min(da[1], db[1])
+            if low > high + TOLERANCE:
+                raise DeadEnd("no common value")
+            return (low, max(low, high))
+        raise DeadEnd("a symbol cannot equal a number")
+
+    def keep_apart(self, a: Term, b: Term) -> None:
+        if not self.possibly_equal(a, b):
+            return
+        ra, rb = self.resolve(a), self.resolve(b)
+        if not is_var(ra) and not is_var(rb):
+            raise DeadEnd(f"{ra} and {rb} must differ")
+        if (is_var(ra) and ra == rb):
+            raise DeadEnd(f"{a} and {b} must differ")
+        # A symbol apart from a constant simply loses that value.
+        for var, other in ((ra, rb), (rb, ra)):
+            if is_var(var) and not is_var(other) and isinstance(self.domain[str(var)], frozenset):
+                remaining = self.domain[str(var)] - {other}  # type: ignore[operator]
+                if not remaining:
+                    raise DeadEnd(f"{a} has no value left")
+                self.domain[str(var)] = remaining
+                return
+        self.apart.append((a, b))
+
+
+# ---------------------------------------------------------------- partial plans
+
+
+@dataclass(frozen=True)
+class Assertion:
+    id: int
+    kind: str  # event | hold | use
+    attribute: str
+    args: tuple[Term, ...]
+    value: Term  # after (event), value (hold), amount (use)
+    before: Term | None  # event only
+    start: str  # timepoints (an event: start == end)
+    end: str
+    owner: str  # task instance id, or "problem"
+    given: bool  # explained or contingent: needs no support
+    line: int
+    goal: pm.GoalMark | None = None
+
+    def text(self, bindings: Bindings | None = None) -> str:
+        show = (lambda t: t) if bindings is None else bindings.resolve
+
+        def fmt(t: Term) -> str:
+            value = show(t)
+            return f"{value:g}" if isinstance(value, float) else str(value)
+        args = f"({', '.join(fmt(a) for a in self.args)})"
+        if self.kind == "event":
+            assert self.before is not None
+            return f"event({self.attribute}{args}: ({fmt(self.before)}, {fmt(self.value)}))"
+        if self.kind == "hold":
+            return f"hold({self.attribute}{args}: {fmt(self.value)})"
+        return f"use({self.attribute}{args}: {fmt(self.value)})"
+
+
+@dataclass(frozen=True)
+class Instance:
+    id: str
+    task: pm.Task
+    variables: tuple[str, ...]  # plan variables, in the order params + task.variables
+
+    def var(self, local: str) -> str:
+        return f"{self.id}{local}"
+
+    def point(self, local: str) -> str:
+        return f"{self.id}.{local}"
+
+    @property
+    def start(self) -> str:
+        return self.point(self.task.start)
+
+    @property
+    def end(self) -> str:
+        return self.point(self.task.end)
+
+
+@dataclass(frozen=True)
+class Link:
+    producer: int
+    consumer: int
+
+
+@dataclass
+class Limits:
+    nodes: int = 20000
+    instances: int = 60
+    per_task: int = 20
+
+
+@dataclass
+class Context:
+    """What every node of one search shares."""
+
+    domain: pm.PlanningDomain
+    horizon_end: str
+    origin: str
+    now: float
+    limits: Limits
+    capacity: Mapping[str, float]
+    producers: dict[str, list[tuple[pm.Task, int]]] = field(default_factory=dict)  # attribute -> (task, event index)
+    failures: dict[str, int] = field(default_factory=dict)  # why resolvers failed, for explanations
+    # Orders nature promises between its own instants (`t_evisi1 < t_svisi2`): (earlier, later).
+    nature_before: set[tuple[str, str]] = field(default_factory=set)
+
+    def __post_init__(self) -> None:
+        for task in self.domain.tasks:
+            for i, a in enumerate(task.assertions):
+                if isinstance(a, pm.Event):
+                    self.producers.setdefault(a.attribute, []).append((task, i))
+
+    def fail(self, reason: str) -> None:
+        self.failures[reason] = self.failures.get(reason, 0) + 1
+
+
+class Node:
+    """One partial plan; children are copies (the search backtracks by dropping them)."""
+
+    def __init__(self, ctx: Context) -> None:
+        self.ctx = ctx
+        self.stn = STN(64)
+        self.anchor: dict[str, tuple[str, float, float]] = {}  # contingent point -> (point, low, high)
+        self.original: list[tuple[str, str, float, float]] = []  # every requirement, as written
+        self.bindings = Bindings()
+        self.instances: dict[str, Instance] = {}
+        self.assertions: list[Assertion] = []
+        self.open: set[int] = set()
+        self.links: list[Link] = []
+        self.durations: dict[str, DurationSpec] = {}  # ground instances
+        self.provisional: dict[str, float] = {}  # instance -> lower bound on its duration so far
+        # Possible threats are tracked incrementally: a new link meets the events already there,
+        # a new event the links; a pair shown harmless stays so in every descendant (constraints
+        # only tighten and bindings only narrow down a branch), so it is dropped for good.
+        self.pending: set[tuple[int, int]] = set()  # (link index, event id) not yet shown harmless
+        self.counter = 0
+
+    def copy(self) -> Node:
+        other = Node.__new__(Node)
+        other.ctx = self.ctx
+        other.stn = self.stn.copy()
+        other.anchor = dict(self.anchor)
+        other.original = list(self.original)
+        other.bindings = self.bindings.copy()
+        other.instances = dict(self.instances)
+        other.assertions = list(self.assertions)
+        other.open = set(self.open)
+        other.links = list(self.links)
+        other.durations = dict(self.durations)
+        other.provisional = dict(self.provisional)
+        other.pending = set(self.pending)
+        other.counter = self.counter
+        return other
+
+    # ------------------------------------------------------------ time
+    def _translate(self, a: str, b: str, low: float, high: float) -> tuple[str, str, float, float]:
+        """`low <= t(b) - t(a) <= high` for every offset nature gives a and b."""
+        pa, la, ha = self.anchor.get(a, (a, 0.0, 0.0))
+        pb, lb, hb = self.anchor.get(b, (b, 0.0, 0.0))
+        new_low = low - (lb - ha) if low > -INF else -INF
+        new_high = high - (hb - la) if high < INF else INF
+        return pa, pb, new_low, new_high
+
+    def require(self, a: str, b: str, low: float = -INF, high: float = INF, record: bool = True) -> None:
+        """Require `low <= t(b) - t(a) <= high` (raises DeadEnd when the network refuses)."""
+        if record:
+            self.original.append((a, b, low, high))
+        pa, pb, new_low, new_high = self._translate(a, b, low, high)
+        if pa == pb:
+            if new_low > TOLERANCE or new_high < -TOLERANCE:
+                raise DeadEnd(f"{b} - {a} cannot stay in [{low:g}, {high:g}] whatever nature does")
+            return
+        try:
+            self.stn.add(pa, pb, new_low - TOLERANCE if new_low > -INF else new_low,
+                         new_high + TOLERANCE if new_high < INF else new_high)
+        except Inconsistent as error:
+            raise DeadEnd(str(error)) from None
+
+    def allows(self, a: str, b: str, low: float = -INF, high: float = INF) -> bool:
+        pa, pb, new_low, new_high = self._translate(a, b, low, high)
+        if pa == pb:
+            return new_low <= TOLERANCE and new_high >= -TOLERANCE
+        return self.stn.allows(pa, pb, new_low - TOLERANCE, new_high + TOLERANCE)
+
+    def bounds(self, a: str, b: str) -> tuple[float, float]:
+        """What t(b) - t(a) may be, nature's choices included."""
+        if a == b:
+            return 0.0, 0.0
+        pa, la, ha = self.anchor.get(a, (a, 0.0, 0.0))
+        pb, lb, hb = self.anchor.get(b, (b, 0.0, 0.0))
+        if pa == pb:
+            return lb - ha, hb - la
+        index, d = self.stn.index, self.stn._distance
+        i, j = index[pa], index[pb]
+        return float(-d[j, i]) + lb - ha, float(d[i, j]) + hb - la
+
+    def surely_before(self, a: str, b: str, gap: float) -> bool:
+        """Does b come at least `gap` after a, whatever nature does?"""
+        return (a, b) in self.ctx.nature_before or self.bounds(a, b)[0] >= gap - SURELY
+
+    def make_contingent(self, point: str, start: str, low: float, high: float) -> None:
+        """Nature now places `point` within [low, high] after `start`: every requirement already
+        written on it is rewritten for its worst case."""
+        self.anchor[point] = (start, low, high)
+        for a, b, lo, hi in self.original:
+            if point in (a, b):
+                self.require(a, b, lo, hi, record=False)
+
+    # ------------------------------------------------------------ assertions
+    def add_assertion(self, **fields: object) -> Assertion:
+        assertion = Assertion(id=len(self.assertions), **fields)  # type: ignore[arg-type]
+        self.assertions.append(assertion)
+        if assertion.kind == "event":
+            for k, link in enumerate(self.links):
+                if self.assertions[link.consumer].attribute == assertion.attribute:
+                    self.pending.add((k, assertion.id))
+        return assertion
+
+    def link(self, producer: Assertion, consumer: Assertion) -> None:
+        """`producer` gives the value `consumer` needs, before it."""
+        if producer.kind != "event" or producer.attribute != consumer.attribute:
+            raise DeadEnd("not a producer")
+        changed: list[str] = []
+        for a, b in zip(producer.args, consumer.args, strict=False):
+            changed += self.bindings.unify(a, b)
+        needed = consumer.before if consumer.kind == "event" else consumer.value
+        assert needed is not None
+        changed += self.bindings.unify(producer.value, needed)
+        self.require(producer.start, consumer.start, EPS if consumer.kind == "event" else 0.0)
+        self.links.append(Link(producer.id, consumer.id))
+        k = len(self.links) - 1
+        for e in self.assertions:
+            if e.kind == "event" and e.attribute == consumer.attribute and e.id not in (producer.id, consumer.id):
+                self.pending.add((k, e.id))
+        self.open.discard(consumer.id)
+        self.bound(changed)
+
+    def bound(self, variables: list[str]) -> None:
+        """Variables gained values: ground the instances that now can be."""
+        owners = {v.split("?", 1)[0] for v in variables if "#" in v.split("?", 1)[0]}
+        for owner in sorted(owners):
+            self.ground(owner)
+
+    def ground(self, instance_id: str) -> None:
+        instance = self.instances.get(instance_id)
+        if instance is None or instance_id in self.durations:
+            return
+        task = instance.task
+        known = {}
+        for local in task.params + task.variables:
+            value = self.bindings.value(instance.var(local))
+            if value is not None:
+                known[local] = value
+        try:
+            spec = duration_of(task, known)
+        except Empty as error:
+            self.ctx.fail(f"{task.name} impossible: {error}")
+            raise DeadEnd(f"{instance_id}: {error}") from None
+        # Variables the task's constraints fix (Modele2's distance symbol) bind the plan's too.
+        changed: list[str] = []
+        for local, value in spec.variables.items():
+            var = instance.var(local)
+            if var in self.bindings.parent and self.bindings.value(var) is None:
+                changed += self.bindings.unify(var, value)
+        complete = all(local in known for local in task.params)
+        if complete and spec.high < INF:
+            self.durations[instance_id] = spec
+            if spec.contingent:
+                self.make_contingent(instance.end, instance.start, spec.low, spec.high)
+            else:
+                self.require(instance.start, instance.end, spec.low, spec.high)
+        elif spec.low > self.provisional.get(instance_id, 0.0):
+            self.provisional[instance_id] = spec.low
+            self.require(instance.start, instance.end, spec.low, INF, record=False)
+        if changed:
+            self.bound(changed)
+
+    # ------------------------------------------------------------ tasks
+    def insert(self, task: pm.Task) -> Instance:
+        count = sum(1 for i in self.instances.values() if i.task.name == task.name)
+        if count >= self.ctx.limits.per_task or len(self.instances) >= self.ctx.limits.instances:
+            raise DeadEnd("too many tasks")
+        self.counter += 1
+        instance = Instance(f"{task.name}#{self.counter}", task,
+                            tuple(f"{task.name}#{self.counter}{v}" for v in task.params + task.variables))
+        self.instances[instance.id] = instance
+        for var in instance.variables:
+            self.bindings.declare(var, None)
+        point = instance.point
+        self.stn.point(instance.start)
+        self.stn.point(instance.end)
+        self.require(self.ctx.origin, instance.start, self.ctx.now)
+        self.require(instance.start, instance.end, 0.0)
+        self.require(instance.end, self.ctx.horizon_end, 0.0)
+        for name in task.timepoints:
+            self.require(instance.start, point(name), 0.0)
+            self.require(point(name), instance.end, 0.0)
+
+        def term(e: pm.Expr) -> Term:
+            if isinstance(e, pm.Num):
+                return e.value
+            if isinstance(e, pm.Sym):
+                return e.name
+            if isinstance(e, pm.Var):
+                return instance.var(e.name)
+            raise DeadEnd(f"{task.name}: expressions in assertions are not planned: {e}")
+
+        # Domains of the task's variables, and what keeps them apart.
+        for c in task.constraints:
+            if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var) and not c.contingent:
+                var = instance.var(c.expr.name)
+                domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
+                          else (c.domain.low, c.domain.high))
+                self.bindings.domain[var] = Bindings._meet(self.bindings.domain[var], domain)
+            elif isinstance(c, pm.Relation) and c.op == "!=" and not _temporal(c.left) and not _temporal(c.right):
+                self.bindings.keep_apart(term(c.left), term(c.right))
+            elif isinstance(c, (pm.Member, pm.Relation)) and _temporal(c) and not _is_duration(c, task):
+                for first, second, low, high in differences(c, point, self.ctx.origin):
+                    self.require(first, second, low, high)
+        start_events: dict[tuple[str, str], Assertion] = {}
+        for a in task.assertions:
+            if isinstance(a, pm.Event):
+                new = self.add_assertion(kind="event", attribute=a.attribute, args=tuple(term(x) for x in a.args),
+                                         value=term(a.after), before=term(a.before), start=point(a.time),
+                                         end=point(a.time), owner=instance.id, given=False, line=a.line)
+            elif isinstance(a, pm.Hold):
+                new = self.add_assertion(kind="hold", attribute=a.attribute, args=tuple(term(x) for x in a.args),
+                                         value=term(a.value), before=None, start=point(a.start), end=point(a.end),
+                                         owner=instance.id, given=False, line=a.line)
+            else:
+                new = self.add_assertion(kind="use", attribute=a.resource, args=tuple(term(x) for x in a.args),
+                                         value=term(a.amount), before=None, start=point(a.start), end=point(a.end),
+                                         owner=instance.id, given=True, line=a.line)
+                self.require(new.start, new.end, 0.0)
+                continue
+            self.open.add(new.id)
+            key = (new.attribute, new.start)
+            if new.kind == "event":
+                # The task's own start event gives what its holds and its later events need.
+                own = start_events.get(key)
+                if own is None:
+                    start_events[key] = new
+            self._own_support(new, instance)
+        self.ground(instance.id)
+        return instance
+
+    def _own_support(self, new: Assertion, instance: Instance) -> None:
+        """Link the task's assertions the task itself explains (its start event sets the value a
+        hold over the task, or its end event, needs): IxTeT writes tasks this way."""
+        mine = [a for a in self.assertions if a.owner == instance.id]
+        for producer in mine:
+            for consumer in mine:
+                if (consumer.id in self.open and producer.kind == "event" and producer is not consumer
+                        and producer.attribute == consumer.attribute and producer.args == consumer.args
+                        and producer.value == (consumer.before if consumer.kind == "event" else consumer.value)
+                        and producer.start == instance.start and consumer.start in (instance.start, instance.end)
+                        and not (consumer.kind == "event" and consumer.start == producer.start)):
+                    self.link(producer, consumer)
+
+    # ------------------------------------------------------------ flaws
+    def producers(self, need: Assertion) -> list[Assertion]:
+        found = []
+        wanted = need.before if need.kind == "event" else need.value
+        assert wanted is not None
+        gap = EPS if need.kind == "event" else 0.0
+        for e in self.assertions:
+            if (e.kind != "event" or e.attribute != need.attribute or e.id == need.id
+                    or not self.bindings.possibly_equal(e.value, wanted)
+                    or not all(self.bindings.possibly_equal(x, y) for x, y in zip(e.args, need.args, strict=False))
+                    or not self.allows(e.start, need.start, gap)):
+                continue
+            found.append(e)
+        return found
+
+    def insertions(self, need: Assertion) -> list[tuple[pm.Task, int]]:
+        wanted = need.before if need.kind == "event" else need.value
+        assert wanted is not None
+        options = []
+        for task, index in self.ctx.producers.get(need.attribute, []):
+            event = task.assertions[index]
+            assert isinstance(event, pm.Event)
+            if not _could_be(event.after, wanted, task, self.bindings) or not all(
+                    _could_be(x, y, task, self.bindings) for x, y in zip(event.args, need.args, strict=False)):
+                continue
+            options.append((task, index))
+        return options
+
+    def threats(self) -> Iterator[tuple[Link, Assertion]]:
+        for k, event_id in sorted(self.pending):
+            link = self.links[k]
+            producer, consumer, e = self.assertions[link.producer], self.assertions[link.consumer], \
+                self.assertions[event_id]
+            gap = EPS if consumer.kind == "event" else 0.0
+            if ((e.before is not None and same_value(self.bindings.resolve(e.before), self.bindings.resolve(e.value)))
+                    or not all(self.bindings.possibly_equal(x, y) for x, y in zip(e.args, consumer.args, strict=False))
+                    or self.surely_before(e.start, producer.start, EPS)
+                    or self.surely_before(consumer.end, e.start, gap)):
+                self.pending.discard((k, event_id))
+                continue
+            yield link, e
+
+    def resource_conflicts(self) -> Iterator[tuple[Assertion, Assertion]]:
+        uses = [a for a in self.assertions if a.kind == "use"]
+        for a, b in itertools.combinations(uses, 2):
+            if a.attribute != b.attribute or not all(
+                    self.bindings.possibly_equal(x, y) for x, y in zip(a.args, b.args, strict=False)):
+                continue
+            amount = _number(self.bindings.resolve(a.value)) + _number(self.bindings.resolve(b.value))
+            if amount <= self.ctx.capacity.get(a.attribute, 1.0) + TOLERANCE:
+                continue
+            if self.bounds(a.end, b.start)[0] >= -SURELY or self.bounds(b.end, a.start)[0] >= -SURELY:
+                continue
+            yield a, b
+
+
+def _number(value: Term) -> float:
+    return float(value) if is_number(value) else 1.0
+
+
+def _temporal(e: pm.Expr | pm.Constraint) -> bool:
+    if isinstance(e, pm.Member):
+        return _temporal(e.expr)
+    if isinstance(e, pm.Relation):
+        return _temporal(e.left) or _temporal(e.right)
+    if isinstance(e, pm.Implies):
+        return False
+    if isinstance(e, pm.Time):
+        return True
+    return isinstance(e, pm.Op) and any(_temporal(a) for a in e.args)
+
+
+def _is_duration(c: pm.Constraint, task: pm.Task) -> bool:
+    span = pm.Op("-", (pm.Time(task.end), pm.Time(task.start)))
+    if isinstance(c, pm.Member):
+        return c.expr == span
+    if isinstance(c, pm.Relation):
+        return span in (c.left, c.right)
+    return False
+
+
+def _could_be(e: pm.Expr, wanted: Term, task: pm.Task, bindings: Bindings) -> bool:
+    """Could a new instance's `e` (a constant, or a variable of `task`) equal `wanted`?"""
+    if isinstance(e, pm.Num):
+        value = bindings.resolve(wanted)
+        return is_var(value) or same_value(e.value, value)
+    if isinstance(e, pm.Sym):
+        value = bindings.resolve(wanted)
+        return (bindings.possibly_equal(wanted, e.name) if is_var(value) else value == e.name)
+    if isinstance(e, pm.Var):
+        value = bindings.resolve(wanted)
+        if is_var(value):
+            return True
+        for c in task.constraints:
+            if isinstance(c, pm.Member) and c.expr == e and not c.contingent:
+                if isinstance(c.domain, pm.Symbols) and value not in c.domain.values:
+                    return False
+                if isinstance(c.domain, pm.Interval) and not (
+                        is_number(value) and c.domain.low <= float(value) <= c.domain.high):
+                    return False
+        return True
+    return True
+
+
+def linear(e: pm.Expr) -> tuple[dict[str, float], float] | None:
+    """`e` as sum(coefficient * timepoint) + constant, or None when it is not linear in time."""
+    if isinstance(e, pm.Num):
+        return {}, e.value
+    if isinstance(e, pm.Time):
+        return {e.name: 1.0}, 0.0
+    if isinstance(e, pm.Op) and e.op in ("+", "-", "neg"):
+        parts = [linear(a) for a in e.args]
+        if any(p is None for p in parts):
+            return None
+        sign = -1.0 if e.op in ("-", "neg") else 1.0
+        first = parts[0]
+        assert first is not None
+        if e.op == "neg":
+            return {k: -v for k, v in first[0].items()}, -first[1]
+        second = parts[1]
+        assert second is not None
+        coefficients = dict(first[0])
+        for k, v in second[0].items():
+            coefficients[k] = coefficients.get(k, 0.0) + sign * v
+        return {k: v for k, v in coefficients.items() if v}, first[1] + sign * second[1]
+    return None
+
+
+def differences(c: pm.Member | pm.Relation, rename: Callable[[str], str] = str,
+                origin: str = "t_start") -> list[tuple[str, str, float, float]]:
+    """A temporal constraint as `low <= t(b) - t(a) <= high` requirements, its timepoints
+    renamed (a date alone is measured from `origin`); ValueError when it is not a difference of
+    two timepoints."""
+    if isinstance(c, pm.Member):
+        if not isinstance(c.domain, pm.Interval):
+            raise ValueError("a timepoint takes numbers")
+        form = linear(c.expr)
+        low, high = c.domain.low, c.domain.high
+    else:
+        left, right = linear(c.left), linear(c.right)
+        form = None
+        if left is not None and right is not None:
+            coefficients = dict(left[0])
+            for k, v in right[0].items():
+                coefficients[k] = coefficients.get(k, 0.0) - v
+            form = ({k: v for k, v in coefficients.items() if v}, left[1] - right[1])
+        strict = EPS if c.op in ("<", ">") else 0.0
+        bounds = {"=": (0.0, 0.0), "<": (-INF, -strict), "<=": (-INF, 0.0), ">": (strict, INF), ">=": (0.0, INF)}
+        if c.op not in bounds:
+            raise ValueError(f"'{c.op}' between timepoints")
+        low, high = bounds[c.op]
+    if form is None:
+        raise ValueError("not linear in time")
+    coefficients, constant = form
+    low, high = low - constant, high - constant
+    plus = [k for k, v in coefficients.items() if v == 1.0]
+    minus = [k for k, v in coefficients.items() if v == -1.0]
+    if len(coefficients) == 2 and len(plus) == 1 and len(minus) == 1:
+        return [(rename(minus[0]), rename(plus[0]), low, high)]
+    if len(coefficients) == 1 and len(plus) == 1:
+        return [(origin, rename(plus[0]), low, high)]
+    if len(coefficients) == 1 and len(minus) == 1:
+        return [(rename(minus[0]), origin, low, high)]
+    raise ValueError("only differences of two timepoints are temporal constraints")

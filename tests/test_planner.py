@@ -1,0 +1,282 @@
+"""The planner on the rover missions of seed 004 (annex A's Modele1 and Modele2, missions M1-M4):
+every plan it returns is checked by the independent validator; goals are dropped by priority and
+explained; replanning starts from the present; bad input ends in a reason, not a crash."""
+
+from __future__ import annotations
+
+import textwrap
+from dataclasses import replace
+from functools import cache, lru_cache
+from pathlib import Path
+
+import pytest
+
+from specc.analysis.planning import domain_model, problem_model
+from specc.model import nodes as m
+from specc.pipeline import load
+from specc.runtime.planner import Planner, PlanResult
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.numeric import Closure, Empty, duration_of, exact_duration
+from specc.runtime.planner.replan import Fact, replanning_problem
+from specc.runtime.planner.validate import validate
+
+ATRV = Path(__file__).resolve().parent.parent / "examples" / "atrv"
+MISSIONS = [f"M{k}_model{n}" for n in (1, 2) for k in (1, 2, 3, 4)]
+
+
+@lru_cache(maxsize=1)
+def program() -> m.Program:
+    loaded = load([ATRV])
+    assert not loaded.errors and loaded.program is not None
+    return loaded.program
+
+
+@cache
+def models(name: str) -> tuple[pm.PlanningDomain, pm.Problem]:
+    prog = program()
+    problem = next(p for p in prog.items if isinstance(p, m.Problem) and p.name == name)
+    domain = next(d for d in prog.items if isinstance(d, m.Domain) and d.name == problem.domain.text)
+    return domain_model(prog, domain), problem_model(prog, problem)
+
+
+def checked(domain: pm.PlanningDomain, problem: pm.Problem, result: PlanResult) -> None:
+    assert result.plan is not None, result.reason
+    violations = validate(domain, problem, result.plan, dropped_lines={g.line for g in result.dropped})
+    assert violations == []
+
+
+def goal_line(problem: pm.Problem, attribute: str, *args: str) -> int:
+    return next(a.line for a in problem.assertions if a.goal is not None and pm.subject(a) == attribute
+                and all(isinstance(x, pm.Sym) and x.name == want for x, want in zip(a.args, args, strict=False)))
+
+
+@pytest.mark.parametrize("mission", MISSIONS)
+def test_every_mission_gets_a_valid_plan_meeting_every_goal_it_allows(mission: str) -> None:
+    domain, problem = models(mission)
+    result = Planner(domain, exact=False).plan(problem)
+    checked(domain, problem, result)
+    dropped = {g.line for g in result.dropped}
+    if mission.startswith("M4"):
+        # M4's second window may last 24 s (opens by 152, may close at 176) while a communication
+        # may take 25 s: no schedule survives every duration, so that goal alone goes.
+        assert dropped == {goal_line(problem, "COMMUNICATION", "W2")}
+        assert "impossible even alone" in result.dropped[0].reason
+    else:
+        assert dropped == set()
+    plan = result.plan
+    assert plan is not None and plan.controllability == "strong"
+    kinds = {a.task for a in plan.actions}
+    assert kinds >= ({"MOVE", "TAKE_PICTURE", "COMMUNICATE"} if "model1" in mission
+                     else {"MOVE_NOMINAL", "TAKE_SHOT", "COMMUNICATE_ANTENNA"})
+
+
+def test_casadi_schedules_the_plan_and_gives_the_true_duration_ranges() -> None:
+    domain, problem = models("M1_model1")
+    result = Planner(domain, exact=True).plan(problem)
+    checked(domain, problem, result)
+    assert result.notes == ()  # CasADi's schedule was used
+    plan = result.plan
+    assert plan is not None
+    move = next(a for a in plan.actions if a.task == "MOVE" and a.args == (0.0, 0.0, 4.0, 0.0))
+    # |dx| + |dy| = 4 m, path 4 * [0.7, 1] m, speed [0.17, 0.35] m/s.
+    assert move.duration == pytest.approx((4 * 0.7 / 0.35, 4 / 0.17), abs=1e-4)
+    # Earliest completion: the mission ends as soon as it may (t_end - t_start in [330, 800]).
+    assert plan.schedule["t_end"] == pytest.approx(330.0, abs=1e-3)
+
+
+def test_a_communication_is_planned_for_the_worst_case_of_the_window_and_of_its_duration() -> None:
+    domain, problem = models("M1_model1")
+    plan = Planner(domain, exact=False).plan(problem).plan
+    assert plan is not None
+    first = next(a for a in plan.actions if a.task == "COMMUNICATE" and a.args == ("W1",))
+    # W1 opens in [125, 127] and closes in [154, 156]; a communication lasts [18, 25] s.
+    assert 127.0 - 1e-6 <= first.dispatch <= 154.0 - 25.0 + 1e-6
+    # A peer scheduling every action at its shortest would start a move right after; here nothing
+    # moves until the communication surely ended.
+    for move in (a for a in plan.actions if a.task == "MOVE"):
+        assert move.dispatch + move.duration[1] <= first.dispatch + 1e-6 or move.dispatch >= first.dispatch + 25 - 1e-6
+
+
+def test_the_validator_rejects_a_planned_move_scheduled_at_its_shortest_duration() -> None:
+    domain, problem = models("M4_model1")
+    plan = Planner(domain, exact=False).plan(problem).plan
+    assert plan is not None
+    move = next(a for a in plan.actions if a.task == "MOVE")
+    optimistic = replace(plan, actions=tuple(replace(a, duration=(a.duration[0], a.duration[0])) if a is move else a
+                                             for a in plan.actions))
+    assert any(move.id in v for v in validate(domain, problem, optimistic, dropped_lines={44}))
+
+
+def test_preemption_keywords_reach_the_plan() -> None:
+    domain, problem = models("M1_model1")
+    plan = Planner(domain, exact=False).plan(problem).plan
+    assert plan is not None
+    flags = {a.task: a.preemptible for a in plan.actions}
+    assert flags["MOVE"] and flags["COMMUNICATE"]  # latePreemptive
+    assert not flags["TAKE_PICTURE"] and not flags["MOVE_PAN_TILT_UNIT"]  # nonPreemptive
+
+
+@pytest.mark.parametrize("mission", ["M4_model1", "M4_model2"])
+def test_a_300_s_horizon_drops_the_lowest_priority_goals_that_must_go(mission: str) -> None:
+    domain, problem = models(mission)
+    short = pm.with_horizon(problem, 300.0)
+    planner = Planner(domain, exact=False)
+    result = planner.plan(short)
+    checked(domain, short, result)
+    kept = [g for g in result.goals if g.kept]
+    dropped = {g.line: g for g in result.dropped}
+    w4 = goal_line(problem, "COMMUNICATION", "W4")
+    assert w4 in dropped and "impossible even alone" in dropped[w4].reason
+    # Home and the first and third windows stay; every dropped goal of a higher priority than a
+    # photo was impossible on its own.
+    assert {g.priority for g in kept} >= {4.0, 3.0}
+    assert all("impossible even alone" in g.reason for g in dropped.values() if g.priority > 2)
+    assert any(g.priority == 2 for g in dropped.values())
+    assert any(g.priority == 2 for g in kept)
+    # The search is bounded: never more partial plans than its budgets allow.
+    goals = len(result.goals)
+    assert result.nodes <= planner.nodes + planner.goal_nodes * (2 * goals + 1)
+
+
+def test_replanning_mid_mission_plans_only_the_remaining_goals_from_the_present() -> None:
+    domain, problem = models("M1_model1")
+    now = 170.0
+    facts = [Fact.parse(text) for text in (
+        "AT_ROBOT_X() = 4", "AT_ROBOT_Y() = 0", "ROBOT_STATUS() = STILL", "PTU_POSITION() = STRAIGHT",
+        "PICTURE(OBJ1, 0, 0) = DONE", "PICTURE(OBJ2, 4, 0) = DONE", "COMMUNICATION(W1) = DONE")]
+    remaining = {goal_line(problem, "COMMUNICATION", "W2"), goal_line(problem, "PICTURE", "OBJ3"),
+                 goal_line(problem, "AT_ROBOT_X"), goal_line(problem, "AT_ROBOT_Y")}
+    state = replanning_problem(problem, facts, remaining, now)
+    result = Planner(domain, exact=False).plan(state, now=now)
+    checked(domain, state, result)
+    plan = result.plan
+    assert plan is not None
+    assert {g.line for g in result.goals} == remaining and not result.dropped
+    assert all(a.dispatch >= now for a in plan.actions)
+    tasks = [a.text() for a in plan.ordered()]
+    assert "TAKE_PICTURE(OBJ3, 3, -3)" in tasks and "COMMUNICATE(W2)" in tasks
+    assert not any(t.startswith(("TAKE_PICTURE(OBJ1", "TAKE_PICTURE(OBJ2", "COMMUNICATE(W1")) for t in tasks)
+    first_move = next(a for a in plan.ordered() if a.task == "MOVE")
+    assert first_move.args[:2] == (4.0, 0.0)  # from where the robot is, not from the start
+
+
+def test_facts_are_parsed_and_checked_against_the_model() -> None:
+    assert Fact.parse("PICTURE(OBJ1, 0, -3) = DONE") == Fact("PICTURE", ("OBJ1", 0.0, -3.0), "DONE")
+    with pytest.raises(ValueError):
+        Fact.parse("AT_ROBOT_X = 3")
+    domain, problem = models("M1_model1")
+    wrong = replanning_problem(problem, [Fact("PTU_POSITION", (), "SIDEWAYS")], [], 10.0)
+    result = Planner(domain, exact=False).plan(wrong, now=10.0)
+    assert result.plan is None and "'SIDEWAYS' is not a value of PTU_POSITION" in result.reason
+
+
+def test_contradictory_constraints_give_no_plan_and_say_why() -> None:
+    domain, problem = models("M1_model1")
+    # The mission would end before the first window closes, which the W1 goal's timing needs.
+    clash = replace(problem, constraints=problem.constraints + (
+        pm.Member(pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), pm.Interval(0, 100), line=999),))
+    result = Planner(domain, exact=False).plan(clash)
+    assert result.plan is None
+    assert "required assertions and constraints" in result.reason and "t_end" in result.reason
+
+
+def test_an_unbounded_contingent_instant_and_an_unknown_attribute_are_reported() -> None:
+    domain, problem = models("M1_model1")
+    unbounded = replace(problem, constraints=tuple(
+        c for c in problem.constraints if "t_svisi1" not in repr(c)))
+    result = Planner(domain, exact=False).plan(unbounded)
+    assert result.plan is None and "t_svisi1" in result.reason and "needs bounds" in result.reason
+    odd = replace(problem, assertions=problem.assertions + (
+        pm.Event("BATTERY", (), pm.Sym("LOW"), pm.Sym("HIGH"), "t_start", kind="explained", line=998),))
+    result = Planner(domain, exact=False).plan(odd)
+    assert result.plan is None and "unknown attribute 'BATTERY'" in result.reason
+
+
+def test_an_unreachable_required_hold_gives_no_plan() -> None:
+    domain, problem = models("M1_model1")
+    stuck = replace(problem, assertions=problem.assertions + (
+        pm.Hold("AT_ROBOT_X", (), pm.Num(50.0), "t_goal1", "t_end", line=997),))  # outside [-10, 10]
+    result = Planner(domain, exact=False).plan(stuck)
+    assert result.plan is None
+    assert "every partial plan failed" in result.reason or "nothing can give" in result.reason
+
+
+# ---------------------------------------------------------------- numeric constraints
+
+
+def test_move_durations_follow_the_distance_and_the_speed_interval() -> None:
+    domain, _ = models("M1_model1")
+    move = domain.task("MOVE")
+    assert move is not None
+    spec = duration_of(move, {"?x1": 0.0, "?y1": 0.0, "?x2": 3.0, "?y2": -3.0})
+    assert spec.contingent and (spec.low, spec.high) == pytest.approx((6 * 0.7 / 0.35, 6 / 0.17))
+    assert spec.variables["?di"] == pytest.approx(6.0)
+    with pytest.raises(Empty):  # shorter than Modele1's 0.5 m minimum
+        duration_of(move, {"?x1": 0.0, "?y1": 0.0, "?x2": 0.2, "?y2": 0.1})
+    key = tuple(sorted({"?x1": 0.0, "?y1": 0.0, "?x2": 3.0, "?y2": -3.0}.items()))
+    assert exact_duration(move, key) == pytest.approx((12.0, 6 / 0.17), abs=1e-4)
+
+
+def test_modele2_distance_tables_decide_the_distance_symbol() -> None:
+    domain, _ = models("M1_model2")
+    move = domain.task("MOVE_NOMINAL")
+    assert move is not None
+    spec = duration_of(move, {"?p1": "O2", "?p2": "O3"})
+    assert spec.variables["?D#1"] == "D5" and spec.variables["?di"] == pytest.approx(5.16)
+    with pytest.raises(Empty):  # no table entry leads from a point to itself
+        duration_of(move, {"?p1": "O2", "?p2": "O2"})
+
+
+def test_interval_propagation_through_max_min_and_products() -> None:
+    x, y, z = pm.Var("?x"), pm.Var("?y"), pm.Var("?z")
+    closure = Closure(constraints=(
+        pm.Member(x, pm.Interval(-2, 5)), pm.Member(y, pm.Interval(1, 3)),
+        pm.Relation("=", z, pm.Op("max", (x, y))), pm.Relation("<=", z, pm.Num(2.0)),
+        pm.Relation("=", pm.Num(6.0), pm.Op("*", (y, pm.Var("?t")))),
+    ))
+    closure.propagate()
+    assert closure.domains["?x"] == (-2, 2) and closure.domains["?z"] == (1, 2)
+    assert closure.domains["?t"] == pytest.approx((3.0, 6.0))  # y <= z <= 2, so t = 6 / y >= 3
+    with pytest.raises(Empty):
+        Closure(constraints=(pm.Member(x, pm.Interval(0, 1)), pm.Relation("=", x, pm.Num(3.0)))).propagate()
+
+
+# ---------------------------------------------------------------- resources
+
+
+RESOURCE_SPEC = """
+domain cameras {
+  constant DONE_STATES = {TODO, DONE};
+  attribute SHOT(?o) { ?o in {A, B}; ?value in DONE_STATES; }
+  resource CAMERA() { ?value in [0, 1]; }
+  task TAKE(?o) (t_start, t_end) {
+    ?o in {A, B};
+    event(SHOT(?o): (TODO, DONE), t_end);
+    use(CAMERA(): 1, (t_start, t_end));
+    (t_end - t_start) in [5, 5];
+  } nonPreemptive
+}
+problem two_shots for cameras {
+  timepoint t1, t2;
+  explained event(SHOT(A): (DONE, TODO), t_start);
+  explained event(SHOT(B): (DONE, TODO), t_start);
+  hold(SHOT(A): DONE, (t1, t_end)) goal(1, 0);
+  hold(SHOT(B): DONE, (t2, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 30];
+}
+"""
+
+
+def test_two_uses_of_a_unary_resource_never_overlap(tmp_path: Path) -> None:
+    spec = tmp_path / "cameras.spec"
+    spec.write_text(textwrap.dedent(RESOURCE_SPEC))
+    loaded = load([spec])
+    assert not loaded.errors, loaded.errors
+    assert loaded.program is not None
+    domain = domain_model(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Domain)))
+    problem = problem_model(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Problem)))
+    result = Planner(domain, exact=False).plan(problem)
+    checked(domain, problem, result)
+    assert result.plan is not None
+    first, second = sorted(result.plan.actions, key=lambda a: a.dispatch)
+    assert second.dispatch >= first.dispatch + 5 - 1e-6
