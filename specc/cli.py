@@ -419,8 +419,8 @@ def plan(paths: PathsArg,
              help="A replanning: the source line of a goal still to meet (repeatable; default: all).")] = None,
          picture: Annotated[Optional[Path], typer.Option("--picture", "-o", help="Draw the plan's timeline "
                                                          "(PNG, SVG, PDF).")] = None,
-         nodes: Annotated[int, typer.Option(min=1, help="Partial plans the search for every goal at once may "
-                                                        "expand (each smaller search gets 2/5 of it).")] = 500,
+         nodes: Annotated[int, typer.Option(min=1, help="Partial plans each search may expand (one for every "
+                                                        "goal at once, then one per goal added).")] = 300,
          exact: Annotated[bool, typer.Option(help="Durations and schedule by CasADi (else the interval "
                                                   "enclosures and the temporal network alone).")] = True) -> None:
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),

@@ -58,7 +58,7 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
             raise ValueError(f"no goal on line(s) {', '.join(map(str, unknown))} of {problem.source} "
                              f"(goal lines: {', '.join(map(str, sorted(lines)))})")
         problem = replanning_problem(problem, [Fact.parse(f) for f in facts], lines if goals is None else goals, now)
-    result = Planner(model, nodes=nodes, goal_nodes=max(1, nodes * 2 // 5), exact=exact).plan(problem, now=now)
+    result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact).plan(problem, now=now)
     violations = []
     if result.plan is not None:
         violations = validate(model, problem, result.plan, dropped_lines={g.line for g in result.dropped})

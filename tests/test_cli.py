@@ -317,3 +317,42 @@ def test_verify_procedures_says_when_it_stopped_short() -> None:
     assert short.returncode == 0 and "500 states in" in short.stdout and "more not explored" in short.stdout
     assert "no finding" not in short.stdout  # nothing is established about what was not explored
     assert "deadlocks, cycles and dead statements are not established" in short.stderr
+
+
+def test_plan_prints_the_plan_checked_by_the_validator_and_draws_its_timeline(tmp_path: Path) -> None:
+    picture = tmp_path / "m1.png"
+    result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M1", "--domain", "model1", "--no-exact",
+                   "-o", str(picture))
+    assert result.returncode == 0, result.stderr
+    assert "problem M1_model1 for domain model1" in result.stdout
+    assert "COMMUNICATE(W1)" in result.stdout and "strongly controllable" in result.stdout
+    assert "validator: the plan is valid" in result.stdout
+    assert picture.read_bytes().startswith(b"\x89PNG")
+
+
+def test_plan_with_a_short_horizon_lists_the_dropped_goals_and_why() -> None:
+    result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M4_model1", "--horizon", "300", "--no-exact")
+    assert result.returncode == 0, result.stderr
+    dropped = [line for line in result.stdout.splitlines() if "DROPPED" in line]
+    assert any("COMMUNICATION(W4)" in line and "impossible even alone" in line for line in dropped)
+
+
+def test_plan_replans_from_facts_given_on_the_command_line() -> None:
+    result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M1_model1", "--no-exact", "--now", "170",
+                   "--fact", "AT_ROBOT_X() = 4", "--fact", "AT_ROBOT_Y() = 0", "--fact", "PICTURE(OBJ1, 0, 0) = DONE",
+                   "--fact", "PICTURE(OBJ2, 4, 0) = DONE", "--goal", "29", "--goal", "30", "--goal", "39")
+    assert result.returncode == 0, result.stderr
+    assert "MOVE(4, 0, 3, -3)" in result.stdout and "TAKE_PICTURE(OBJ1" not in result.stdout
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (("--problem", "M1"), "ambiguous (M1_model1, M1_model2); add --domain"),
+    (("--problem", "M9"), "no problem 'M9'"),
+    (("--problem", "M1_model1", "--horizon", "-5"), "--horizon must be positive"),
+    (("--problem", "M1_model1", "--fact", "AT_ROBOT_X = 3"), "is not a fact"),
+    (("--problem", "M1_model1", "--goal", "5"), "no goal on line(s) 5"),
+])
+def test_plan_bad_input_is_one_clear_error(args: tuple[str, ...], message: str) -> None:
+    result = specc("plan", str(EXAMPLES / "atrv"), *args)
+    assert result.returncode == 1
+    assert message in result.stderr and "Traceback" not in result.stderr

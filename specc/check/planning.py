@@ -16,6 +16,7 @@ from specc.model import nodes as m
 from specc.model.visitor import Visitor, walk
 
 VALUE_VAR = "?value"
+FUNCTIONS = ("abs", "max", "min")  # what the planner's propagators and CasADi know
 PROBLEM_TIMEPOINTS = ("t_start", "t_end")
 
 
@@ -152,15 +153,24 @@ class ScopeChecker(Visitor):
 
     # One visit method per statement kind; expressions are checked by `expr`, not visited.
     def visit_Hold(self, s: m.Hold) -> None:
+        if isinstance(s.attr.value, m.Transition):
+            self.ctx.report("hold-transition", "a hold keeps one value: write hold(A(): v, (t1, t2)), or "
+                            "event(A(): (v1, v2), t) for a change", s.attr.value.span)
         self.attr_value(s.attr, self.scope)
         self.time(s.start, self.scope)
         self.time(s.end, self.scope)
 
     def visit_Event(self, s: m.Event) -> None:
+        if not isinstance(s.attr.value, m.Transition):
+            self.ctx.report("event-without-transition", "an event changes a value: write event(A(): (before, "
+                            "after), t), or hold(A(): v, (t1, t2)) for a value that persists", s.attr.span)
         self.attr_value(s.attr, self.scope)
         self.time(s.time, self.scope)
 
     def visit_ResourceUse(self, s: m.ResourceUse) -> None:
+        if s.verb != "use" or not isinstance(s.when, m.Window):
+            self.ctx.report("unsupported-resource-use", f"the planner borrows resources over an interval only: "
+                            f"write use(R(): amount, (t1, t2)); '{s.verb}' at one instant is not planned", s.span)
         self.attr_value(s.attr, self.scope, resource=True)
         for time in (s.when.start, s.when.end) if isinstance(s.when, m.Window) else (s.when,):
             self.time(time, self.scope)
@@ -257,6 +267,12 @@ class ScopeChecker(Visitor):
 
     def expr(self, e: m.IxExpr, scope: Scope) -> None:
         for node in walk(e):
+            if isinstance(node, m.IxCall) and node.function not in FUNCTIONS:
+                self.ctx.unknown("undefined-function", "function", node.function, FUNCTIONS, node.span)
+            elif isinstance(node, m.IxCall) and node.function == "abs" and len(node.args) != 1:
+                self.ctx.report("arity-mismatch", f"abs takes one argument, {len(node.args)} given", node.span)
+            elif isinstance(node, m.IxCall) and len(node.args) < 2 and node.function != "abs":
+                self.ctx.report("arity-mismatch", f"{node.function} takes two arguments or more", node.span)
             if isinstance(node, m.IxVar) and node.name not in scope.variables:
                 self.ctx.report("undeclared-variable",
                                 f"variable '{node.name}' is not declared; add 'variable {node.name};'", node.span)

@@ -66,7 +66,7 @@ class Attempt:
 
 
 class Planner:
-    def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 500, goal_nodes: int = 300,
+    def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
                  exact: bool = True, limits: Limits | None = None) -> None:
         self.domain = domain
         self.nodes = nodes  # budget of the search for every goal at once
@@ -440,18 +440,27 @@ def optimise_schedule(network: STN, reduced: list[tuple[str, str, float, float]]
     import casadi
 
     points = [name for name in network.names if name != "origin"]
+    index = {name: i for i, name in enumerate(points)}
+    # The tightest bounds per pair, as one sparse system low <= A x <= high (Opti's per-constraint
+    # overhead would dominate otherwise).
+    tightest: dict[tuple[str, str], list[float]] = {}
+    for a, b, low, high in reduced:
+        bounds = tightest.setdefault((a, b), [-INF, INF])
+        bounds[0], bounds[1] = max(bounds[0], low), min(bounds[1], high)
+    rows, columns, entries, lows, highs = [], [], [], [], []
+    for row, ((a, b), (low, high)) in enumerate(sorted(tightest.items())):
+        for name, sign in ((b, 1.0), (a, -1.0)):
+            if name == "origin":
+                continue  # date 0
+            rows.append(row)
+            columns.append(index[name])
+            entries.append(sign)
+        lows.append(low if low > -INF else -1e9)  # IPOPT takes large finite bounds better than inf
+        highs.append(high if high < INF else 1e9)
     opti = casadi.Opti()
     x = opti.variable(len(points))
-    index = {name: i for i, name in enumerate(points)}
-
-    def date(name: str) -> casadi.MX | float:
-        return 0.0 if name == "origin" else x[index[name]]
-
-    for a, b, low, high in reduced:
-        if low > -INF:
-            opti.subject_to(date(b) - date(a) >= low)
-        if high < INF:
-            opti.subject_to(date(b) - date(a) <= high)
+    matrix = casadi.DM.triplet(rows, columns, casadi.DM(entries), len(tightest), len(points))
+    opti.subject_to(opti.bounded(casadi.DM(lows), casadi.mtimes(matrix, x), casadi.DM(highs)))
     opti.subject_to(x >= 0)
     opti.minimize(casadi.sum1(x))
     opti.set_initial(x, [earliest[p] for p in points])
