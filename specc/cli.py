@@ -450,6 +450,43 @@ def plan(paths: PathsArg,
         raise typer.Exit(1)
 
 
+@app.command(name="export")
+def export_problem(paths: PathsArg,
+                   problem: Annotated[str, typer.Option(help="The problem to export: its name, or a prefix with "
+                                                             "--domain.")],
+                   output: Annotated[Path, typer.Option("--output", "-o", help="Folder receiving domain.pddl and "
+                                                        "problem.pddl.")],
+                   domain: Annotated[Optional[str], typer.Option(help="Keep the problems of this domain.")] = None,
+                   ) -> None:
+    """Export a planning domain and problem through unified-planning to PDDL 2.1, saying what could not
+    be expressed."""
+    from specc.analysis.planning import domain_model, problem_model
+    from specc.analysis.planning_export import constant_set_names, export, write_pddl
+    from specc.plan_report import choose_problem
+
+    loaded = load(paths)
+    if report(loaded):
+        raise typer.Exit(1)
+    assert loaded.program is not None
+    try:
+        chosen = choose_problem(loaded.program, problem, domain)
+    except ValueError as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(1) from None
+    block = next(d for d in loaded.program.items if isinstance(d, m.Domain) and d.name == chosen.domain.text)
+    exported = export(domain_model(loaded.program, block), problem_model(loaded.program, chosen),
+                      constant_set_names(loaded.program, block))
+    try:
+        written = write_pddl(exported, output)
+    except OSError as exc:
+        err.print(f"error: cannot write into '{output}': {exc}", markup=False)
+        raise typer.Exit(1) from None
+    for path in written:
+        out.print(f"wrote {path}", markup=False)
+    for note in exported.unsupported:
+        out.print(f"not expressed: {note}", markup=False)
+
+
 @app.command(name="rules")
 def rules_report(paths: PathsArg,
                  limit: Annotated[int, typer.Option(help="Findings shown per rule base (0: all).")] = 20) -> None:

@@ -342,7 +342,7 @@ _DURATIONS: dict[tuple[int, tuple[tuple[str, Value], ...]], tuple[pm.Task, Durat
 
 
 def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> DurationSpec:
-    closure = Closure(constraints=tuple(c for c in task.constraints if not _is_duration(c, task)))
+    closure = Closure(constraints=tuple(c for c in task.constraints if not is_duration(c, task)))
     for name, value in key:
         closure.domains[name] = frozenset((value,)) if isinstance(value, str) else (float(value), float(value))
     closure.propagate()
@@ -369,7 +369,8 @@ def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> Durat
     return DurationSpec(max(0.0, low), high, contingent, known)
 
 
-def _is_duration(c: pm.Constraint, task: pm.Task) -> bool:
+def is_duration(c: pm.Constraint, task: pm.Task) -> bool:
+    """Does `c` bound the task's duration (`t_end - t_start`)?"""
     return _duration_constraint(c, task) is not None
 
 

@@ -30,6 +30,7 @@ from specc.runtime.planner.search import (
     Node,
     Term,
     differences,
+    is_temporal,
     is_var,
     same_value,
 )
@@ -186,7 +187,7 @@ class Setup:
         self.requirements: list[tuple[str, str, float, float, int]] = []
         self.nature_before: set[tuple[str, str]] = set()
         for c in problem.constraints:
-            if isinstance(c, pm.Implies) or not _temporal(c):
+            if isinstance(c, pm.Implies) or not is_temporal(c):
                 if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
                     continue  # a variable's domain
                 raise PlanningInputError(f"line {c.line}: only temporal constraints and variable domains are "
@@ -647,12 +648,6 @@ def unbound(node: Node) -> list[Resolver] | None:
                 raise DeadEnd(f"{var} has no value to take")
             return [Resolver("bind", terms=(var, v)) for v in values]
     return None
-
-
-def _temporal(c: pm.Constraint) -> bool:
-    from specc.runtime.planner.search import _temporal as temporal
-
-    return temporal(c)
 
 
 def _points(a: pm.Assertion) -> tuple[str, ...]:

@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.numeric import DurationSpec, Empty, duration_of, is_number
+from specc.runtime.planner.numeric import DurationSpec, Empty, duration_of, is_duration, is_number
 from specc.runtime.stn import STN, Inconsistent
 
 INF = math.inf
@@ -477,9 +477,9 @@ class Node:
                 domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
                           else (c.domain.low, c.domain.high))
                 self.bindings.domain[var] = Bindings._meet(self.bindings.domain[var], domain)
-            elif isinstance(c, pm.Relation) and c.op == "!=" and not _temporal(c.left) and not _temporal(c.right):
+            elif isinstance(c, pm.Relation) and c.op == "!=" and not is_temporal(c.left) and not is_temporal(c.right):
                 self.bindings.keep_apart(term(c.left), term(c.right))
-            elif isinstance(c, (pm.Member, pm.Relation)) and _temporal(c) and not _is_duration(c, task):
+            elif isinstance(c, (pm.Member, pm.Relation)) and is_temporal(c) and not is_duration(c, task):
                 for first, second, low, high in differences(c, point, self.ctx.origin):
                     self.require(first, second, low, high)
         start_events: dict[tuple[str, str], Assertion] = {}
@@ -582,25 +582,16 @@ def _number(value: Term) -> float:
     return float(value) if is_number(value) else 1.0
 
 
-def _temporal(e: pm.Expr | pm.Constraint) -> bool:
+def is_temporal(e: pm.Expr | pm.Constraint) -> bool:
     if isinstance(e, pm.Member):
-        return _temporal(e.expr)
+        return is_temporal(e.expr)
     if isinstance(e, pm.Relation):
-        return _temporal(e.left) or _temporal(e.right)
+        return is_temporal(e.left) or is_temporal(e.right)
     if isinstance(e, pm.Implies):
         return False
     if isinstance(e, pm.Time):
         return True
-    return isinstance(e, pm.Op) and any(_temporal(a) for a in e.args)
-
-
-def _is_duration(c: pm.Constraint, task: pm.Task) -> bool:
-    span = pm.Op("-", (pm.Time(task.end), pm.Time(task.start)))
-    if isinstance(c, pm.Member):
-        return c.expr == span
-    if isinstance(c, pm.Relation):
-        return span in (c.left, c.right)
-    return False
+    return isinstance(e, pm.Op) and any(is_temporal(a) for a in e.args)
 
 
 def _could_be(e: pm.Expr, wanted: Term, task: pm.Task, bindings: Bindings) -> bool:

@@ -1,0 +1,199 @@
+"""Export of the rover's planning models (seed 004, annex A) to unified_planning and PDDL 2.1:
+durative actions over user types, goals, timed initial literals for the contingent windows,
+duration tables computed from the tasks' constraints, and a note for every approximation. The
+Aries run that solves M1 is a benchmark (`make bench`)."""
+
+from __future__ import annotations
+
+import time
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+from unified_planning.io import PDDLReader
+from unified_planning.model import DurativeAction
+
+from specc.analysis.planning import domain_model, problem_model
+from specc.analysis.planning_export import Exported, bounds, constant_set_names, export, write_pddl
+from specc.model import nodes as m
+from specc.pipeline import load
+from specc.runtime.planner import model as pm
+
+ATRV = Path(__file__).resolve().parent.parent / "examples" / "atrv"
+
+
+@pytest.fixture(scope="module")
+def program() -> m.Program:
+    loaded = load([ATRV])
+    assert loaded.program is not None and not loaded.errors
+    return loaded.program
+
+
+def exported(program: m.Program, domain_name: str, problem_name: str) -> Exported:
+    domain = next(i for i in program.items if isinstance(i, m.Domain) and i.name == domain_name)
+    problem = next(i for i in program.items if isinstance(i, m.Problem) and i.name == problem_name)
+    return export(domain_model(program, domain), problem_model(program, problem), constant_set_names(program, domain))
+
+
+@pytest.fixture(scope="module")
+def modele1(program: m.Program) -> Exported:
+    return exported(program, "model1", "M1_model1")
+
+
+@pytest.fixture(scope="module")
+def modele2(program: m.Program) -> Exported:
+    return exported(program, "model2_M1", "M1_model2")
+
+
+def signatures(result: Exported) -> dict[str, list[str]]:
+    actions = result.problem.actions
+    assert all(isinstance(a, DurativeAction) for a in actions)
+    return {a.name: [p.type.name for p in a.parameters] for a in actions}
+
+
+def static_value(result: Exported, function: str, *objects: str) -> object:
+    problem = result.problem
+    fluent = problem.fluent(function)
+    return problem.initial_value(fluent(*(problem.object(o) for o in objects))).constant_value()
+
+
+def timed_literals(result: Exported) -> set[tuple[Fraction, str, bool]]:
+    return {(timing.delay, str(e.fluent), e.value.bool_constant_value())
+            for timing, effects in result.problem.timed_effects.items() for e in effects}
+
+
+def mentions(result: Exported, *words: str) -> bool:
+    return any(all(w in note for w in words) for note in result.unsupported)
+
+
+def test_modele1_m1_exports_its_six_tasks_over_typed_parameters(modele1: Exported) -> None:
+    assert signatures(modele1) == {
+        "MOVE": ["AT_ROBOT_X_value", "AT_ROBOT_Y_value", "AT_ROBOT_X_value", "AT_ROBOT_Y_value"],
+        "MOVE_PAN_TILT_UNIT": ["PANTILT_POSITIONS", "PANTILT_POSITIONS"],
+        "TAKE_PICTURE": ["OBJECTS", "AT_ROBOT_X_value", "AT_ROBOT_Y_value"],
+        "COMMUNICATE": ["VISIBILITY_WINDOWS"],
+        "INIT_PTU_DRIVER": [],
+        "INIT_MVT_GENERATION": [],
+    }
+    assert {str(g) for g in modele1.problem.goals} == {
+        "AT_ROBOT_X(AT_ROBOT_X_0)", "AT_ROBOT_Y(AT_ROBOT_Y_0)",
+        "COMMUNICATION_DONE(W1)", "COMMUNICATION_DONE(W2)",
+        "PICTURE_DONE(OBJ1, AT_ROBOT_X_0, AT_ROBOT_Y_0)", "PICTURE_DONE(OBJ2, AT_ROBOT_X_4, AT_ROBOT_Y_0)",
+        "PICTURE_DONE(OBJ3, AT_ROBOT_X_3, AT_ROBOT_Y_m3)",
+    }
+
+
+def move(function: str, x1: str, y1: str, x2: str, y2: str) -> tuple[str, ...]:
+    return (function, f"AT_ROBOT_X_{x1}", f"AT_ROBOT_Y_{y1}", f"AT_ROBOT_X_{x2}", f"AT_ROBOT_Y_{y2}")
+
+
+def test_modele1_move_durations_come_from_the_distance(modele1: Exported) -> None:
+    # d = |dx| + |dy|; the longest move lasts d * 1 / 0.17 s, rounded up to a whole second.
+    assert static_value(modele1, *move("MOVE_duration", "0", "0", "4", "0")) == 24
+    assert static_value(modele1, *move("MOVE_duration", "3", "m3", "0", "0")) == 36
+    # A move shorter than 0.5 m (here: staying put) and a move to the in-motion marker 1000 are not allowed.
+    assert static_value(modele1, *move("MOVE_allowed", "4", "0", "4", "0")) is False
+    assert static_value(modele1, *move("MOVE_allowed", "0", "0", "1000", "0")) is False
+    assert static_value(modele1, *move("MOVE_allowed", "0", "0", "3", "m3")) is True
+    communicate = modele1.problem.action("COMMUNICATE")
+    assert communicate.duration.lower.constant_value() == communicate.duration.upper.constant_value() == 25
+
+
+def test_modele1_windows_are_timed_literals_at_their_pessimistic_dates(modele1: Exported) -> None:
+    literals = timed_literals(modele1)
+    # W1 opens in [125, 127] and closes in [154, 156]: usable from 127 to 154 only.
+    assert {(125, "VISIBILITY_WINDOW_OUT(W1)", False), (127, "VISIBILITY_WINDOW_IN(W1)", True),
+            (154, "VISIBILITY_WINDOW_IN(W1)", False), (156, "VISIBILITY_WINDOW_OUT(W1)", True)} <= literals
+    assert (800, "within_horizon", False) in literals  # the horizon's latest end is a deadline
+
+
+def test_modele1_notes_say_what_is_approximated(modele1: Exported) -> None:
+    assert mentions(modele1, "MOVE", "contingent duration", "upper bound")
+    assert mentions(modele1, "COMMUNICATE", "contingent duration [18, 25]")
+    assert mentions(modele1, "priorities", "oversubscription")
+    assert mentions(modele1, "MOVE", "real-valued", "?x1 in {0, 3, 4}")
+    assert mentions(modele1, "timed initial literals", "latest opening", "earliest closing")
+    assert mentions(modele1, "?x1, ?y1", "unification")
+
+
+def test_modele2_m1_exports_its_seven_tasks(modele2: Exported) -> None:
+    assert signatures(modele2) == {
+        "MOVE_NOMINAL": ["OBJECTS", "OBJECTS"],
+        "MOVE_RECOV": ["LOCALISATION", "OBJECTS"],
+        "MOVE_PTU": ["PTU_PAN_value", "PTU_TILT_value", "PTU_PAN_value", "PTU_TILT_value"],
+        "TAKE_SHOT": ["OBJECTS", "IDLE_INITED"],  # the task's ?state becomes a parameter
+        "COMMUNICATE_ANTENNA": ["WINDOWS", "IDLE_INITED"],
+        "INIT_PTU": ["IDLE_INITED"],
+        "INIT_FRAME": [],
+    }
+    assert {str(g) for g in modele2.problem.goals} == {
+        "FRAME_POS(O1)", "COMMUNICATION_TRUE(W1)", "COMMUNICATION_TRUE(W2)",
+        "SHOT_TRUE(O1)", "SHOT_TRUE(O2)", "SHOT_TRUE(O3)",
+    }
+    # The distance table: O1 -> O2 is 6 m, at 0.17 m/s at worst; a move from O1 to O1 has no distance.
+    assert static_value(modele2, "MOVE_NOMINAL_duration", "O1", "O2") == 36
+    assert static_value(modele2, "MOVE_NOMINAL_allowed", "O1", "O1") is False
+    assert mentions(modele2, "MOVE_NOMINAL", "contingent duration", "MOVE_NOMINAL_duration")
+    assert mentions(modele2, "priorities", "oversubscription")
+
+
+def test_modele2_communicates_in_each_window(modele2: Exported) -> None:
+    # Modele2 has one WINDOW() for every window, so the time constraints of the problem decide which
+    # communication happens in which window.
+    communicate = modele2.problem.action("COMMUNICATE_ANTENNA")
+    guards = {str(c) for conditions in communicate.conditions.values() for c in conditions}
+    literals = timed_literals(modele2)
+    # hold(COMMUNICATION(W2): FALSE, (t_start, t_evisi1)): W2's communication ends after W1's latest closing.
+    assert "(past_t_evisi1 or (not (w == W2)))" in guards
+    assert (156, "past_t_evisi1", True) in literals
+    assert mentions(modele2, "COMMUNICATION(W2): FALSE", "kept until t_evisi1")
+    # COMMUNICATION(W1) is a goal by t_goal3e, 2 to 4 s after W1 closes in [154, 156]: done by 154 + 4 s.
+    assert "(before_t_goal3e or (not (w == W1)))" in guards
+    assert (158, "before_t_goal3e", False) in literals
+    assert mentions(modele2, "COMMUNICATION(W1): TRUE", "reached by 158 s")
+
+
+@pytest.mark.parametrize("model", ["modele1", "modele2"])
+def test_write_pddl_is_read_back(model: str, request: pytest.FixtureRequest, tmp_path: Path) -> None:
+    result: Exported = request.getfixturevalue(model)
+    domain, problem = write_pddl(result, tmp_path)
+    assert (domain, problem) == (tmp_path / "domain.pddl", tmp_path / "problem.pddl")
+    text = domain.read_text()
+    assert "(:durative-action" in text and ":timed-initial-literals" in text and ":numeric-fluents" in text
+    parsed = PDDLReader().parse_problem(str(domain), str(problem))
+    assert {a.name for a in parsed.actions} == {a.name.lower() for a in result.problem.actions}
+    assert len(parsed.timed_effects) == len(result.problem.timed_effects)
+
+
+def test_bounds_propagate_through_the_tasks_arithmetic() -> None:
+    d, s, duration = pm.Var("?d"), pm.Var("?s"), pm.Var("?duration")
+    constraints: list[pm.Constraint] = [
+        pm.Relation("=", d, pm.Op("max", (pm.Op("-", (pm.Num(4.0), pm.Num(1.0))), pm.Num(0.0)))),
+        pm.Member(s, pm.Interval(0.17, 0.35)),
+        pm.Relation("=", d, pm.Op("*", (s, duration))),
+        pm.Relation("=", duration, pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), contingent=True),
+    ]
+    found = bounds(constraints, {("time", "t_start"): (0.0, 0.0)}, [("time", "t_end")])
+    assert found is not None
+    low, high = found[("time", "t_end")]  # type: ignore[misc]
+    assert low == pytest.approx(3 / 0.35) and high == pytest.approx(3 / 0.17)
+    assert bounds([*constraints, pm.Relation("<=", duration, pm.Num(5.0))], {("time", "t_start"): (0.0, 0.0)},
+                  []) is None
+
+
+@pytest.mark.bench
+def test_aries_solves_m1_modele2(modele2: Exported) -> None:
+    pytest.importorskip("up_aries")
+    from unified_planning.engines import PlanGenerationResultStatus
+    from unified_planning.shortcuts import OneshotPlanner, get_environment
+
+    get_environment().credits_stream = None
+    started = time.perf_counter()
+    with OneshotPlanner(name="aries") as planner:
+        result = planner.solve(modele2.problem, timeout=600)
+    elapsed = time.perf_counter() - started
+    print(f"\nAries on M1 (Modele2): {result.status.name} in {elapsed:.1f} s")
+    assert result.status in (PlanGenerationResultStatus.SOLVED_SATISFICING, PlanGenerationResultStatus.SOLVED_OPTIMALLY)
+    print(result.plan)
+    names = {a.action.name for _, a, _ in result.plan.timed_actions}
+    assert {"TAKE_SHOT", "COMMUNICATE_ANTENNA", "MOVE_NOMINAL"} <= names
