@@ -291,16 +291,17 @@ class Setup:
         except DeadEnd as error:
             failures[_generic(str(error))] += 1
             return Attempt(None, 1, True, failures)
-        # First a plain depth-first search on a quarter of the budget: the heuristic is usually
-        # right, and the few dead ends met are close to where they were made. Then limited
-        # discrepancy search: plans departing from the heuristic at one choice, then two... so
-        # that a wrong early choice costs one discrepancy, not the exhaustion of everything below
-        # it (depth-first search's thrashing).
+        # With `discrepancies`: a short depth-first dive (a twentieth of the budget), enough when
+        # the heuristic is right; then limited discrepancy search: plans departing from the
+        # heuristic at one choice, then two... so that a wrong early choice costs one
+        # discrepancy, not the exhaustion of everything below it (depth-first search's
+        # thrashing). Without: depth-first search alone, whose local backtracking suits a
+        # problem the heuristic leads through.
         nodes = 0
         for allowed in itertools.chain((INF,), itertools.count(1)):
             stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
             cut = False  # some branch was left out for lack of discrepancies
-            limit = budget // 4 if allowed == INF and discrepancies else budget
+            limit = budget // 20 if allowed == INF and discrepancies else budget
             while stack:
                 node, resolver, used = stack.pop()
                 if resolver is not None:
@@ -619,10 +620,24 @@ def need_resolvers(node: Node, need: Assertion) -> list[Resolver]:
     siblings = {node.assertions[k.producer].owner for k in node.links
                 if node.assertions[k.consumer].owner == need.owner and need.owner != "problem"} - {"problem"}
     existing = node.producers(need)
-    existing.sort(key=lambda e: (e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id))
-    options = [Resolver("link", need=need.id, producer=e.id) for e in existing]
-    options += [Resolver("insert", need=need.id, task=task, index=index) for task, index in node.insertions(need)]
-    return options
+    gap = EPS if need.kind == "event" else 0.0
+
+    def clobbered(producer: Assertion) -> int:
+        """Events that could change the value between the producer and the need: a link to a
+        value set long ago (the pan-tilt unit STRAIGHT at the start) has many, and a new task
+        giving it afresh is the better bet."""
+        return sum(1 for e in node.assertions
+                   if e.kind == "event" and e.attribute == need.attribute and e.id not in (producer.id, need.id)
+                   and all(node.bindings.possibly_equal(x, y) for x, y in zip(e.args, need.args, strict=False))
+                   and not node.surely_before(e.start, producer.start, EPS)
+                   and not node.surely_before(need.end, e.start, gap))
+
+    ranked = sorted((clobbered(e) > 0, e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id, e.id)
+                    for e in existing)
+    links = [(r[0], Resolver("link", need=need.id, producer=r[-1])) for r in ranked]
+    inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in node.insertions(need)]
+    # Safe links first, then new tasks, then links something may undo.
+    return [r for risky, r in links if not risky] + inserts + [r for risky, r in links if risky]
 
 
 def unbound(node: Node) -> list[Resolver] | None:

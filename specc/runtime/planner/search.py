@@ -265,7 +265,6 @@ class Context:
     limits: Limits
     capacity: Mapping[str, float]
     producers: dict[str, list[tuple[pm.Task, int]]] = field(default_factory=dict)  # attribute -> (task, event index)
-    failures: dict[str, int] = field(default_factory=dict)  # why resolvers failed, for explanations
     # Orders nature promises between its own instants (`t_evisi1 < t_svisi2`): (earlier, later).
     nature_before: set[tuple[str, str]] = field(default_factory=set)
 
@@ -274,9 +273,6 @@ class Context:
             for i, a in enumerate(task.assertions):
                 if isinstance(a, pm.Event):
                     self.producers.setdefault(a.attribute, []).append((task, i))
-
-    def fail(self, reason: str) -> None:
-        self.failures[reason] = self.failures.get(reason, 0) + 1
 
 
 class Node:
@@ -419,7 +415,6 @@ class Node:
         try:
             spec = duration_of(task, known)
         except Empty as error:
-            self.ctx.fail(f"{task.name} impossible: {error}")
             raise DeadEnd(f"{instance_id}: {error}") from None
         # Variables the task's constraints fix (Modele2's distance symbol) bind the plan's too.
         changed: list[str] = []
