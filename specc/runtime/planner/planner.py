@@ -249,7 +249,7 @@ class Setup:
             if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
                 domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
                           else (c.domain.low, c.domain.high))
-                node.bindings.domain[c.expr.name] = domain
+                node.bindings.restrict(c.expr.name, domain)
 
         def term(e: pm.Expr) -> Term:
             if isinstance(e, pm.Num):

@@ -57,17 +57,26 @@ class Bindings:
         self.parent: dict[str, str] = {}
         self.domain: dict[str, frozenset[str] | tuple[float, float] | None] = {}
         self.apart: list[tuple[Term, Term]] = []
+        self.resolved: dict[str, Term] = {}  # memo of resolve(), emptied when a domain changes
 
     def copy(self) -> Bindings:
         other = Bindings.__new__(Bindings)
         other.parent = dict(self.parent)
         other.domain = dict(self.domain)
         other.apart = list(self.apart)
+        other.resolved = dict(self.resolved)
         return other
 
     def declare(self, var: str, domain: frozenset[str] | tuple[float, float] | None) -> None:
         self.parent[var] = var
         self.domain[var] = domain
+        self.resolved.clear()
+
+    def restrict(self, var: str, domain: frozenset[str] | tuple[float, float] | None) -> None:
+        """Narrow the domain of the variable's class (raises DeadEnd when nothing is left)."""
+        r = self.root(var)
+        self.domain[r] = self._meet(self.domain[r], domain)
+        self.resolved.clear()
 
     def root(self, var: str) -> str:
         while self.parent[var] != var:
@@ -80,13 +89,18 @@ class Bindings:
         if not is_var(term):
             return term
         assert isinstance(term, str)
+        known = self.resolved.get(term)
+        if known is not None:
+            return known
         r = self.root(term)
         d = self.domain[r]
+        result: Term = r
         if isinstance(d, frozenset) and len(d) == 1:
-            return next(iter(d))
-        if isinstance(d, tuple) and d[0] == d[1]:
-            return d[0]
-        return r
+            result = next(iter(d))
+        elif isinstance(d, tuple) and d[0] == d[1]:
+            result = d[0]
+        self.resolved[term] = result
+        return result
 
     def value(self, term: Term) -> Term | None:
         resolved = self.resolve(term)
@@ -125,6 +139,7 @@ class Bindings:
     def unify(self, a: Term, b: Term) -> list[str]:
         """Make a and b codesignate; returns the variables that gained a value (raises DeadEnd)."""
         ra, rb = self.resolve(a), self.resolve(b)
+        self.resolved.clear()
         if not is_var(ra) and not is_var(rb):
             if not same_value(ra, rb):
                 raise DeadEnd(f"{ra} is not {rb}")
@@ -172,6 +187,7 @@ class Bindings:
         if not self.possibly_equal(a, b):
             return
         ra, rb = self.resolve(a), self.resolve(b)
+        self.resolved.clear()
         if not is_var(ra) and not is_var(rb):
             raise DeadEnd(f"{ra} and {rb} must differ")
         if (is_var(ra) and ra == rb):
@@ -353,7 +369,7 @@ class Node:
             return lb - ha, hb - la
         index, d = self.stn.index, self.stn._distance
         i, j = index[pa], index[pb]
-        return float(-d[j, i]) + lb - ha, float(d[i, j]) + hb - la
+        return lb - ha - d.item(j, i), hb - la + d.item(i, j)
 
     def surely_before(self, a: str, b: str, gap: float) -> bool:
         """Does b come at least `gap` after a, whatever nature does?"""
@@ -371,7 +387,8 @@ class Node:
     def add_assertion(self, **fields: object) -> Assertion:
         assertion = Assertion(id=len(self.assertions), **fields)  # type: ignore[arg-type]
         self.assertions.append(assertion)
-        if assertion.kind == "event":
+        # An event that sets the value it finds (a fact restated at a replanning) changes nothing.
+        if assertion.kind == "event" and assertion.before != assertion.value:
             for k, link in enumerate(self.links):
                 if self.assertions[link.consumer].attribute == assertion.attribute:
                     self.pending.add((k, assertion.id))
@@ -391,7 +408,8 @@ class Node:
         self.links.append(Link(producer.id, consumer.id))
         k = len(self.links) - 1
         for e in self.assertions:
-            if e.kind == "event" and e.attribute == consumer.attribute and e.id not in (producer.id, consumer.id):
+            if (e.kind == "event" and e.attribute == consumer.attribute and e.id not in (producer.id, consumer.id)
+                    and e.before != e.value):
                 self.pending.add((k, e.id))
         self.open.discard(consumer.id)
         self.bound(changed)
@@ -471,7 +489,7 @@ class Node:
                 var = instance.var(c.expr.name)
                 domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
                           else (c.domain.low, c.domain.high))
-                self.bindings.domain[var] = Bindings._meet(self.bindings.domain[var], domain)
+                self.bindings.restrict(var, domain)
             elif isinstance(c, pm.Relation) and c.op == "!=" and not is_temporal(c.left) and not is_temporal(c.right):
                 self.bindings.keep_apart(term(c.left), term(c.right))
             elif isinstance(c, (pm.Member, pm.Relation)) and is_temporal(c) and not is_duration(c, task):
@@ -551,8 +569,7 @@ class Node:
             producer, consumer, e = self.assertions[link.producer], self.assertions[link.consumer], \
                 self.assertions[event_id]
             gap = EPS if consumer.kind == "event" else 0.0
-            if ((e.before is not None and same_value(self.bindings.resolve(e.before), self.bindings.resolve(e.value)))
-                    or not all(self.bindings.possibly_equal(x, y) for x, y in zip(e.args, consumer.args, strict=False))
+            if (not all(self.bindings.possibly_equal(x, y) for x, y in zip(e.args, consumer.args, strict=False))
                     or self.surely_before(e.start, producer.start, EPS)
                     or self.surely_before(consumer.end, e.start, gap)):
                 self.pending.discard((k, event_id))
