@@ -356,3 +356,12 @@ def test_plan_bad_input_is_one_clear_error(args: tuple[str, ...], message: str) 
     result = specc("plan", str(EXAMPLES / "atrv"), *args)
     assert result.returncode == 1
     assert message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_export_writes_pddl_and_says_what_it_could_not_express(tmp_path: Path) -> None:
+    result = specc("export", str(EXAMPLES / "atrv"), "--problem", "M1_model2", "-o", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert "(:durative-action" in (tmp_path / "domain.pddl").read_text().lower()
+    assert "(:init" in (tmp_path / "problem.pddl").read_text().lower()
+    notes = [line for line in result.stdout.splitlines() if line.startswith("not expressed:")]
+    assert any("priorit" in line for line in notes) and any("contingent" in line for line in notes)
