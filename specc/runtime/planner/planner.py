@@ -525,9 +525,10 @@ def select(node: Node) -> list[Resolver] | None:
     when the plan has no flaw left: it is a solution."""
     while True:
         best: list[Resolver] | None = None
+        chosen: tuple[int, int, Assertion] | None = None
         forced = False
         for link, event in list(node.threats()):
-            resolvers = threat_resolvers(node, link.producer, link.consumer, event)
+            resolvers = threat_resolvers(node, link.producer, link.consumer, event, complete=False)
             if not resolvers:
                 producer = node.assertions[link.producer]
                 consumer = node.assertions[link.consumer]
@@ -538,9 +539,11 @@ def select(node: Node) -> list[Resolver] | None:
                 resolvers[0].apply(node)
                 forced = True
             elif best is None or len(resolvers) < len(best):
-                best = resolvers
+                best, chosen = resolvers, (link.producer, link.consumer, event)
         if forced:
             continue
+        if chosen is not None:
+            best = threat_resolvers(node, *chosen)
         for a, b in node.resource_conflicts():
             resolvers = [r for r in (Resolver("order", first=a.end, second=b.start),
                                      Resolver("order", first=b.end, second=a.start))
@@ -569,7 +572,10 @@ def select(node: Node) -> list[Resolver] | None:
         return resolvers
 
 
-def threat_resolvers(node: Node, producer_id: int, consumer_id: int, event: Assertion) -> list[Resolver]:
+def threat_resolvers(node: Node, producer_id: int, consumer_id: int, event: Assertion,
+                     complete: bool = True) -> list[Resolver]:
+    """The ways to keep `event` off the link; without `complete`, the two orders when both are
+    possible (enough to know the threat is not forced, and cheaper)."""
     producer, consumer = node.assertions[producer_id], node.assertions[consumer_id]
     gap = EPS if consumer.kind == "event" else 0.0
     options = []
@@ -580,7 +586,9 @@ def threat_resolvers(node: Node, producer_id: int, consumer_id: int, event: Asse
             return [r]  # already so (nature promises it): nothing to choose
         if node.allows(r.first, r.second, r.gap):
             options.append(r)
-    # The order that delays the schedule least first (the minimal-shift rule of scheduling).
+    if len(options) == 2 and not complete:
+        return options
+    # The order leaving the most room first.
     options.sort(key=lambda r: -(node.bounds(r.first, r.second)[1] - r.gap))
     for x, y in zip(event.args, consumer.args, strict=False):
         rx, ry = node.bindings.resolve(x), node.bindings.resolve(y)
