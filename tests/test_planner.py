@@ -132,7 +132,8 @@ def test_a_300_s_horizon_drops_the_lowest_priority_goals_that_must_go(mission: s
     assert {g.priority for g in kept} >= {4.0, 3.0}
     assert all("impossible even alone" in g.reason for g in dropped.values() if g.priority > 2)
     assert any(g.priority == 2 for g in dropped.values())
-    assert any(g.priority == 2 for g in kept)
+    # Modele1 fits two photos around the windows ((-5, 5), then (5, 6)); Modele2's longer moves one.
+    assert sum(g.priority == 2 for g in kept) >= (2 if mission == "M4_model1" else 1)
     # The search is bounded: never more partial plans than its budgets allow.
     goals = len(result.goals)
     assert result.nodes <= planner.nodes + planner.goal_nodes * (2 * goals + 1)
