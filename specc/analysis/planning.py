@@ -102,7 +102,7 @@ class Lowering:
         left, right = self.expr(e.left, scope), self.expr(e.right, scope)
         op = e.op.rstrip(".")
         if isinstance(left, pm.Num) and isinstance(right, pm.Num):
-            folded = fold(op, left.value, right.value)
+            folded = pm.fold(op, left.value, right.value)
             if folded is not None:
                 return pm.Num(folded)
         return pm.Op(op, (left, right))
@@ -256,18 +256,6 @@ class Lowering:
             tuple(self.resource(r) for r in self.members if isinstance(r, m.Resource)),
             tuple(self.task(t) for t in self.members if isinstance(t, m.Task)),
             source)
-
-
-def fold(op: str, left: float, right: float) -> float | None:
-    if op == "+":
-        return left + right
-    if op == "-":
-        return left - right
-    if op == "*":
-        return left * right
-    if op == "/" and right:
-        return left / right
-    return None
 
 
 def domain_model(program: m.Program, domain: m.Domain) -> pm.PlanningDomain:

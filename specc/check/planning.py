@@ -14,6 +14,7 @@ from typing import Any
 from specc.check.context import Context
 from specc.model import nodes as m
 from specc.model.visitor import Visitor, walk
+from specc.runtime.planner.model import fold
 
 VALUE_VAR = "?value"
 FUNCTIONS = ("abs", "max", "min")  # what the planner's propagators and CasADi know
@@ -296,15 +297,9 @@ def constant_value(e: m.IxExpr) -> float | None:
         left, right = constant_value(e.left), constant_value(e.right)
         if left is None or right is None:
             return None
-        op = e.op.rstrip(".")
-        if op == "+":
-            return left + right
-        if op == "-":
-            return left - right
-        if op == "*":
-            return left * right
-        return left / right if right else None
+        return fold(e.op.rstrip("."), left, right)
     return None
+
 
 
 def check_members(ctx: Context, tables_: DomainTables) -> None:

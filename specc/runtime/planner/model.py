@@ -64,6 +64,17 @@ class Op:
 
 Expr = Union[Num, Sym, Var, Time, Op]
 ARITHMETIC = ("+", "-", "*", "/")
+
+
+def fold(op: str, left: float, right: float) -> float | None:
+    """`left op right` for the four operations; None for a division by zero."""
+    if op == "+":
+        return left + right
+    if op == "-":
+        return left - right
+    if op == "*":
+        return left * right
+    return left / right if op == "/" and right else None
 FUNCTIONS = ("max", "min", "abs")
 
 
