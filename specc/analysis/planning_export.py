@@ -70,6 +70,7 @@ from unified_planning.shortcuts import (
 from specc.analysis.planning import Lowering
 from specc.model import nodes as m
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.numeric import describe, div, evaluate, mul
 
 VALUE = -1  # the position of an attribute's value, next to its argument positions 0, 1, ...
 ROOT_TYPE = "symbol"
@@ -151,48 +152,8 @@ def _keys(e: pm.Expr | pm.Constraint) -> set[Key]:
     return {key} if key else set()
 
 
-def _fix(low: float, high: float) -> Span:
-    return (-math.inf if math.isnan(low) else low, math.inf if math.isnan(high) else high)
-
-
-def _times(a: float, b: float) -> float:
-    return 0.0 if a == 0 or b == 0 else a * b
-
-
-def _mul(a: Span, b: Span) -> Span:
-    products = [_times(x, y) for x in a for y in b]
-    return _fix(min(products), max(products))
-
-
-def _div(a: Span, b: Span) -> Span:
-    if b[0] <= 0 <= b[1]:
-        return FULL
-    return _mul(a, (1 / b[1], 1 / b[0]))
-
-
 def _apply(op: str, args: list[Span]) -> Span:
-    if op == "+":
-        return _fix(args[0][0] + args[1][0], args[0][1] + args[1][1])
-    if op == "-":
-        return _fix(args[0][0] - args[1][1], args[0][1] - args[1][0])
-    if op == "*":
-        return _mul(args[0], args[1])
-    if op == "/":
-        return _div(args[0], args[1])
-    if op == "neg":
-        return (-args[0][1], -args[0][0])
-    if op == "max":
-        return (max(a[0] for a in args), max(a[1] for a in args))
-    if op == "min":
-        return (min(a[0] for a in args), min(a[1] for a in args))
-    if op == "abs":
-        low, high = args[0]
-        if low >= 0:
-            return (low, high)
-        if high <= 0:
-            return (-high, -low)
-        return (0.0, max(-low, high))
-    return FULL
+    return evaluate(op, args) if op in ("+", "-", "*", "/", "neg", "max", "min", "abs") else FULL
 
 
 def _close(a: float, b: float) -> bool:
@@ -296,13 +257,13 @@ class _Box:
             changed |= self.project(args[1], _apply("-", [spans[0], target]))
         elif op == "*":
             if not spans[1][0] <= 0 <= spans[1][1]:
-                changed |= self.project(args[0], _div(target, spans[1]))
+                changed |= self.project(args[0], div(target, spans[1]))
             if not spans[0][0] <= 0 <= spans[0][1]:
-                changed |= self.project(args[1], _div(target, spans[0]))
+                changed |= self.project(args[1], div(target, spans[0]))
         elif op == "/":
-            changed |= self.project(args[0], _mul(target, spans[1]))
+            changed |= self.project(args[0], mul(target, spans[1]))
             if not target[0] <= 0 <= target[1]:
-                changed |= self.project(args[1], _div(spans[0], target))
+                changed |= self.project(args[1], div(spans[0], target))
         elif op == "neg":
             changed |= self.project(args[0], (-target[1], -target[0]))
         elif op == "max":
@@ -454,21 +415,13 @@ def _number_text(v: float) -> str:
     return text.replace("-", "m").replace(".", "p").replace("+", "")
 
 
-def _show(e: pm.Expr) -> str:
-    if isinstance(e, pm.Num):
-        return f"{e.value:g}"
-    if isinstance(e, (pm.Sym, pm.Var, pm.Time)):
-        return e.name
-    return f"{e.op}({', '.join(_show(a) for a in e.args)})"
-
-
 def _describe(a: pm.Assertion) -> str:
-    args = ", ".join(_show(x) for x in a.args)
+    args = ", ".join(describe(x) for x in a.args)
     if isinstance(a, pm.Event):
-        return f"event({a.attribute}({args}): ({_show(a.before)}, {_show(a.after)}), {a.time})"
+        return f"event({a.attribute}({args}): ({describe(a.before)}, {describe(a.after)}), {a.time})"
     if isinstance(a, pm.Hold):
-        return f"hold({a.attribute}({args}): {_show(a.value)}, ({a.start}, {a.end}))"
-    return f"use({a.resource}({args}): {_show(a.amount)}, ({a.start}, {a.end}))"
+        return f"hold({a.attribute}({args}): {describe(a.value)}, ({a.start}, {a.end}))"
+    return f"use({a.resource}({args}): {describe(a.amount)}, ({a.start}, {a.end}))"
 
 
 def _seconds(v: float) -> str:
@@ -763,7 +716,7 @@ class _Exporter:
     # ------------------------------------------------------------ fluents and terms
     def fluent(self, attribute: str, value: pm.Expr) -> Any:
         """The boolean fluent of `attribute` (with a value parameter) or of `attribute` = value."""
-        name = attribute if attribute in self.valued else f"{attribute}_{_show(value)}"
+        name = attribute if attribute in self.valued else f"{attribute}_{describe(value)}"
         if name not in self.fluents:
             attr = self.domain.attribute(attribute)
             params = list(attr.params) if attr else []
@@ -785,7 +738,7 @@ class _Exporter:
             return self.objects[e.name]
         if isinstance(e, pm.Num):
             return self.number_objects[(id(self.slot_class(slot)), e.value)]
-        raise KeyError(_show(e))
+        raise KeyError(describe(e))
 
     def atom(self, attribute: str, args: Sequence[pm.Expr], value: pm.Expr, bound: Mapping[str, Any]) -> Any:
         fluent = self.fluent(attribute, value)
@@ -915,7 +868,7 @@ class _Exporter:
                     and isinstance(c.right, pm.Var) and len(param_keys) == 2 \
                     and not by_var[c.left.name].numeric and not by_var[c.right.name].numeric:
                 # A (dis)equality of two symbolic parameters is a plain condition, not a table.
-                same = Equals(bound[_show(c.left)], bound[_show(c.right)])
+                same = Equals(bound[describe(c.left)], bound[describe(c.right)])
                 action.add_condition(StartTiming(), same if c.op == "=" else Not(same))
             elif len(keys) == 1 and param_keys:
                 unary.setdefault(param_keys[0][1], []).append(c)
@@ -1094,7 +1047,7 @@ class _Exporter:
             touches = And(*equalities) if equalities else None
             if guard.fluent is None and touches is None:
                 self.note(f"{action.name} can never run: it would end the required "
-                          f"{attribute}({', '.join(_show(a) for a in guard.args)}) = {_show(guard.value)}.")
+                          f"{attribute}({', '.join(describe(a) for a in guard.args)}) = {describe(guard.value)}.")
                 action.add_condition(at, FALSE())
             elif guard.fluent is None:
                 action.add_condition(at, Not(touches))
@@ -1175,7 +1128,7 @@ class _Exporter:
                 found.append(binding)
         shown = ", ".join(variables)
         if found:
-            choices = "; ".join(", ".join(f"{k} = {_show(v)}" for k, v in b.items()) for b in found)
+            choices = "; ".join(", ".join(f"{k} = {describe(v)}" for k, v in b.items()) for b in found)
             self.note(f"the problem variables {shown} of {_describe(a)} are bound by unification with the goals "
                       f"({choices}); the exported initial state holds each binding.")
             return found

@@ -45,6 +45,15 @@ class Contingent:
     high: float
 
 
+def for_every_offset(low: float, high: float, first: tuple[float, float],
+                     second: tuple[float, float]) -> tuple[float, float]:
+    """Bounds on t(b') - t(a') that keep `low <= t(b) - t(a) <= high` whatever nature picks, when
+    t(a) = t(a') + an offset in `first` and t(b) = t(b') + an offset in `second` (Vidal & Fargier's
+    reduction for strong controllability)."""
+    return (low - (second[0] - first[1]) if low > -INF else -INF,
+            high - (second[1] - first[0]) if high < INF else INF)
+
+
 class STN:
     def __init__(self, capacity: int = 16) -> None:
         self.names: list[str] = []
@@ -166,9 +175,7 @@ class STN:
         try:
             for c in self.constraints:
                 (a, a_low, a_high), (b, b_low, b_high) = anchor(c.first), anchor(c.second)
-                # t(second) - t(first) = t(b) - t(a) + (offset_b - offset_a): hold it for the worst offsets.
-                low = c.low - (b_low - a_high) if c.low > -INF else -INF
-                high = c.high - (b_high - a_low) if c.high < INF else INF
+                low, high = for_every_offset(c.low, c.high, (a_low, a_high), (b_low, b_high))
                 reduced.add(self.names[a], self.names[b], low, high)
         except Inconsistent:
             return None

@@ -63,7 +63,6 @@ class Op:
 
 
 Expr = Union[Num, Sym, Var, Time, Op]
-ARITHMETIC = ("+", "-", "*", "/")
 
 
 def fold(op: str, left: float, right: float) -> float | None:
@@ -252,6 +251,21 @@ class Problem:
     source: str = ""
     start: str = "t_start"
     end: str = "t_end"
+
+
+def timepoints_of(e: Expr | Constraint) -> set[str]:
+    """The timepoints an expression or a constraint mentions."""
+    if isinstance(e, Time):
+        return {e.name}
+    if isinstance(e, Op):
+        return set().union(*(timepoints_of(a) for a in e.args))
+    if isinstance(e, Member):
+        return timepoints_of(e.expr)
+    if isinstance(e, Relation):
+        return timepoints_of(e.left) | timepoints_of(e.right)
+    if isinstance(e, Implies):
+        return timepoints_of(e.condition) | timepoints_of(e.consequence)
+    return set()
 
 
 def with_horizon(problem: Problem, seconds: float) -> Problem:

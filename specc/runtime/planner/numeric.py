@@ -67,6 +67,40 @@ def div(a: Interval, b: Interval) -> Interval:
     return mul(a, (1 / b[1], 1 / b[0]))
 
 
+def evaluate(op: str, args: list[Interval]) -> Interval:
+    """The interval an operator (`+ - * / neg max min abs`) gives its argument intervals."""
+    if op == "+":
+        low, high = add(args[0], args[1])
+    elif op == "-":
+        low, high = sub(args[0], args[1])
+    elif op == "*":
+        return mul(args[0], args[1])
+    elif op == "/":
+        return div(args[0], args[1])
+    elif op == "neg":
+        return (-args[0][1], -args[0][0])
+    elif op == "max":
+        return (max(a[0] for a in args), max(a[1] for a in args))
+    elif op == "min":
+        return (min(a[0] for a in args), min(a[1] for a in args))
+    elif op == "abs":
+        low, high = args[0]
+        if low >= 0:
+            return (low, high)
+        if high <= 0:
+            return (-high, -low)
+        return (0.0, max(-low, high))
+    else:
+        raise ValueError(f"unknown operator {op!r}")
+    # inf - inf: the sum of unbounded intervals is unbounded.
+    return (-INF if math.isnan(low) else low, INF if math.isnan(high) else high)
+
+
+def domain_of(values: pm.Values) -> Dom:
+    """A declared domain as the propagators hold it: a set of symbols or an interval."""
+    return frozenset(values.values) if isinstance(values, pm.Symbols) else (values.low, values.high)
+
+
 def intersect(a: Interval, b: Interval) -> Interval:
     low, high = max(a[0], b[0]), min(a[1], b[1])
     if low > high + 1e-9 * max(1.0, abs(low)):
@@ -102,29 +136,7 @@ class Closure:
             return self.domains.setdefault(e.name, (-INF, INF))
         if isinstance(e, pm.Time):
             return (-INF, INF)  # timepoints are the temporal network's business
-        args = [self.numeric(self.forward(a)) for a in e.args]
-        if e.op == "+":
-            return add(args[0], args[1])
-        if e.op == "-":
-            return sub(args[0], args[1])
-        if e.op == "*":
-            return mul(args[0], args[1])
-        if e.op == "/":
-            return div(args[0], args[1])
-        if e.op == "neg":
-            return (-args[0][1], -args[0][0])
-        if e.op == "max":
-            return (max(a[0] for a in args), max(a[1] for a in args))
-        if e.op == "min":
-            return (min(a[0] for a in args), min(a[1] for a in args))
-        if e.op == "abs":
-            low, high = args[0]
-            if low >= 0:
-                return (low, high)
-            if high <= 0:
-                return (-high, -low)
-            return (0.0, max(-low, high))
-        raise ValueError(f"unknown operator {e.op!r}")
+        return evaluate(e.op, [self.numeric(self.forward(a)) for a in e.args])
 
     @staticmethod
     def numeric(d: Dom) -> Interval:
@@ -203,9 +215,7 @@ class Closure:
     # ------------------------------------------------------------ constraints
     def apply(self, c: pm.Constraint) -> bool:
         if isinstance(c, pm.Member):
-            domain: Dom = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
-                           else (c.domain.low, c.domain.high))
-            return self.narrow(c.expr, domain)
+            return self.narrow(c.expr, domain_of(c.domain))
         if isinstance(c, pm.Relation):
             return self.relation(c.op, c.left, c.right)
         return self.implication(c)

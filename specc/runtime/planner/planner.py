@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.numeric import exact_duration
+from specc.runtime.planner.numeric import describe, domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult
 from specc.runtime.planner.search import (
     EPS,
@@ -29,10 +29,11 @@ from specc.runtime.planner.search import (
     Limits,
     Node,
     Term,
+    as_term,
     differences,
     is_temporal,
     is_var,
-    same_value,
+    translate,
 )
 from specc.runtime.stn import STN, Inconsistent
 
@@ -53,8 +54,8 @@ class Goal:
     @property
     def text(self) -> str:
         a = self.hold
-        args = f"({', '.join(_expr_text(x) for x in a.args)})"
-        value = _expr_text(a.value) if isinstance(a, pm.Hold) else _expr_text(a.after)
+        args = f"({', '.join(describe(x) for x in a.args)})"
+        value = describe(a.value) if isinstance(a, pm.Hold) else describe(a.after)
         return f"{a.attribute}{args} = {value} (line {a.line}, priority {self.priority:g})"
 
 
@@ -170,6 +171,10 @@ class Setup:
             if pm.subject(a) not in {x.name for x in domain.attributes} | {r.name for r in domain.resources}:
                 raise PlanningInputError(f"line {a.line}: unknown attribute '{pm.subject(a)}' in problem "
                                          f"'{problem.name}'")
+            terms = a.args + ((a.value,) if isinstance(a, pm.Hold) else (a.before, a.after)
+                              if isinstance(a, pm.Event) else (a.amount,))
+            if any(isinstance(t, (pm.Op, pm.Time)) for t in terms):
+                raise PlanningInputError(f"line {a.line}: assertions take values and variables, not expressions")
             declared = domain.attribute(pm.subject(a))
             # An explained event's former value is history: only what it sets must be a value.
             values: tuple[pm.Expr, ...] = (a.value,) if isinstance(a, pm.Hold) else () if not isinstance(
@@ -225,6 +230,7 @@ class Setup:
         self.owned = {point: owners for point, owners in used_by.items()
                       if owners <= goal_indexes and point not in (self.origin, problem.end)}
         self.capacity = {r.name: r.capacity for r in domain.resources}
+        self.producers = Context(domain, problem.end, self.origin, now, limits, self.capacity).producers
 
     def root(self, active: list[Goal], ctx: Context) -> Node:
         node = Node(ctx)
@@ -247,19 +253,9 @@ class Setup:
             node.bindings.declare(var, None)
         for c in problem.constraints:
             if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
-                domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
-                          else (c.domain.low, c.domain.high))
-                node.bindings.restrict(c.expr.name, domain)
+                node.bindings.restrict(c.expr.name, domain_of(c.domain))
 
-        def term(e: pm.Expr) -> Term:
-            if isinstance(e, pm.Num):
-                return e.value
-            if isinstance(e, pm.Sym):
-                return e.name
-            if isinstance(e, pm.Var):
-                return e.name
-            raise PlanningInputError(f"expressions are not planned in assertions: {e}")
-
+        term = as_term
         for i, a in enumerate(problem.assertions):
             if a.goal is not None and i not in active_indexes:
                 continue
@@ -284,7 +280,7 @@ class Setup:
     # ------------------------------------------------------------ search
     def search(self, active: list[Goal], budget: int, discrepancies: bool = True) -> Attempt:
         ctx = Context(self.domain, self.problem.end, self.origin, self.now, self.limits, self.capacity,
-                      nature_before=self.nature_before)
+                      self.producers, nature_before=self.nature_before)
         failures: Counter[str] = Counter()
         try:
             root = self.root(active, ctx)
@@ -357,12 +353,9 @@ class Setup:
                 network.point(name)
         reduced = []
         for a, b, low, high in node.original:
-            pa, la, ha = anchors.get(a, (a, 0.0, 0.0))
-            pb, lb, hb = anchors.get(b, (b, 0.0, 0.0))
+            pa, pb, new_low, new_high = translate(anchors, a, b, low, high)
             if pa == pb:
                 continue
-            new_low = low - (lb - ha) if low > -INF else -INF
-            new_high = high - (hb - la) if high < INF else INF
             reduced.append((pa, pb, new_low, new_high))
             try:
                 network.add(pa, pb, new_low, new_high)
@@ -679,12 +672,3 @@ def _points(a: pm.Assertion) -> tuple[str, ...]:
     return (a.start, a.end)
 
 
-def _expr_text(e: pm.Expr) -> str:
-    if isinstance(e, pm.Num):
-        return f"{e.value:g}"
-    if isinstance(e, (pm.Sym, pm.Var, pm.Time)):
-        return e.name
-    return f"{e.op}({', '.join(_expr_text(a) for a in e.args)})"
-
-
-__all__ = ["Planner", "PlanningInputError", "same_value"]

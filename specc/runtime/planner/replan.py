@@ -81,20 +81,6 @@ def replanning_problem(problem: pm.Problem, facts: Iterable[Fact], remaining_goa
     # The timepoints of the goals left out go with them, and so do the constraints on them.
     used = {point for a in assertions for point in ((a.time,) if isinstance(a, pm.Event) else (a.start, a.end))}
     gone = {point for point in problem.timepoints if point not in used}
-    constraints = tuple(c for c in problem.constraints if not _times(c) & gone)
+    constraints = tuple(c for c in problem.constraints if not pm.timepoints_of(c) & gone)
     return replace(problem, name=f"{problem.name}@{now:g}", assertions=tuple(assertions), constraints=constraints,
                    timepoints=tuple(p for p in problem.timepoints if p not in gone))
-
-
-def _times(c: pm.Constraint | pm.Expr) -> set[str]:
-    if isinstance(c, pm.Time):
-        return {c.name}
-    if isinstance(c, pm.Op):
-        return set().union(*(_times(a) for a in c.args))
-    if isinstance(c, pm.Member):
-        return _times(c.expr)
-    if isinstance(c, pm.Relation):
-        return _times(c.left) | _times(c.right)
-    if isinstance(c, pm.Implies):
-        return _times(c.condition) | _times(c.consequence)
-    return set()

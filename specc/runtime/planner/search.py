@@ -22,8 +22,8 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.numeric import DurationSpec, Empty, duration_of, is_duration, is_number
-from specc.runtime.stn import STN, Inconsistent
+from specc.runtime.planner.numeric import DurationSpec, Empty, domain_of, duration_of, is_duration, is_number
+from specc.runtime.stn import STN, Inconsistent, for_every_offset
 
 INF = math.inf
 EPS = 0.01  # seconds between two events that must not be simultaneous (IxTeT's strict precedence)
@@ -34,6 +34,27 @@ Term = float | str  # a value, or a variable when the string holds a '?'
 
 class DeadEnd(Exception):
     """This partial plan has no completion."""
+
+
+def as_term(e: pm.Expr, variable: Callable[[str], str] = str) -> Term:
+    """An assertion's argument or value as the plan holds it: a number, a symbol, or the plan's
+    name of a variable."""
+    if isinstance(e, pm.Num):
+        return e.value
+    if isinstance(e, pm.Sym):
+        return e.name
+    if isinstance(e, pm.Var):
+        return variable(e.name)
+    raise DeadEnd(f"expressions are not planned in assertions: {e}")
+
+
+def translate(anchors: Mapping[str, tuple[str, float, float]], a: str, b: str, low: float,
+              high: float) -> tuple[str, str, float, float]:
+    """`low <= t(b) - t(a) <= high` rewritten on the timepoints a and b hang from (themselves when
+    the plan schedules them), for every offset nature gives them."""
+    pa, la, ha = anchors.get(a, (a, 0.0, 0.0))
+    pb, lb, hb = anchors.get(b, (b, 0.0, 0.0))
+    return (pa, pb) + for_every_offset(low, high, (la, ha), (lb, hb))
 
 
 def is_var(term: Term) -> bool:
@@ -265,7 +286,8 @@ class Link:
 
 @dataclass
 class Limits:
-    nodes: int = 20000
+    """How large a partial plan may grow."""
+
     instances: int = 60
     per_task: int = 20
 
@@ -285,6 +307,8 @@ class Context:
     nature_before: set[tuple[str, str]] = field(default_factory=set)
 
     def __post_init__(self) -> None:
+        if self.producers:
+            return  # shared by the searches of one problem
         for task in self.domain.tasks:
             for i, a in enumerate(task.assertions):
                 if isinstance(a, pm.Event):
@@ -332,11 +356,7 @@ class Node:
     # ------------------------------------------------------------ time
     def _translate(self, a: str, b: str, low: float, high: float) -> tuple[str, str, float, float]:
         """`low <= t(b) - t(a) <= high` for every offset nature gives a and b."""
-        pa, la, ha = self.anchor.get(a, (a, 0.0, 0.0))
-        pb, lb, hb = self.anchor.get(b, (b, 0.0, 0.0))
-        new_low = low - (lb - ha) if low > -INF else -INF
-        new_high = high - (hb - la) if high < INF else INF
-        return pa, pb, new_low, new_high
+        return translate(self.anchor, a, b, low, high)
 
     def require(self, a: str, b: str, low: float = -INF, high: float = INF, record: bool = True) -> None:
         """Require `low <= t(b) - t(a) <= high` (raises DeadEnd when the network refuses)."""
@@ -475,21 +495,13 @@ class Node:
             self.require(point(name), instance.end, 0.0)
 
         def term(e: pm.Expr) -> Term:
-            if isinstance(e, pm.Num):
-                return e.value
-            if isinstance(e, pm.Sym):
-                return e.name
-            if isinstance(e, pm.Var):
-                return instance.var(e.name)
-            raise DeadEnd(f"{task.name}: expressions in assertions are not planned: {e}")
+            return as_term(e, instance.var)
 
         # Domains of the task's variables, and what keeps them apart.
         for c in task.constraints:
             if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var) and not c.contingent:
                 var = instance.var(c.expr.name)
-                domain = (frozenset(c.domain.values) if isinstance(c.domain, pm.Symbols)
-                          else (c.domain.low, c.domain.high))
-                self.bindings.restrict(var, domain)
+                self.bindings.restrict(var, domain_of(c.domain))
             elif isinstance(c, pm.Relation) and c.op == "!=" and not is_temporal(c.left) and not is_temporal(c.right):
                 self.bindings.keep_apart(term(c.left), term(c.right))
             elif isinstance(c, (pm.Member, pm.Relation)) and is_temporal(c) and not is_duration(c, task):
@@ -595,15 +607,8 @@ def _number(value: Term) -> float:
 
 
 def is_temporal(e: pm.Expr | pm.Constraint) -> bool:
-    if isinstance(e, pm.Member):
-        return is_temporal(e.expr)
-    if isinstance(e, pm.Relation):
-        return is_temporal(e.left) or is_temporal(e.right)
-    if isinstance(e, pm.Implies):
-        return False
-    if isinstance(e, pm.Time):
-        return True
-    return isinstance(e, pm.Op) and any(is_temporal(a) for a in e.args)
+    """Does it mention a timepoint? (An implication never does: it is numeric or symbolic.)"""
+    return not isinstance(e, pm.Implies) and bool(pm.timepoints_of(e))
 
 
 def _could_be(e: pm.Expr, wanted: Term, task: pm.Task, bindings: Bindings) -> bool:
