@@ -25,6 +25,7 @@ demo: $(STAMP)
 	$(BIN)/specc verify examples/hilare --goal '!(COLLECT-OBJECTS 1)' --fail ARM-OBJ --steps 4 \
 	    --reach 'Explore:254; TakeObject:236 ?(& (OBJ-FOUND @I) (> @I (+ @TAKEN 1)))'
 	$(BIN)/specc plan examples/atrv --problem M4 --domain model1 -o build/m4-plan.png
+	$(BIN)/python examples/hilare/run_sim.py --goal 9,7 --goal 2,7 -o build/hilare-run.png
 
 test: $(STAMP)
 	$(BIN)/ruff check specc tests

@@ -1,5 +1,6 @@
 """Drive Hilare's executive (seed 000 §5.3) as the task level would: the initialisation services,
-one modelling cycle, then an exploration trajectory cut short by an object (Fig 5.6, rule 1).
+one modelling cycle, the grasping position of an object (the one seen, or one noted by hand), then
+an exploration trajectory cut short by the planning of a path to that object (Fig 5.6, rule 1).
 
 Run from the repository root after `specc compile examples/hilare -o generated`:
     python examples/hilare/run_executive.py
@@ -9,6 +10,7 @@ Every (REPLY id result) and (WARNING service id type) fact is printed as it reac
 from __future__ import annotations
 
 import os
+import random
 import sys
 import time
 from pathlib import Path
@@ -22,6 +24,8 @@ from hilare.executive import hilare  # noqa: E402
 from specc.runtime import executive as rx  # noqa: E402
 from specc.runtime import functional as rt  # noqa: E402
 
+SEED = 7  # VISUAL places the objects at random (readObstacles, §5.2.4): a fixed seed, a repeatable run
+PLACED_OBJECT = {"x": 1.65, "y": 6.15, "i": 5, "j": 20}  # in a free cell of worlds/room.toml
 INITIALISATIONS = ("AVOID-ON", "SET-DYNAMIC", "AUTOBOX-OFF", "SET-BOX", "READ-MODEL", "INIT-MODEL", "READ-OBST")
 
 
@@ -55,6 +59,7 @@ class TaskLevel:
 
 def main() -> None:
     os.chdir(HERE)  # the robot's files (worlds/room.toml) are named relative to its folder
+    random.seed(SEED)
     started = time.perf_counter()
     registry = rt.Registry()
     modules.create_all(registry)
@@ -66,8 +71,12 @@ def main() -> None:
     print("modelling cycle: TAKE-IMAGE, then SEARCH-OBJ and TURN-CAMERA in parallel (§5.4):")
     task.call("TAKE-IMAGE")
     found, _ = task.wait(task.send("SEARCH-OBJ"), task.send("TURN-CAMERA"))
-    if isinstance(found, int) and found > 0:
-        task.call("GET-NEAR-OBJ")
+    print("grasping position of an object (CALC-OBJ), for later:")
+    seen = isinstance(found, int) and found > 0 and task.call("GET-NEAR-OBJ") == "OK"
+    if not (seen and task.call("CALC-OBJ") == "OK"):
+        # none seen, or out of reach: one is noted by hand, as GET-NEAR-OBJ's output function does
+        executive.context.vars["object"] = dict(PLACED_OBJECT)
+        task.call("CALC-OBJ")
     print("exploration: CALC-GOAL, CALC-TRAJ-GOAL, EXEC-TRAJ-GOAL; an object turns up on the way:")
     task.call("CALC-GOAL")
     task.call("CALC-TRAJ-GOAL")

@@ -11,7 +11,6 @@ import heapq
 import itertools
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 
@@ -38,13 +37,13 @@ class WallClock(Clock):
             time.sleep(delay)
 
 
-@dataclass(order=True)
 class _Event:
-    when: float
-    priority: int
-    order: int
-    action: Callable[[], Any] = field(compare=False)
-    cancelled: bool = field(default=False, compare=False)
+    __slots__ = ("when", "action", "cancelled")
+
+    def __init__(self, when: float, action: Callable[[], Any]) -> None:
+        self.when = when
+        self.action = action
+        self.cancelled = False
 
 
 class Timer:
@@ -67,14 +66,16 @@ class Kernel:
     def __init__(self, clock: Clock | None = None, start: float = 0.0):
         self.clock = clock or Clock()
         self.now = start
-        self._queue: list[_Event] = []
+        # (when, priority, order, event): tuples compare in C, several times faster than a
+        # dataclass's generated ordering, which weighed on a simulated robot's every step.
+        self._queue: list[tuple[float, int, int, _Event]] = []
         self._order = itertools.count()
 
     def call_at(self, when: float, action: Callable[[], Any], priority: int = 0) -> Timer:
         if when < self.now:
             when = self.now
-        event = _Event(when, priority, next(self._order), action)
-        heapq.heappush(self._queue, event)
+        event = _Event(when, action)
+        heapq.heappush(self._queue, (when, priority, next(self._order), event))
         return Timer(event)
 
     def call_later(self, delay: float, action: Callable[[], Any], priority: int = 0) -> Timer:
@@ -83,7 +84,7 @@ class Kernel:
     def step(self) -> bool:
         """Run the next event; False when nothing is scheduled."""
         while self._queue:
-            event = heapq.heappop(self._queue)
+            event = heapq.heappop(self._queue)[3]
             if event.cancelled:
                 continue
             self.clock.wait_until(event.when, self.now)
@@ -93,9 +94,9 @@ class Kernel:
         return False
 
     def next_time(self) -> float | None:
-        while self._queue and self._queue[0].cancelled:
+        while self._queue and self._queue[0][3].cancelled:
             heapq.heappop(self._queue)
-        return self._queue[0].when if self._queue else None
+        return self._queue[0][0] if self._queue else None
 
     def run_until(self, instant: float) -> None:
         """Run every event due at or before `instant`, then set the clock to `instant`."""

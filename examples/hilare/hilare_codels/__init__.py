@@ -2,7 +2,8 @@
 
 One Python module per GenoM module (``codels: "hilare_codels.<module>"`` in each spec), plus
 ``executive.py`` (input/output functions of the executive's services) and ``prs.py`` (primitive
-actions of the task level). The algorithms are minimal placeholders; the real ones come later.
+actions of the task level). PLAN, PILO and EXPLOR run the algorithms of §5.2.2, §5.2.1 and §5.2.5
+(pure functions, tested in tests/test_hilare_algorithms.py); the others are minimal placeholders.
 
 Interface these codels assume from the runtime (kept deliberately small):
 

@@ -1,4 +1,5 @@
-"""Codels of ARM (seed 000 §5.2.3, Table 5.3): a simulated manipulator arm."""
+"""Codels of ARM (seed 000 §5.2.3, Table 5.3): a simulated manipulator arm (the simulator's
+arm when one is attached, else joints integrated here)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,8 @@ def initArm(sdi):
     sdi.config.q = list(REST)
     sdi.target.q = list(REST)
     sdi.grip = "OPEN"
+    if sdi.hardware is not None and sdi.hardware.arm is not None:
+        sdi.hardware.arm.reset(REST)
     return "exec"
 
 
@@ -37,7 +40,13 @@ def planArmToRest(sdi, request):
 
 
 def moveArm(sdi, request):
-    """goObject/goBack exec: move every joint towards the target at bounded speed."""
+    """goObject/goBack exec: move every joint towards the target at bounded speed (the
+    simulated arm's joints when a simulator is attached)."""
+    arm = sdi.hardware.arm if sdi.hardware is not None else None
+    if arm is not None:
+        arm.move_to(list(sdi.target.q))
+        sdi.config.q = arm.q
+        return "exec" if arm.moving else "ether"
     step = JOINT_SPEED * PERIOD
     done = True
     for i in range(N_JOINTS):
@@ -52,6 +61,9 @@ def moveArm(sdi, request):
 
 def stopArm(sdi, request):
     """Inter phase: stop where the arm is."""
+    if sdi.hardware is not None and sdi.hardware.arm is not None:
+        sdi.hardware.arm.move_to(sdi.hardware.arm.q)
+        sdi.config.q = sdi.hardware.arm.q
     sdi.target.q = list(sdi.config.q)
     return "ether"
 
@@ -59,4 +71,6 @@ def stopArm(sdi, request):
 def setGrip(sdi, request):
     """gripState: open or close the gripper."""
     sdi.grip = request.grip
+    if sdi.hardware is not None and sdi.hardware.arm is not None:
+        sdi.hardware.arm.grip = str(request.grip)
     return "end"

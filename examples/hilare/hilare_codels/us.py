@@ -1,4 +1,4 @@
-"""Codels of US (seed 000 §2.3): the belt of 32 ultrasonic range finders (placeholder)."""
+"""Codels of US (seed 000 §2.3): the belt of 32 ultrasonic range finders."""
 
 from __future__ import annotations
 
@@ -28,8 +28,9 @@ def startScan(sdi, request):
 
 
 def readSensors(sdi, request):
-    """scan exec: read the enabled sensors (the simulator provides sdi.measure_ranges)."""
-    measured = sdi.measure_ranges() if hasattr(sdi, "measure_ranges") else sdi.ranges
+    """scan exec: read the enabled sensors (none without hardware: the ranges stay as they are)."""
+    hardware = sdi.hardware
+    measured = [float(r) for r in hardware.sonars.read()] if hardware is not None else sdi.ranges
     if len(measured) != N_SENSORS:
         return "SENSOR_FAILURE"
     sdi.ranges = [

@@ -1,4 +1,9 @@
-"""Codels of VISUAL (seed 000 §5.2.4, Table 5.4): simulated perception and modelling."""
+"""Codels of VISUAL (seed 000 §5.2.4, Table 5.4): perception and modelling.
+
+With a simulator attached (`sdi.hardware`), the camera on the simulated pan-tilt unit takes the
+images: the objects are the world's, occluded by its obstacles and detected with probability
+f(r, θ). Without one, VISUAL simulates them itself, as the thesis' module did.
+"""
 
 from __future__ import annotations
 
@@ -7,19 +12,21 @@ import pathlib
 import random
 import tomllib
 
+from specc.runtime.sim import WorldError, parse_world
+from specc.runtime.sim import reliability as sim_reliability
+
 NX = NY = 64  # invented grid size (4096 cells)
 CELL = 0.30  # m (§5.6)
 R_MIN, R_MAX = 0.5, 4.0  # m, invented perception range
 THETA_OPEN = math.radians(60)  # invented field of view
 MAX_OBJECTS = 16
 N_WORLD_OBJECTS = 10  # §5.6: 10 objects scattered in the room
+OBJECT_CLEARANCE = 0.45  # m from walls and obstacles: EXPLOR's grown obstacles (0.40 m) leave them reachable
 
 
 def reliability(r, theta):
     """Fig 5.4: detection reliability f(r, θ) of an object at range r and bearing θ."""
-    if R_MIN <= r <= R_MAX and -THETA_OPEN <= 2 * theta <= THETA_OPEN:
-        return math.exp(-((r / R_MAX) ** 2) - (2 * theta / THETA_OPEN) ** 2)
-    return 0.0
+    return sim_reliability(r, theta, R_MIN, R_MAX, THETA_OPEN)
 
 
 def initVisual(sdi):
@@ -49,7 +56,8 @@ def markObstacleCells(sdi, request):
     then place the simulated objects at random in free cells (§5.2.4)."""
     try:
         world = tomllib.loads(pathlib.Path(sdi.modelFile).read_text())
-    except (OSError, tomllib.TOMLDecodeError):
+        room = parse_world(world, sdi.modelFile)
+    except (OSError, tomllib.TOMLDecodeError, WorldError):
         return "FILE_NOT_FOUND"
     sdi.model.free = [True] * (NX * NY)
     for obstacle in world.get("obstacles", []):
@@ -59,8 +67,12 @@ def markObstacleCells(sdi, request):
             for j in range(int(min(ys) / CELL), int(max(ys) / CELL) + 1):
                 if 0 <= i < NX and 0 <= j < NY:
                     sdi.model.free[j * NX + i] = False
-    free_cells = [k for k in range(NX * NY) if sdi.model.free[k]]
-    chosen = random.sample(free_cells, min(N_WORLD_OBJECTS, len(free_cells), MAX_OBJECTS))
+    # Objects lie where the robot can stand on them (EXPLOR's calcObj puts its centre on the
+    # object's cell): inside the room, clear of walls and obstacles.
+    free_cells = [k for k in range(NX * NY) if sdi.model.free[k]
+                  and room.clearance((k % NX + 0.5) * CELL, (k // NX + 0.5) * CELL) >= OBJECT_CLEARANCE]
+    wanted = 0 if sdi.hardware is not None else N_WORLD_OBJECTS  # the simulator has its own objects
+    chosen = random.sample(free_cells, min(wanted, len(free_cells), MAX_OBJECTS))
     for slot, k in zip(sdi.worldObjects, chosen, strict=False):
         slot.i, slot.j = k % NX, k // NX
         slot.x, slot.y = (slot.i + 0.5) * CELL, (slot.j + 0.5) * CELL
@@ -74,6 +86,8 @@ def setCameraPan(sdi, request):
     if not math.isfinite(request.pan):
         return "BAD_ORIENTATION"
     sdi.pan = math.atan2(math.sin(request.pan), math.cos(request.pan))
+    if sdi.hardware is not None:
+        sdi.hardware.pan_tilt.point(sdi.pan, 0.0)
     sdi.write_poster("Model")
     return "end"
 
@@ -82,6 +96,20 @@ def grabImage(sdi, request):
     """takeImage: store the pose from which the (simulated) image is taken."""
     pose = sdi.read_poster("loco.Robot").robot
     sdi.image.pose, sdi.image.pan, sdi.image.valid = pose, sdi.pan, True
+    sdi.image.nbSeen = 0
+    hardware = sdi.hardware
+    if hardware is not None:
+        # The camera sees the world from where the robot really is; the model places what it
+        # saw from where the robot believes it is (odometry drift shifts the objects with it).
+        candidates = [k for k in range(len(hardware.objects)) if k not in hardware.trace.taken]
+        pan = hardware.pan_tilt.pan.position
+        for sighting in hardware.camera.detect([hardware.objects[k] for k in candidates])[: MAX_OBJECTS]:
+            hardware.trace.detected.add(candidates[sighting.index])
+            heading = pose.theta + pan + sighting.bearing
+            x, y = pose.x + sighting.r * math.cos(heading), pose.y + sighting.r * math.sin(heading)
+            slot = sdi.image.seen[sdi.image.nbSeen]
+            slot.x, slot.y, slot.i, slot.j = x, y, int(x // CELL), int(y // CELL)
+            sdi.image.nbSeen += 1
     return "end"
 
 
@@ -102,17 +130,25 @@ def analyseImage(sdi, request):
             c = sdi.model.certainty[k]
             sdi.model.certainty[k] = c + (1.0 - c) * f
     detected = {(o.i, o.j) for o in sdi.objects[: sdi.nbObjects]}
-    for obj in sdi.worldObjects[: sdi.nbWorldObjects]:
-        if (obj.i, obj.j) in detected:
-            continue
-        r = math.hypot(obj.x - pose.x, obj.y - pose.y)
-        bearing = math.remainder(math.atan2(obj.y - pose.y, obj.x - pose.x) - heading, math.tau)
-        if random.random() < reliability(r, bearing) and sdi.nbObjects < MAX_OBJECTS:
+    if sdi.hardware is not None:
+        seen = sdi.image.seen[: sdi.image.nbSeen]  # the camera's detections, at takeImage
+    else:
+        seen = []
+        for obj in sdi.worldObjects[: sdi.nbWorldObjects]:
+            r = math.hypot(obj.x - pose.x, obj.y - pose.y)
+            bearing = math.remainder(math.atan2(obj.y - pose.y, obj.x - pose.x) - heading, math.tau)
+            if random.random() < reliability(r, bearing):
+                seen.append(obj)
+    for obj in seen:
+        if (obj.i, obj.j) not in detected and sdi.nbObjects < MAX_OBJECTS:
             sdi.objects[sdi.nbObjects] = obj
             sdi.nbObjects += 1
+            detected.add((obj.i, obj.j))
             found += 1
     sdi.image.valid = False
     request.nbFound = found
+    if sdi.hardware is not None:
+        sdi.hardware.trace.certainty = (CELL, NX, NY, list(sdi.model.certainty))
     sdi.write_poster("Model")  # the certainties changed
     return "ether"
 
@@ -136,6 +172,11 @@ def nearestObject(sdi, request):
             sdi.worldObjects[n] = world[-1]
             sdi.nbWorldObjects -= 1
             break
+    hardware = sdi.hardware
+    if hardware is not None and hardware.objects:  # the simulator's object nearest to the believed one
+        k = min(range(len(hardware.objects)), key=lambda n: math.hypot(hardware.objects[n][0] - sdi.nearest.x,
+                                                                       hardware.objects[n][1] - sdi.nearest.y))
+        hardware.trace.taken.add(k)
     request.object = sdi.nearest
     return "end"
 

@@ -31,6 +31,12 @@ class Ref:
 
 
 @dataclass
+class WheelTravel:
+    left: float = 0.0
+    right: float = 0.0
+
+
+@dataclass
 class LocoData(rt.InternalData):
     """The internal data (SDI) of module loco."""
 
@@ -38,6 +44,7 @@ class LocoData(rt.InternalData):
     odoError: PosError = field(default_factory=PosError)
     ref: Ref = field(default_factory=Ref)
     trackedPoster: str = ""
+    encoders: WheelTravel = field(default_factory=WheelTravel)
 
 
 @dataclass
@@ -67,7 +74,8 @@ class RobotPoster:
 Posit.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", "float", None),)  # type: ignore[attr-defined]
 PosError.__specc_fields__ = (("cov", "float", 9),)  # type: ignore[attr-defined]
 Ref.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", "float", None), ("v", "float", None), ("w", "float", None),)  # type: ignore[attr-defined]
-LocoData.__specc_fields__ = (("robot", Posit, None), ("odoError", PosError, None), ("ref", Ref, None), ("trackedPoster", "str", None),)  # type: ignore[attr-defined]
+WheelTravel.__specc_fields__ = (("left", "float", None), ("right", "float", None),)  # type: ignore[attr-defined]
+LocoData.__specc_fields__ = (("robot", Posit, None), ("odoError", PosError, None), ("ref", Ref, None), ("trackedPoster", "str", None), ("encoders", WheelTravel, None),)  # type: ignore[attr-defined]
 GoToInput.__specc_fields__ = (("ref", Ref, None),)  # type: ignore[attr-defined]
 TrackInput.__specc_fields__ = (("trackedPoster", "str", None),)  # type: ignore[attr-defined]
 RobotPoster.__specc_fields__ = (("robot", Posit, None), ("odoError", PosError, None), ("ref", Ref, None),)  # type: ignore[attr-defined]

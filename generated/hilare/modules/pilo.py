@@ -54,6 +54,8 @@ class PiloData(rt.InternalData):
     traj: Trajectory = field(default_factory=Trajectory)
     nextPoint: int = 0
     setpoint: Ref = field(default_factory=Ref)
+    limits: Dynamic = field(default_factory=Dynamic)
+    elapsed: float = 0.0
 
 
 @dataclass
@@ -88,7 +90,7 @@ class SetpointPoster:
 Ref.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", "float", None), ("v", "float", None), ("w", "float", None),)  # type: ignore[attr-defined]
 Dynamic.__specc_fields__ = (("vmax", "float", None), ("wmax", "float", None), ("amax", "float", None), ("dwmax", "float", None),)  # type: ignore[attr-defined]
 Trajectory.__specc_fields__ = (("kind", TrajKind, None), ("nbPoints", "int", None), ("x", "float", 64), ("y", "float", 64), ("theta", "float", 64), ("tolerance", "float", None),)  # type: ignore[attr-defined]
-PiloData.__specc_fields__ = (("avoidOn", "bool", None), ("dynamic", Dynamic, None), ("trajPoster", "str", None), ("traj", Trajectory, None), ("nextPoint", "int", None), ("setpoint", Ref, None),)  # type: ignore[attr-defined]
+PiloData.__specc_fields__ = (("avoidOn", "bool", None), ("dynamic", Dynamic, None), ("trajPoster", "str", None), ("traj", Trajectory, None), ("nextPoint", "int", None), ("setpoint", Ref, None), ("limits", Dynamic, None), ("elapsed", "float", None),)  # type: ignore[attr-defined]
 AvoidOnOffInput.__specc_fields__ = (("on", "bool", None),)  # type: ignore[attr-defined]
 SetDynamicInput.__specc_fields__ = (("dynamic", Dynamic, None),)  # type: ignore[attr-defined]
 ExecPosterTrajInput.__specc_fields__ = (("trajPoster", "str", None),)  # type: ignore[attr-defined]

@@ -107,6 +107,13 @@ class TrajPoster:
     traj: Trajectory = field(default_factory=Trajectory)
 
 
+@dataclass
+class EnvPoster:
+    """The content of poster plan.Env."""
+
+    box: Box = field(default_factory=Box)
+
+
 # Checked by the runtime on every request: (field, kind, array length).
 Posit.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", "float", None),)  # type: ignore[attr-defined]
 Polygon.__specc_fields__ = (("n", "int", None), ("x", "float", 16), ("y", "float", 16),)  # type: ignore[attr-defined]
@@ -119,6 +126,7 @@ ReadModelFileInput.__specc_fields__ = (("file", "str", None),)  # type: ignore[a
 PlanInput.__specc_fields__ = (("start", Posit, None), ("goal", Posit, None),)  # type: ignore[attr-defined]
 ReplanInput.__specc_fields__ = (("start", Posit, None), ("goal", Posit, None),)  # type: ignore[attr-defined]
 TrajPoster.__specc_fields__ = (("traj", Trajectory, None),)  # type: ignore[attr-defined]
+EnvPoster.__specc_fields__ = (("box", Box, None),)  # type: ignore[attr-defined]
 
 SPEC = rt.ModuleSpec(
     name="plan",
@@ -129,14 +137,15 @@ SPEC = rt.ModuleSpec(
         "autoBox": rt.RequestSpec(name="autoBox", kind="control", input_type=AutoBoxInput, output_type=None, validate="setAutoBox", codels={}, yields={}, fail=(), incompatible=(), task=None, sends=()),
         "setPlannerEnv": rt.RequestSpec(name="setPlannerEnv", kind="control", input_type=SetPlannerEnvInput, output_type=None, validate="checkBox", codels={}, yields={}, fail=("BAD_BOX",), incompatible=(), task=None, sends=()),
         "readModelFile": rt.RequestSpec(name="readModelFile", kind="exec", input_type=ReadModelFileInput, output_type=None, validate=None, codels={"start": "openModelFile", "exec": "readPolygons", "inter": "abortPlanning"}, yields={}, fail=("FILE_NOT_FOUND", "BAD_MODEL"), incompatible=("plan", "replan", "readModelFile"), task="PlanTask", sends=()),
-        "plan": rt.RequestSpec(name="plan", kind="exec", input_type=PlanInput, output_type=None, validate=None, codels={"start": "startPlan", "exec": "computePlan", "inter": "abortPlanning"}, yields={}, fail=("NO_MODEL", "NO_PATH"), incompatible=("plan", "replan", "readModelFile"), task="PlanTask", sends=()),
-        "replan": rt.RequestSpec(name="replan", kind="exec", input_type=ReplanInput, output_type=None, validate=None, codels={"start": "startReplan", "exec": "computePlan", "inter": "abortPlanning"}, yields={}, fail=("NO_MODEL", "NO_PATH"), incompatible=("plan", "replan", "readModelFile"), task="PlanTask", sends=()),
+        "plan": rt.RequestSpec(name="plan", kind="exec", input_type=PlanInput, output_type=None, validate=None, codels={"start": "startPlan", "exec": "computePlan", "inter": "abortPlanning"}, yields={}, fail=("NO_MODEL", "NO_PATH", "START_IN_OBSTACLE", "GOAL_IN_OBSTACLE"), incompatible=("plan", "replan", "readModelFile"), task="PlanTask", sends=()),
+        "replan": rt.RequestSpec(name="replan", kind="exec", input_type=ReplanInput, output_type=None, validate=None, codels={"start": "startReplan", "exec": "computePlan", "inter": "abortPlanning"}, yields={}, fail=("NO_MODEL", "NO_PATH", "START_IN_OBSTACLE", "GOAL_IN_OBSTACLE"), incompatible=("plan", "replan", "readModelFile"), task="PlanTask", sends=()),
     },
     tasks=(
         rt.ExecTaskSpec(name="PlanTask", period=0.1, delay=0.0, priority=100, init=None, permanent=None),
     ),
     posters=(
         rt.PosterSpec(name="Traj", type=TrajPoster, fields=("traj",), update="auto", activity="computePlan"),
+        rt.PosterSpec(name="Env", type=EnvPoster, fields=("box",), update="manual", activity=None),
     ),
 )
 
@@ -164,19 +173,23 @@ class PlanClient(rt.ModuleClient):
 
     def plan(self, start: Posit, goal: Posit, *, interm_timeout: float | None = None,
             final_timeout: float | None = None) -> int:
-        """Send plan (exec request; fail messages: NO_MODEL, NO_PATH). Returns the request id."""
+        """Send plan (exec request; fail messages: NO_MODEL, NO_PATH, START_IN_OBSTACLE, GOAL_IN_OBSTACLE). Returns the request id."""
         return self.send("plan", PlanInput(start=start, goal=goal), interm_timeout=interm_timeout,
                          final_timeout=final_timeout)
 
     def replan(self, start: Posit, goal: Posit, *, interm_timeout: float | None = None,
             final_timeout: float | None = None) -> int:
-        """Send replan (exec request; fail messages: NO_MODEL, NO_PATH). Returns the request id."""
+        """Send replan (exec request; fail messages: NO_MODEL, NO_PATH, START_IN_OBSTACLE, GOAL_IN_OBSTACLE). Returns the request id."""
         return self.send("replan", ReplanInput(start=start, goal=goal), interm_timeout=interm_timeout,
                          final_timeout=final_timeout)
 
     def poster_Traj(self) -> rt.Snapshot[TrajPoster] | None:
         """The latest content of poster Traj and its date (None before the first write)."""
         return self.poster("Traj")
+
+    def poster_Env(self) -> rt.Snapshot[EnvPoster] | None:
+        """The latest content of poster Env and its date (None before the first write)."""
+        return self.poster("Env")
 
 
 def create(registry: rt.Registry, codels: Any = None) -> rt.Module:

@@ -29,6 +29,8 @@ class Image:
     pose: Posit = field(default_factory=Posit)
     pan: float = 0.0
     valid: bool = False
+    seen: list[Object] = field(default_factory=lambda: [Object() for _ in range(16)])
+    nbSeen: int = 0
 
 
 @dataclass
@@ -103,7 +105,7 @@ class ObjectsPoster:
 # Checked by the runtime on every request: (field, kind, array length).
 Posit.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", "float", None),)  # type: ignore[attr-defined]
 Object.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("i", "int", None), ("j", "int", None),)  # type: ignore[attr-defined]
-Image.__specc_fields__ = (("pose", Posit, None), ("pan", "float", None), ("valid", "bool", None),)  # type: ignore[attr-defined]
+Image.__specc_fields__ = (("pose", Posit, None), ("pan", "float", None), ("valid", "bool", None), ("seen", Object, 16), ("nbSeen", "int", None),)  # type: ignore[attr-defined]
 Model.__specc_fields__ = (("nx", "int", None), ("ny", "int", None), ("cellSize", "float", None), ("certainty", "float", 4096), ("free", "bool", 4096),)  # type: ignore[attr-defined]
 VisualData.__specc_fields__ = (("model", Model, None), ("pan", "float", None), ("image", Image, None), ("objects", Object, 16), ("nbObjects", "int", None), ("nearest", Object, None), ("modelFile", "str", None), ("worldObjects", Object, 16), ("nbWorldObjects", "int", None),)  # type: ignore[attr-defined]
 ReadObstaclesInput.__specc_fields__ = (("file", "str", None),)  # type: ignore[attr-defined]

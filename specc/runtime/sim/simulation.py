@@ -1,0 +1,139 @@
+"""A simulated robot in a world, stepping on the event kernel the modules run on.
+
+    sim = Simulation(load_world("worlds/W2.toml"), ATRV, seed=7)
+    sim.attach(registry)          # codels reach the devices as `sdi.hardware`
+    registry.kernel.run_for(60.0)
+    sim.trace                     # what happened, for pictures and tests
+
+Physics runs on the kernel at a fixed period, before any exec task due at the same instant, so
+every codel reads the state of its instant and every command takes effect at the next step.
+Each source of randomness has its own stream spawned from the seed: the same seed gives the same
+run, and drawing more sonar noise does not change where the objects are.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from specc.runtime.kernel import Kernel
+from specc.runtime.sim.devices import Antenna, Arm, Camera, Encoders, PanTilt, RangeSensor, Wheels
+from specc.runtime.sim.rays import RayCaster
+from specc.runtime.sim.rover import HILARE, RobotConfig, Rover
+from specc.runtime.sim.world import World
+
+PHYSICS_PRIORITY = -1000  # before the exec tasks of the same instant
+OBJECT_CLEARANCE = 0.4  # m: random objects are placed at least this far from walls and obstacles
+
+
+@dataclass
+class Trace:
+    """What a run leaves behind: the true path, and what the codels chose to note."""
+
+    times: list[float] = field(default_factory=list)
+    poses: list[tuple[float, float, float]] = field(default_factory=list)  # true x, y, theta
+    estimated: list[tuple[float, float, float, float]] = field(default_factory=list)  # t, odometry x, y, theta
+    paths: list[list[tuple[float, float]]] = field(default_factory=list)  # planned trajectories
+    detected: set[int] = field(default_factory=set)  # objects seen by the camera
+    taken: set[int] = field(default_factory=set)  # objects picked up or photographed
+    photos: list[tuple[float, str, bool]] = field(default_factory=list)  # time, target, success
+    certainty: tuple[float, int, int, list[float]] | None = None  # cell size, nx, ny, c per cell
+    goal: tuple[float, float] | None = None  # the observation position last chosen
+    blocked_at: float | None = None  # when the rover was first found blocked
+
+    def path_array(self) -> np.ndarray:
+        return np.asarray(self.poses, dtype=float).reshape(-1, 3)
+
+
+class Simulation:
+    def __init__(self, world: World, robot: RobotConfig = HILARE, *, seed: int = 0, kernel: Kernel | None = None,
+                 physics_period: float = 0.025, trace_period: float = 0.1) -> None:
+        self.world = world
+        self.robot = robot
+        self.seed = seed
+        self.kernel = kernel or Kernel()
+        self.physics_period = physics_period
+        streams = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(5)]
+        encoder_rng, range_rng, camera_rng, object_rng, _spare = streams
+        self.rover = Rover(world, robot, encoder_rng)
+        self.caster = RayCaster.for_world(world)
+        self.wheels = Wheels(self.rover)
+        self.encoders = Encoders(self.rover)
+        edge = robot.radius if robot.length == 0 else robot.length / 2.0
+        self.sonars = RangeSensor(self.rover, self.caster, np.linspace(0.0, math.tau, robot.sonars, endpoint=False),
+                                  robot.sonar_range, robot.sonar_noise, range_rng, offset=edge) \
+            if robot.sonars else None
+        self.laser = RangeSensor(self.rover, self.caster,
+                                 np.linspace(-robot.laser_fov / 2.0, robot.laser_fov / 2.0, robot.laser_beams),
+                                 robot.laser_range, robot.laser_noise, range_rng, offset=edge) \
+            if robot.laser_beams else None
+        self.pan_tilt = PanTilt(robot.pan_speed, robot.tilt_speed)
+        self.camera = Camera(self.rover, self.caster, self.pan_tilt, robot.camera_r_min, robot.camera_r_max,
+                             robot.camera_open, camera_rng)
+        self.arm = Arm(robot.arm_joints, robot.arm_speed) if robot.arm_joints else None
+        self.antenna = Antenna(world.windows, lambda: self.kernel.now)
+        self.objects = list(world.objects) + self._scatter(world.random_objects, object_rng)
+        self.trace = Trace()
+        self._trace_every = max(1, round(trace_period / physics_period))
+        self._steps = 0
+        self._origin = self.kernel.now
+        self._record()
+        self.kernel.call_at(self._origin + physics_period, self._tick, PHYSICS_PRIORITY)
+
+    # ------------------------------------------------------------ set-up
+    def attach(self, registry: Any) -> Simulation:
+        """Give a module registry's codels this robot's devices (`sdi.hardware`)."""
+        if registry.kernel is not self.kernel:
+            raise ValueError("the simulation and the modules must share one kernel: "
+                             "create the Simulation with kernel=registry.kernel")
+        registry.hardware = self
+        return self
+
+    def _scatter(self, count: int, rng: np.random.Generator) -> list[tuple[float, float]]:
+        xmin, xmax, ymin, ymax = self.world.bounds
+        placed: list[tuple[float, float]] = []
+        for _ in range(1000 * max(count, 1)):
+            if len(placed) == count:
+                break
+            x, y = float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax))
+            if self.world.clearance(x, y) >= OBJECT_CLEARANCE and all(
+                    math.hypot(x - px, y - py) >= OBJECT_CLEARANCE for px, py in placed):
+                placed.append((round(x, 3), round(y, 3)))
+        if len(placed) < count:
+            raise ValueError(f"{self.world.source or self.world.name}: no room for {count} objects "
+                             f"{OBJECT_CLEARANCE} m clear of the obstacles")
+        return placed
+
+    # ------------------------------------------------------------ running
+    def _tick(self) -> None:
+        dt = self.physics_period
+        self.rover.step(dt)
+        self.pan_tilt.advance(dt)
+        if self.arm is not None:
+            self.arm.advance(dt)
+        self._steps += 1
+        if self.trace.blocked_at is None and self.rover.blocked:
+            self.trace.blocked_at = self.now
+        if self._steps % self._trace_every == 0:
+            self._record()
+        # On the grid origin + k * period, so that no rounding drift reorders it with the tasks.
+        self.kernel.call_at(round(self._origin + (self._steps + 1) * dt, 9), self._tick, PHYSICS_PRIORITY)
+
+    def _record(self) -> None:
+        self.trace.times.append(self.kernel.now)
+        self.trace.poses.append(self.rover.pose)
+
+    def run_for(self, seconds: float) -> None:
+        self.kernel.run_for(seconds)
+
+    @property
+    def now(self) -> float:
+        return self.kernel.now
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        """The robot's true pose (what odometry estimates)."""
+        return self.rover.pose

@@ -1,0 +1,273 @@
+"""World files: the static obstacles, objects, photo targets and visibility windows a simulated
+robot lives among (seed 000 §5.6, seed 004 §4.1.2.1), read from TOML.
+
+```toml
+[world]                      # optional
+name = "W2"
+description = "a few cylinders"
+[room]                       # walls around [0, width] x [0, height] (Hilare's room) ...
+width = 12.0
+height = 9.0
+[bounds]                     # ... or around [xmin, xmax] x [ymin, ymax]
+xmin = -20.0                 # (seed 004, note 3: far walls at 20 m keep the laser fed)
+xmax = 20.0
+ymin = -20.0
+ymax = 20.0
+[start]                      # the robot's pose at t = 0 (default: 0, 0, 0)
+x = 0.0
+y = 0.0
+theta = 0.0
+[[obstacles]]
+polygon = [[3.0, 2.0], [4.6, 2.0], [4.6, 2.8], [3.0, 2.8]]   # counter-clockwise corners
+[[obstacles]]
+circle = [2.0, 1.5, 0.3]     # centre x, centre y, radius
+[objects]                    # objects for the camera to find, placed at random (seeded) ...
+count = 10
+[[objects.at]]               # ... or where they are
+x = 1.0
+y = 2.0
+[[targets]]                  # photo targets
+name = "OBJ1"
+x = -5.0
+y = 5.0
+[[windows]]                  # the antenna's visibility windows, in mission seconds
+name = "W1"
+start = 60.0
+end = 90.0
+```
+
+Units are metres, radians and seconds. Every mistake is reported as a `WorldError` naming the
+file, the entry and what to write instead.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+class WorldError(ValueError):
+    """A world file that cannot be used, with where and why."""
+
+
+@dataclass(frozen=True)
+class Polygon:
+    points: tuple[tuple[float, float], ...]  # counter-clockwise
+
+    def edges(self) -> list[tuple[float, float, float, float]]:
+        n = len(self.points)
+        return [(*self.points[k], *self.points[(k + 1) % n]) for k in range(n)]
+
+    def contains(self, x: float, y: float) -> bool:
+        inside = False
+        n = len(self.points)
+        for k in range(n):
+            (x1, y1), (x2, y2) = self.points[k], self.points[(k + 1) % n]
+            if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
+                inside = not inside
+        return inside
+
+    def distance(self, x: float, y: float) -> float:
+        """0 inside, else the distance to the nearest edge."""
+        if self.contains(x, y):
+            return 0.0
+        return min(_segment_distance(x, y, *edge) for edge in self.edges())
+
+
+@dataclass(frozen=True)
+class Circle:
+    x: float
+    y: float
+    radius: float
+
+    def contains(self, x: float, y: float) -> bool:
+        return math.hypot(x - self.x, y - self.y) <= self.radius
+
+    def distance(self, x: float, y: float) -> float:
+        return max(0.0, math.hypot(x - self.x, y - self.y) - self.radius)
+
+
+Obstacle = Polygon | Circle
+
+
+@dataclass(frozen=True)
+class Target:
+    name: str
+    x: float
+    y: float
+
+
+@dataclass(frozen=True)
+class Window:
+    name: str
+    start: float
+    end: float
+
+
+@dataclass(frozen=True)
+class World:
+    name: str
+    bounds: tuple[float, float, float, float]  # xmin, xmax, ymin, ymax: walls all around
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    obstacles: tuple[Obstacle, ...] = ()
+    objects: tuple[tuple[float, float], ...] = ()  # where they are (fixed in the file)
+    random_objects: int = 0  # how many more to scatter in free space (seeded)
+    targets: tuple[Target, ...] = ()
+    windows: tuple[Window, ...] = ()
+    description: str = ""
+    source: str = field(default="", compare=False)
+
+    def clearance(self, x: float, y: float) -> float:
+        """Distance from (x, y) to the nearest obstacle or wall (0 inside one)."""
+        xmin, xmax, ymin, ymax = self.bounds
+        walls = min(x - xmin, xmax - x, y - ymin, ymax - y)
+        if walls <= 0:
+            return 0.0
+        return min([walls] + [o.distance(x, y) for o in self.obstacles])
+
+    def segments(self) -> list[tuple[float, float, float, float]]:
+        """Every straight edge: the polygons' and the four walls'."""
+        xmin, xmax, ymin, ymax = self.bounds
+        walls = [(xmin, ymin, xmax, ymin), (xmax, ymin, xmax, ymax), (xmax, ymax, xmin, ymax),
+                 (xmin, ymax, xmin, ymin)]
+        return walls + [e for o in self.obstacles if isinstance(o, Polygon) for e in o.edges()]
+
+    def circles(self) -> list[tuple[float, float, float]]:
+        return [(o.x, o.y, o.radius) for o in self.obstacles if isinstance(o, Circle)]
+
+
+def load_world(path: str | Path) -> World:
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise WorldError(f"{path}: cannot read the world file ({error.strerror or error})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise WorldError(f"{path}: not valid TOML: {error}") from None
+    return parse_world(data, str(path), default_name=path.stem)
+
+
+def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: str = "world") -> World:
+    where = _Where(source)
+    known = {"world", "room", "bounds", "start", "obstacles", "objects", "targets", "windows"}
+    for key in data:
+        if key not in known:
+            raise WorldError(f"{source}: unknown section [{key}] (known: {', '.join(sorted(known))})")
+    header = where.table(data, "world")
+    name = where.text(header, "name", "world", default_name)
+    description = where.text(header, "description", "world", "")
+    if "room" in data and "bounds" in data:
+        raise WorldError(f"{source}: give [room] or [bounds], not both")
+    if "room" in data:
+        room = where.table(data, "room")
+        width, height = where.number(room, "width", "room"), where.number(room, "height", "room")
+        if width <= 0 or height <= 0:
+            raise WorldError(f"{source}: [room] width and height must be positive")
+        bounds = (0.0, width, 0.0, height)
+    elif "bounds" in data:
+        box = where.table(data, "bounds")
+        bounds = tuple(where.number(box, k, "bounds") for k in ("xmin", "xmax", "ymin", "ymax"))  # type: ignore[assignment]
+        if not (bounds[0] < bounds[1] and bounds[2] < bounds[3]):
+            raise WorldError(f"{source}: [bounds] needs xmin < xmax and ymin < ymax")
+    else:
+        raise WorldError(f"{source}: the world needs walls: a [room] (width, height) or [bounds] "
+                         "(xmin, xmax, ymin, ymax)")
+    start_table = where.table(data, "start")
+    start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
+             where.number(start_table, "theta", "start", 0.0))
+    obstacles: list[Obstacle] = []
+    for k, entry in enumerate(where.array(data, "obstacles")):
+        label = f"obstacles[{k}]"
+        if "polygon" in entry and "circle" not in entry:
+            points = entry["polygon"]
+            if not isinstance(points, list) or len(points) < 3 or not all(
+                    isinstance(p, list) and len(p) == 2 and all(isinstance(c, int | float) for c in p) for p in points):
+                raise WorldError(f"{source}: {label}: polygon must list at least 3 [x, y] corners")
+            polygon = tuple((float(x), float(y)) for x, y in points)
+            if _signed_area(polygon) < 0:
+                polygon = polygon[::-1]  # the rest of the simulator wants counter-clockwise corners
+            if abs(_signed_area(polygon)) < 1e-9:
+                raise WorldError(f"{source}: {label}: the polygon has no area")
+            obstacles.append(Polygon(polygon))
+        elif "circle" in entry and "polygon" not in entry:
+            c = entry["circle"]
+            if not (isinstance(c, list) and len(c) == 3 and all(isinstance(v, int | float) for v in c) and c[2] > 0):
+                raise WorldError(f"{source}: {label}: circle must be [x, y, radius] with radius > 0")
+            obstacles.append(Circle(float(c[0]), float(c[1]), float(c[2])))
+        else:
+            raise WorldError(f"{source}: {label}: give either polygon = [[x, y], ...] or circle = [x, y, r]")
+    objects_table = where.table(data, "objects")
+    count = where.number(objects_table, "count", "objects", 0.0)
+    if count < 0 or count != int(count):
+        raise WorldError(f"{source}: [objects] count must be a whole number >= 0")
+    placed = tuple((where.number(o, "x", f"objects.at[{k}]"), where.number(o, "y", f"objects.at[{k}]"))
+                   for k, o in enumerate(where.array(objects_table, "at")))
+    targets = tuple(Target(where.text(t, "name", f"targets[{k}]", f"T{k + 1}"),
+                           where.number(t, "x", f"targets[{k}]"), where.number(t, "y", f"targets[{k}]"))
+                    for k, t in enumerate(where.array(data, "targets")))
+    windows = []
+    for k, w in enumerate(where.array(data, "windows")):
+        label = f"windows[{k}]"
+        window = Window(where.text(w, "name", label, f"W{k + 1}"), where.number(w, "start", label),
+                        where.number(w, "end", label))
+        if not 0 <= window.start < window.end:
+            raise WorldError(f"{source}: {label}: needs 0 <= start < end")
+        windows.append(window)
+    world = World(name, bounds, start, tuple(obstacles), placed, int(count), targets, tuple(windows),
+                  description, source)
+    for label, (x, y) in [("start", start[:2])] + [(f"objects.at[{k}]", p) for k, p in enumerate(placed)]:
+        if world.clearance(x, y) <= 0:
+            raise WorldError(f"{source}: {label} ({x:g}, {y:g}) is inside an obstacle or outside the walls")
+    return world
+
+
+class _Where:
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def table(self, data: Mapping[str, Any], key: str) -> Mapping[str, Any]:
+        value = data.get(key, {})
+        if not isinstance(value, dict):
+            raise WorldError(f"{self.source}: [{key}] must be a table")
+        return value
+
+    def array(self, data: Mapping[str, Any], key: str) -> list[Mapping[str, Any]]:
+        value = data.get(key, [])
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            raise WorldError(f"{self.source}: {key} must be an array of tables ([[{key}]])")
+        return value
+
+    def number(self, table: Mapping[str, Any], key: str, label: str, default: float | None = None) -> float:
+        if key not in table:
+            if default is None:
+                raise WorldError(f"{self.source}: {label}: missing '{key}' (a number)")
+            return default
+        value = table[key]
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            raise WorldError(f"{self.source}: {label}: '{key}' must be a finite number, not {value!r}")
+        return float(value)
+
+    def text(self, table: Mapping[str, Any], key: str, label: str, default: str) -> str:
+        value = table.get(key, default)
+        if not isinstance(value, str):
+            raise WorldError(f"{self.source}: {label}: '{key}' must be a string")
+        return value
+
+
+def _signed_area(points: tuple[tuple[float, float], ...]) -> float:
+    n = len(points)
+    return 0.5 * sum(points[k][0] * points[(k + 1) % n][1] - points[(k + 1) % n][0] * points[k][1]
+                     for k in range(n))
+
+
+def _segment_distance(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
+    ex, ey = bx - ax, by - ay
+    length2 = ex * ex + ey * ey
+    u = 0.0 if length2 == 0 else max(0.0, min(1.0, ((px - ax) * ex + (py - ay) * ey) / length2))
+    return math.hypot(px - ax - u * ex, py - ay - u * ey)
