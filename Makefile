@@ -26,6 +26,8 @@ demo: $(STAMP)
 	    --reach 'Explore:254; TakeObject:236 ?(& (OBJ-FOUND @I) (> @I (+ @TAKEN 1)))'
 	$(BIN)/specc plan examples/atrv --problem M4 --domain model1 -o build/m4-plan.png
 	$(BIN)/python examples/hilare/run_sim.py --goal 9,7 --goal 2,7 -o build/hilare-run.png
+	$(BIN)/python examples/atrv/run_sim.py --world W3 --goal 2,1 --goal -1,2 --goal -2,-2 --goal 1,-3 \
+	    --goal 0,0 --photos -o build/atrv-w3.png
 
 test: $(STAMP)
 	$(BIN)/ruff check specc tests

@@ -58,7 +58,10 @@ class Wheels:
         self._rover.drive(v, w)
 
     def stop(self) -> None:
+        """Zero speeds; what was asked before no longer counts towards being blocked, so a
+        module may try again at once after a blocked motion."""
         self._rover.wheels(0.0, 0.0)
+        self._rover.forget_progress()
 
     @property
     def max_speed(self) -> float:
@@ -71,7 +74,9 @@ class Wheels:
 
 class RangeSensor:
     """Range finders around or in front of the robot, occluded by the world's obstacles: Hilare's
-    ring of sonars, the ATRV's laser scanner. Angles are relative to the robot's heading."""
+    ring of sonars, the ATRV's laser scanner. Angles are relative to the robot's heading; each
+    beam is cast from the robot's centre and its range read from `offset` along it (the body's
+    edge), so a reading r puts the echo at r + offset from the centre."""
 
     def __init__(self, rover: Rover, caster: RayCaster, angles: np.ndarray, max_range: float, noise: float,
                  rng: np.random.Generator, offset: float = 0.0) -> None:
@@ -81,11 +86,11 @@ class RangeSensor:
         self.max_range = max_range
         self.noise = noise
         self._rng = rng
-        self._offset = offset  # the sensors sit this far from the centre (on the body's edge)
+        self.offset = offset
 
     def read(self) -> np.ndarray:
         x, y, theta = self._rover.pose
-        distances = self._caster.cast(x, y, self.angles + theta, self.max_range + self._offset) - self._offset
+        distances = self._caster.cast(x, y, self.angles + theta, self.max_range + self.offset) - self.offset
         if self.noise > 0.0:
             distances = distances + self.noise * self._rng.standard_normal(len(distances))
         return np.clip(distances, 0.0, self.max_range)

@@ -146,7 +146,7 @@ def _scene(ax: Any, sim: Simulation) -> None:
     if world.targets:
         ax.plot([], [], marker="*", ls="", color="#7c3aed", label="photo target")
     if trace.goal is not None:
-        ax.plot(*trace.goal, marker="s", ms=9, mfc="none", mec="#dc2626", ls="", label="observation goal", zorder=4)
+        ax.plot(*trace.goal, marker="s", ms=9, mfc="none", mec="#dc2626", ls="", label="goal", zorder=4)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")

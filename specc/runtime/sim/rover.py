@@ -124,6 +124,12 @@ class Rover:
         half = w * self.config.wheel_base / 2.0
         self.wheels(v - half, v + half)
 
+    def forget_progress(self) -> None:
+        """A new start: motion asked before now no longer counts towards being blocked."""
+        self._progress.clear()
+        self._asked = self._done = 0.0
+        self._stuck = False
+
     def wheels(self, left: float, right: float) -> None:
         limit = self.config.max_wheel_speed
         self.left, self.right = max(-limit, min(limit, left)), max(-limit, min(limit, right))
@@ -180,8 +186,9 @@ class Rover:
     # ------------------------------------------------------------ reading
     @property
     def pose(self) -> tuple[float, float, float]:
+        """x, y and the heading in (-π, π] (pymunk's angle keeps counting turns)."""
         x, y = self.body.position
-        return float(x), float(y), float(self.body.angle)
+        return float(x), float(y), math.remainder(float(self.body.angle), math.tau)
 
     @property
     def speed(self) -> tuple[float, float]:
