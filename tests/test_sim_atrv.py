@@ -15,13 +15,14 @@ from typing import Any
 import pytest
 
 from specc.runtime import functional as rt
+from specc.runtime.sim import ATRV as ATRV_ROBOT
 from specc.runtime.sim import Window, load_world, parse_world
 from specc.runtime.sim.world import Circle, Polygon
 from tests.conftest import EXAMPLES
 
 ATRV = EXAMPLES / "atrv"
 WORLDS = ATRV / "worlds"
-HALF_WIDTH = 0.325  # m, the simulated ATRV's (1.05 m x 0.65 m)
+HALF_WIDTH = ATRV_ROBOT.width / 2.0  # m, the simulated ATRV's (1.05 m x 0.65 m)
 TOLERANCE = 0.3
 
 
@@ -178,7 +179,9 @@ def test_photo_of_a_target_in_view_succeeds_and_out_of_view_fails(run_sim: Modul
     failed = r.camera.final(r.camera.TakePicture("M1_OBJ2"))
     assert (failed.status, failed.report.code) == (rt.Status.END, "NO_TARGET_IN_VIEW")
     assert r.sim.trace.photos[-1] == (failed.time, "M1_OBJ2", False)
-    assert r.platine.final(r.platine.MoveTo(*run_sim.AT_MY_FEET)).ok  # annex A's AT_MY_FEET
+    from atrv_codels.platine import AT_MY_FEET
+
+    assert r.platine.final(r.platine.MoveTo(*AT_MY_FEET)).ok  # annex A's AT_MY_FEET
     feet = r.camera.final(r.camera.TakePicture("M1_OBJ1"))  # the target under the robot
     assert feet.ok and feet.output.photo.targets == "M1_OBJ1"
 

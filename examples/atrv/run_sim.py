@@ -19,7 +19,7 @@ import math
 import re
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,12 +27,10 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 WORLDS = HERE / "worlds"
 TOLERANCE = 0.3  # m: how close to a goal counts as there (INVENTED)
-AT_MY_FEET = (0.0, -1.2)  # (pan, tilt), rad: atrv_codels.platine.AT_MY_FEET
-STRAIGHT = (0.0, 0.0)
 # Without --goal: mission M2's three targets (far apart, around W2's and W3's obstacles) and
 # home; in W4 the way to M2's (5, 5), across the pocket.
-DEFAULT_GOALS = {"W4": [(5.0, 5.0)]}
 TOUR = [(-5.0, 3.0), (5.0, 5.0), (4.0, -5.0), (0.0, 0.0)]
+TRAP = [(5.0, 5.0)]
 
 
 class UsageError(Exception):
@@ -52,7 +50,6 @@ class Rover:
     platine: Any
     camera: Any
     antenna: Any
-    log: list[str] = field(default_factory=list)
 
     @property
     def kernel(self) -> Any:
@@ -176,6 +173,8 @@ class Mission:
         return self.call(ndd, f"ndd.GotoTarget({x:g}, {y:g}, {tolerance:g})", ndd.GotoTarget(x, y, tolerance)).ok
 
     def photograph(self, target: str) -> bool:
+        from atrv_codels.platine import AT_MY_FEET, STRAIGHT  # importable once the rover is built
+
         platine, camera = self.rover.platine, self.rover.camera
         steps = [(platine, f"platine.MoveTo{AT_MY_FEET}", lambda: platine.MoveTo(*AT_MY_FEET)),
                  (camera, f"camera.TakePicture({target!r})", lambda: camera.TakePicture(target)),
@@ -188,7 +187,7 @@ class Mission:
 
 def run(argv: list[str] | None = None) -> int:
     args = parser().parse_args(_glue_negative_goals(list(sys.argv[1:] if argv is None else argv)))
-    from specc.runtime.sim import WorldError, load_world
+    from specc.runtime.sim import ATRV, WorldError, load_world
 
     path = world_path(args.world)
     try:
@@ -196,14 +195,18 @@ def run(argv: list[str] | None = None) -> int:
     except WorldError as exc:
         hint = "" if path.exists() else "; --world takes W1, W2, W3, W4 or a world file"
         raise UsageError(f"{exc}{hint}") from None
-    goals = [parse_goal(g) for g in args.goal] or DEFAULT_GOALS.get(world.name, TOUR)
+    goals = [parse_goal(g) for g in args.goal] or (TRAP if world.name == "W4" else TOUR)
     xmin, xmax, ymin, ymax = world.bounds
     for x, y in goals:
         if not (xmin < x < xmax and ymin < y < ymax):
             raise UsageError(f"--goal {x:g},{y:g} is outside the walls of {world.name} "
                              f"([{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}])")
-        if world.clearance(x, y) <= 0.0:
-            raise UsageError(f"--goal {x:g},{y:g} is inside an obstacle of {world.name}")
+        if world.clearance(x, y) < ATRV.width / 2.0:
+            raise UsageError(f"--goal {x:g},{y:g} is inside an obstacle of {world.name} or too near one "
+                             f"for the rover ({ATRV.width / 2.0:g} m at least)")
+    for option, picture, suffix in (("-o", args.output, ".png"), ("--gif", args.gif, ".gif")):
+        if picture is not None and Path(picture).suffix.lower() != suffix:
+            raise UsageError(f"{option} {picture}: the file name must end in {suffix}")
     if not (math.isfinite(args.tolerance) and args.tolerance > 0):
         raise UsageError(f"--tolerance {args.tolerance:g}: must be a positive number of metres")
     if not (math.isfinite(args.duration) and args.duration > 0):
@@ -226,7 +229,6 @@ def run(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - started
 
     x, y, theta = sim.pose
-    theta = math.remainder(theta, math.tau)  # the simulated body's angle is not wrapped
     odo = rover.rflex.poster_Robot()
     print(f"true pose ({x:.2f}, {y:.2f}, {math.degrees(theta):.0f} deg)", end="")
     if odo is not None:

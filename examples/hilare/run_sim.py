@@ -20,7 +20,7 @@ sys.path[:0] = [str(HERE.parent.parent / "generated"), str(HERE)]
 
 from hilare import modules  # noqa: E402
 from hilare.modules.pilo import PiloClient  # noqa: E402
-from hilare.modules.plan import PlanClient, Posit  # noqa: E402
+from hilare.modules.plan import Box, PlanClient, Posit  # noqa: E402
 from hilare.modules.visual import VisualClient  # noqa: E402
 
 from specc.runtime import functional as rt  # noqa: E402
@@ -40,11 +40,14 @@ def parse_goal(text: str) -> tuple[float, float]:
 
 def run(world_path: Path, goals: list[tuple[float, float]], seed: int, budget: float) -> tuple[Simulation, list[str]]:
     registry = rt.Registry()
-    sim = Simulation(load_world(world_path), HILARE, seed=seed, kernel=registry.kernel).attach(registry)
+    world = load_world(world_path)
+    sim = Simulation(world, HILARE, seed=seed, kernel=registry.kernel).attach(registry)
     made = modules.create_all(registry)
     plan, pilo, visual = PlanClient(made["plan"]), PiloClient(made["pilo"]), VisualClient(made["visual"])
+    xmin, xmax, ymin, ymax = world.bounds
     log = []
-    for name, reply in (("plan.readModelFile", plan.final(plan.readModelFile(str(world_path)))),
+    for name, reply in (("plan.setPlannerEnv", plan.final(plan.setPlannerEnv(Box(xmin, ymin, xmax, ymax)))),
+                        ("plan.readModelFile", plan.final(plan.readModelFile(str(world_path)))),
                         ("visual.readObstacles", visual.final(visual.readObstacles(str(world_path)))),
                         ("pilo.avoidOnOff", pilo.final(pilo.avoidOnOff(True)))):
         log.append(f"{registry.kernel.now:7.2f} s  {name}: {reply.status} {reply.report.code}")

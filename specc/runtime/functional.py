@@ -385,9 +385,7 @@ class TaskRunner:
         self.spec = spec
         self.activities: list[Activity] = []
         self.timer: Timer | None = None
-        self.last_tick: float | None = None
-        self.last_k: int | None = None  # the grid slot of the last tick
-        self.next_k = 0
+        self.slot: int | None = None  # k of the pending tick, or of the last one when none is pending
         self.initialised = False
         self.cycles = 0
 
@@ -416,20 +414,15 @@ class TaskRunner:
             return
         kernel = self.module.kernel
         period, delay = self.spec.period, self.spec.delay
-        if self.last_k is not None and self.last_tick == kernel.now:
-            k = self.last_k + 1  # rescheduled by the tick itself: the next slot of the grid
-        else:
-            k = max(0, math.ceil((kernel.now - delay) / period - 1e-9))
-            if self.last_k is not None and k <= self.last_k:
-                k = self.last_k + 1
-        self.next_k = k
+        k = max(0, math.ceil((kernel.now - delay) / period - 1e-9))
+        if self.slot is not None:
+            k = max(k, self.slot + 1)  # never twice a slot (a tick rescheduling itself is in its own)
+        self.slot = k
         # Rounded to the nanosecond: 3 x 0.1 s and 1 x 0.3 s are one instant, so priority orders them.
         self.timer = kernel.call_at(round(delay + k * period, 9), self.tick, self.spec.priority)
 
     def tick(self) -> None:
         self.timer = None
-        self.last_tick = self.module.kernel.now
-        self.last_k = self.next_k
         module = self.module
         self.cycles += 1
         self.initialise()

@@ -79,12 +79,14 @@ def full_stack_speed() -> tuple[float, str]:
     sys.path[:0] = [str(ROOT / "generated"), str(ROOT / "examples" / "hilare")]
     from hilare import modules
     from hilare.modules.pilo import PiloClient
-    from hilare.modules.plan import PlanClient, Posit
+    from hilare.modules.plan import Box, PlanClient, Posit
 
     registry = rt.Registry()
     sim = Simulation(load_world(ROOM), HILARE, seed=1, kernel=registry.kernel).attach(registry)
     made = modules.create_all(registry)
     plan, pilo = PlanClient(made["plan"]), PiloClient(made["pilo"])
+    xmin, xmax, ymin, ymax = sim.world.bounds
+    assert plan.final(plan.setPlannerEnv(Box(xmin, ymin, xmax, ymax))).ok
     assert plan.final(plan.readModelFile(str(ROOM))).ok and pilo.final(pilo.avoidOnOff(True)).ok
     goals = [(9.0, 7.0), (2.0, 7.0), (10.0, 2.0), (1.0, 1.0)]
     started, origin, legs = time.perf_counter(), sim.now, 0

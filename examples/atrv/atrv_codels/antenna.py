@@ -48,9 +48,10 @@ def transmit(sdi, request):
         return _sent(sdi, request, "")
     if hardware.now < sdi.link.end - 1e-9:
         return "exec" if hardware.antenna.window() is not None else "LINK_LOST"
-    if not hardware.antenna.record(sdi.link.start, sdi.link.end):
+    window = hardware.antenna.record(sdi.link.start, sdi.link.end)
+    if window is None:
         return "LINK_LOST"
-    return _sent(sdi, request, hardware.antenna.sent[-1][2])
+    return _sent(sdi, request, window.name)
 
 
 def closeLink(sdi, request):

@@ -43,8 +43,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from specc.runtime.sim import ATRV
+
 PERIOD = 0.1  # s, NavTask period
-HALF_LENGTH, HALF_WIDTH = 0.525, 0.325  # m, the ATRV's body (1.05 m x 0.65 m)
+HALF_LENGTH, HALF_WIDTH = ATRV.length / 2.0, ATRV.width / 2.0  # m, the ATRV's body (1.05 m x 0.65 m)
 RADIUS = math.hypot(HALF_LENGTH, HALF_WIDTH)  # its bounding circle: what turning in place sweeps
 MARGIN = 0.15  # m kept between that circle and obstacles along a chosen direction
 LOOKAHEAD = 1.5  # m of free length a direction needs (less when the goal is nearer)

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import math
 
+from specc.runtime.sim.devices import Axis
+
 PERIOD = 0.05  # s, PtuTask period
 PAN_LIMIT = math.pi  # rad: the unit turns all round
 TILT_LIMIT = math.pi / 2  # rad: from straight down to straight up
 SPEED = math.radians(60)  # rad/s per axis without a simulator (the simulated unit's own rate)
-REACHED = 1e-3  # rad
 TIMEOUT = 20.0  # s: a motion that lasts longer than this has failed (INVENTED)
 STRAIGHT = (0.0, 0.0)  # annex A's PTU positions, in (pan, tilt)
 AT_MY_FEET = (0.0, -1.2)  # INVENTED: looking down at the ground just ahead of the robot
@@ -38,11 +39,10 @@ def readAxes(sdi):
         sdi.position.pan, sdi.position.tilt = unit.pan.position, unit.tilt.position
         sdi.moving = bool(unit.moving)
     else:
-        step = SPEED * PERIOD
         for axis in ("pan", "tilt"):
-            here, there = getattr(sdi.position, axis), getattr(sdi.target, axis)
-            moved = there if abs(there - here) <= step else here + math.copysign(step, there - here)
-            setattr(sdi.position, axis, moved)
+            moved = Axis(getattr(sdi.position, axis), getattr(sdi.target, axis), SPEED)
+            moved.advance(PERIOD)
+            setattr(sdi.position, axis, moved.position)
         sdi.moving = sdi.position.pan != sdi.target.pan or sdi.position.tilt != sdi.target.tilt
     return "exec"
 
@@ -65,8 +65,7 @@ def startMove(sdi, request):
 def waitArrival(sdi, request):
     """MoveTo exec: done when both axes are at the target."""
     sdi.elapsed += PERIOD
-    there = abs(sdi.position.pan - sdi.target.pan) <= REACHED and abs(sdi.position.tilt - sdi.target.tilt) <= REACHED
-    if there and not sdi.moving:
+    if not sdi.moving:  # readAxes, the task's permanent codel, ran first this cycle
         return "ether"
     if sdi.elapsed > TIMEOUT:
         return "PTU_TIMEOUT"

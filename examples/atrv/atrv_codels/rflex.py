@@ -38,7 +38,9 @@ def odometry(sdi):
     dl, dr = left - sdi.encoders.left, right - sdi.encoders.right
     sdi.encoders.left, sdi.encoders.right = left, right
     integrate(sdi, (dl + dr) / 2.0, (dr - dl) / hardware.encoders.wheel_base)
-    sdi.blocked = bool(hardware.wheels.blocked)
+    # Kept until a new TrackSpeed starts: stopping the wheels clears the device's own flag,
+    # and NDD must see it whatever its period.
+    sdi.blocked = sdi.blocked or bool(hardware.wheels.blocked)
     hardware.trace.estimated.append((hardware.now, sdi.pose.x, sdi.pose.y, sdi.pose.theta))
     return "exec"
 
@@ -58,6 +60,7 @@ def findSpeedPoster(sdi, request):
     if sdi.read_poster(request.speedPoster) is None:
         return "POSTER_NOT_FOUND"
     sdi.speedPoster = request.speedPoster
+    sdi.blocked = False
     return "exec"
 
 

@@ -8,10 +8,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
+from specc.runtime.sim import ATRV
+
 BEAMS = 181
 FIELD = math.pi  # rad, centred on the heading
 MAX_RANGE = 30.0  # m (SICK LMS)
-MOUNT = 0.525  # m from the centre to the front edge, where ranges start: the ATRV's half length
+MOUNT = ATRV.length / 2.0  # m from the centre to the front edge, where ranges start
 FALLBACK_RANGE = 20.0  # m: the far walls of note 3, when no simulator gives a scan
 
 
@@ -28,8 +32,7 @@ def initLaser(sdi):
             raise ValueError(f"the simulated laser has {len(angles)} beams, SICK expects {BEAMS}")
         scan.firstAngle, scan.step = float(angles[0]), float(angles[1] - angles[0])
         scan.maxRange = float(laser.max_range)
-        robot = hardware.robot
-        scan.mount = robot.length / 2.0 if robot.length > 0 else robot.radius
+        scan.mount = float(laser.offset)  # ranges are read from there along each beam
     scan.ranges = [scan.maxRange] * BEAMS
     scan.number = 0
     scan.echo = False
@@ -41,7 +44,7 @@ def readLaser(sdi):
     scan = sdi.scan
     hardware = sdi.hardware
     if hardware is not None:
-        ranges = [min(float(r), scan.maxRange) for r in hardware.laser.read()]
+        ranges = np.minimum(hardware.laser.read(), scan.maxRange).tolist()
     else:
         ranges = [min(FALLBACK_RANGE, scan.maxRange)] * BEAMS
     scan.ranges = ranges

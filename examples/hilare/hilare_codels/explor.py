@@ -133,8 +133,7 @@ def radial_scores(free: np.ndarray, certainty: np.ndarray, cell: float, candidat
     candidates = np.asarray(candidates, dtype=np.intp).reshape(-1, 2)
     ny, nx = free.shape
     angles = np.arange(axes) * (math.tau / axes)
-    radii = np.arange(1, int(R_MAX / (RAY_STEP * cell)) + 1) * RAY_STEP  # in cells
-    weights = np.array([reliability(r * cell, 0.0) for r in radii]) * radii * (math.tau / axes) * RAY_STEP
+    radii, weights = _radial_weights(cell, axes)
     dx, dy = np.cos(angles)[:, None] * radii, np.sin(angles)[:, None] * radii  # (axes, samples)
     gain = 1.0 - np.asarray(certainty, dtype=float)
     scores = np.zeros(len(candidates))
@@ -149,6 +148,15 @@ def radial_scores(free: np.ndarray, certainty: np.ndarray, cell: float, candidat
         gains[seen] = gain[sj[seen], si[seen]]
         scores[k] = float((gains @ weights).sum())
     return scores
+
+
+@functools.lru_cache(maxsize=8)
+def _radial_weights(cell: float, axes: int) -> tuple[np.ndarray, np.ndarray]:
+    """The sample radii along an axis (in cells) and what each sample weighs: f(r, 0) times
+    the area of the ring sector it stands for (constant for a grid: computed once)."""
+    radii = np.arange(1, int(R_MAX / (RAY_STEP * cell)) + 1) * RAY_STEP
+    weights = np.array([reliability(r * cell, 0.0) for r in radii]) * radii * (math.tau / axes) * RAY_STEP
+    return radii, weights
 
 
 def sampled_candidates(valid: np.ndarray, cell: float) -> np.ndarray:
@@ -225,6 +233,14 @@ def model_grid(model, box=None) -> tuple[np.ndarray, np.ndarray]:
 # ---------------------------------------------------------------- codels
 
 
+@functools.lru_cache(maxsize=4)
+def _candidates(free: bytes, shape: tuple[int, int], cell: float, variant: str) -> np.ndarray:
+    """The candidate cells of a free grid: the free cells change only when VISUAL reads the
+    obstacles, so the periods of a search (and later searches) share one list."""
+    grid = np.frombuffer(free, dtype=bool).reshape(shape)
+    return candidates_of(candidate_cells(grid, cell), cell, variant)
+
+
 def _grid(sdi):
     poster = sdi.read_poster("visual.Model")
     if poster is None:
@@ -247,7 +263,7 @@ def scoreCandidates(sdi, request):
     if grid is None:
         return "NO_MODEL"
     free, certainty, cell = grid
-    candidates = candidates_of(candidate_cells(free, cell), cell, VARIANT)
+    candidates = _candidates(free.tobytes(), free.shape, cell, VARIANT)
     block = candidates[sdi.candidate:sdi.candidate + CANDIDATES_PER_PERIOD[VARIANT]]
     for (i, j), score in zip(block, scores_of(free, certainty, cell, block, VARIANT), strict=True):
         if score > sdi.bestScore:

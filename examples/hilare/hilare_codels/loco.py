@@ -49,6 +49,7 @@ def pumpReference(sdi, request):
     hardware = sdi.hardware
     if hardware is not None and hardware.wheels.blocked:
         _hold_position(sdi)
+        hardware.wheels.stop()  # and forget the motion asked so far: a new Track may try again
         return "SHOCK"
     sdi.ref = ref
     return "exec"

@@ -74,8 +74,11 @@ class Piece:
         if self.sharpness == 0.0:
             if self.kappa == 0.0:
                 return self.x + s * math.cos(self.theta), self.y + s * math.sin(self.theta), theta
-            return (self.x + (math.sin(theta) - math.sin(self.theta)) / self.kappa,
-                    self.y - (math.cos(theta) - math.cos(self.theta)) / self.kappa, theta)
+            # The chord, 2 sin(κs/2)/κ along the mid heading: no cancellation for a nearly
+            # straight arc, where (sin θ - sin θ0)/κ loses digits.
+            chord = 2.0 * math.sin(0.5 * self.kappa * s) / self.kappa
+            middle = self.theta + 0.5 * self.kappa * s
+            return self.x + chord * math.cos(middle), self.y + chord * math.sin(middle), theta
         nodes, weights = _GAUSS  # a clothoid: Fresnel integrals, by Gauss-Legendre quadrature
         u = 0.5 * s * (nodes + 1.0)
         angles = self.theta + self.kappa * u + 0.5 * self.sharpness * u * u

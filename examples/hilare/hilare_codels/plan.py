@@ -32,9 +32,10 @@ import functools
 import heapq
 import math
 import pathlib
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
+
+from specc.runtime.sim.world import Polygon, WorldError, load_world, signed_area
 
 MAX_POINTS = 64  # capacity of the Trajectory arrays (plan.spec)
 ROBOT_RADIUS = 0.35  # m, radius of the circle that holds Hilare 2 (invented)
@@ -59,13 +60,6 @@ class PlanningError(Exception):
 
 
 # ---------------------------------------------------------------- polygons
-
-
-def signed_area(polygon: Sequence[Point]) -> float:
-    """The signed area, positive for a counter-clockwise polygon."""
-    n = len(polygon)
-    return 0.5 * sum(polygon[k][0] * polygon[(k + 1) % n][1] - polygon[(k + 1) % n][0] * polygon[k][1]
-                     for k in range(n))
 
 
 def _cross(o: Point, a: Point, b: Point) -> float:
@@ -352,7 +346,7 @@ def escape_point(env: Environment, p: Point, max_distance: float = START_ESCAPE)
     rxmin, rymin, rxmax, rymax = env.room
     if not (rxmin <= x <= rxmax and rymin <= y <= rymax):
         return None
-    if any(_point_in_polygon(p, o) for o in env.obstacles):
+    if any(Polygon(tuple(o)).contains(*p) for o in env.obstacles):
         return None
     xmin, ymin, xmax, ymax = env.bounds
 
@@ -378,16 +372,6 @@ def _push_out(a: Point, b: Point, p: Point) -> Point:
     t = min(1.0, max(0.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2))
     length = math.sqrt(length2)
     return a[0] + t * dx + 10 * EPS * dy / length, a[1] + t * dy - 10 * EPS * dx / length
-
-
-def _point_in_polygon(p: Point, polygon: Sequence[Point]) -> bool:
-    inside = False
-    n = len(polygon)
-    for k in range(n):
-        (x0, y0), (x1, y1) = polygon[k], polygon[(k + 1) % n]
-        if (y0 > p[1]) != (y1 > p[1]) and p[0] < x0 + (p[1] - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside
 
 
 def path_length(path: Sequence[Point]) -> float:
@@ -450,18 +434,17 @@ def readPolygons(sdi, request):
 
 
 def _read_polygons(path: str, max_polygons: int, max_vertices: int) -> list[list[Point]] | None:
+    """The world file's obstacles as simple counter-clockwise polygons (circles by their
+    outline), or None if the file is unusable or does not fit the SDI."""
     try:
-        world = tomllib.loads(pathlib.Path(path).read_text())
-        polygons = [[(float(x), float(y)) for x, y in o["polygon"]] for o in world.get("obstacles", [])]
-    except (OSError, tomllib.TOMLDecodeError, KeyError, TypeError, ValueError):
+        polygons = load_world(path).polygons()
+    except WorldError:
         return None
     if len(polygons) > max_polygons:
         return None
     result = []
-    for polygon in polygons:
-        if not all(math.isfinite(v) for p in polygon for v in p):
-            return None
-        polygon = normalise(polygon)
+    for obstacle in polygons:
+        polygon = normalise(obstacle.points)
         if not 3 <= len(polygon) <= max_vertices or not is_simple(polygon):
             return None
         result.append(polygon)

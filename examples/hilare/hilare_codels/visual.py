@@ -10,9 +10,10 @@ from __future__ import annotations
 import math
 import pathlib
 import random
-import tomllib
 
-from specc.runtime.sim import WorldError, parse_world
+import numpy as np
+
+from specc.runtime.sim import WorldError, load_world
 from specc.runtime.sim import reliability as sim_reliability
 
 NX = NY = 64  # invented grid size (4096 cells)
@@ -21,7 +22,6 @@ R_MIN, R_MAX = 0.5, 4.0  # m, invented perception range
 THETA_OPEN = math.radians(60)  # invented field of view
 MAX_OBJECTS = 16
 N_WORLD_OBJECTS = 10  # §5.6: 10 objects scattered in the room
-OBJECT_CLEARANCE = 0.45  # m from walls and obstacles: EXPLOR's grown obstacles (0.40 m) leave them reachable
 
 
 def reliability(r, theta):
@@ -55,23 +55,19 @@ def markObstacleCells(sdi, request):
     """readObstacles exec: mark the cells meeting an obstacle's bounding box as not free,
     then place the simulated objects at random in free cells (§5.2.4)."""
     try:
-        world = tomllib.loads(pathlib.Path(sdi.modelFile).read_text())
-        room = parse_world(world, sdi.modelFile)
-    except (OSError, tomllib.TOMLDecodeError, WorldError):
+        room = load_world(sdi.modelFile)
+    except WorldError:
         return "FILE_NOT_FOUND"
     sdi.model.free = [True] * (NX * NY)
-    for obstacle in world.get("obstacles", []):
-        xs = [p[0] for p in obstacle["polygon"]]
-        ys = [p[1] for p in obstacle["polygon"]]
+    for polygon in room.polygons():
+        xs = [p[0] for p in polygon.points]
+        ys = [p[1] for p in polygon.points]
         for i in range(int(min(xs) / CELL), int(max(xs) / CELL) + 1):
             for j in range(int(min(ys) / CELL), int(max(ys) / CELL) + 1):
                 if 0 <= i < NX and 0 <= j < NY:
                     sdi.model.free[j * NX + i] = False
-    # Objects lie where the robot can stand on them (EXPLOR's calcObj puts its centre on the
-    # object's cell): inside the room, clear of walls and obstacles.
-    free_cells = [k for k in range(NX * NY) if sdi.model.free[k]
-                  and room.clearance((k % NX + 0.5) * CELL, (k // NX + 0.5) * CELL) >= OBJECT_CLEARANCE]
     wanted = 0 if sdi.hardware is not None else N_WORLD_OBJECTS  # the simulator has its own objects
+    free_cells = _standing_cells(sdi.model.free, room.bounds) if wanted else []
     chosen = random.sample(free_cells, min(wanted, len(free_cells), MAX_OBJECTS))
     for slot, k in zip(sdi.worldObjects, chosen, strict=False):
         slot.i, slot.j = k % NX, k // NX
@@ -79,6 +75,18 @@ def markObstacleCells(sdi, request):
     sdi.nbWorldObjects = len(chosen)
     sdi.write_poster("Model")  # the free cells changed
     return "ether"
+
+
+def _standing_cells(free, bounds):
+    """The cells where the robot can stand, as EXPLOR's calcObj requires of an object's cell
+    (its centre on the cell's): inside the room, clear of the grown obstacles."""
+    from hilare_codels.explor import candidate_cells  # EXPLOR imports this module: import late
+
+    xmin, xmax, ymin, ymax = bounds
+    grid = np.array(free, dtype=bool).reshape(NY, NX)
+    i, j = np.meshgrid(np.arange(NX), np.arange(NY))
+    grid &= (i * CELL >= xmin) & ((i + 1) * CELL <= xmax) & (j * CELL >= ymin) & ((j + 1) * CELL <= ymax)
+    return [int(k) for k in np.flatnonzero(candidate_cells(grid, CELL))]
 
 
 def setCameraPan(sdi, request):
@@ -95,14 +103,15 @@ def setCameraPan(sdi, request):
 def grabImage(sdi, request):
     """takeImage: store the pose from which the (simulated) image is taken."""
     pose = sdi.read_poster("loco.Robot").robot
-    sdi.image.pose, sdi.image.pan, sdi.image.valid = pose, sdi.pan, True
-    sdi.image.nbSeen = 0
     hardware = sdi.hardware
+    # Where the camera really points: the pan-tilt unit may still be turning towards sdi.pan.
+    pan = hardware.pan_tilt.pan.position if hardware is not None else sdi.pan
+    sdi.image.pose, sdi.image.pan, sdi.image.valid = pose, pan, True
+    sdi.image.nbSeen = 0
     if hardware is not None:
         # The camera sees the world from where the robot really is; the model places what it
         # saw from where the robot believes it is (odometry drift shifts the objects with it).
         candidates = [k for k in range(len(hardware.objects)) if k not in hardware.trace.taken]
-        pan = hardware.pan_tilt.pan.position
         for sighting in hardware.camera.detect([hardware.objects[k] for k in candidates])[: MAX_OBJECTS]:
             hardware.trace.detected.add(candidates[sighting.index])
             heading = pose.theta + pan + sighting.bearing
@@ -173,10 +182,12 @@ def nearestObject(sdi, request):
             sdi.nbWorldObjects -= 1
             break
     hardware = sdi.hardware
-    if hardware is not None and hardware.objects:  # the simulator's object nearest to the believed one
-        k = min(range(len(hardware.objects)), key=lambda n: math.hypot(hardware.objects[n][0] - sdi.nearest.x,
-                                                                       hardware.objects[n][1] - sdi.nearest.y))
-        hardware.trace.taken.add(k)
+    if hardware is not None:  # the simulator's object nearest to the believed one
+        left = [n for n in range(len(hardware.objects)) if n not in hardware.trace.taken]
+        if left:
+            k = min(left, key=lambda n: math.hypot(hardware.objects[n][0] - sdi.nearest.x,
+                                                   hardware.objects[n][1] - sdi.nearest.y))
+            hardware.trace.taken.add(k)
     request.object = sdi.nearest
     return "end"
 

@@ -105,6 +105,8 @@ class Axis:
     speed: float
 
     def advance(self, dt: float) -> None:
+        if self.position == self.target:
+            return
         error = self.target - self.position
         step = self.speed * dt
         self.position = self.target if abs(error) <= step else self.position + math.copysign(step, error)
@@ -125,10 +127,8 @@ class PanTilt:
         self.pan.target, self.tilt.target = wrap(pan), max(-math.pi / 2, min(math.pi / 2, tilt))
 
     def advance(self, dt: float) -> None:
-        if self.pan.position != self.pan.target:
-            self.pan.advance(dt)
-        if self.tilt.position != self.tilt.target:
-            self.tilt.advance(dt)
+        self.pan.advance(dt)
+        self.tilt.advance(dt)
 
     @property
     def moving(self) -> bool:
@@ -157,8 +157,7 @@ class Arm:
 
     def advance(self, dt: float) -> None:
         for joint in self.joints:
-            if joint.position != joint.target:
-                joint.advance(dt)
+            joint.advance(dt)
 
     @property
     def q(self) -> list[float]:
@@ -203,14 +202,19 @@ class Camera:
     def in_view(self, points: list[tuple[float, float]]) -> list[Sighting]:
         """The points the camera could see now (in range, in the field, not occluded)."""
         x, y, heading = self.axis()
-        seen = []
+        candidates = []
         for index, (px, py) in enumerate(points):
             r = math.hypot(px - x, py - y)
             bearing = wrap(math.atan2(py - y, px - x) - heading)
             f = self.reliability(r, bearing)
-            if f > 0.0 and self._caster.visible(x, y, px, py):
-                seen.append(Sighting(index, px, py, r, bearing, f))
-        return seen
+            if f > 0.0:
+                candidates.append(Sighting(index, px, py, r, bearing, f))
+        if not candidates:
+            return []
+        # One cast for every candidate: hidden when something is nearer along its line of sight.
+        angles = np.array([heading + s.bearing for s in candidates])
+        free = self._caster.cast(x, y, angles, self.r_max)
+        return [s for s, reach in zip(candidates, free, strict=True) if reach >= s.r - 1e-9]
 
     def detect(self, points: list[tuple[float, float]]) -> list[Sighting]:
         """One image: each point in view is detected with probability f (one random draw each)."""
@@ -229,9 +233,10 @@ class Antenna:
         t = self._now()
         return next((w for w in self.windows if w.start <= t <= w.end), None)
 
-    def record(self, start: float, end: float) -> bool:
-        """A communication from start to end: it succeeds when one window holds all of it."""
+    def record(self, start: float, end: float) -> Window | None:
+        """A communication from start to end: it succeeds when one window holds all of it, and
+        that window is returned (None when it failed)."""
         window = next((w for w in self.windows if w.start <= start and end <= w.end), None)
         if window is not None:
             self.sent.append((start, end, window.name))
-        return window is not None
+        return window

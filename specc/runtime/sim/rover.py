@@ -165,10 +165,11 @@ class Rover:
             right *= 1.0 + noise * self.rng.standard_normal()
         self.left_travel += left
         self.right_travel += right * (1.0 + self.config.encoder_bias)
-        moved = math.hypot(x1 - x0, y1 - y0) + abs(turn) * self.config.wheel_base / 2.0
-        self.distance += math.hypot(x1 - x0, y1 - y0)
+        travelled = math.hypot(x1 - x0, y1 - y0)
+        self.distance += travelled
+        moved = travelled + abs(half)
         self.time += dt
-        self._watch(dt, dt * (abs(v) + abs(w) * self.config.wheel_base / 2.0), moved)
+        self._watch(dt, dt * (abs(v) + abs(w) * self.config.wheel_base / 2.0), moved)  # both in wheel metres
 
     def _watch(self, dt: float, commanded: float, achieved: float) -> None:
         """Blocked: over the last `blocked_after` seconds, the wheels asked for motion and the

@@ -26,7 +26,7 @@ from specc.runtime.sim.rover import HILARE, RobotConfig, Rover
 from specc.runtime.sim.world import World
 
 PHYSICS_PRIORITY = -1000  # before the exec tasks of the same instant
-OBJECT_CLEARANCE = 0.4  # m: random objects are placed at least this far from walls and obstacles
+OBJECT_CLEARANCE = 0.45  # m: random objects are placed at least this far from walls and obstacles
 
 
 @dataclass
@@ -56,8 +56,8 @@ class Simulation:
         self.seed = seed
         self.kernel = kernel or Kernel()
         self.physics_period = physics_period
-        streams = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(5)]
-        encoder_rng, range_rng, camera_rng, object_rng, _spare = streams
+        streams = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4)]
+        encoder_rng, range_rng, camera_rng, object_rng = streams
         self.rover = Rover(world, robot, encoder_rng)
         self.caster = RayCaster.for_world(world)
         self.wheels = Wheels(self.rover)

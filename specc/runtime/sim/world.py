@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -89,6 +89,12 @@ class Circle:
 
     def distance(self, x: float, y: float) -> float:
         return max(0.0, math.hypot(x - self.x, y - self.y) - self.radius)
+
+    def outline(self, sides: int = 12) -> Polygon:
+        """The circumscribed regular polygon: covers the disc, for polygon-only algorithms."""
+        reach = self.radius / math.cos(math.pi / sides)
+        return Polygon(tuple((self.x + reach * math.cos(math.tau * k / sides),
+                              self.y + reach * math.sin(math.tau * k / sides)) for k in range(sides)))
 
 
 Obstacle = Polygon | Circle
@@ -139,6 +145,10 @@ class World:
     def circles(self) -> list[tuple[float, float, float]]:
         return [(o.x, o.y, o.radius) for o in self.obstacles if isinstance(o, Circle)]
 
+    def polygons(self) -> list[Polygon]:
+        """Every obstacle as a polygon (circles by their circumscribed outline)."""
+        return [o if isinstance(o, Polygon) else o.outline() for o in self.obstacles]
+
 
 def load_world(path: str | Path) -> World:
     path = Path(path)
@@ -146,6 +156,8 @@ def load_world(path: str | Path) -> World:
         text = path.read_text()
     except OSError as error:
         raise WorldError(f"{path}: cannot read the world file ({error.strerror or error})") from None
+    except UnicodeDecodeError:
+        raise WorldError(f"{path}: not a text file (a world file is TOML)") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
@@ -190,9 +202,9 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
                     isinstance(p, list) and len(p) == 2 and all(isinstance(c, int | float) for c in p) for p in points):
                 raise WorldError(f"{source}: {label}: polygon must list at least 3 [x, y] corners")
             polygon = tuple((float(x), float(y)) for x, y in points)
-            if _signed_area(polygon) < 0:
+            if signed_area(polygon) < 0:
                 polygon = polygon[::-1]  # the rest of the simulator wants counter-clockwise corners
-            if abs(_signed_area(polygon)) < 1e-9:
+            if abs(signed_area(polygon)) < 1e-9:
                 raise WorldError(f"{source}: {label}: the polygon has no area")
             obstacles.append(Polygon(polygon))
         elif "circle" in entry and "polygon" not in entry:
@@ -260,7 +272,8 @@ class _Where:
         return value
 
 
-def _signed_area(points: tuple[tuple[float, float], ...]) -> float:
+def signed_area(points: Sequence[tuple[float, float]]) -> float:
+    """Positive for counter-clockwise corners."""
     n = len(points)
     return 0.5 * sum(points[k][0] * points[(k + 1) % n][1] - points[(k + 1) % n][0] * points[k][1]
                      for k in range(n))
