@@ -184,9 +184,24 @@ class Poster(Generic[T]):
     def __init__(self, spec: PosterSpec):
         self.spec = spec
         self._snapshot: Snapshot[T] | None = None
+        self._assembled = dataclasses.is_dataclass(spec.type) and not hasattr(spec.type, "__slots__") and \
+            tuple(f.name for f in dataclasses.fields(spec.type)) == spec.fields
 
     def write(self, data: T, date: float) -> None:
         self._snapshot = Snapshot(clone(data), date)
+
+    def publish(self, sdi: Any, date: float) -> None:
+        """Write the poster's fields copied from the module's SDI: the record is assembled from
+        the copies directly, as `write(type(**fields))` would copy every field a second time."""
+        spec = self.spec
+        if not self._assembled:  # a type with more fields than the poster: its constructor fills them
+            self.write(spec.type(**{f: getattr(sdi, f) for f in spec.fields}), date)
+            return
+        record: Any = object.__new__(spec.type)
+        state = record.__dict__
+        for name in spec.fields:
+            state[name] = clone(getattr(sdi, name))
+        self._snapshot = Snapshot(record, date)
 
     def read(self) -> Snapshot[T] | None:
         if self._snapshot is None:
@@ -796,9 +811,7 @@ class Module:
                 self.update_poster(name)
 
     def update_poster(self, name: str) -> None:
-        poster = self.posters[name]
-        data = poster.spec.type(**{f: getattr(self.sdi, f) for f in poster.spec.fields})
-        poster.write(data, self.kernel.now)
+        self.posters[name].publish(self.sdi, self.kernel.now)
 
     def control_poster(self) -> Snapshot[tuple[ActivityInfo, ...]]:
         """The standard control poster: every activity, its state and when it started."""

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from specc.runtime.sim.rays import RayCaster
+from specc.runtime.sim.rays import RayCaster, unit_directions
 from specc.runtime.sim.world import Window
 
 if TYPE_CHECKING:
@@ -82,18 +82,26 @@ class RangeSensor:
                  rng: np.random.Generator, offset: float = 0.0) -> None:
         self._rover = rover
         self._caster = caster
-        self.angles = angles
+        self._angles = angles
+        self._units = unit_directions(angles)
         self.max_range = max_range
         self.noise = noise
         self._rng = rng
         self.offset = offset
 
+    @property
+    def angles(self) -> np.ndarray:
+        """The beams' angles from the heading (fixed: their directions are computed once)."""
+        return self._angles
+
     def read(self) -> np.ndarray:
         x, y, theta = self._rover.pose
-        distances = self._caster.cast(x, y, self.angles + theta, self.max_range + self.offset) - self.offset
+        distances = self._caster.fan(x, y, theta, self._units, self.max_range + self.offset)
+        distances -= self.offset
         if self.noise > 0.0:
-            distances = distances + self.noise * self._rng.standard_normal(len(distances))
-        return np.clip(distances, 0.0, self.max_range)
+            distances += self.noise * self._rng.standard_normal(len(distances))
+        # np.clip costs twice as much on a few dozen values
+        return np.minimum(np.maximum(distances, 0.0, out=distances), self.max_range, out=distances)
 
 
 @dataclass
