@@ -3,9 +3,11 @@ updates speak of tasks and attributes that some planner's domain defines."""
 
 from __future__ import annotations
 
+from specc.analysis.ftplan import NotConstant, term
 from specc.check.context import Context
 from specc.check.planning import DomainTables, tables
 from specc.model import nodes as m
+from specc.runtime.ftplan.config import HEURISTICS
 
 
 def check(ctx: Context) -> None:
@@ -17,6 +19,10 @@ def check(ctx: Context) -> None:
             if planner.domain is None:
                 ctx.report("missing-property", f"planner '{planner.name}' needs 'domain: <domain>;'", planner.span)
                 continue
+            if planner.heuristic is not None and planner.heuristic.text not in HEURISTICS:
+                choices = ", ".join(sorted(HEURISTICS)) or "none yet: leave 'heuristic' out"
+                ctx.report("unknown-heuristic", f"specc's planner has no heuristic '{planner.heuristic.text}' "
+                           f"(it knows {choices})", planner.heuristic.span)
             domain = ctx.lookup(m.Domain, planner.domain, planner.domain.span, "undefined-domain")
             if domain is not None:
                 found = tables(_quiet(ctx), domain.members)
@@ -36,11 +42,40 @@ def check(ctx: Context) -> None:
                 check_task(ctx, known, task, rule.span, getattr(rule, "args", None))
             if isinstance(rule, m.AnalyzerCondition):
                 check_attribute(ctx, known, rule.requirement.attribute, len(rule.requirement.args), rule.span)
+                value = rule.requirement.value
+                if isinstance(value, m.Transition):
+                    ctx.report("bad-rule-argument", "a requirement names one value, not a transition "
+                               "(write `ATTRIBUTE(args): VALUE`)", value.span)
+                else:
+                    check_terms(ctx, (*rule.args, *rule.requirement.args, value))
+                    check_bound(ctx, rule.args, (*rule.requirement.args, value), f"task '{rule.task}'")
         for update in ftplan.state_updates:
             if update.report != "report":
                 check_task(ctx, known, update.task, update.span, update.args)
             for fact in update.updates:
                 check_attribute(ctx, known, fact.attribute, len(fact.args), fact.span)
+                check_terms(ctx, (*fact.args, fact.value))
+                check_bound(ctx, update.args, (*fact.args, fact.value), f"{update.report} '{update.task}'")
+            check_terms(ctx, update.args)
+
+
+def check_terms(ctx: Context, exprs: tuple[m.IxExpr, ...]) -> None:
+    """FTplan matches and writes facts: a rule's arguments and values are ?variables or constants."""
+    for expr in exprs:
+        try:
+            term(expr)
+        except NotConstant:
+            ctx.report("bad-rule-argument", "an FTplan rule argument is a ?variable, a symbol or a number, "
+                       "not an expression", expr.span)
+
+
+def check_bound(ctx: Context, binding: tuple[m.IxExpr, ...], used: tuple[m.IxExpr, ...], where: str) -> None:
+    """A rule's ?variables take their values from the task's (or report's) arguments."""
+    bound = {e.name for e in binding if isinstance(e, m.IxVar)}
+    for expr in used:
+        if isinstance(expr, m.IxVar) and expr.name not in bound:
+            ctx.report("unbound-variable", f"{expr.name} is not an argument of {where}: name it among the "
+                       f"arguments, or write a constant", expr.span)
 
 
 def _quiet(ctx: Context) -> Context:

@@ -1,0 +1,82 @@
+"""An `ftplan` block as the runtime's configuration (`specc.runtime.ftplan.config`): what the
+back end `ftplan` writes into the generated package."""
+
+from __future__ import annotations
+
+from specc.model import nodes as m
+from specc.runtime.ftplan import config as fc
+
+DEFAULT_WATCHDOG = 10.0  # seconds, when the block names none
+
+
+class NotConstant(ValueError):
+    """An argument of an analyzer or state rule that is neither a ?variable nor a constant."""
+
+
+def term(e: m.IxExpr) -> fc.Term:
+    """A rule argument: a ?variable, a symbol, or a number (`-3`, `0 - 3.0` folded)."""
+    if isinstance(e, m.IxVar):
+        return fc.Var(e.name)
+    if isinstance(e, m.IxName):
+        return e.name
+    value = number(e)
+    if value is None:
+        raise NotConstant("a rule argument is a ?variable, a symbol or a number")
+    return value
+
+
+def number(e: m.IxExpr) -> float | None:
+    if isinstance(e, m.Number):
+        return float(e.value)
+    if isinstance(e, m.IxUnary) and e.op == "-":
+        inner = number(e.operand)
+        return None if inner is None else -inner
+    if isinstance(e, m.IxBinary) and e.op in ("+", "-", "*"):
+        left, right = number(e.left), number(e.right)
+        if left is None or right is None:
+            return None
+        return left + right if e.op == "+" else left - right if e.op == "-" else left * right
+    return None
+
+
+def terms(exprs: tuple[m.IxExpr, ...]) -> tuple[fc.Term, ...]:
+    return tuple(term(e) for e in exprs)
+
+
+def analyzer_rule(rule: m.AnalyzerRule) -> fc.AnalyzerRule:
+    line = rule.span.line
+    if isinstance(rule, m.AnalyzerNoOverlap):
+        first, second = (rule.tasks + rule.tasks)[:2]
+        return fc.NoOverlap(first, second, line)
+    if isinstance(rule, m.AnalyzerMaxDuration):
+        return fc.MaxDuration(rule.task, rule.limit.seconds, line)
+    value = rule.requirement.value
+    if isinstance(value, m.Transition):
+        raise NotConstant("an analyzer requirement names one value, not a transition")
+    return fc.Requirement(rule.kind, rule.task, terms(rule.args), rule.requirement.attribute,
+                          terms(rule.requirement.args), term(value), line)
+
+
+def state_rule(update: m.StateUpdate) -> fc.StateRule:
+    return fc.StateRule(update.report, update.task, terms(update.args),
+                        tuple(fc.FactUpdate(f.attribute, terms(f.args), term(f.value)) for f in update.updates),
+                        update.span.line)
+
+
+def ftplan_config(ftplan: m.FtPlan) -> fc.FtPlanConfig:
+    planners = {p.name: p for p in ftplan.planners}
+    order = [ref.text for ref in ftplan.order] or list(planners)
+    order += [name for name in planners if name not in order]  # unlisted planners come last
+    return fc.FtPlanConfig(
+        name=ftplan.name,
+        planners=tuple(planner_config(planners[name]) for name in order),
+        policy=ftplan.policy or "successive",
+        watchdog=ftplan.watchdog.seconds if ftplan.watchdog is not None else DEFAULT_WATCHDOG,
+        analyzer=tuple(analyzer_rule(r) for r in ftplan.analyzer),
+        state_rules=tuple(state_rule(u) for u in ftplan.state_updates),
+    )
+
+
+def planner_config(planner: m.Planner) -> fc.PlannerConfig:
+    return fc.PlannerConfig(planner.name, planner.domain.text if planner.domain is not None else "",
+                            planner.heuristic.text if planner.heuristic is not None else None)

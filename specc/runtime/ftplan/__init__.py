@@ -1,0 +1,18 @@
+"""FTplan, the fault-tolerant planning component of seed 004 (ch. 3): diversified planners in
+their own processes, a planning watchdog, a plan analyzer, action-failure detection, on-line goal
+verification, successive (Fig 3.1) and concurrent (Fig 3.2) recovery.
+
+    from specc.runtime.ftplan import FtPlan, ProcessPool, ScriptedExecutor
+    with ProcessPool(config.planners, domains) as pool:
+        result = FtPlan(config, problem, pool, ScriptedExecutor()).run()
+"""
+
+from __future__ import annotations
+
+from specc.runtime.ftplan.component import CostModel, FtPlan, MissionFailure, MissionResult
+from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig, configurations
+from specc.runtime.ftplan.execution import Executor, Outcome, Report, ScriptedExecutor
+from specc.runtime.ftplan.pools import LocalPool, ProcessPool
+
+__all__ = ["CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure", "MissionResult",
+           "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor", "configurations"]

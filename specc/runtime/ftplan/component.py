@@ -1,0 +1,436 @@
+"""FTplan, the fault-tolerant planning component of seed 004 (ch. 3).
+
+It sits between the supervisor and several planners with diversified models or heuristics and
+tolerates design faults in planning knowledge with four detection mechanisms:
+
+- the planning watchdog (a late, crashed or plan-less planner: killed and restarted);
+- the plan analyzer (constraints written apart from the models, checked before execution);
+- action-failure detection (from the execution reports);
+- on-line goal verification (FTplan's own state, after each action and when a plan ends);
+
+and two recovery policies, written line for line after the seed's algorithms: successive
+planning (Fig 3.1) and concurrent planning (Fig 3.2). Every step taken is recorded in `trace`
+with the figure's line number, so that a run can be read against the figure.
+
+Mission time and planning. Planning wall time is charged to mission time. By default the charge
+is deterministic: a cost model on the partial plans the planner expanded (`CostModel`), and the
+watchdog judges that charge, so that a run depends on its seed only; concurrent planning then
+lets the plan of the lowest charge count as the first found. With `timing="wall"` the measured
+wall time is charged, the watchdog is a wall-clock one, and the first plan to arrive wins. In
+both modes a planner silent for `wall_limit` wall seconds is killed: that is how a hung one ends.
+
+Two departures from the figures, both where they are silent:
+- a planner that answers "no plan" or crashes is treated as a late one (§3.2.2.2: "si la
+  planification prend trop de temps ou si aucune solution n'a été trouvée, FTplan tue le
+  processus IxTeT en échec, le relance, puis bascule sur un autre modèle");
+- the loops of Fig 3.1/3.2 end when goals remain after a round in which every planner gave a
+  valid plan, carried out to its end, that met no goal (they all leave those goals aside): the
+  remaining goals are reported missed instead of replanning until their deadlines pass. A
+  round with a failure goes on as the figures say; its failures cost mission time, so the goals'
+  deadlines end it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Collection, Generator
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from specc.runtime.ftplan.analyzer import Violation, analyse
+from specc.runtime.ftplan.config import FtPlanConfig
+from specc.runtime.ftplan.execution import Execution, Executor, Report
+from specc.runtime.ftplan.planners import Answer
+from specc.runtime.ftplan.state import SystemState
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import Plan, format_value
+from specc.runtime.planner.replan import replanning_problem
+
+MISSION_FAILED_IN_TIME = "mission failure: no valid plan found in time"  # Fig 3.1 line 24, Fig 3.2 line 24
+MISSION_FAILED = "mission failure: no valid plan found"  # Fig 3.2 line 20
+
+
+class MissionFailure(Exception):
+    """The mission exception: the redundant planners are exhausted."""
+
+
+# ---------------------------------------------------------------- planners, as FTplan sees them
+
+
+class PlannerPool(Protocol):
+    """The planners, each in its own process (`specc.runtime.ftplan.processes`) or in this one."""
+
+    names: tuple[str, ...]
+
+    def request(self, name: str, problem: pm.Problem, now: float) -> None:
+        """Send a planning request (envoyer(demande_plan) à k); returns at once."""
+        ...
+
+    def next_answer(self, names: Collection[str], wall_timeout: float) -> Answer | None:
+        """The first answer of one of `names` (requested and not yet answered) within
+        `wall_timeout` wall seconds; None when none came."""
+        ...
+
+    def abandon(self, name: str) -> None:
+        """Stop the planner's current planning (kill it and start it again)."""
+        ...
+
+
+@dataclass(frozen=True)
+class CostModel:
+    """Deterministic charge of a planning to mission time: IxTeT's cycle is of the order of two
+    seconds (§3.2.2.2); a partial plan costs a little more."""
+
+    base: float = 2.0  # seconds per planning
+    per_node: float = 0.01  # seconds per partial plan expanded
+
+    def seconds(self, answer: Answer) -> float:
+        return self.base + self.per_node * answer.nodes
+
+
+# ---------------------------------------------------------------- results
+
+
+@dataclass(frozen=True)
+class Event:
+    """One entry of FTplan's log: what happened at which mission time."""
+
+    time: float
+    kind: str  # plan-request, plan, watchdog, invalid-plan, execute, report, action-failed, goal-met,
+    # goal-missed, safe-state, operator, mission-failure, mission-end
+    text: str
+    planner: str = ""
+
+
+@dataclass
+class MissionResult:
+    met: list[str]
+    missed: dict[str, str]  # goal -> why
+    failure: str  # the mission exception's message, "" when none was raised
+    now: float  # mission time at the end
+    plannings: int  # planning requests sent
+    replannings: int  # requests after the first
+    planner_failures: int  # watchdog expiries, crashes, plan-less answers, invalid plans
+    events: list[Event]
+    trace: list[tuple[int, str]]  # (line of Fig 3.1 / 3.2, what happened)
+
+    @property
+    def success(self) -> bool:
+        return not self.failure and not self.missed
+
+
+# ---------------------------------------------------------------- the component
+
+
+@dataclass
+class FtPlan:
+    config: FtPlanConfig
+    problem: pm.Problem  # the mission, in the vocabulary of FTplan's state rules
+    pool: PlannerPool
+    executor: Executor
+    analyzer: bool = True  # the plan analyzer on (the seed's prototype had none)
+    timing: str = "model"  # model | wall
+    cost: CostModel = field(default_factory=CostModel)
+    wall_limit: float | None = None  # wall seconds before a silent planner is killed (default: the watchdog)
+    policy: str | None = None  # overrides the block's policy (the Robot1/2c configuration)
+    operator: Callable[[str], None] | None = None  # messages to the operator
+
+    def __post_init__(self) -> None:
+        if self.timing not in ("model", "wall"):
+            raise ValueError(f"timing is 'model' or 'wall', not '{self.timing}'")
+        policy = self.policy or self.config.policy
+        if policy not in ("successive", "concurrent"):
+            raise ValueError(f"policy is 'successive' or 'concurrent', not '{policy}'")
+        self.policy = policy
+        self.state = SystemState.from_problem(self.problem)
+        self.now = 0.0
+        self.events: list[Event] = []
+        self.trace: list[tuple[int, str]] = []
+        self.plannings = 0
+        self.planner_failures = 0
+
+    # ------------------------------------------------------------ entry point
+    def run(self) -> MissionResult:
+        failure = ""
+        try:
+            if self.policy == "successive":
+                self.successive()
+            else:
+                self.concurrent()
+        except MissionFailure as error:
+            failure = str(error)
+            self.log("mission-failure", failure)
+            self.tell_operator(failure)
+            self.now = self.executor.safe_state(self.now)
+        self.state.check_goals(self.now, mission_over=True)
+        for goal in self.state.goals:
+            if goal.line in self.state.missed:
+                self.log("goal-missed", f"{goal.text()}: {self.state.missed[goal.line]}")
+        self.log("mission-end", f"{len(self.state.met)} of {len(self.state.goals)} goals met")
+        by_line = {g.line: g.text() for g in self.state.goals}
+        return MissionResult(
+            met=[by_line[line] for line in sorted(self.state.met)],
+            missed={by_line[line]: why for line, why in sorted(self.state.missed.items())},
+            failure=failure, now=self.now, plannings=self.plannings, replannings=max(0, self.plannings - 1),
+            planner_failures=self.planner_failures, events=self.events, trace=self.trace)
+
+    # ------------------------------------------------------------ Fig 3.1
+    def successive(self) -> None:
+        planners = [p.name for p in self.config.planners]
+        failed: set[str] = set()
+        self.step(2, "failed <- {}")
+        while self.objectives():
+            self.step(3, "goals remain")
+            candidates = list(planners)
+            self.step(4, f"candidates <- {', '.join(candidates)}")
+            outcomes: list[str] = []  # of this round: met, idle (nothing met), failed
+            while candidates and self.objectives():
+                self.step(5, "candidates and goals remain")
+                # Some candidate is not in `failed`: the set is emptied by every valid plan, so
+                # when it held every candidate left, it would hold all planners (line 23 caught that).
+                k = next(k for k in candidates if k not in failed)
+                self.step(6, f"choose {k}")
+                candidates.remove(k)
+                self.step(7, f"candidates <- {', '.join(candidates) or '{}'}")
+                self.step(8, f"arm the watchdog ({self.config.watchdog:g} s)")
+                self.request(k)
+                self.step(9, f"request a plan from {k}")
+                self.step(10, "wait for the plan or the watchdog")
+                answer = self.pool.next_answer([k], self.wall_seconds())
+                if answer is None:
+                    self.silent([k])
+                    self.now += self.config.watchdog
+                    plan = None
+                else:  # a late planner is killed when the watchdog fires: no later
+                    self.now += min(self.charge(answer), self.config.watchdog)
+                    plan = self.plan_of(answer, self.config.watchdog)
+                if plan is not None:
+                    self.step(11, f"plan found by {k}")
+                    self.step(12, "disarm the watchdog")
+                    violations = self.analyse(k, plan)
+                    if not violations:
+                        self.step(13, "analysis OK")
+                        failed.clear()
+                        self.step(14, "failed <- {}")
+                        self.step(15, f"{k} executes its plan")
+                        outcomes.append(self.execute(k, plan))
+                    else:
+                        outcomes.append("failed")
+                        self.step(16, "analysis found errors")
+                        self.step(17, f"tell the operator: invalid plan from {k}")
+                        failed.add(k)
+                        self.step(18, f"failed <- {', '.join(sorted(failed))}")
+                else:
+                    outcomes.append("failed")
+                    self.step(20, f"watchdog: no plan from {k}")
+                    failed.add(k)
+                    self.step(21, f"failed <- {', '.join(sorted(failed))}")
+                if failed >= set(planners):
+                    self.step(23, "every planner failed in a row")
+                    self.step(24, MISSION_FAILED_IN_TIME)
+                    raise MissionFailure(MISSION_FAILED_IN_TIME)
+            if outcomes and set(outcomes) == {"idle"} and self.objectives():
+                self.give_up("every planner's plan left them aside")
+                return
+
+    # ------------------------------------------------------------ Fig 3.2
+    def concurrent(self) -> None:
+        planners = [p.name for p in self.config.planners]
+        while self.objectives():
+            self.step(2, "goals remain")
+            candidates = list(planners)
+            self.step(3, f"candidates <- {', '.join(candidates)}")
+            self.step(4, f"arm the watchdog ({self.config.watchdog:g} s)")
+            problem = self.planning_problem()
+            for k in candidates:
+                self.request(k, problem)
+            self.step(5, f"request a plan from {', '.join(candidates)}")
+            started = self.now
+            arrivals = self.arrivals(candidates)
+            outcome = ""
+            while candidates:
+                self.step(6, "candidates remain")
+                answer = next(arrivals, None)
+                if answer is None:
+                    self.now = max(self.now, started + self.config.watchdog)
+                    self.step(23, "the watchdog expired")
+                    self.step(24, MISSION_FAILED_IN_TIME)
+                    raise MissionFailure(MISSION_FAILED_IN_TIME)
+                k = answer.planner
+                self.now = max(self.now, started + self.charge(answer))
+                self.step(8, f"answer from {k}")
+                candidates.remove(k)
+                self.step(9, f"candidates <- {', '.join(candidates) or '{}'}")
+                self.step(10, "pause the watchdog")
+                plan = self.plan_of(answer)
+                valid = plan is not None and not self.analyse(k, plan)
+                if plan is not None and valid:
+                    self.step(11, f"analysis of {k}'s plan OK")
+                    self.step(12, "disarm the watchdog")
+                    arrivals.close()
+                    for other in candidates:
+                        self.pool.abandon(other)
+                    self.step(13, f"abandon planning: {', '.join(candidates) or 'none left'}")
+                    candidates = []
+                    self.step(14, "candidates <- {}")
+                    self.step(15, f"{k} executes its plan")
+                    outcome = self.execute(k, plan)
+                else:
+                    self.step(16, f"no valid plan from {k}")
+                    self.step(17, "resume the watchdog")
+                    self.step(18, f"tell the operator: invalid plan from {k}")
+                    if not candidates:
+                        self.step(19, "no candidate left")
+                        self.step(20, MISSION_FAILED)
+                        raise MissionFailure(MISSION_FAILED)
+            if outcome == "idle" and self.objectives():
+                self.give_up("the first valid plan left them aside")
+                return
+
+    def arrivals(self, candidates: list[str]) -> Generator[Answer, None, None]:
+        """The answers of a concurrent planning in the order they count as found, within the
+        watchdog. Wall timing: as they arrive; the watchdog is paused while the consumer analyses
+        one (the time between two `next`). Model timing: all are collected, then given in the
+        order of their charge (ties: the planners' order); those charged beyond the watchdog
+        never count."""
+        waiting = list(candidates)
+        if self.timing == "model":
+            collected = []
+            while waiting:
+                answer = self.pool.next_answer(waiting, self.wall_seconds())
+                if answer is None:
+                    self.silent(waiting)
+                    break
+                waiting.remove(answer.planner)
+                collected.append(answer)
+            collected.sort(key=lambda a: (self.charge(a), candidates.index(a.planner)))
+            for answer in collected:
+                if self.charge(answer) > self.config.watchdog:
+                    self.pool.abandon(answer.planner)
+                    self.log("watchdog", f"{answer.planner} planned for {self.charge(answer):.3g} s, "
+                             f"beyond the {self.config.watchdog:g} s watchdog", answer.planner)
+                    return
+                yield answer
+            return
+        remaining = self.wall_seconds()
+        while waiting:
+            asked = time.monotonic()
+            answer = self.pool.next_answer(waiting, max(0.0, remaining))
+            remaining -= time.monotonic() - asked  # paused while the consumer analyses
+            if answer is None:
+                self.silent(waiting)
+                return
+            waiting.remove(answer.planner)
+            yield answer
+
+    def silent(self, names: list[str]) -> None:
+        for k in names:
+            self.pool.abandon(k)
+            self.planner_failures += 1
+            self.log("watchdog", f"{k} did not answer within {self.wall_seconds():g} s: killed, restarted", k)
+
+    # ------------------------------------------------------------ the mechanisms
+    def objectives(self) -> bool:
+        """Goals remain (Fig 3.1 lines 3 and 5, Fig 3.2 line 2): on-line goal verification."""
+        self.state.check_goals(self.now)
+        return bool(self.state.pending())
+
+    def planning_problem(self) -> pm.Problem:
+        """What FTplan sends: its own facts, the goals still open, the mission time (§3.2.2.3)."""
+        if self.plannings == 0:
+            return self.problem
+        return replanning_problem(self.problem, self.state.facts_list(), [g.line for g in self.state.open_goals()],
+                                  self.now)
+
+    def request(self, k: str, problem: pm.Problem | None = None) -> None:
+        problem = problem or self.planning_problem()
+        self.plannings += 1
+        goals = ", ".join(g.text() for g in self.state.open_goals())
+        self.log("plan-request", f"{k} asked to plan at {self.now:g} s for: {goals}", k)
+        self.pool.request(k, problem, self.now)
+
+    def charge(self, answer: Answer) -> float:
+        return self.cost.seconds(answer) if self.timing == "model" else answer.seconds
+
+    def plan_of(self, answer: Answer, watchdog: float = math.inf) -> Plan | None:
+        """The answer's plan, or None when the planner failed — late, crashed or plan-less —
+        and was killed and restarted (the watchdog's detection)."""
+        k, spent = answer.planner, self.charge(answer)
+        why = ""
+        if spent > watchdog:
+            why = f"{k} planned for {spent:.3g} s, beyond the {watchdog:g} s watchdog"
+        elif answer.result is None:
+            why = f"{k} {answer.status}: {answer.error or answer.detail or 'no reason given'}"
+        elif answer.result.plan is None:
+            why = f"{k} found no plan: {answer.result.reason}"
+        if why:
+            self.pool.abandon(k)
+            self.planner_failures += 1
+            self.log("watchdog", f"{why}: killed, restarted", k)
+            return None
+        assert answer.result is not None and answer.result.plan is not None
+        dropped = "; ".join(f"{g.description}: {g.reason}" for g in answer.result.dropped)
+        self.log("plan", f"{k}: {len(answer.result.plan.actions)} actions"
+                 + (f", dropped {dropped}" if dropped else ""), k)
+        return answer.result.plan
+
+    def analyse(self, k: str, plan: Plan) -> list[Violation] | list[str]:
+        if not self.analyzer:
+            return []
+        violations = analyse(plan, self.config, self.state, self.problem)
+        if violations:
+            self.planner_failures += 1
+            text = f"invalid plan from {k}: " + "; ".join(v.message for v in violations)
+            self.log("invalid-plan", text, k)
+            self.tell_operator(text)
+        return violations
+
+    def execute(self, k: str, plan: Plan) -> str:
+        """k.executer(plan): blocking; FTplan's state follows the reports, the goals are checked
+        after each action. `failed` (an action failed), `met` (it ended and met some goal) or
+        `idle` (it ended, meeting none)."""
+        met_before = len(self.state.met)
+        self.log("execute", f"{k}'s plan of {len(plan.actions)} actions starts", k)
+
+        def report(r: Report) -> None:
+            self.state.report(self.config.state_rules, r.kind, r.name, r.args)
+            self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
+                     + (f": {r.why}" if r.why else ""), k, r.time)
+            if r.kind in ("ended", "report"):
+                for goal in self.state.check_goals(r.time):
+                    self.log("goal-met", goal.text(), k, r.time)
+
+        outcome: Execution = self.executor.execute(plan, self.now, report)
+        self.now = outcome.now
+        if not outcome.completed:
+            self.log("action-failed", f"{outcome.why} (action {outcome.failed_action})", k)
+            self.now = self.executor.safe_state(self.now)
+            self.log("safe-state", "running activities stopped before recovery", k)
+            return "failed"
+        else:
+            self.state.check_goals(self.now)
+            left = ", ".join(g.text() for g in self.state.pending())
+            if left:
+                self.log("goals-open", f"{k}'s plan ended with goals open: {left}", k)
+        return "met" if len(self.state.met) > met_before else "idle"
+
+    def give_up(self, why: str) -> None:
+        for goal in self.state.open_goals():
+            self.state.missed[goal.line] = why
+        self.tell_operator(f"remaining goals abandoned: {why}")
+
+    # ------------------------------------------------------------ bookkeeping
+    def wall_seconds(self) -> float:
+        return self.wall_limit if self.wall_limit is not None else self.config.watchdog
+
+    def step(self, line: int, text: str) -> None:
+        self.trace.append((line, text))
+
+    def log(self, kind: str, text: str, planner: str = "", at: float | None = None) -> None:
+        self.events.append(Event(self.now if at is None else at, kind, text, planner))
+
+    def tell_operator(self, text: str) -> None:
+        self.log("operator", text)
+        if self.operator is not None:
+            self.operator(text)

@@ -1,0 +1,136 @@
+"""How FTplan's plans are carried out, as FTplan sees it: actions started, their reports, and
+a way to bring the system to a safe state (seed 004 §3.1.2: running activities are stopped
+before any recovery).
+
+`Executor` is what the rest of the architecture provides (in a whole run, the supervisor and
+executive driving the simulated robot). `ScriptedExecutor` carries a plan out in mission time
+against a `world` function that decides each action's outcome: it is the executor of the
+FTplan tests and of runs without a robot.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from specc.runtime.planner.plan import Action, Plan, Value
+
+
+@dataclass(frozen=True)
+class Report:
+    """What the execution layer tells FTplan: `started`, `ended` or `failed` for an action of
+    the plan, or `report` for a measurement (ROBOT_POSITION(x, y))."""
+
+    kind: str  # started | ended | failed | report
+    name: str  # the task, or the report's name
+    args: tuple[Value, ...]
+    time: float
+    action: str = ""  # the plan's action id
+    why: str = ""  # for a failure
+
+
+@dataclass(frozen=True)
+class Execution:
+    completed: bool  # every action of the plan ended
+    now: float  # mission time when the execution stopped
+    failed_action: str = ""
+    why: str = ""
+
+
+class Executor(Protocol):
+    def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
+        """Carry `plan` out from mission time `now`, calling `report` for every report; stop at
+        the first failed action. Blocking, as in Fig 3.1 line 15."""
+        ...
+
+    def safe_state(self, now: float) -> float:
+        """Stop every running activity; the mission time when the system is safe."""
+        ...
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What the world does with one action: how long it really takes, whether it ends, and the
+    measurements reported with it."""
+
+    ended: bool = True
+    duration: float | None = None  # None: the planned duration's upper bound; beyond it, a failure
+    reports: tuple[tuple[str, tuple[Value, ...]], ...] = ()  # measurements sent when it ends
+    why: str = ""
+
+
+World = Callable[[Action, float], Outcome]
+OVERRUN_TOLERANCE = 1e-6  # seconds
+
+
+def nominal(action: Action, now: float) -> Outcome:
+    """Every action ends, taking the longest its planned duration allows."""
+    return Outcome()
+
+
+@dataclass
+class ScriptedExecutor:
+    """Carries a plan out in mission time: each action starts at its dispatch date, or later
+    when an action the plan orders before it ends late; actions overlap as the plan lets them;
+    `world` decides each outcome. Reports come in the order of their dates."""
+
+    world: World = nominal
+    executed: list[tuple[float, str, str]] = field(default_factory=list)  # (start, action text, outcome)
+    safe_states: list[float] = field(default_factory=list)
+
+    def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
+        waiting = plan.ordered()
+        by_end = {a.end: a for a in plan.actions}
+        after: dict[str, list[tuple[str, float]]] = {a.id: [] for a in plan.actions}  # action -> (predecessor, delay)
+        for first, second, delay in plan.orderings:
+            before = by_end.get(first)
+            for action in plan.actions:
+                if action.start == second and before is not None and before is not action:
+                    after[action.id].append((before.id, delay))
+        ended_at: dict[str, float] = {}
+        running: list[tuple[float, int, Action, Outcome]] = []  # (end date, order, action, outcome)
+        clock, order = now, 0
+        while waiting or running:
+            ready = [a for a in waiting if all(p in ended_at for p, _ in after[a.id])]
+            starts = [(max(clock, a.dispatch, *(ended_at[p] + d for p, d in after[a.id])), a) for a in ready]
+            next_start = min(starts, key=lambda s: (s[0], s[1].dispatch, s[1].id), default=None)
+            if running and (next_start is None or running[0][0] <= next_start[0]):
+                end, _, action, outcome = heapq.heappop(running)
+                clock = end
+                if not outcome.ended:
+                    self.executed.append((end, action.text(), "failed"))
+                    report(Report("failed", action.task, action.args, end, action.id, outcome.why))
+                    return Execution(False, end, action.id, outcome.why or f"{action.text()} failed")
+                for name, args in outcome.reports:
+                    report(Report("report", name, args, end, action.id))
+                ended_at[action.id] = end
+                self.executed.append((end, action.text(), "ended"))
+                report(Report("ended", action.task, action.args, end, action.id))
+                continue
+            if next_start is None:  # an ordering no action ends: the plan is malformed
+                stuck = ", ".join(a.text() for a in waiting)
+                return Execution(False, clock, waiting[0].id, f"{stuck} wait for actions that never end")
+            start, action = next_start
+            waiting.remove(action)
+            clock = start
+            report(Report("started", action.task, action.args, start, action.id))
+            outcome = self.world(action, start)
+            planned = action.duration[1]
+            duration = planned if outcome.duration is None else outcome.duration
+            if duration > planned + OVERRUN_TOLERANCE:
+                # Temporal execution control (seed 004 §3.2.2.2, IxTeT's): an action still running
+                # past its planned latest end has failed; the executive stops it then.
+                outcome = Outcome(False, planned, why=f"{action.text()} overran its planned duration "
+                                  f"[{action.duration[0]:.3g}, {planned:.3g}] s (it needed {duration:.3g} s)")
+                duration = planned
+            end = start + (duration if math.isfinite(duration) else 0.0)
+            order += 1
+            heapq.heappush(running, (end, order, action, outcome))
+        return Execution(True, clock)
+
+    def safe_state(self, now: float) -> float:
+        self.safe_states.append(now)
+        return now

@@ -1,0 +1,558 @@
+"""FTplan's planners, each in its own OS process, and the planning watchdog (seed 004 §3.1.1,
+§3.2.2.2 "Le chien de garde temporel").
+
+A planner that hangs, loops or dies must not take FTplan with it, and FTplan must be able to
+stop it at any instant: so every planner runs in a child process of its own, which FTplan kills
+and restarts when the watchdog fires (as the prototype kills and relaunches the late IxTeT).
+
+    with PlannerProcess(config, domains) as planner:
+        watchdog = Watchdog()
+        watchdog.arm(ftplan.watchdog)
+        planner.request(problem, now)
+        answer = planner.poll(watchdog.remaining())
+        if answer is None:            # the watchdog fired: the planner is late
+            planner.restart()
+
+What crosses to the child is plain data: the planner's `PlannerConfig` and the planning
+domains (`pm.PlanningDomain`, frozen dataclasses; about 10 kB pickled for the rover's Modele1),
+then one `pm.Problem` per request; a `PlanResult` comes back. Passing the domain objects rather
+than the name of the generated package to import spares the child any sys.path set-up, and lets
+tests and tools plan domains that were never generated. `planning_domains(DOMAINS)` turns a
+generated `planner` package's `DOMAINS` into that mapping.
+
+The factory. `PlannerConfig.factory` names, as "module:callable", a callable that the child
+calls once at start, as `factory(config, domains)` with `domains` the mapping name ->
+`pm.PlanningDomain` given to `PlannerProcess`, and that returns an object with
+`plan(problem, now) -> PlanResult` (`SupportsPlan`). A factory that raises leaves the process up,
+answering every request with that error, so a bad configuration reads as any other planner
+failure; `wait_ready()` reports it at once to whoever wants to know before the mission.
+
+Start method: "forkserver". `fork` is the fastest (a planner ready in 6-10 ms), but FTplan's
+process runs threads (the executive, the simulator) and forking a threaded process can deadlock
+the child on a lock held by a thread that does not exist in it. "spawn" is safe but starts a
+fresh interpreter per planner and imports the planner anew each time: 0.3-0.5 s on every
+restart, measured here. "forkserver" forks each planner from a server that has already imported
+the planner (`PRELOAD`): as safe (the server runs no thread of ours; numpy's OpenBLAS pool
+there handles fork itself), and a planner is ready in about 20 ms once the server is up, which
+costs one interpreter start (about 0.4 s) on the first planner of the program. The forkserver
+is one per program, shared by every user of that start method; if it is already running, our
+preload is not applied and children import the planner themselves (slower, still correct). As
+with "spawn", the program's main module is imported again in each child: scripts that start
+planners keep their top level under `if __name__ == "__main__":`.
+
+No zombies, no orphans: `kill()` joins what it killed; the processes are daemonic, so
+multiprocessing terminates them at interpreter exit; and each child watches its parent (a
+thread waiting on the parent's sentinel) and exits at once when FTplan dies, even mid-planning.
+"""
+
+from __future__ import annotations
+
+import importlib
+import itertools
+import multiprocessing
+import os
+import signal
+import threading
+import time
+import traceback
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from multiprocessing.connection import Connection, wait
+from types import ModuleType, TracebackType
+from typing import Final, Literal, Protocol
+
+from specc.runtime.ftplan.config import HEURISTICS, PlannerConfig
+from specc.runtime.planner import Planner, PlanResult
+from specc.runtime.planner import model as pm
+
+START_METHOD: Final = "forkserver"
+# Imported once by the forkserver, so that a planner's process starts without importing them
+# (casadi, which the planner imports at its first plan, is 0.2 s of it).
+PRELOAD = ["specc.runtime.planner", "specc.runtime.ftplan.planners", "casadi"]
+KILL_GRACE = 1.0  # seconds a planner has to exit on SIGTERM before it gets SIGKILL
+
+
+
+class SupportsPlan(Protocol):
+    """What a factory builds: a planner answering one planning request at a time."""
+
+    def plan(self, problem: pm.Problem, now: float) -> PlanResult: ...
+
+
+PlannerFactory = Callable[[PlannerConfig, Mapping[str, pm.PlanningDomain]], SupportsPlan]
+
+
+_CLOSED = object()  # what reading a pipe whose other end is closed gives
+
+
+class PlannerStartError(RuntimeError):
+    """The planner's process could not build its planner, or died before saying it had."""
+
+
+def standard_planner(config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain]) -> Planner:
+    """specc's temporal planner on the domain `config` names: the default factory."""
+    if config.heuristic is not None and config.heuristic not in HEURISTICS:
+        known = ", ".join(sorted(HEURISTICS)) or "none yet: leave the heuristic out"
+        raise ValueError(f"planner '{config.name}': specc's planner has no heuristic '{config.heuristic}' "
+                         f"(known: {known})")
+    if config.domain not in domains:
+        raise ValueError(f"planner '{config.name}': no planning domain '{config.domain}' "
+                         f"(given: {', '.join(sorted(domains)) or 'none'})")
+    return Planner(domains[config.domain])
+
+
+def planning_domains(generated: Mapping[str, ModuleType]) -> dict[str, pm.PlanningDomain]:
+    """The domains of a generated `planner` package's `DOMAINS` (name -> module with `.DOMAIN`)."""
+    return {name: module.DOMAIN for name, module in generated.items()}
+
+
+def load_factory(reference: str) -> PlannerFactory:
+    """The callable "module:callable" names (the callable may be dotted: "module:Class.build")."""
+    module_name, colon, attribute = reference.partition(":")
+    if not colon or not module_name or not attribute:
+        raise ValueError(f"planner factory '{reference}' is not 'module:callable'")
+    target: object = importlib.import_module(module_name)
+    for part in attribute.split("."):
+        target = getattr(target, part)
+    if not callable(target):
+        raise TypeError(f"planner factory '{reference}' is not callable")
+    return target  # type: ignore[return-value]
+
+
+# ---------------------------------------------------------------- the watchdog
+
+class Watchdog:
+    """The planning watchdog: a budget of planning seconds that runs out.
+
+    Successive planning arms it for each request and disarms it on the answer (Fig 3.1 lines 8,
+    12). Concurrent planning arms it once for all the planners and pauses it while FTplan
+    analyses a plan, so that the analysis is not charged to the planners (Fig 3.2 lines 4, 10,
+    17). The clock is injectable so that tests are deterministic; by default it is monotonic
+    wall time, which setting the system clock does not move.
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.monotonic) -> None:
+        self._clock = clock
+        self._budget: float | None = None  # None: disarmed
+        self._spent = 0.0  # seconds counted before the current run (pauses stop the count)
+        self._running_since: float | None = None  # None: paused (or disarmed)
+
+    def arm(self, seconds: float) -> None:
+        if seconds < 0:
+            raise ValueError(f"a watchdog is armed for a duration >= 0, not {seconds}")
+        self._budget, self._spent, self._running_since = seconds, 0.0, self._clock()
+
+    def pause(self) -> None:
+        if self._running_since is not None:
+            self._spent += self._clock() - self._running_since
+            self._running_since = None
+
+    def resume(self) -> None:
+        if self._budget is not None and self._running_since is None:
+            self._running_since = self._clock()
+
+    def disarm(self) -> None:
+        self._budget, self._spent, self._running_since = None, 0.0, None
+
+    @property
+    def armed(self) -> bool:
+        return self._budget is not None
+
+    @property
+    def paused(self) -> bool:
+        return self._budget is not None and self._running_since is None
+
+    def elapsed(self) -> float:
+        """Seconds counted since `arm`, pauses excluded."""
+        running = 0.0 if self._running_since is None else self._clock() - self._running_since
+        return self._spent + running
+
+    def remaining(self) -> float | None:
+        """Seconds left before the watchdog fires (0 once it has), None when disarmed: what to
+        give `poll` or `first_answer` as their timeout."""
+        if self._budget is None:
+            return None
+        return max(0.0, self._budget - self.elapsed())
+
+    def expired(self) -> bool:
+        remaining = self.remaining()
+        return remaining is not None and remaining <= 0.0
+
+
+# ---------------------------------------------------------------- messages
+
+@dataclass(frozen=True)
+class _Request:
+    id: int
+    problem: pm.Problem
+    now: float
+
+
+@dataclass(frozen=True)
+class _Started:
+    error: str  # "": the planner is built; else why it could not be (every request gets it back)
+
+
+@dataclass(frozen=True)
+class _Reply:
+    id: int
+    result: PlanResult | None
+    error: str  # "Type: message" of what the planner raised ("" when it answered)
+    detail: str  # its traceback
+    seconds: float  # the planning as the child timed it
+
+
+Status = Literal["answered", "raised", "crashed"]
+
+
+@dataclass(frozen=True)
+class Answer:
+    """How one planning request ended.
+
+    answered: the planner returned a PlanResult (with a plan or with why there is none);
+    raised: the planner raised, and `error` / `detail` say what and where;
+    crashed: the process died (os._exit, a signal, ...), `exitcode` says how (negative: -signal).
+    """
+
+    planner: str
+    request: int
+    status: Status
+    result: PlanResult | None
+    seconds: float  # wall time from the request to the answer, as FTplan saw it
+    planner_seconds: float = 0.0  # the planning alone, as the child timed it
+    error: str = ""
+    detail: str = ""
+    exitcode: int | None = None
+
+    @property
+    def nodes(self) -> int:
+        """Partial plans the search expanded: the deterministic measure of planning effort."""
+        return self.result.nodes if self.result is not None else 0
+
+    @property
+    def failed(self) -> bool:
+        return self.status != "answered"
+
+    def charged_seconds(self, seconds_per_node: float | None = None) -> float:
+        """The mission time this planning costs: `nodes * seconds_per_node` (the same on every
+        run and machine), or the measured wall time when no cost per node is given."""
+        if seconds_per_node is None:
+            return self.seconds
+        return self.nodes * seconds_per_node
+
+
+def _exit_description(exitcode: int | None) -> str:
+    if exitcode is None:
+        return "died"
+    if exitcode < 0:
+        try:
+            return f"killed by signal {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"killed by signal {-exitcode}"
+    return f"exited with code {exitcode}"
+
+
+def _describe(error: BaseException) -> str:
+    return f"{type(error).__name__}: {error}"
+
+
+# ---------------------------------------------------------------- the child
+
+def _exit_with_parent() -> None:
+    """End this process as soon as its parent is gone, even in the middle of a planning: a
+    planner must not outlive FTplan (nobody would ever kill it)."""
+    parent = multiprocessing.parent_process()
+    if parent is None or parent.sentinel is None:
+        return
+    sentinel = parent.sentinel
+
+    def watch() -> None:
+        wait([sentinel])
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
+def _serve(config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain], connection: Connection) -> None:
+    """The planner's process: build the planner, then answer requests until told to stop.
+    Whatever the planner raises is sent back rather than ending the process silently."""
+    _exit_with_parent()
+    # Ctrl-C reaches the whole process group: FTplan, not the terminal, decides when planners stop.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    planner: SupportsPlan | None = None
+    startup_error = ""
+    try:
+        planner = load_factory(config.factory)(config, domains)
+    except Exception as error:
+        startup_error = f"building planner '{config.name}' with {config.factory} failed: {_describe(error)}"
+    connection.send(_Started(startup_error))
+    while True:
+        try:
+            request = connection.recv()
+        except EOFError:  # FTplan closed its end: nothing more to plan
+            return
+        if request is None:
+            return
+        started = time.perf_counter()
+        try:
+            if planner is None:
+                raise PlannerStartError(startup_error)
+            result = planner.plan(request.problem, request.now)
+            if not isinstance(result, PlanResult):
+                raise TypeError(f"the planner returned a {type(result).__name__}, not a PlanResult")
+            reply = _Reply(request.id, result, "", "", time.perf_counter() - started)
+        except Exception as error:
+            reply = _Reply(request.id, None, _describe(error), traceback.format_exc(), time.perf_counter() - started)
+        try:
+            connection.send(reply)
+        except Exception as error:  # the result does not pickle: say so rather than die
+            connection.send(_Reply(request.id, None, f"the answer could not be sent: {_describe(error)}",
+                                   traceback.format_exc(), reply.seconds))
+
+
+# ---------------------------------------------------------------- the parent's handle
+
+class PlannerProcess:
+    """One planner in its own OS process, one request at a time.
+
+    `request` sends a problem without waiting; `poll(timeout)` returns the `Answer` or None when
+    the timeout passes first (the caller's watchdog then decides); `kill` stops the process,
+    `restart` kills and starts it again (the planner is built anew), `abandon` drops a request
+    under way (Fig 3.2 line 13: the planner cannot be interrupted mid-search, so it is
+    restarted). Use it as a context manager, or call `close()`; from one thread.
+    """
+
+    _ids = itertools.count(1)  # request ids, unique in FTplan's process
+
+    def __init__(self, config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain], *,
+                 kill_grace: float = KILL_GRACE) -> None:
+        module, colon, attribute = config.factory.partition(":")
+        if not colon or not module or not attribute:
+            raise ValueError(f"planner '{config.name}': factory '{config.factory}' is not 'module:callable'")
+        self.config = config
+        self.domains = dict(domains)
+        self.kill_grace = kill_grace
+        self._process: multiprocessing.process.BaseProcess | None = None
+        self._connection: Connection | None = None
+        self._started = False  # the child said it is ready
+        self._startup_error = ""
+        self._pending: _Request | None = None
+        self._sent_at = 0.0
+        self.started_at = 0.0  # perf_counter() at the last start
+        self.startup_seconds: float | None = None  # from start to the child's ready message
+
+    @property
+    def name(self) -> str:
+        return self.config.name
+
+    @property
+    def pid(self) -> int | None:
+        return self._process.pid if self._process is not None else None
+
+    @property
+    def running(self) -> bool:
+        return self._process is not None and self._process.is_alive()
+
+    @property
+    def busy(self) -> bool:
+        """A request is under way (sent, not answered)."""
+        return self._pending is not None
+
+    def __repr__(self) -> str:
+        return f"PlannerProcess({self.name!r}, pid={self.pid}, busy={self.busy})"
+
+    # ------------------------------------------------------------ life cycle
+    def start(self) -> None:
+        """Start the process; does not wait for the planner to be built (see `wait_ready`)."""
+        if self._process is not None:
+            raise RuntimeError(f"planner '{self.name}' is already started (restart() it)")
+        context = multiprocessing.get_context(START_METHOD)
+        context.set_forkserver_preload(PRELOAD)
+        ours, theirs = context.Pipe(duplex=True)
+        process = context.Process(target=_serve, args=(self.config, self.domains, theirs),
+                                  name=f"ftplan-planner-{self.name}", daemon=True)
+        self.started_at = time.perf_counter()
+        try:
+            process.start()
+        except BaseException:
+            ours.close()
+            raise
+        finally:
+            theirs.close()  # the child has its own copy: ours closed, its death reads as EOF here
+        self._process, self._connection = process, ours
+        self._started, self._startup_error, self.startup_seconds = False, "", None
+
+    def wait_ready(self, timeout: float | None = None) -> None:
+        """Block until the planner is built; raise PlannerStartError if it could not be (bad
+        factory, unknown domain or heuristic) or the process died, TimeoutError if it is late."""
+        process, connection = self._require_started()
+        deadline = None if timeout is None else time.perf_counter() + timeout
+        while not self._started:
+            if not wait([connection, process.sentinel], _left(deadline)):
+                raise TimeoutError(f"planner '{self.name}' not ready within {timeout} s")
+            message = self._read(connection)
+            if not self._take_started(message) and (message is _CLOSED or not process.is_alive()):
+                self._reap(process)
+                raise PlannerStartError(f"planner '{self.name}' {_exit_description(process.exitcode)} "
+                                        f"before it was ready")
+        if self._startup_error:
+            raise PlannerStartError(self._startup_error)
+
+    def kill(self) -> None:
+        """Stop the process (SIGTERM, then SIGKILL after `kill_grace`) and reap it. Any request
+        under way is dropped. Does nothing if the process is not started."""
+        process, connection = self._process, self._connection
+        self._process, self._connection, self._pending, self._started = None, None, None, False
+        if connection is not None:
+            connection.close()
+        if process is None:
+            return
+        if process.is_alive():
+            process.terminate()
+            process.join(self.kill_grace)
+            if process.is_alive():
+                process.kill()
+        process.join()
+        process.close()
+
+    def restart(self) -> None:
+        self.kill()
+        self.start()
+
+    def abandon(self) -> None:
+        """Drop the request under way, if any: the planner is restarted to stop its search."""
+        if self._pending is not None:
+            self.restart()
+
+    def close(self) -> None:
+        """Ask the planner to stop, give it `kill_grace` to do so, then kill it."""
+        process, connection = self._process, self._connection
+        if process is not None and connection is not None and self._pending is None and process.is_alive():
+            try:
+                connection.send(None)
+            except OSError:
+                pass  # already gone: kill() reaps it
+            process.join(self.kill_grace)
+        self.kill()
+
+    def __enter__(self) -> PlannerProcess:
+        if self._process is None:
+            self.start()
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
+                 trace: TracebackType | None) -> None:
+        self.close()
+
+    # ------------------------------------------------------------ planning
+    def request(self, problem: pm.Problem, now: float = 0.0) -> int:
+        """Send a planning request and return its id, without waiting for the answer."""
+        _, connection = self._require_started()
+        if self._pending is not None:
+            raise RuntimeError(f"planner '{self.name}' is still planning request {self._pending.id}: "
+                               f"poll() its answer or abandon() it first")
+        request = _Request(next(self._ids), problem, now)
+        self._pending, self._sent_at = request, time.perf_counter()
+        try:
+            connection.send(request)
+        except OSError:
+            pass  # the process is dead: poll() reports it as crashed
+        return request.id
+
+    def poll(self, timeout: float | None = 0.0) -> Answer | None:
+        """The answer to the request under way, waiting at most `timeout` seconds for it (None:
+        as long as it takes); None if it has not come by then, or if no request is under way."""
+        if self._pending is None:
+            return None
+        process, connection = self._require_started()
+        deadline = None if timeout is None else time.perf_counter() + timeout
+        while True:
+            ready = wait([connection, process.sentinel], _left(deadline))
+            if not ready:
+                return None
+            # A dying child may have written its answer first: read the pipe before the sentinel.
+            answer = self._receive(process, connection)
+            if answer is not None:
+                return answer
+
+    def handles(self) -> list[Connection | int]:
+        """What `multiprocessing.connection.wait` may wait on for this planner's next event."""
+        if self._process is None or self._connection is None:
+            return []
+        return [self._connection, self._process.sentinel]
+
+    # ------------------------------------------------------------ internals
+    def _require_started(self) -> tuple[multiprocessing.process.BaseProcess, Connection]:
+        if self._process is None or self._connection is None:
+            raise RuntimeError(f"planner '{self.name}' is not started")
+        return self._process, self._connection
+
+    @staticmethod
+    def _read(connection: Connection) -> object | None:
+        """The child's next message if one is there, None if none is, _CLOSED if the child's end
+        of the pipe is closed (it died: its exit code follows on its sentinel)."""
+        try:
+            return connection.recv() if connection.poll() else None
+        except (EOFError, OSError):
+            return _CLOSED
+
+    def _take_started(self, message: object | None) -> bool:
+        if not isinstance(message, _Started):
+            return False
+        self._started, self._startup_error = True, message.error
+        self.startup_seconds = time.perf_counter() - self.started_at
+        return True
+
+    def _receive(self, process: multiprocessing.process.BaseProcess, connection: Connection) -> Answer | None:
+        """Consume one event: the child's message, or its death. An Answer when it ends the
+        request under way; None for anything else (the ready message, nothing yet)."""
+        pending = self._pending
+        assert pending is not None
+        message = self._read(connection)
+        if self._take_started(message):
+            return None
+        seconds = time.perf_counter() - self._sent_at
+        if isinstance(message, _Reply) and message.id == pending.id:
+            self._pending = None
+            status: Status = "answered" if message.result is not None else "raised"
+            return Answer(self.name, pending.id, status, message.result, seconds, message.seconds,
+                          message.error, message.detail)
+        if message is not _CLOSED and process.is_alive():
+            return None
+        self._reap(process)
+        self._pending = None
+        exitcode = process.exitcode
+        return Answer(self.name, pending.id, "crashed", None, seconds, error=f"the planner's process "
+                      f"{_exit_description(exitcode)}", exitcode=exitcode)
+
+
+    def _reap(self, process: multiprocessing.process.BaseProcess) -> None:
+        """Join a process whose pipe closed, so that it is no zombie and its exit code is known;
+        one that closed its pipe and lives on is of no use and is killed."""
+        process.join(self.kill_grace)
+        if process.is_alive():
+            process.kill()
+            process.join()
+
+
+def _left(deadline: float | None) -> float | None:
+    return None if deadline is None else max(0.0, deadline - time.perf_counter())
+
+
+def first_answer(processes: Iterable[PlannerProcess], timeout: float | None) -> tuple[PlannerProcess, Answer] | None:
+    """The first answer among the planners with a request under way (concurrent planning), or
+    None if none comes within `timeout` seconds (None: wait as long as it takes). Answers already
+    there are taken in the order `processes` gives, so a tie goes to the preferred planner."""
+    waiting = [p for p in processes if p.busy]
+    if not waiting:
+        raise ValueError("no planner has a request under way")
+    deadline = None if timeout is None else time.perf_counter() + timeout
+    while True:
+        for process in waiting:
+            answer = process.poll(0.0)
+            if answer is not None:
+                return process, answer
+        left = _left(deadline)
+        if left is not None and left <= 0.0:
+            return None
+        wait([handle for p in waiting for handle in p.handles()], left)

@@ -1,0 +1,226 @@
+"""FTplan's recovery algorithms read against the seed's figures (004 Fig 3.1 successive, Fig 3.2
+concurrent), with scripted planners in FTplan's process (`LocalPool`) whose answers are real plans
+of mission M1 (Modele1) or scripted faults; the executor carries the plans out in mission time."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+from specc.runtime.ftplan import FtPlan, LocalPool, MissionResult, Outcome, Report, ScriptedExecutor
+from specc.runtime.ftplan.component import MISSION_FAILED, MISSION_FAILED_IN_TIME
+from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
+from specc.runtime.ftplan.execution import Execution, nominal
+from specc.runtime.planner import Planner, PlanResult
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import Action, Plan
+from tests.atrv import atrv_models, mutation_1_592
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "generated"))
+from atrv.ftplan import rover  # noqa: E402  (the generated package of examples/atrv)
+
+WATCHDOG = rover.CONFIG.watchdog
+LATE = 10**6  # partial plans: charged far beyond any watchdog by the cost model
+
+
+@cache
+def mission() -> tuple[pm.PlanningDomain, pm.Problem]:
+    return atrv_models("M1_model1")
+
+
+def config(names: tuple[str, ...], policy: str = "successive") -> FtPlanConfig:
+    return replace(rover.CONFIG, planners=tuple(PlannerConfig(n, "model1") for n in names), policy=policy)
+
+
+@dataclass
+class Scripted:
+    """A planner answering its requests from a script: `plan` (specc's planner on Modele1),
+    `invalid` (Modele1 with mutation 1-592: a plan the analyzer rejects), `late` (a plan charged
+    beyond the watchdog), `none` (no plan), `raise`; an extra `nodes` sets the charge."""
+
+    script: list[str]
+    nodes: int = 0
+
+    def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+        what = self.script.pop(0)
+        domain, _ = mission()
+        if what == "raise":
+            raise RuntimeError("scripted fault")
+        if what == "none":
+            return PlanResult(None, reason="scripted: no plan")
+        result = Planner(mutation_1_592(domain) if what == "invalid" else domain).plan(problem, now)
+        assert result.plan is not None
+        return replace(result, nodes=LATE if what == "late" else self.nodes)
+
+
+@dataclass
+class FailingExecutor(ScriptedExecutor):
+    """Fails the first action of the executions numbered in `failing` (1, 2, ...)."""
+
+    failing: frozenset[int] = frozenset()
+    count: int = 0
+
+    def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
+        self.count += 1
+        self.world = broken if self.count in self.failing else nominal
+        return super().execute(plan, now, report)
+
+
+def broken(action: Action, now: float) -> Outcome:
+    return Outcome(ended=False, why=f"scripted failure of {action.text()}")
+
+
+def run(names: tuple[str, ...], scripts: dict[str, list[str]], policy: str = "successive",
+        executor: ScriptedExecutor | None = None,
+        nodes: dict[str, int] | None = None) -> tuple[MissionResult, LocalPool]:
+    _, problem = mission()
+    pool = LocalPool({n: Scripted(list(scripts[n]), (nodes or {}).get(n, 0)) for n in names})
+    result = FtPlan(config(names, policy), problem, pool, executor or ScriptedExecutor()).run()
+    return result, pool
+
+
+def lines(result: MissionResult) -> list[int]:
+    return [line for line, _ in result.trace]
+
+
+def chosen(result: MissionResult) -> list[str]:
+    return [text.removeprefix("choose ") for line, text in result.trace if line == 6]
+
+
+# ---------------------------------------------------------------- Fig 3.1
+
+
+def test_successive_planning_follows_fig_3_1_and_resets_the_failed_set_on_a_valid_plan() -> None:
+    # p1 late -> failed {p1}; p2 plans, its plan is valid (failed emptied, line 14) and fails in
+    # execution; p3 late -> failed {p3}; a new round (line 4): p1 is chosen again because the
+    # reset forgot its failure; p1 late, p2 late -> failed = every planner: the mission exception.
+    result, _ = run(("p1", "p2", "p3"), {"p1": ["late", "late"], "p2": ["plan", "late"], "p3": ["late"]},
+                    executor=FailingExecutor(failing=frozenset({1})))
+    assert chosen(result) == ["p1", "p2", "p3", "p1", "p2"]
+    assert lines(result) == [
+        2, 3, 4,
+        5, 6, 7, 8, 9, 10, 20, 21,  # p1: the watchdog
+        5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15,  # p2: analysed, failed <- {}, executed (and failed)
+        5, 6, 7, 8, 9, 10, 20, 21,  # p3: the watchdog
+        3, 4,  # candidates exhausted, goals remain: all planners again
+        5, 6, 7, 8, 9, 10, 20, 21,  # p1
+        5, 6, 7, 8, 9, 10, 20, 21, 23, 24,  # p2: failed = {p1, p2, p3}
+    ]
+    failed_sets = [text for line, text in result.trace if line in (14, 21)]
+    assert failed_sets == ["failed <- p1", "failed <- {}", "failed <- p3", "failed <- p1, p3", "failed <- p1, p2, p3"]
+    assert result.failure == MISSION_FAILED_IN_TIME and not result.success
+    assert [e.kind for e in result.events].count("action-failed") == 1
+    assert any(e.kind == "safe-state" for e in result.events)
+
+
+def test_successive_planning_switches_planner_after_an_invalid_plan_and_completes() -> None:
+    messages: list[str] = []
+    _, problem = mission()
+    pool = LocalPool({"p1": Scripted(["invalid"]), "p2": Scripted(["plan"])})
+    result = FtPlan(config(("p1", "p2")), problem, pool, ScriptedExecutor(), operator=messages.append).run()
+    assert lines(result)[:25] == [2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 16, 17, 18,
+                                  5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15]
+    assert result.success and not result.missed and result.failure == ""
+    assert len(messages) == 1 and messages[0].startswith("invalid plan from p1") and "PTU_POSITION" in messages[0]
+
+
+def test_successive_planning_with_every_plan_invalid_raises_the_mission_exception() -> None:
+    result, _ = run(("p1", "p2"), {"p1": ["invalid"], "p2": ["invalid"]})
+    assert lines(result)[-3:] == [18, 23, 24]
+    assert result.failure == MISSION_FAILED_IN_TIME
+    assert result.met == [g for g in result.met if g.startswith("AT_ROBOT")]  # it never left home
+    assert len(result.missed) == 5
+
+
+def test_a_crashed_or_planless_planner_counts_as_a_late_one() -> None:
+    result, pool = run(("p1", "p2", "p3"), {"p1": ["raise"], "p2": ["none"], "p3": ["plan"]})
+    assert chosen(result) == ["p1", "p2", "p3"]
+    assert lines(result).count(20) == 2 and result.success
+    assert pool.abandoned == ["p1", "p2"]  # killed and restarted
+    watchdog = [e.text for e in result.events if e.kind == "watchdog"]
+    assert "scripted fault" in watchdog[0] and "no plan" in watchdog[1]
+
+
+def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner() -> None:
+    # p1's plan meets every goal but COMMUNICATION(W2) (a planner that silently drops it); the
+    # goal check at the plan's end finds it open and line 5 gives it to p2.
+    _, problem = mission()
+    w2 = next(g for g in problem.assertions if g.goal is not None and getattr(g, "args", ()) == (pm.Sym("W2"),))
+
+    @dataclass
+    class DropsW2:
+        def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+            kept = replace(problem, assertions=tuple(a for a in problem.assertions if a is not w2))
+            return Planner(mission()[0]).plan(kept, now)
+
+    requests: list[pm.Problem] = []
+
+    @dataclass
+    class Recording:
+        def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+            requests.append(problem)
+            return Planner(mission()[0]).plan(problem, now)
+
+    result = FtPlan(config(("p1", "p2")), problem, LocalPool({"p1": DropsW2(), "p2": Recording()}),
+                    ScriptedExecutor()).run()
+    assert result.success, result.missed
+    assert chosen(result) == ["p1", "p2"]
+    assert any(e.kind == "goals-open" and "COMMUNICATION(W2)" in e.text for e in result.events)
+    goals = {a.line for a in requests[0].assertions if a.goal is not None}
+    assert w2.line in goals and len(goals) == 3  # W2, and the return home (X and Y) still to hold
+
+
+# ---------------------------------------------------------------- Fig 3.2
+
+
+def test_concurrent_planning_follows_fig_3_2_first_valid_plan_wins() -> None:
+    # In model timing the charge orders the answers: p1 (10 partial plans) comes first with an
+    # invalid plan, p2 (20) second with a valid one: p3 (30) is abandoned, p2's plan executed.
+    result, pool = run(("p1", "p2", "p3"), {"p1": ["invalid"], "p2": ["plan"], "p3": ["plan"]},
+                       policy="concurrent", nodes={"p1": 10, "p2": 20, "p3": 30})
+    assert lines(result)[:21] == [2, 3, 4, 5,
+                                  6, 8, 9, 10, 16, 17, 18,  # p1's plan rejected, the watchdog resumed
+                                  6, 8, 9, 10, 11, 12, 13, 14, 15,  # p2's accepted, the others abandoned
+                                  ]
+    assert [text for line, text in result.trace if line == 8] == ["answer from p1", "answer from p2"]
+    assert pool.abandoned == ["p3"]
+    assert result.success and result.plannings == 3
+
+
+def test_concurrent_planning_with_every_plan_invalid_raises_the_mission_exception() -> None:
+    result, _ = run(("p1", "p2"), {"p1": ["invalid"], "p2": ["invalid"]}, policy="concurrent")
+    assert lines(result)[-4:] == [17, 18, 19, 20]
+    assert result.failure == MISSION_FAILED
+
+
+def test_concurrent_planning_past_the_watchdog_raises_the_mission_exception_in_time() -> None:
+    result, _ = run(("p1", "p2"), {"p1": ["late"], "p2": ["late"]}, policy="concurrent")
+    assert lines(result)[-3:] == [6, 23, 24]
+    assert result.failure == MISSION_FAILED_IN_TIME
+    assert result.now == pytest.approx(WATCHDOG)
+
+
+def test_model_timing_makes_a_mission_reproducible() -> None:
+    first, _ = run(("p1", "p2"), {"p1": ["invalid"], "p2": ["plan"]})
+    second, _ = run(("p1", "p2"), {"p1": ["invalid"], "p2": ["plan"]})
+    assert first.events == second.events and first.now == second.now
+
+
+def test_mutation_1_592_goes_unseen_without_the_analyzer_and_is_refused_with_it() -> None:
+    # Robot1 of the seed with mutation 1-592 (§4.2.2.3): no mechanism FTplan had could see it,
+    # the photos are "taken" with the camera looking ahead. With the analyzer, the plan is
+    # refused before execution and the mission exception says no valid plan exists.
+    _, problem = mission()
+    unseen = FtPlan(config(("p1",)), problem, LocalPool({"p1": Scripted(["invalid"])}), ScriptedExecutor(),
+                    analyzer=False).run()
+    assert unseen.success and any(e.kind == "execute" for e in unseen.events)
+    refused = FtPlan(config(("p1",)), problem, LocalPool({"p1": Scripted(["invalid"])}), ScriptedExecutor()).run()
+    assert not any(e.kind == "execute" for e in refused.events)
+    assert refused.failure == MISSION_FAILED_IN_TIME
+    assert any(e.kind == "invalid-plan" and "PTU_POSITION" in e.text for e in refused.events)
