@@ -9,17 +9,14 @@ from __future__ import annotations
 import statistics
 import time
 from collections.abc import Callable
-from functools import cache
 from pathlib import Path
 
 import pytest
 
-from specc.analysis.planning import domain_model, problem_model
-from specc.model import nodes as m
-from specc.pipeline import load
 from specc.runtime.planner import Planner
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.validate import validate
+from tests.atrv import atrv_models
 
 pytestmark = pytest.mark.bench
 
@@ -27,15 +24,6 @@ ATRV = Path(__file__).resolve().parents[2] / "examples" / "atrv"
 RUNS = 5
 ARIES_RUNS = 3  # Aries takes tens of seconds where it plans at all (see docs/planning.md)
 ARIES_TIMEOUT = 60.0
-
-
-@cache
-def models(name: str) -> tuple[pm.PlanningDomain, pm.Problem]:
-    loaded = load([ATRV])
-    assert loaded.program is not None
-    problem = next(p for p in loaded.program.items if isinstance(p, m.Problem) and p.name == name)
-    domain = next(d for d in loaded.program.items if isinstance(d, m.Domain) and d.name == problem.domain.text)
-    return domain_model(loaded.program, domain), problem_model(loaded.program, problem)
 
 
 def median_seconds(run: Callable[[], object], runs: int = RUNS) -> float:
@@ -78,7 +66,7 @@ def test_planning_time_per_mission_against_aries() -> None:
     for model in ("model1", "model2"):
         for k in (1, 2, 3, 4):
             name = f"M{k}_{model}"
-            domain, problem = models(name)
+            domain, problem = atrv_models(name)
             result = Planner(domain).plan(problem)  # warm-up: CasADi's import, the caches
             assert result.plan is not None
             assert validate(domain, problem, result.plan, dropped_lines={g.line for g in result.dropped}) == []
@@ -89,7 +77,7 @@ def test_planning_time_per_mission_against_aries() -> None:
                 lines.append(f"{name:22} {ours:10.3f} {'-':>10} {'-':>8}  {kept}  (Aries: {status})")
             else:
                 lines.append(f"{name:22} {ours:10.3f} {theirs:10.3f} {theirs / ours:7.1f}x  {kept}")
-    domain, problem = models("M4_model1")
+    domain, problem = atrv_models("M4_model1")
     short = pm.with_horizon(problem, 300.0)
     result = Planner(domain).plan(short)
     assert result.plan is not None and result.dropped

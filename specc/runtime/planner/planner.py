@@ -29,6 +29,7 @@ from specc.runtime.planner.search import (
     Limits,
     Node,
     Term,
+    Threat,
     as_term,
     differences,
     is_temporal,
@@ -347,7 +348,7 @@ class Setup:
             instance = node.instances[instance_id]
             if spec.contingent:
                 anchors[instance.end] = (instance.start, spec.low, spec.high)
-        network = STN(max(16, len(node.stn.names)))
+        network = STN()
         for name in node.stn.names:
             if name not in anchors:
                 network.point(name)
@@ -499,8 +500,9 @@ class Resolver:
             node.link(node.assertions[self.producer], node.assertions[self.need])
         elif self.kind == "insert":
             assert self.task is not None
-            instance = node.insert(self.task)
-            mine = [a for a in node.assertions if a.owner == instance.id and a.kind == "event"]
+            own_from = len(node.assertions)  # the instance's assertions follow, together
+            node.insert(self.task)
+            mine = [a for a in node.assertions[own_from:] if a.kind == "event"]
             event = self.task.assertions[self.index]
             assert isinstance(event, pm.Event)
             producer = next(a for a in mine if a.line == event.line and a.attribute == event.attribute)
@@ -518,25 +520,33 @@ def select(node: Node) -> list[Resolver] | None:
     when the plan has no flaw left: it is a solution."""
     while True:
         best: list[Resolver] | None = None
-        chosen: tuple[int, int, Assertion] | None = None
+        chosen: Threat | None = None
+        fewest = INF
         forced = False
-        for link, event in list(node.threats()):
-            resolvers = threat_resolvers(node, link.producer, link.consumer, event, complete=False)
-            if not resolvers:
-                producer = node.assertions[link.producer]
-                consumer = node.assertions[link.consumer]
-                raise DeadEnd(f"{event.text(node.bindings)} of {event.owner} may come while {consumer.owner} "
-                              f"needs the {consumer.attribute} value {producer.owner} gives it")
-            if len(resolvers) == 1:
-                # Constraints only tighten: a threat with one resolver left keeps just that one.
-                resolvers[0].apply(node)
-                forced = True
-            elif best is None or len(resolvers) < len(best):
-                best, chosen = resolvers, (link.producer, link.consumer, event)
+        # Each threat is read as it comes, so a forced resolver applied here counts for the next.
+        for threat in node.threats():
+            if threat.before and threat.after:
+                count = 2  # not forced; the apart resolvers it may have are only listed if it is chosen
+            else:
+                resolvers = threat_resolvers(node, threat)
+                if not resolvers:
+                    producer = node.assertions[threat.link.producer]
+                    consumer = node.assertions[threat.link.consumer]
+                    event = threat.event
+                    raise DeadEnd(f"{event.text(node.bindings)} of {event.owner} may come while {consumer.owner} "
+                                  f"needs the {consumer.attribute} value {producer.owner} gives it")
+                if len(resolvers) == 1:
+                    # Constraints only tighten: a threat with one resolver left keeps just that one.
+                    resolvers[0].apply(node)
+                    forced = True
+                    continue
+                count = len(resolvers)
+            if count < fewest:
+                fewest, chosen = count, threat
         if forced:
             continue
         if chosen is not None:
-            best = threat_resolvers(node, *chosen)
+            best = threat_resolvers(node, chosen)
         for a, b in node.resource_conflicts():
             resolvers = [r for r in (Resolver("order", first=a.end, second=b.start),
                                      Resolver("order", first=b.end, second=a.start))
@@ -565,22 +575,18 @@ def select(node: Node) -> list[Resolver] | None:
         return resolvers
 
 
-def threat_resolvers(node: Node, producer_id: int, consumer_id: int, event: Assertion,
-                     complete: bool = True) -> list[Resolver]:
-    """The ways to keep `event` off the link; without `complete`, the two orders when both are
-    possible (enough to know the threat is not forced, and cheaper)."""
-    producer, consumer = node.assertions[producer_id], node.assertions[consumer_id]
+def threat_resolvers(node: Node, threat: Threat) -> list[Resolver]:
+    """The ways to keep the threat's event off the link: the orders still possible, as
+    Node.threats read them (an order that already holds leaves no threat), then keeping arguments
+    apart."""
+    producer, consumer = node.assertions[threat.link.producer], node.assertions[threat.link.consumer]
+    event = threat.event
     gap = EPS if consumer.kind == "event" else 0.0
     options = []
-    before = Resolver("order", first=event.start, second=producer.start, gap=EPS)
-    after = Resolver("order", first=consumer.end, second=event.start, gap=gap)
-    for r in (before, after):
-        if node.surely_before(r.first, r.second, r.gap):
-            return [r]  # already so (nature promises it): nothing to choose
-        if node.allows(r.first, r.second, r.gap):
-            options.append(r)
-    if len(options) == 2 and not complete:
-        return options
+    if threat.before:
+        options.append(Resolver("order", first=event.start, second=producer.start, gap=EPS))
+    if threat.after:
+        options.append(Resolver("order", first=consumer.end, second=event.start, gap=gap))
     # The order leaving the most room first.
     options.sort(key=lambda r: -(node.bounds(r.first, r.second)[1] - r.gap))
     for x, y in zip(event.args, consumer.args, strict=False):
@@ -599,44 +605,48 @@ def pick_need(node: Node) -> tuple[Assertion, list[Resolver]] | None:
         return None
     mine = [node.assertions[i] for i in node.open if node.assertions[i].owner != "problem"]
     if mine:
-        newest = max(int(a.owner.split("#")[1]) for a in mine)
-        best: tuple[Assertion, list[Resolver]] | None = None
-        for need in sorted((a for a in mine if int(a.owner.split("#")[1]) == newest), key=lambda a: a.id):
-            resolvers = need_resolvers(node, need)
-            if best is None or len(resolvers) < len(best[1]):
-                best = (need, resolvers)
-            if len(resolvers) <= 1:
+        # Tasks come in the order they are numbered, each with its assertions: the newest task's
+        # assertions are the last ones.
+        newest = max(mine, key=lambda a: a.id).owner
+        # Counted first, ranked only for the need chosen.
+        best: tuple[Assertion, list[Assertion], list[tuple[pm.Task, int]]] | None = None
+        for need in sorted((a for a in mine if a.owner == newest), key=lambda a: a.id):
+            existing, insertions = node.producers(need), node.insertions(need)
+            count = len(existing) + len(insertions)
+            if best is None or count < len(best[1]) + len(best[2]):
+                best = (need, existing, insertions)
+            if count <= 1:
                 break
-        return best
+        assert best is not None
+        return best[0], need_resolvers(node, *best)
 
     def order(a: Assertion) -> tuple[float, float, float, int]:
         if a.goal is None:
             return (0.0, 0.0, 0.0, a.id)
         return (1.0, node.bounds("origin", a.start)[0], a.goal.priority, a.id)
     need = min((node.assertions[i] for i in node.open), key=order)
-    return need, need_resolvers(node, need)
+    return need, need_resolvers(node, need, node.producers(need), node.insertions(need))
 
 
-def need_resolvers(node: Node, need: Assertion) -> list[Resolver]:
+def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
+                   insertions: list[tuple[pm.Task, int]]) -> list[Resolver]:
+    """The need's resolvers, ranked, from its producers and the tasks that could give it."""
+    inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions]
+    if not existing:
+        return inserts
     siblings = {node.assertions[k.producer].owner for k in node.links
                 if node.assertions[k.consumer].owner == need.owner and need.owner != "problem"} - {"problem"}
-    existing = node.producers(need)
-    gap = EPS if need.kind == "event" else 0.0
+    changers = node.changers(need)
 
-    def clobbered(producer: Assertion) -> int:
-        """Events that could change the value between the producer and the need: a link to a
-        value set long ago (the pan-tilt unit STRAIGHT at the start) has many, and a new task
-        giving it afresh is the better bet."""
-        return sum(1 for e in node.assertions
-                   if e.kind == "event" and e.attribute == need.attribute and e.id not in (producer.id, need.id)
-                   and all(node.bindings.possibly_equal(x, y) for x, y in zip(e.args, need.args, strict=False))
-                   and not node.surely_before(e.start, producer.start, EPS)
-                   and not node.surely_before(need.end, e.start, gap))
+    def clobbered(producer: Assertion) -> bool:
+        """May an event change the value between the producer and the need? A link to a value
+        set long ago (the pan-tilt unit STRAIGHT at the start) often may, and a new task giving
+        it afresh is the better bet."""
+        return any(e.id != producer.id and not node.surely_before(e.start, producer.start, EPS) for e in changers)
 
-    ranked = sorted((clobbered(e) > 0, e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id, e.id)
+    ranked = sorted((clobbered(e), e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id, e.id)
                     for e in existing)
     links = [(r[0], Resolver("link", need=need.id, producer=r[-1])) for r in ranked]
-    inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in node.insertions(need)]
     # Safe links first, then new tasks, then links something may undo.
     return [r for risky, r in links if not risky] + inserts + [r for risky, r in links if risky]
 

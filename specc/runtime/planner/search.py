@@ -20,6 +20,7 @@ import itertools
 import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.numeric import DurationSpec, Empty, domain_of, duration_of, is_duration, is_number
@@ -78,7 +79,11 @@ class Bindings:
         self.parent: dict[str, str] = {}
         self.domain: dict[str, frozenset[str] | tuple[float, float] | None] = {}
         self.apart: list[tuple[Term, Term]] = []
-        self.resolved: dict[str, Term] = {}  # memo of resolve(), emptied when a domain changes
+        # Memos, forgotten when a class or a domain changes: resolve()'s answers, and the `apart`
+        # pairs resolved, as what each representative must differ from (built when first asked,
+        # then only replaced, so that copies may share it).
+        self.resolved: dict[str, Term] = {}
+        self._apart_from: dict[str, list[Term]] | None = None
 
     def copy(self) -> Bindings:
         other = Bindings.__new__(Bindings)
@@ -86,18 +91,24 @@ class Bindings:
         other.domain = dict(self.domain)
         other.apart = list(self.apart)
         other.resolved = dict(self.resolved)
+        other._apart_from = self._apart_from
         return other
 
+    def _forget(self) -> None:
+        self.resolved.clear()
+        self._apart_from = None
+
     def declare(self, var: str, domain: frozenset[str] | tuple[float, float] | None) -> None:
+        if var in self.parent:
+            self._forget()  # a new variable changes no other's class: only a redeclared one counts
         self.parent[var] = var
         self.domain[var] = domain
-        self.resolved.clear()
 
     def restrict(self, var: str, domain: frozenset[str] | tuple[float, float] | None) -> None:
         """Narrow the domain of the variable's class (raises DeadEnd when nothing is left)."""
         r = self.root(var)
         self.domain[r] = self._meet(self.domain[r], domain)
-        self.resolved.clear()
+        self._forget()
 
     def root(self, var: str) -> str:
         while self.parent[var] != var:
@@ -107,9 +118,8 @@ class Bindings:
 
     def resolve(self, term: Term) -> Term:
         """The term's value when known, else its class's representative."""
-        if not is_var(term):
+        if not isinstance(term, str) or "?" not in term:  # is_var, inlined: the search's hottest test
             return term
-        assert isinstance(term, str)
         known = self.resolved.get(term)
         if known is not None:
             return known
@@ -129,15 +139,17 @@ class Bindings:
 
     def possibly_equal(self, a: Term, b: Term) -> bool:
         a, b = self.resolve(a), self.resolve(b)
-        if not is_var(a) and not is_var(b):
+        a_var, b_var = isinstance(a, str) and "?" in a, isinstance(b, str) and "?" in b  # is_var, inlined
+        if not a_var and not b_var:
             return same_value(a, b)
-        if is_var(a) and is_var(b) and a == b:
+        if a_var and b_var and a == b:
             return True
-        if any(self._same_pair(a, b, x, y) for x, y in self.apart):
+        var, other = (a, b) if a_var else (b, a)
+        assert isinstance(var, str)
+        if any(same_value(other, x) for x in self._kept_apart(var)):
             return False
-        for var, other in ((a, b), (b, a)):
-            if is_var(var) and not is_var(other):
-                return self._admits(self.domain[str(var)], other)
+        if not (a_var and b_var):
+            return self._admits(self.domain[var], other)
         da, db = self.domain[str(a)], self.domain[str(b)]
         if isinstance(da, frozenset) and isinstance(db, frozenset):
             return bool(da & db)
@@ -145,9 +157,18 @@ class Bindings:
             return max(da[0], db[0]) <= min(da[1], db[1]) + TOLERANCE
         return da is None or db is None
 
-    def _same_pair(self, a: Term, b: Term, x: Term, y: Term) -> bool:
-        x, y = self.resolve(x), self.resolve(y)
-        return (same_value(a, x) and same_value(b, y)) or (same_value(a, y) and same_value(b, x))
+    def _kept_apart(self, representative: str) -> list[Term]:
+        """What the class must differ from (values, or other classes' representatives)."""
+        if self._apart_from is None:
+            apart_from: dict[str, list[Term]] = {}
+            for x, y in self.apart:
+                rx, ry = self.resolve(x), self.resolve(y)
+                if is_var(rx):
+                    apart_from.setdefault(str(rx), []).append(ry)
+                if is_var(ry):
+                    apart_from.setdefault(str(ry), []).append(rx)
+            self._apart_from = apart_from
+        return self._apart_from.get(representative, [])
 
     @staticmethod
     def _admits(domain: frozenset[str] | tuple[float, float] | None, value: Term) -> bool:
@@ -160,7 +181,7 @@ class Bindings:
     def unify(self, a: Term, b: Term) -> list[str]:
         """Make a and b codesignate; returns the variables that gained a value (raises DeadEnd)."""
         ra, rb = self.resolve(a), self.resolve(b)
-        self.resolved.clear()
+        self._forget()
         if not is_var(ra) and not is_var(rb):
             if not same_value(ra, rb):
                 raise DeadEnd(f"{ra} is not {rb}")
@@ -184,7 +205,8 @@ class Bindings:
             rx, ry = self.resolve(x), self.resolve(y)
             if (not is_var(rx) and not is_var(ry) and same_value(rx, ry)) or (is_var(rx) and rx == ry):
                 raise DeadEnd(f"{x} and {y} must differ")
-        return [v for v in self.parent if self.root(v) == ra]
+        # Most variables are their own class's root: only the others need the walk up.
+        return [v for v, up in self.parent.items() if v == ra or (up != v and self.root(v) == ra)]
 
     @staticmethod
     def _meet(da: frozenset[str] | tuple[float, float] | None,
@@ -208,7 +230,7 @@ class Bindings:
         if not self.possibly_equal(a, b):
             return
         ra, rb = self.resolve(a), self.resolve(b)
-        self.resolved.clear()
+        self._forget()
         if not is_var(ra) and not is_var(rb):
             raise DeadEnd(f"{ra} and {rb} must differ")
         if (is_var(ra) and ra == rb):
@@ -284,6 +306,15 @@ class Link:
     consumer: int
 
 
+class Threat(NamedTuple):
+    """An event that may change a linked value while the link needs it."""
+
+    link: Link
+    event: Assertion
+    before: bool  # may the event still come before the producer
+    after: bool  # may it still come after the consumer
+
+
 @dataclass
 class Limits:
     """How large a partial plan may grow."""
@@ -320,7 +351,7 @@ class Node:
 
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
-        self.stn = STN(64)
+        self.stn = STN()
         self.anchor: dict[str, tuple[str, float, float]] = {}  # contingent point -> (point, low, high)
         self.original: list[tuple[str, str, float, float]] = []  # every requirement, as written
         self.bindings = Bindings()
@@ -334,6 +365,13 @@ class Node:
         # a new event the links; a pair shown harmless stays so in every descendant (constraints
         # only tighten and bindings only narrow down a branch), so it is dropped for good.
         self.pending: set[tuple[int, int]] = set()  # (link index, event id) not yet shown harmless
+        # Indexes by attribute, so that finding producers and threats reads only the attribute's
+        # own events and links, not the whole plan.
+        self.events: dict[str, tuple[int, ...]] = {}  # attribute -> ids of the events on it, oldest first
+        self.links_on: dict[str, tuple[int, ...]] = {}  # attribute -> indexes of the links giving it
+        # Where each timepoint sits in the network: the index of the point it hangs from and its
+        # offset range (0, 0 when the plan schedules it); only a point made contingent moves.
+        self.places: dict[str, tuple[int, float, float]] = {}
         self.counter = 0
 
     def copy(self) -> Node:
@@ -350,6 +388,9 @@ class Node:
         other.durations = dict(self.durations)
         other.provisional = dict(self.provisional)
         other.pending = set(self.pending)
+        other.events = dict(self.events)
+        other.links_on = dict(self.links_on)
+        other.places = dict(self.places)
         other.counter = self.counter
         return other
 
@@ -374,31 +415,65 @@ class Node:
             raise DeadEnd(str(error)) from None
 
     def allows(self, a: str, b: str, low: float = -INF, high: float = INF) -> bool:
-        pa, pb, new_low, new_high = self._translate(a, b, low, high)
-        if pa == pb:
-            return new_low <= TOLERANCE and new_high >= -TOLERANCE
-        return self.stn.allows(pa, pb, new_low - TOLERANCE, new_high + TOLERANCE)
+        """Could `require(a, b, low, high)` succeed? (STN.allows on the points a and b hang from,
+        read here directly: the search asks it of every candidate producer.)"""
+        i, la, ha = self._place(a)
+        j, lb, hb = self._place(b)
+        back, ahead = self._span(i, j)
+        new_low, new_high = for_every_offset(low, high, (la, ha), (lb, hb))
+        low, high = new_low - TOLERANCE, new_high + TOLERANCE  # as require() loosens them
+        return low <= high and high + back >= 0 and -low + ahead >= 0
+
+    def _place(self, point: str) -> tuple[int, float, float]:
+        place = self.places.get(point)
+        if place is None:
+            base, low, high = self.anchor.get(point, (point, 0.0, 0.0))
+            place = self.places[point] = (self.stn.index[base], low, high)
+        return place
+
+    def _span(self, i: int, j: int) -> tuple[float, float]:
+        """(back, ahead): the network puts t(j) - t(i) in [-back, ahead]; a point is at 0 from
+        itself (whatever rounding leaves on the network's diagonal)."""
+        if i == j:
+            return 0.0, 0.0
+        d = self.stn.distances
+        return d.item(j, i), d.item(i, j)
 
     def bounds(self, a: str, b: str) -> tuple[float, float]:
         """What t(b) - t(a) may be, nature's choices included."""
         if a == b:
             return 0.0, 0.0
-        pa, la, ha = self.anchor.get(a, (a, 0.0, 0.0))
-        pb, lb, hb = self.anchor.get(b, (b, 0.0, 0.0))
-        if pa == pb:
-            return lb - ha, hb - la
-        index, d = self.stn.index, self.stn._distance
-        i, j = index[pa], index[pb]
-        return lb - ha - d.item(j, i), hb - la + d.item(i, j)
+        i, la, ha = self._place(a)
+        j, lb, hb = self._place(b)
+        back, ahead = self._span(i, j)
+        return lb - ha - back, hb - la + ahead
 
     def surely_before(self, a: str, b: str, gap: float) -> bool:
         """Does b come at least `gap` after a, whatever nature does?"""
         return (a, b) in self.ctx.nature_before or self.bounds(a, b)[0] >= gap - SURELY
 
+    def ordering(self, a: str, b: str, gap: float) -> tuple[bool, bool]:
+        """(surely_before(a, b, gap), allows(a, b, gap)) from one reading of the network: the
+        search asks both of every possible threat, at every node."""
+        # _place() and _span(), inlined: the threats' scan calls this most of all.
+        places = self.places
+        i, la, ha = places.get(a) or self._place(a)
+        j, lb, hb = places.get(b) or self._place(b)
+        if i == j:
+            back = ahead = 0.0
+        else:
+            d = self.stn.distances
+            back, ahead = d.item(j, i), d.item(i, j)
+        # The same arithmetic as bounds() and allows().
+        low = 0.0 if a == b else lb - ha - back
+        surely = (a, b) in self.ctx.nature_before or low >= gap - SURELY
+        return surely, -(gap - (lb - ha) - TOLERANCE) + ahead >= 0
+
     def make_contingent(self, point: str, start: str, low: float, high: float) -> None:
         """Nature now places `point` within [low, high] after `start`: every requirement already
         written on it is rewritten for its worst case."""
         self.anchor[point] = (start, low, high)
+        self.places.pop(point, None)
         for a, b, lo, hi in self.original:
             if point in (a, b):
                 self.require(a, b, lo, hi, record=False)
@@ -407,10 +482,11 @@ class Node:
     def add_assertion(self, **fields: object) -> Assertion:
         assertion = Assertion(id=len(self.assertions), **fields)  # type: ignore[arg-type]
         self.assertions.append(assertion)
-        # An event that sets the value it finds (a fact restated at a replanning) changes nothing.
-        if assertion.kind == "event" and assertion.before != assertion.value:
-            for k, link in enumerate(self.links):
-                if self.assertions[link.consumer].attribute == assertion.attribute:
+        if assertion.kind == "event":
+            self.events[assertion.attribute] = self.events.get(assertion.attribute, ()) + (assertion.id,)
+            # An event that sets the value it finds (a fact restated at a replanning) changes nothing.
+            if assertion.before != assertion.value:
+                for k in self.links_on.get(assertion.attribute, ()):
                     self.pending.add((k, assertion.id))
         return assertion
 
@@ -427,10 +503,10 @@ class Node:
         self.require(producer.start, consumer.start, EPS if consumer.kind == "event" else 0.0)
         self.links.append(Link(producer.id, consumer.id))
         k = len(self.links) - 1
-        for e in self.assertions:
-            if (e.kind == "event" and e.attribute == consumer.attribute and e.id not in (producer.id, consumer.id)
-                    and e.before != e.value):
-                self.pending.add((k, e.id))
+        self.links_on[consumer.attribute] = self.links_on.get(consumer.attribute, ()) + (k,)
+        self.pending.update((k, event_id) for event_id in self.events.get(consumer.attribute, ())
+                            if event_id not in (producer.id, consumer.id)
+                            and self.assertions[event_id].before != self.assertions[event_id].value)
         self.open.discard(consumer.id)
         self.bound(changed)
 
@@ -446,8 +522,8 @@ class Node:
             return
         task = instance.task
         known = {}
-        for local in task.params + task.variables:
-            value = self.bindings.value(instance.var(local))
+        for local, var in zip(task.params + task.variables, instance.variables, strict=True):
+            value = self.bindings.value(var)
             if value is not None:
                 known[local] = value
         try:
@@ -497,17 +573,17 @@ class Node:
         def term(e: pm.Expr) -> Term:
             return as_term(e, instance.var)
 
-        # Domains of the task's variables, and what keeps them apart.
-        for c in task.constraints:
-            if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var) and not c.contingent:
-                var = instance.var(c.expr.name)
-                self.bindings.restrict(var, domain_of(c.domain))
-            elif isinstance(c, pm.Relation) and c.op == "!=" and not is_temporal(c.left) and not is_temporal(c.right):
-                self.bindings.keep_apart(term(c.left), term(c.right))
-            elif isinstance(c, (pm.Member, pm.Relation)) and is_temporal(c) and not is_duration(c, task):
-                for first, second, low, high in differences(c, point, self.ctx.origin):
-                    self.require(first, second, low, high)
+        # Domains of the task's variables, what keeps them apart, and its temporal constraints.
+        constraints = task_constraints(task)
+        for local, domain in constraints.domains:
+            self.bindings.restrict(instance.var(local), domain)
+        for left, right in constraints.apart:
+            self.bindings.keep_apart(term(left), term(right))
+        for c in constraints.temporal:
+            for first, second, low, high in differences(c, point, self.ctx.origin):
+                self.require(first, second, low, high)
         start_events: dict[tuple[str, str], Assertion] = {}
+        own_from = len(self.assertions)  # the instance's assertions follow, together
         for a in task.assertions:
             if isinstance(a, pm.Event):
                 new = self.add_assertion(kind="event", attribute=a.attribute, args=tuple(term(x) for x in a.args),
@@ -530,37 +606,50 @@ class Node:
                 own = start_events.get(key)
                 if own is None:
                     start_events[key] = new
-            self._own_support(new, instance)
+            self._own_support(self.assertions[own_from:], instance)
         self.ground(instance.id)
         return instance
 
-    def _own_support(self, new: Assertion, instance: Instance) -> None:
-        """Link the task's assertions the task itself explains (its start event sets the value a
-        hold over the task, or its end event, needs): IxTeT writes tasks this way."""
-        mine = [a for a in self.assertions if a.owner == instance.id]
-        for producer in mine:
-            for consumer in mine:
-                if (consumer.id in self.open and producer.kind == "event" and producer is not consumer
-                        and producer.attribute == consumer.attribute and producer.args == consumer.args
-                        and producer.value == (consumer.before if consumer.kind == "event" else consumer.value)
-                        and producer.start == instance.start and consumer.start in (instance.start, instance.end)
-                        and not (consumer.kind == "event" and consumer.start == producer.start)):
-                    self.link(producer, consumer)
+    def _own_support(self, mine: list[Assertion], instance: Instance) -> None:
+        """Link the task's assertions (`mine`, so far, the newest last) the task itself explains
+        (its start event sets the value a hold over the task, or its end event, needs): IxTeT
+        writes tasks this way. Only pairs with the newest are tried: the others were when the
+        later of them came, and nothing they depend on has changed since (a need only leaves the
+        open set)."""
+        new = mine[-1]
+        pairs = [(producer, new) for producer in mine[:-1]] + [(new, consumer) for consumer in mine]
+        for producer, consumer in pairs:
+            if (consumer.id in self.open and producer.kind == "event" and producer is not consumer
+                    and producer.attribute == consumer.attribute and producer.args == consumer.args
+                    and producer.value == (consumer.before if consumer.kind == "event" else consumer.value)
+                    and producer.start == instance.start and consumer.start in (instance.start, instance.end)
+                    and not (consumer.kind == "event" and consumer.start == producer.start)):
+                self.link(producer, consumer)
 
     # ------------------------------------------------------------ flaws
-    def producers(self, need: Assertion) -> list[Assertion]:
+    def _alike(self, need: Assertion) -> list[Assertion]:
+        """The other events on the need's attribute whose arguments may be the need's."""
+        possibly_equal = self.bindings.possibly_equal
         found = []
+        for event_id in self.events.get(need.attribute, ()):
+            e = self.assertions[event_id]
+            if event_id != need.id and (not e.args or all(
+                    possibly_equal(x, y) for x, y in zip(e.args, need.args, strict=False))):
+                found.append(e)
+        return found
+
+    def producers(self, need: Assertion) -> list[Assertion]:
+        """The events that may give the need its value, oldest first."""
         wanted = need.before if need.kind == "event" else need.value
         assert wanted is not None
         gap = EPS if need.kind == "event" else 0.0
-        for e in self.assertions:
-            if (e.kind != "event" or e.attribute != need.attribute or e.id == need.id
-                    or not self.bindings.possibly_equal(e.value, wanted)
-                    or not all(self.bindings.possibly_equal(x, y) for x, y in zip(e.args, need.args, strict=False))
-                    or not self.allows(e.start, need.start, gap)):
-                continue
-            found.append(e)
-        return found
+        return [e for e in self._alike(need)
+                if self.bindings.possibly_equal(e.value, wanted) and self.allows(e.start, need.start, gap)]
+
+    def changers(self, need: Assertion) -> list[Assertion]:
+        """The events that may change the value the need reads before it ends, oldest first."""
+        gap = EPS if need.kind == "event" else 0.0
+        return [e for e in self._alike(need) if not self.surely_before(need.end, e.start, gap)]
 
     def insertions(self, need: Assertion) -> list[tuple[pm.Task, int]]:
         wanted = need.before if need.kind == "event" else need.value
@@ -575,18 +664,22 @@ class Node:
             options.append((task, index))
         return options
 
-    def threats(self) -> Iterator[tuple[Link, Assertion]]:
-        for k, event_id in sorted(self.pending):
-            link = self.links[k]
-            producer, consumer, e = self.assertions[link.producer], self.assertions[link.consumer], \
-                self.assertions[event_id]
-            gap = EPS if consumer.kind == "event" else 0.0
-            if (not all(self.bindings.possibly_equal(x, y) for x, y in zip(e.args, consumer.args, strict=False))
-                    or self.surely_before(e.start, producer.start, EPS)
-                    or self.surely_before(consumer.end, e.start, gap)):
-                self.pending.discard((k, event_id))
-                continue
-            yield link, e
+    def threats(self) -> Iterator[Threat]:
+        """The possible threats, each read from the network as it is when it comes (a resolver
+        applied meanwhile counts), with the orders that could still keep it off."""
+        possibly_equal = self.bindings.possibly_equal
+        for pair in sorted(self.pending):
+            link = self.links[pair[0]]
+            consumer, e = self.assertions[link.consumer], self.assertions[pair[1]]
+            if not e.args or all(possibly_equal(x, y) for x, y in zip(e.args, consumer.args, strict=False)):
+                already_before, may_be_before = self.ordering(e.start, self.assertions[link.producer].start, EPS)
+                if not already_before:
+                    gap = EPS if consumer.kind == "event" else 0.0
+                    already_after, may_be_after = self.ordering(consumer.end, e.start, gap)
+                    if not already_after:
+                        yield Threat(link, e, may_be_before, may_be_after)
+                        continue
+            self.pending.discard(pair)  # harmless now, so for good
 
     def resource_conflicts(self) -> Iterator[tuple[Assertion, Assertion]]:
         uses = [a for a in self.assertions if a.kind == "use"]
@@ -600,6 +693,35 @@ class Node:
             if self.bounds(a.end, b.start)[0] >= -SURELY or self.bounds(b.end, a.start)[0] >= -SURELY:
                 continue
             yield a, b
+
+
+@dataclass(frozen=True)
+class TaskConstraints:
+    """A task's constraints, sorted out once for all its instances."""
+
+    domains: tuple[tuple[str, frozenset[str] | tuple[float, float] | None], ...]  # (variable, domain)
+    apart: tuple[tuple[pm.Expr, pm.Expr], ...]  # terms that must differ
+    temporal: tuple[pm.Member | pm.Relation, ...]  # between its timepoints, its duration aside
+
+
+def task_constraints(task: pm.Task) -> TaskConstraints:
+    """Cached by the task's identity, as numeric.duration_of is: every insertion of the task
+    asks, and hashing a task (a deep frozen record) would cost more than sorting them out."""
+    found = _TASK_CONSTRAINTS.get(id(task))
+    if found is None:
+        domains, apart, temporal = [], [], []
+        for c in task.constraints:
+            if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var) and not c.contingent:
+                domains.append((c.expr.name, domain_of(c.domain)))
+            elif isinstance(c, pm.Relation) and c.op == "!=" and not is_temporal(c.left) and not is_temporal(c.right):
+                apart.append((c.left, c.right))
+            elif isinstance(c, (pm.Member, pm.Relation)) and is_temporal(c) and not is_duration(c, task):
+                temporal.append(c)
+        found = _TASK_CONSTRAINTS[id(task)] = (task, TaskConstraints(tuple(domains), tuple(apart), tuple(temporal)))
+    return found[1]
+
+
+_TASK_CONSTRAINTS: dict[int, tuple[pm.Task, TaskConstraints]] = {}  # the task is kept so that its id stays its own
 
 
 def _number(value: Term) -> float:
