@@ -437,7 +437,7 @@ def plan(paths: PathsArg,
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None
     print_result(outcome, out)
-    if picture is not None and outcome.result.plan is not None:
+    if picture is not None and outcome.useful:
         from specc.pictures import draw_timeline
 
         try:
@@ -446,7 +446,7 @@ def plan(paths: PathsArg,
             err.print(f"error: cannot draw '{picture}': {exc}", markup=False)
             raise typer.Exit(1) from None
         out.print(f"wrote {written}", markup=False)
-    if outcome.result.plan is None or outcome.violations:
+    if not outcome.useful or outcome.violations:
         raise typer.Exit(1)
 
 
@@ -460,7 +460,7 @@ def export_problem(paths: PathsArg,
                    ) -> None:
     """Export a planning domain and problem through unified-planning to PDDL 2.1, saying what could not
     be expressed."""
-    from specc.analysis.planning import domain_model, problem_model
+    from specc.analysis.planning import domain_block, domain_model, problem_model
     from specc.analysis.planning_export import constant_set_names, export, write_pddl
     from specc.plan_report import choose_problem
 
@@ -473,7 +473,7 @@ def export_problem(paths: PathsArg,
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None
-    block = next(d for d in loaded.program.items if isinstance(d, m.Domain) and d.name == chosen.domain.text)
+    block = domain_block(loaded.program, chosen)
     exported = export(domain_model(loaded.program, block), problem_model(loaded.program, chosen),
                       constant_set_names(loaded.program, block))
     try:

@@ -341,12 +341,14 @@ def draw_timeline(plan: Any, problem: Any, target: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from specc.runtime.planner.plan import format_value
+
     tasks = sorted({a.task for a in plan.actions}, key=lambda t: min(a.dispatch for a in plan.actions if a.task == t))
     row = {task: i for i, task in enumerate(tasks)}
     colour = {task: GROUP_COLOURS[i % len(GROUP_COLOURS)] for i, task in enumerate(tasks)}
     figure, axes = plt.subplots(figsize=(12, 1.2 + 0.55 * max(1, len(tasks))))
-    span = max([plan.makespan, plan.schedule.get(problem.end, 0.0)]) - min([plan.now] + [a.dispatch for a in
-                                                                                         plan.actions]) + 1.0
+    first = min([plan.now] + [a.dispatch for a in plan.actions])
+    span = max(plan.makespan, plan.schedule.get(problem.end, 0.0)) - first + 1.0
     seconds_per_char = span / 230  # about 230 characters of 7-point text across the axes
     for action in plan.actions:
         y = row[action.task]
@@ -356,11 +358,11 @@ def draw_timeline(plan: Any, problem: Any, target: Path) -> Path:
         if high > low:
             axes.barh(y, high - low, left=action.dispatch + low, height=0.6, color=colour[action.task], alpha=0.3,
                       edgecolor=colour[action.task], hatch="//", linewidth=0.5)
-        label = ", ".join(str(a) if not isinstance(a, float) else f"{a:g}" for a in action.args)
+        label = ", ".join(format_value(a) for a in action.args)
         if len(label) * seconds_per_char < high:  # only labels that fit their bar
             axes.text(action.dispatch + 0.5, y, label, va="center", ha="left", fontsize=7, clip_on=True)
     # Contingent instants of the problem (window openings and closings): where nature may put them.
-    openings = sorted((name, span) for name, span in plan.uncontrolled.items() if "." not in name)
+    openings = sorted((name, dates) for name, dates in plan.uncontrolled.items() if "." not in name)
     for name, (early, late) in openings:
         axes.axvspan(early, late, color="tab:gray", alpha=0.25, linewidth=0)
         axes.text((early + late) / 2, len(tasks) - 0.35, name, rotation=90, fontsize=6, ha="center", va="bottom")
@@ -371,7 +373,7 @@ def draw_timeline(plan: Any, problem: Any, target: Path) -> Path:
     axes.set_yticks(range(len(tasks)), tasks)
     axes.invert_yaxis()
     axes.set_xlabel("mission time (s): solid = shortest duration, hatched = what nature may add")
-    axes.set_xlim(left=min([plan.now] + [a.dispatch for a in plan.actions]) - 2)
+    axes.set_xlim(left=first - 2)
     axes.set_title(f"plan for {plan.problem} ({plan.domain}): {len(plan.actions)} actions, "
                    f"strongly controllable, done by {plan.makespan:.0f} s at worst", fontsize=10)
     axes.grid(axis="x", alpha=0.3)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from rich.console import Console
 from rich.table import Table
 
-from specc.analysis.planning import domain_model, problem_model
+from specc.analysis.planning import domain_block, domain_model, problem_model
 from specc.model import nodes as m
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
@@ -24,13 +24,19 @@ class Outcome:
     result: PlanResult
     violations: list[str]
 
+    @property
+    def useful(self) -> bool:
+        """Is there a plan, meeting some goal when the problem has any? (A plan dropping every goal
+        does nothing: the problem is unsolvable as it stands.)"""
+        goals = self.result.goals
+        return self.result.plan is not None and (not goals or any(g.kept for g in goals))
+
 
 def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Problem:
     problems = [p for p in program.items if isinstance(p, m.Problem)]
     if domain is not None:
-        problems = [p for p in problems if p.domain.text == domain or p.domain.text.startswith(domain)]
-    exact = [p for p in problems if p.name == name]
-    found = exact or [p for p in problems if p.name.startswith(name + "_") or p.name.startswith(name)]
+        problems = [p for p in problems if p.domain.text.startswith(domain)]  # model2 takes model2_M1
+    found = [p for p in problems if p.name == name] or [p for p in problems if p.name.startswith(name)]
     if len(found) == 1:
         return found[0]
     if not found:
@@ -44,8 +50,7 @@ def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Probl
 def solve(program: m.Program, name: str, domain_name: str | None, horizon: float | None, now: float,
           facts: list[str], goals: list[int] | None, nodes: int, exact: bool) -> Outcome:
     chosen = choose_problem(program, name, domain_name)
-    domain = next(d for d in program.items if isinstance(d, m.Domain) and d.name == chosen.domain.text)
-    model = domain_model(program, domain)
+    model = domain_model(program, domain_block(program, chosen))
     problem = problem_model(program, chosen)
     if horizon is not None:
         if horizon <= 0:
@@ -69,15 +74,17 @@ def print_result(outcome: Outcome, out: Console) -> None:
     result, problem = outcome.result, outcome.problem
     out.print(f"problem {problem.name} for domain {outcome.domain.name}: "
               f"{result.nodes} partial plans, {result.seconds:.2f} s", markup=False)
-    goals = Table(title="goals", title_justify="left", show_edge=False)
-    for column in ("", "goal", "why dropped"):
-        goals.add_column(column, overflow="fold")
-    for g in result.goals:
-        goals.add_row("kept" if g.kept else "DROPPED", g.description, g.reason)
-    out.print(goals)
-    if result.plan is None:
-        out.print(f"no plan: {result.reason}", markup=False)
+    if result.goals:  # none when the problem could not be read
+        goals = Table(title="goals", title_justify="left", show_edge=False)
+        for column in ("", "goal", "why dropped"):
+            goals.add_column(column, overflow="fold")
+        for g in result.goals:
+            goals.add_row("kept" if g.kept else "DROPPED", g.description, g.reason)
+        out.print(goals)
+    if not outcome.useful:
+        out.print(f"no plan: {result.reason or 'every goal is dropped, for the reasons above'}", markup=False)
         return
+    assert result.plan is not None
     plan = result.plan
     table = Table(title=f"plan ({len(plan.actions)} actions, {plan.controllability}ly controllable: the dates hold "
                         "whatever durations nature picks)", title_justify="left", show_edge=False)
@@ -87,7 +94,7 @@ def print_result(outcome: Outcome, out: Console) -> None:
         low, high = a.duration
         kind = "contingent" if a.contingent else "controllable"
         table.add_row(f"{a.dispatch:.2f}", a.text(), f"{low:.2f}-{high:.2f} {kind}",
-                      f"{plan.uncontrolled.get(a.end, (0.0, a.dispatch + high))[1]:.2f}",
+                      f"{plan.ends_by(a):.2f}",
                       f"{a.window[0]:.2f}-{a.window[1]:.2f}", "preemptible" if a.preemptible else "")
     out.print(table)
     points = ", ".join(f"{name}={date:.2f}" for name, date in sorted(plan.schedule.items(), key=lambda kv: kv[1])

@@ -358,6 +358,19 @@ def test_plan_bad_input_is_one_clear_error(args: tuple[str, ...], message: str) 
     assert message in result.stderr and "Traceback" not in result.stderr
 
 
+@pytest.mark.parametrize(("args", "message"), [
+    (("--now", "10", "--fact", "PTU_POSITION() = SIDEWAYS"),  # a value unknown to the model, at run time
+     "no plan: fact PTU_POSITION() = SIDEWAYS: 'SIDEWAYS' is not a value of PTU_POSITION"),
+    (("--now", "900"),  # the mission must end by 800 s: contradictory constraints
+     "no plan: no plan satisfies the problem's required assertions and constraints"),
+    (("--horizon", "1"), "no plan: every goal is dropped, for the reasons above"),  # unsolvable
+])
+def test_plan_without_a_plan_says_why_and_fails(args: tuple[str, ...], message: str) -> None:
+    result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M1_model1", "--no-exact", *args)
+    assert result.returncode == 1
+    assert message in result.stdout and "Traceback" not in result.stderr
+
+
 def test_export_writes_pddl_and_says_what_it_could_not_express(tmp_path: Path) -> None:
     result = specc("export", str(EXAMPLES / "atrv"), "--problem", "M1_model2", "-o", str(tmp_path))
     assert result.returncode == 0, result.stderr

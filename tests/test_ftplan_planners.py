@@ -15,8 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from specc.runtime.ftplan.config import PlannerConfig
+from specc.runtime.ftplan import CostModel, FtPlan, LocalPool, ScriptedExecutor
+from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.planners import (
+    Answer,
     PlannerProcess,
     PlannerStartError,
     Watchdog,
@@ -57,6 +59,13 @@ def no_planner_left() -> Iterator[None]:
     yield
     left = [p for p in multiprocessing.active_children() if p.name.startswith("ftplan-planner-")]
     assert not left, f"planner processes left behind: {left}"
+
+
+def charged(answer: Answer, problem: pm.Problem, timing: str = "model", cost: CostModel | None = None) -> float:
+    """The mission time FTplan charges for the planning that gave `answer`."""
+    config = FtPlanConfig("ftplan", (PlannerConfig("ixtet1", "model1"),))
+    ftplan = FtPlan(config, problem, LocalPool({}), ScriptedExecutor(), timing=timing, cost=cost or CostModel())
+    return ftplan.charge(answer)
 
 
 def gone(pid: int) -> bool:
@@ -148,8 +157,8 @@ def test_standard_planner_in_its_process_plans_as_in_process(
         assert answer.result.goals == expected.goals and answer.nodes == expected.nodes > 0
         # Time accounting: the wall time FTplan saw covers the planning the child timed.
         assert answer.seconds >= answer.planner_seconds > 0
-        assert answer.charged_seconds() == answer.seconds
-        assert answer.charged_seconds(seconds_per_node=0.01) == pytest.approx(0.01 * expected.nodes)
+        assert charged(answer, problem, timing="wall") == answer.seconds
+        assert charged(answer, problem, cost=CostModel(base=0.0, per_node=0.01)) == pytest.approx(0.01 * expected.nodes)
         assert planner.poll(0.0) is None  # nothing under way any more
     assert not planner.running and planner.pid is None
 

@@ -634,15 +634,22 @@ def test_the_full_algorithm_matches_the_literal_one(nx: int, ny: int, data: st.D
         assert best is None
 
 
-def room_model() -> tuple[np.ndarray, float]:
-    """VISUAL's grid of the room (64 x 64 cells of 0.3 m; obstacles' bounding boxes not free),
-    less the cells outside the room (PLAN's Env box)."""
+def visual_free_cells() -> np.ndarray:
+    """VISUAL's free cells (64 x 64 cells of 0.3 m; obstacles' bounding boxes not free), those
+    outside the room included."""
     cell, n = visual.CELL, visual.NX
     free = np.ones((n, n), dtype=bool)
     for obstacle in OBSTACLES:
         xs, ys = [p[0] for p in obstacle], [p[1] for p in obstacle]
         free[int(min(ys) / cell):int(max(ys) / cell) + 1, int(min(xs) / cell):int(max(xs) / cell) + 1] = False
-    model = SimpleNamespace(nx=n, ny=n, cellSize=cell, free=free.ravel().tolist(), certainty=[0.0] * (n * n))
+    return free
+
+
+def room_model() -> tuple[np.ndarray, float]:
+    """VISUAL's grid of the room less the cells outside the room (PLAN's Env box)."""
+    cell, n = visual.CELL, visual.NX
+    model = SimpleNamespace(nx=n, ny=n, cellSize=cell, free=visual_free_cells().ravel().tolist(),
+                            certainty=[0.0] * (n * n))
     box = SimpleNamespace(xmin=ROOM_BOX[0], ymin=ROOM_BOX[1], xmax=ROOM_BOX[2], ymax=ROOM_BOX[3])
     return explor.model_grid(model, box)[0], cell
 
@@ -689,13 +696,8 @@ def explor_sdi(certainty: np.ndarray | None = None, robot: Point = (1.0, 1.0)): 
     free, cell = room_model()
     n = visual.NX
     # VISUAL's own model: the cells outside the room are free for VISUAL, EXPLOR masks them
-    model = vis.Model(nx=n, ny=n, cellSize=cell, free=np.ones(n * n, dtype=bool).tolist(),
+    model = vis.Model(nx=n, ny=n, cellSize=cell, free=visual_free_cells().ravel().tolist(),
                       certainty=(np.zeros(n * n) if certainty is None else certainty.ravel()).tolist())
-    for obstacle in OBSTACLES:
-        xs, ys = [p[0] for p in obstacle], [p[1] for p in obstacle]
-        for j in range(int(min(ys) / cell), int(max(ys) / cell) + 1):
-            for i in range(int(min(xs) / cell), int(max(xs) / cell) + 1):
-                model.free[j * n + i] = False
     posters = {"visual.Model": SimpleNamespace(model=model, pan=0.0),
                "plan.Env": generated("plan").Box(*ROOM_BOX),
                "loco.Robot": SimpleNamespace(robot=SimpleNamespace(x=robot[0], y=robot[1], theta=0.0))}

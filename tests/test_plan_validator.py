@@ -5,19 +5,14 @@ is rejected with a message naming the faulty action or goal."""
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import pytest
 
-from specc.analysis.planning import domain_model, problem_model
-from specc.model import nodes as m
-from specc.pipeline import load
 from specc.runtime.planner.model import Interval, Member, Num, Op, PlanningDomain, Problem, Resource, Task, Time, Use
 from specc.runtime.planner.plan import Action, Plan, Value
 from specc.runtime.planner.validate import check_task, validate
-
-ATRV = Path(__file__).resolve().parent.parent / "examples" / "atrv"
+from tests.atrv import atrv_models
 
 # Claimed duration ranges: MOVE is (|dx| + |dy|) * [0.7, 1] / [0.17, 0.35] m/s in Modele1; Modele2's
 # MOVE_NOMINAL is the table distance (O1->O2 6 m, O2->O3 5.16 m, O3->O1 6.24 m) / [0.17, 0.35] m/s.
@@ -76,24 +71,13 @@ def build_plan(domain: str, problem: str, actions: list[Action], goal_dates: dic
 
 
 @pytest.fixture(scope="module")
-def program() -> m.Program:
-    return load([ATRV]).program
-
-
-def lowered(program: m.Program, domain_name: str, problem_name: str) -> tuple[PlanningDomain, Problem]:
-    domain = next(i for i in program.items if isinstance(i, m.Domain) and i.name == domain_name)
-    problem = next(i for i in program.items if isinstance(i, m.Problem) and i.name == problem_name)
-    return domain_model(program, domain), problem_model(program, problem)
+def model1() -> tuple[PlanningDomain, Problem]:
+    return atrv_models("M1_model1")  # domain model1
 
 
 @pytest.fixture(scope="module")
-def model1(program: m.Program) -> tuple[PlanningDomain, Problem]:
-    return lowered(program, "model1", "M1_model1")
-
-
-@pytest.fixture(scope="module")
-def model2(program: m.Program) -> tuple[PlanningDomain, Problem]:
-    return lowered(program, "model2_M1", "M1_model2")
+def model2() -> tuple[PlanningDomain, Problem]:
+    return atrv_models("M1_model2")  # domain model2_M1
 
 
 @pytest.fixture(scope="module")

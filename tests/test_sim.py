@@ -46,6 +46,11 @@ def test_room_world_loads():
     ({**EMPTY, "start": {"x": "near"}}, "'x' must be a finite number"),
     ({**EMPTY, "windows": [{"start": 10.0, "end": 5.0}]}, "windows[0]"),
     ({**EMPTY, "rooms": {}}, "unknown section [rooms]"),
+    ({**EMPTY, "start": {"x": 1.0, "thetaa": 1.0}}, "[start]: unknown key 'thetaa'"),
+    ({**EMPTY, "obstacles": [{"circle": [3.0, 3.0, 0.5], "colour": "red"}]}, "obstacles[0]: unknown key 'colour'"),
+    ({**EMPTY, "objects": {"at": [{"x": 1.0, "y": 2.0, "z": 0.0}]}}, "objects.at[0]: unknown key 'z'"),
+    ({**EMPTY, "obstacles": [{"circle": [3.0, 3.0, float("inf")]}]}, "obstacles[0]: circle must be"),
+    ({**EMPTY, "obstacles": [{"polygon": [[2, 2], [3, float("nan")], [3, 3]]}]}, "obstacles[0]: polygon must"),
 ])
 def test_bad_worlds_say_where_and_what(data, fragment):
     with pytest.raises(WorldError) as error:
@@ -60,6 +65,12 @@ def test_missing_and_malformed_world_files(tmp_path):
     broken.write_text("[room\nwidth = 3")
     with pytest.raises(WorldError, match="not valid TOML"):
         load_world(broken)
+
+
+def test_more_random_objects_than_the_room_holds_are_refused_at_once():
+    with pytest.raises(WorldError, match="no room for 100000 objects"):
+        Simulation(parse_world({"room": {"width": 3.0, "height": 3.0}, "start": {"x": 1.0, "y": 1.0},
+                                "objects": {"count": 100000}}, "full.toml"), HILARE, seed=0)
 
 
 def test_clockwise_polygons_are_turned_round():
@@ -80,6 +91,17 @@ def test_rays_against_a_wall_and_a_circle():
     assert not caster.visible(0.0, 0.0, 6.0, 0.0) and caster.visible(0.0, 0.0, 0.0, 6.0)
 
 
+def test_rays_along_an_edge_line_away_from_the_edge_are_no_echo():
+    """Sonar rings on the lines of the table's edges (its corners are (3, 2) and (4.6, 2.8)):
+    the rays running along an edge's line away from the table reach the walls. They once met the
+    edge behind them at t = -0, a false echo at distance 0."""
+    caster = RayCaster.for_world(load_world(ROOM))
+    ring = np.linspace(0.0, math.tau, 32, endpoint=False)  # ring[16] looks west, ring[24] south
+    assert caster.cast(2.0, 2.0, ring, 5.0)[16] == pytest.approx(2.0)
+    assert caster.cast(2.0, 2.8, ring, 5.0)[16] == pytest.approx(2.0)
+    assert caster.cast(4.6, 1.0, ring, 5.0)[24] == pytest.approx(1.0)
+
+
 @settings(max_examples=60, deadline=None)
 @given(x=st.floats(0.5, 11.5), y=st.floats(0.5, 8.5), heading=st.floats(-math.pi, math.pi))
 def test_vectorised_rays_agree_with_pymunk_queries(x, y, heading):
@@ -89,12 +111,22 @@ def test_vectorised_rays_agree_with_pymunk_queries(x, y, heading):
     space.add(*[pymunk.Segment(space.static_body, (a, b), (c, d), 0.0) for a, b, c, d in room.segments()])
     angles = heading + np.linspace(0.0, math.tau, 32, endpoint=False)
     ours = RayCaster.for_world(room).cast(x, y, angles, 5.0)
+    corners = {(a, b) for a, b, _, _ in room.segments()}
     for angle, distance in zip(angles, ours, strict=True):
         end = (x + 5.0 * math.cos(angle), y + 5.0 * math.sin(angle))
         hit = space.segment_query_first((x, y), end, 0.0, pymunk.ShapeFilter())
         expected = 5.0 if hit is None else hit.alpha * 5.0
-        if not any(o.contains(x, y) for o in room.obstacles):
+        if not any(o.contains(x, y) for o in room.obstacles) and not grazes_a_corner(x, y, angle, corners):
             assert distance == pytest.approx(expected, abs=1e-6)
+
+
+def grazes_a_corner(x: float, y: float, angle: float, corners: set[tuple[float, float]]) -> bool:
+    """Does the ray pass exactly through a corner (along an edge, or grazing)? There a touch is an
+    echo or not by convention (ours: it is; pymunk's segment query: not always), so the two
+    casters are not compared on it."""
+    dx, dy = math.cos(angle), math.sin(angle)
+    return any((cx - x) * dx + (cy - y) * dy > 0.0 and abs((cx - x) * dy - (cy - y) * dx) < 1e-9
+               for cx, cy in corners)
 
 
 # ---------------------------------------------------------------- the rover
@@ -265,9 +297,9 @@ def test_hilare_reaches_goals_among_obstacles_through_its_modules(hilare):
         import run_sim
     finally:
         sys.path.remove(str(ROOT / "examples" / "hilare"))
-    sim, log = run_sim.run(ROOM, [(9.0, 7.0), (2.0, 7.0)], seed=1, budget=200.0)
+    room = load_world(ROOM)
+    sim, log, _ = run_sim.run(ROOM, room, [(9.0, 7.0), (2.0, 7.0)], seed=1, budget=200.0)
     assert sum("execPosterTraj: END OK" in line for line in log) == 2, log
     assert math.hypot(sim.pose[0] - 2.0, sim.pose[1] - 7.0) < 0.3
-    room = load_world(ROOM)
     assert min(room.clearance(x, y) for x, y, _ in sim.trace.poses) > HILARE.radius - 0.01  # no collision
     assert sim.trace.certainty is not None and max(sim.trace.certainty[3]) > 0.5  # images were analysed

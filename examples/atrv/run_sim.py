@@ -213,7 +213,10 @@ def run(argv: list[str] | None = None) -> int:
         raise UsageError(f"--duration {args.duration:g}: must be a positive number of seconds")
     output = args.output or ROOT / "build" / f"atrv-{world.name}.png"
 
-    rover = build(world, args.seed)
+    try:
+        rover = build(world, args.seed)
+    except WorldError as exc:  # what the world asks cannot be built (objects without room)
+        raise UsageError(str(exc)) from None
     sim = rover.sim
     print(f"world {world.name} ({world.description or path}), seed {args.seed}, "
           f"{len(goals)} goal(s), at most {args.duration:g} s")

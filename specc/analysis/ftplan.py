@@ -3,10 +3,18 @@ back end `ftplan` writes into the generated package."""
 
 from __future__ import annotations
 
+import math
+
+from specc.analysis.planning import Lowering, PlanningError, Scope
 from specc.model import nodes as m
 from specc.runtime.ftplan import config as fc
+from specc.runtime.planner import model as pm
 
 DEFAULT_WATCHDOG = 10.0  # seconds, when the block names none
+
+# A rule argument names no constant set, macro or timepoint: lowered as a planning model's
+# expression is (the same folding of constant arithmetic, `-3` and `0 -. 3.0` alike), with no scope.
+_LOWERING = Lowering(m.Program(), ())
 
 
 class NotConstant(ValueError):
@@ -14,29 +22,18 @@ class NotConstant(ValueError):
 
 
 def term(e: m.IxExpr) -> fc.Term:
-    """A rule argument: a ?variable, a symbol, or a number (`-3`, `0 - 3.0` folded)."""
-    if isinstance(e, m.IxVar):
-        return fc.Var(e.name)
-    if isinstance(e, m.IxName):
-        return e.name
-    value = number(e)
-    if value is None:
-        raise NotConstant("a rule argument is a ?variable, a symbol or a number")
-    return value
-
-
-def number(e: m.IxExpr) -> float | None:
-    if isinstance(e, m.Number):
-        return float(e.value)
-    if isinstance(e, m.IxUnary) and e.op == "-":
-        inner = number(e.operand)
-        return None if inner is None else -inner
-    if isinstance(e, m.IxBinary) and e.op in ("+", "-", "*"):
-        left, right = number(e.left), number(e.right)
-        if left is None or right is None:
-            return None
-        return left + right if e.op == "+" else left - right if e.op == "-" else left * right
-    return None
+    """A rule argument: a ?variable, a symbol, or a number."""
+    try:
+        lowered: pm.Expr | None = _LOWERING.expr(e, Scope({}, {}))
+    except PlanningError:  # an unknown function
+        lowered = None
+    if isinstance(lowered, pm.Var):
+        return fc.Var(lowered.name)
+    if isinstance(lowered, pm.Sym):
+        return lowered.name
+    if isinstance(lowered, pm.Num) and math.isfinite(lowered.value):
+        return lowered.value
+    raise NotConstant("a rule argument is a ?variable, a symbol or a number")
 
 
 def terms(exprs: tuple[m.IxExpr, ...]) -> tuple[fc.Term, ...]:

@@ -262,10 +262,16 @@ def domain_model(program: m.Program, domain: m.Domain) -> pm.PlanningDomain:
     return Lowering(program, domain.members).domain_model(domain.name, domain.span.file)
 
 
-def problem_model(program: m.Program, problem: m.Problem) -> pm.Problem:
+def domain_block(program: m.Program, problem: m.Problem) -> m.Domain:
+    """The `domain` block a problem is written for."""
     domain = next((d for d in program.items if isinstance(d, m.Domain) and d.name == problem.domain.text), None)
     if domain is None:
         raise PlanningError(f"unknown domain '{problem.domain.text}'")
+    return domain
+
+
+def problem_model(program: m.Program, problem: m.Problem) -> pm.Problem:
+    domain = domain_block(program, problem)
     # The problem sees the domain's constants and macros, then what its own fragments bring.
     lowering = Lowering(program, list(domain.members) + list(problem.body))
     statements = [s for s in lowering.members if not isinstance(s, (m.Constant, m.Attribute, m.Resource, m.Macro,

@@ -70,7 +70,8 @@ from unified_planning.shortcuts import (
 from specc.analysis.planning import Lowering
 from specc.model import nodes as m
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.numeric import describe, div, evaluate, mul
+from specc.runtime.planner.model import describe
+from specc.runtime.planner.numeric import div, evaluate, mul
 
 VALUE = -1  # the position of an attribute's value, next to its argument positions 0, 1, ...
 ROOT_TYPE = "symbol"

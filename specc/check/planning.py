@@ -14,10 +14,9 @@ from typing import Any
 from specc.check.context import Context
 from specc.model import nodes as m
 from specc.model.visitor import Visitor, walk
-from specc.runtime.planner.model import fold
+from specc.runtime.planner.model import FUNCTIONS, fold
 
 VALUE_VAR = "?value"
-FUNCTIONS = ("abs", "max", "min")  # what the planner's propagators and CasADi know
 PROBLEM_TIMEPOINTS = ("t_start", "t_end")
 
 
@@ -299,7 +298,6 @@ def constant_value(e: m.IxExpr) -> float | None:
             return None
         return fold(e.op.rstrip("."), left, right)
     return None
-
 
 
 def check_members(ctx: Context, tables_: DomainTables) -> None:

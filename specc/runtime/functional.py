@@ -184,24 +184,15 @@ class Poster(Generic[T]):
     def __init__(self, spec: PosterSpec):
         self.spec = spec
         self._snapshot: Snapshot[T] | None = None
-        self._assembled = dataclasses.is_dataclass(spec.type) and not hasattr(spec.type, "__slots__") and \
-            tuple(f.name for f in dataclasses.fields(spec.type)) == spec.fields
 
     def write(self, data: T, date: float) -> None:
         self._snapshot = Snapshot(clone(data), date)
 
     def publish(self, sdi: Any, date: float) -> None:
-        """Write the poster's fields copied from the module's SDI: the record is assembled from
-        the copies directly, as `write(type(**fields))` would copy every field a second time."""
+        """Write the poster's fields copied from the module's SDI (each copied once: the record
+        is built from the copies, not copied again whole as `write` would)."""
         spec = self.spec
-        if not self._assembled:  # a type with more fields than the poster: its constructor fills them
-            self.write(spec.type(**{f: getattr(sdi, f) for f in spec.fields}), date)
-            return
-        record: Any = object.__new__(spec.type)
-        state = record.__dict__
-        for name in spec.fields:
-            state[name] = clone(getattr(sdi, name))
-        self._snapshot = Snapshot(record, date)
+        self._snapshot = Snapshot(spec.type(**{f: clone(getattr(sdi, f)) for f in spec.fields}), date)
 
     def read(self) -> Snapshot[T] | None:
         if self._snapshot is None:
@@ -326,8 +317,11 @@ class TransitionError(RuntimeError):
     """An arc that Fig. 2.3 does not have: a bug in the runtime, never a user error."""
 
 
-_UNKNOWN = object()
-_SINGLE_FIELD: dict[type, Any] = {}  # poster type -> its only field's name, or None
+@functools.cache
+def _single_field(poster_type: type) -> str | None:
+    """The name of a poster type's only field, None when it has several."""
+    names = [f.name for f in dataclasses.fields(poster_type)]
+    return names[0] if len(names) == 1 else None
 
 
 class InternalData:
@@ -346,10 +340,8 @@ class InternalData:
         if snapshot is None:
             return None
         data = snapshot.data
-        single = _SINGLE_FIELD.get(type(data), _UNKNOWN)
-        if single is _UNKNOWN:
-            names = [f.name for f in dataclasses.fields(data)]
-            single = _SINGLE_FIELD[type(data)] = names[0] if len(names) == 1 else None
+        poster_type: type = type(data)
+        single = _single_field(poster_type)
         return getattr(data, single) if single is not None else data
 
     def write_poster(self, name: str) -> None:
@@ -400,7 +392,7 @@ class TaskRunner:
         self.spec = spec
         self.activities: list[Activity] = []
         self.timer: Timer | None = None
-        self.slot: int | None = None  # k of the pending tick, or of the last one when none is pending
+        self.slot = -1  # k of the pending tick, or of the last one when none is pending (-1: none yet)
         self.initialised = False
         self.cycles = 0
 
@@ -429,9 +421,8 @@ class TaskRunner:
             return
         kernel = self.module.kernel
         period, delay = self.spec.period, self.spec.delay
-        k = max(0, math.ceil((kernel.now - delay) / period - 1e-9))
-        if self.slot is not None:
-            k = max(k, self.slot + 1)  # never twice a slot (a tick rescheduling itself is in its own)
+        # Never twice a slot: a tick rescheduling itself is in its own.
+        k = max(math.ceil((kernel.now - delay) / period - 1e-9), self.slot + 1)
         self.slot = k
         # Rounded to the nanosecond: 3 x 0.1 s and 1 x 0.3 s are one instant, so priority orders them.
         self.timer = kernel.call_at(round(delay + k * period, 9), self.tick, self.spec.priority)

@@ -37,7 +37,9 @@ class WallClock(Clock):
             time.sleep(delay)
 
 
-class _Event:
+class Timer:
+    """A scheduled event that can be cancelled before it fires (the queue holds it itself)."""
+
     __slots__ = ("when", "action", "cancelled")
 
     def __init__(self, when: float, action: Callable[[], Any]) -> None:
@@ -45,38 +47,25 @@ class _Event:
         self.action = action
         self.cancelled = False
 
-
-class Timer:
-    """A scheduled event that can be cancelled before it fires."""
-
-    __slots__ = ("_event",)
-
-    def __init__(self, event: _Event):
-        self._event = event
-
     def cancel(self) -> None:
-        self._event.cancelled = True
-
-    @property
-    def when(self) -> float:
-        return self._event.when
+        self.cancelled = True
 
 
 class Kernel:
     def __init__(self, clock: Clock | None = None, start: float = 0.0):
         self.clock = clock or Clock()
         self.now = start
-        # (when, priority, order, event): tuples compare in C, several times faster than a
+        # (when, priority, order, timer): tuples compare in C, several times faster than a
         # dataclass's generated ordering, which weighed on a simulated robot's every step.
-        self._queue: list[tuple[float, int, int, _Event]] = []
+        self._queue: list[tuple[float, int, int, Timer]] = []
         self._order = itertools.count()
 
     def call_at(self, when: float, action: Callable[[], Any], priority: int = 0) -> Timer:
         if when < self.now:
             when = self.now
-        event = _Event(when, action)
-        heapq.heappush(self._queue, (when, priority, next(self._order), event))
-        return Timer(event)
+        timer = Timer(when, action)
+        heapq.heappush(self._queue, (when, priority, next(self._order), timer))
+        return timer
 
     def call_later(self, delay: float, action: Callable[[], Any], priority: int = 0) -> Timer:
         return self.call_at(self.now + max(delay, 0.0), action, priority)
@@ -84,12 +73,12 @@ class Kernel:
     def step(self) -> bool:
         """Run the next event; False when nothing is scheduled."""
         while self._queue:
-            event = heapq.heappop(self._queue)[3]
-            if event.cancelled:
+            timer = heapq.heappop(self._queue)[3]
+            if timer.cancelled:
                 continue
-            self.clock.wait_until(event.when, self.now)
-            self.now = event.when
-            event.action()
+            self.clock.wait_until(timer.when, self.now)
+            self.now = timer.when
+            timer.action()
             return True
         return False
 

@@ -100,12 +100,6 @@ class STN:
         self._tighten(i, j, high)
         self._tighten(j, i, -low)
 
-    def allows(self, first: str | int, second: str | int, low: float = -INF, high: float = INF) -> bool:
-        """Could `low <= t(second) - t(first) <= high` be added without inconsistency?"""
-        i, j = self._id(first), self._id(second)
-        d = self.distances
-        return low <= high and high + d.item(j, i) >= 0 and -low + d.item(i, j) >= 0
-
     def add_contingent(self, start: str | int, end: str | int, low: float, high: float) -> None:
         """Nature puts `end` between `low` and `high` after `start` (0 <= low <= high)."""
         if not 0 <= low <= high < INF:

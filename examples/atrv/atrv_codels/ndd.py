@@ -9,7 +9,7 @@ Every period, `decide` picks a motion direction from that map in the spirit of t
 Diagram navigation of [Minguez & Montano 2004] ("divide and conquer": identify the situation,
 then apply its law):
 
-* for each direction all around, the *free length* is how far a disc of radius ``clearance``
+* for each direction all around, the *free length* is how far a disc of radius ``CLEARANCE``
   (the robot's bounding circle plus a margin) can travel that way before touching an obstacle
   point: the valleys of the nearness diagram are the runs of directions free for LOOKAHEAD
   (less near the goal), and their borders already stand off by the robot's width;
@@ -49,8 +49,10 @@ PERIOD = 0.1  # s, NavTask period
 HALF_LENGTH, HALF_WIDTH = ATRV.length / 2.0, ATRV.width / 2.0  # m, the ATRV's body (1.05 m x 0.65 m)
 RADIUS = math.hypot(HALF_LENGTH, HALF_WIDTH)  # its bounding circle: what turning in place sweeps
 MARGIN = 0.15  # m kept between that circle and obstacles along a chosen direction
+CLEARANCE = RADIUS + MARGIN  # the disc a direction's free length is measured with
 LOOKAHEAD = 1.5  # m of free length a direction needs (less when the goal is nearer)
 DIRECTIONS = np.radians(np.arange(-180.0, 180.0, 1.0))  # the directions examined, from the heading
+STEP = float(DIRECTIONS[1] - DIRECTIONS[0])  # rad between two directions examined
 WIDE = math.radians(45)  # a valley at least this wide is "wide" (HSWR), else narrow (HSNR)
 BORDER_OFFSET = math.radians(6)  # HSWR: aim this far inside the valley from its border
 SIDE_PENALTY = math.radians(60)  # hysteresis: a direction on the other side costs this much more
@@ -125,6 +127,12 @@ class Decision:
 def free_lengths(points, directions, clearance, horizon):
     """For each direction, how far a disc of radius `clearance` can move along it from the
     robot's centre before touching a point (at most `horizon`)."""
+    if len(points):
+        # A point d from the centre stops the disc no sooner than d - clearance whatever the
+        # direction: the map's points beyond horizon + clearance (most of them, it reaches
+        # MAP_RADIUS) cannot shorten a free length, and are left out of the (D, P) products
+        # (the 1e-6 keeps rounding from ever mattering: the result is the same to the bit).
+        points = points[np.hypot(points[:, 0], points[:, 1]) < horizon + clearance + 1e-6]
     if len(points) == 0:
         return np.full(len(directions), float(horizon))
     ux, uy = np.cos(directions), np.sin(directions)
@@ -163,14 +171,16 @@ def _valley(open_, best):
 def decide(points, goal_distance, goal_bearing, params, side=0, tolerance=0.0):
     """One nearness-diagram decision from the obstacle points around the robot (robot frame)."""
     vmax, wmax, security = params["vmax"], params["wmax"], params["security"]
-    clearance = RADIUS + MARGIN
     need = max(min(goal_distance - tolerance, LOOKAHEAD), 0.05)
-    ahead = float(free_lengths(points, np.array([0.0]), clearance, LOOKAHEAD + SLOW_DOWN)[0])
+    # Straight ahead and towards the goal in one call; the goal's free length is not capped at
+    # LOOKAHEAD, which changes no comparison with `need` (at most LOOKAHEAD).
+    ahead, towards_goal = free_lengths(points, np.array([0.0, goal_bearing]), CLEARANCE,
+                                       LOOKAHEAD + SLOW_DOWN).tolist()
 
-    if free_lengths(points, np.array([goal_bearing]), clearance, LOOKAHEAD)[0] >= need:
+    if towards_goal >= need:
         situation, direction, side = "HSGR", goal_bearing, 0
     else:
-        free = free_lengths(points, DIRECTIONS, clearance, LOOKAHEAD)
+        free = free_lengths(points, DIRECTIONS, CLEARANCE, LOOKAHEAD)
         open_ = free >= need
         if not open_.any():
             more_left = free[DIRECTIONS > 0].sum() >= free[DIRECTIONS < 0].sum()
@@ -182,14 +192,13 @@ def decide(points, goal_distance, goal_bearing, params, side=0, tolerance=0.0):
             cost[~open_] = np.inf
             best = int(np.argmin(cost))
             low, high, size = _valley(open_, best)
-            step = float(DIRECTIONS[1] - DIRECTIONS[0])
-            if size * step >= WIDE:
+            if size * STEP >= WIDE:
                 situation = "HSWR"
                 inward = 1.0 if best == low else -1.0 if best == high else 0.0
-                direction = float(DIRECTIONS[best]) + inward * min(BORDER_OFFSET, size * step / 2)
+                direction = float(DIRECTIONS[best]) + inward * min(BORDER_OFFSET, size * STEP / 2)
             else:
                 situation = "HSNR"
-                direction = float(DIRECTIONS[low]) + (size - 1) * step / 2
+                direction = float(DIRECTIONS[low]) + (size - 1) * STEP / 2
             side = 1 if offset[best] > 0 else -1
 
     if situation != "TURN" and len(points):
@@ -330,5 +339,5 @@ def _load_map(sdi):
 def _store_map(sdi, points):
     n = len(points)
     sdi.map.count = n
-    sdi.map.x = [float(v) for v in points[:, 0]] + [0.0] * (MAP_SIZE - n)
-    sdi.map.y = [float(v) for v in points[:, 1]] + [0.0] * (MAP_SIZE - n)
+    sdi.map.x = points[:, 0].tolist() + [0.0] * (MAP_SIZE - n)
+    sdi.map.y = points[:, 1].tolist() + [0.0] * (MAP_SIZE - n)

@@ -72,5 +72,5 @@ def setGrip(sdi, request):
     """gripState: open or close the gripper."""
     sdi.grip = request.grip
     if sdi.hardware is not None and sdi.hardware.arm is not None:
-        sdi.hardware.arm.grip = str(request.grip)
+        sdi.hardware.arm.grip = getattr(request.grip, "name", request.grip)  # "CLOSE", not "GripState.CLOSE"
     return "end"

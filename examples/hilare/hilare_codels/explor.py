@@ -216,6 +216,14 @@ def reachable_cells(valid: np.ndarray, start: tuple[int, int]) -> np.ndarray:
     return reached
 
 
+def cells_in_box(nx: int, ny: int, cell: float, xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
+    """The cells of an nx x ny grid wholly inside the box (a boolean grid)."""
+    edges_x, edges_y = np.arange(nx + 1) * cell, np.arange(ny + 1) * cell
+    in_x = (edges_x[:-1] >= xmin - 1e-6) & (edges_x[1:] <= xmax + 1e-6)
+    in_y = (edges_y[:-1] >= ymin - 1e-6) & (edges_y[1:] <= ymax + 1e-6)
+    return in_y[:, None] & in_x[None, :]
+
+
 def model_grid(model, box=None) -> tuple[np.ndarray, np.ndarray]:
     """VISUAL's model as numpy grids (free, certainty); with the room's box, the cells not
     wholly inside it are not free."""
@@ -223,10 +231,7 @@ def model_grid(model, box=None) -> tuple[np.ndarray, np.ndarray]:
     free = np.array(model.free[:nx * ny], dtype=bool).reshape(ny, nx)
     certainty = np.array(model.certainty[:nx * ny], dtype=float).reshape(ny, nx)
     if box is not None and box.xmin < box.xmax and box.ymin < box.ymax:
-        edges_x, edges_y = np.arange(nx + 1) * cell, np.arange(ny + 1) * cell
-        in_x = (edges_x[:-1] >= box.xmin - 1e-6) & (edges_x[1:] <= box.xmax + 1e-6)
-        in_y = (edges_y[:-1] >= box.ymin - 1e-6) & (edges_y[1:] <= box.ymax + 1e-6)
-        free &= in_y[:, None] & in_x[None, :]
+        free &= cells_in_box(nx, ny, cell, box.xmin, box.ymin, box.xmax, box.ymax)
     return free, certainty
 
 

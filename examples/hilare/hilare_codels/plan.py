@@ -33,7 +33,7 @@ import heapq
 import math
 import pathlib
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from specc.runtime.sim.world import Polygon, WorldError, load_world, signed_area
 
@@ -210,7 +210,7 @@ def build_environment(obstacles: Sequence[Sequence[Point]], room: Bounds,
                    max(p[1] for p in piece)) for piece in pieces)
     env = Environment(polygons, pieces, room, free_bounds(room, clearance), (), (), planes, boxes)
     nodes = tuple(p for piece in pieces for p in piece if is_free(env, p))
-    return Environment(polygons, pieces, room, env.bounds, nodes, visibility_graph(nodes, env), planes, boxes)
+    return replace(env, nodes=nodes, graph=visibility_graph(nodes, env))
 
 
 def _half_planes(piece: Sequence[Point]) -> tuple[tuple[float, float, float], ...]:

@@ -30,7 +30,7 @@ def startScan(sdi, request):
 def readSensors(sdi, request):
     """scan exec: read the enabled sensors (none without hardware: the ranges stay as they are)."""
     hardware = sdi.hardware
-    measured = [float(r) for r in hardware.sonars.read()] if hardware is not None else sdi.ranges
+    measured = hardware.sonars.read().tolist() if hardware is not None else sdi.ranges
     if len(measured) != N_SENSORS:
         return "SENSOR_FAILURE"
     sdi.ranges = [

@@ -80,12 +80,10 @@ def markObstacleCells(sdi, request):
 def _standing_cells(free, bounds):
     """The cells where the robot can stand, as EXPLOR's calcObj requires of an object's cell
     (its centre on the cell's): inside the room, clear of the grown obstacles."""
-    from hilare_codels.explor import candidate_cells  # EXPLOR imports this module: import late
+    from hilare_codels.explor import candidate_cells, cells_in_box  # EXPLOR imports this module: import late
 
     xmin, xmax, ymin, ymax = bounds
-    grid = np.array(free, dtype=bool).reshape(NY, NX)
-    i, j = np.meshgrid(np.arange(NX), np.arange(NY))
-    grid &= (i * CELL >= xmin) & ((i + 1) * CELL <= xmax) & (j * CELL >= ymin) & ((j + 1) * CELL <= ymax)
+    grid = np.array(free, dtype=bool).reshape(NY, NX) & cells_in_box(NX, NY, CELL, xmin, ymin, xmax, ymax)
     return [int(k) for k in np.flatnonzero(candidate_cells(grid, CELL))]
 
 

@@ -1536,7 +1536,8 @@ PROBLEMS = {
 }
 
 
-def plan(problem: str | Problem, **options: Any) -> PlanResult:
-    """Plan for one of PROBLEMS (by name) or for a problem built at run time (a replanning)."""
+def plan(problem: str | Problem, now: float = 0.0, **options: Any) -> PlanResult:
+    """Plan for one of PROBLEMS (by name) or for a problem built at run time (a replanning, with
+    the mission time `now` before which nothing starts)."""
     chosen = PROBLEMS[problem] if isinstance(problem, str) else problem
-    return Planner(DOMAIN, **options).plan(chosen)
+    return Planner(DOMAIN, **options).plan(chosen, now=now)

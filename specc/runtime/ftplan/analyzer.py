@@ -25,24 +25,22 @@ from dataclasses import dataclass
 
 from specc.runtime.ftplan.config import FtPlanConfig, MaxDuration, NoOverlap, Requirement, Term, Var
 from specc.runtime.ftplan.state import (
+    Dates,
     FactKey,
     SystemState,
     consequences,
     constant,
     constant_key,
-    date_bounds,
     match,
-    same,
     substitute,
 )
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
+from specc.runtime.planner.validate import same
 
 # Dates computed by the planner's solver differ in their last digits from the same date reached
 # another way (an end's latest date and the next dispatch): closer than this is the same date.
 EPSILON = 1e-6
-
-Dates = tuple[float, float]  # [earliest, latest]
 
 
 @dataclass(frozen=True)
@@ -108,7 +106,7 @@ class Projection:
             ends = end_dates(plan, action)
             for key, value in consequences(config.state_rules, "ended", action.task, action.args):
                 self.effects.setdefault(key, []).append(Change(value, ends, f"set when {action.id} ends", action.id))
-        self.events = _contingent_events(problem, _timepoint_dates(plan, problem))
+        self.events = _contingent_events(problem, _timepoint_dates(plan, state))
 
     def timeline(self, key: FactKey) -> Timeline:
         events = self.events.get(key)
@@ -143,13 +141,10 @@ def _contingent_events(problem: pm.Problem, dates: Mapping[str, Dates]) -> dict[
     return events
 
 
-def _timepoint_dates(plan: Plan, problem: pm.Problem) -> dict[str, Dates]:
+def _timepoint_dates(plan: Plan, state: SystemState) -> dict[str, Dates]:
     """The dates of the problem's timepoints: the plan's (its schedule, and the dates nature may
     choose for the others), else the bounds the problem's own constraints give."""
-    dates = {name: (date, date) for name, date in plan.schedule.items()} | dict(plan.uncontrolled)
-    if all(point in dates for point in (problem.start, problem.end, *problem.timepoints)):
-        return dates
-    return date_bounds(problem) | dates
+    return state.dates | {name: (date, date) for name, date in plan.schedule.items()} | dict(plan.uncontrolled)
 
 
 # ---------------------------------------------------------------- requirements

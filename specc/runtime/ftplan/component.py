@@ -6,7 +6,7 @@ tolerates design faults in planning knowledge with four detection mechanisms:
 - the planning watchdog (a late, crashed or plan-less planner: killed and restarted);
 - the plan analyzer (constraints written apart from the models, checked before execution);
 - action-failure detection (from the execution reports);
-- on-line goal verification (FTplan's own state, after each action and when a plan ends);
+- on-line goal verification (FTplan's own state, after each report and when a plan ends);
 
 and two recovery policies, written line for line after the seed's algorithms: successive
 planning (Fig 3.1) and concurrent planning (Fig 3.2). Every step taken is recorded in `trace`
@@ -18,11 +18,14 @@ watchdog judges that charge, so that a run depends on its seed only; concurrent 
 lets the plan of the lowest charge count as the first found. With `timing="wall"` the measured
 wall time is charged, the watchdog is a wall-clock one, and the first plan to arrive wins. In
 both modes a planner silent for `wall_limit` wall seconds is killed: that is how a hung one ends.
+`arrivals` is where the watchdog is judged, for both policies.
 
 Two departures from the figures, both where they are silent:
-- a planner that answers "no plan" or crashes is treated as a late one (§3.2.2.2: "si la
-  planification prend trop de temps ou si aucune solution n'a été trouvée, FTplan tue le
-  processus IxTeT en échec, le relance, puis bascule sur un autre modèle");
+- a planner that answers "no plan" or crashes is killed and restarted as a late one (§3.2.2.2:
+  "si la planification prend trop de temps ou si aucune solution n'a été trouvée, FTplan tue le
+  processus IxTeT en échec, le relance, puis bascule sur un autre modèle"); Fig 3.1 counts it as
+  a late one (lines 20-21), Fig 3.2, where the watchdog's expiry ends the mission, as an invalid
+  plan (lines 16-20);
 - the loops of Fig 3.1/3.2 end when goals remain after a round in which every planner gave a
   valid plan, carried out to its end, that met no goal (they all leave those goals aside): the
   remaining goals are reported missed instead of replanning until their deadlines pass. A
@@ -32,8 +35,6 @@ Two departures from the figures, both where they are silent:
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Callable, Collection, Generator
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -41,7 +42,7 @@ from typing import Protocol
 from specc.runtime.ftplan.analyzer import Violation, analyse
 from specc.runtime.ftplan.config import FtPlanConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
-from specc.runtime.ftplan.planners import Answer
+from specc.runtime.ftplan.planners import Answer, Watchdog
 from specc.runtime.ftplan.state import SystemState
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Plan, format_value
@@ -59,7 +60,7 @@ class MissionFailure(Exception):
 
 
 class PlannerPool(Protocol):
-    """The planners, each in its own process (`specc.runtime.ftplan.processes`) or in this one."""
+    """The planners, each in its own process (`pools.ProcessPool`) or in this one (`pools.LocalPool`)."""
 
     names: tuple[str, ...]
 
@@ -73,7 +74,8 @@ class PlannerPool(Protocol):
         ...
 
     def abandon(self, name: str) -> None:
-        """Stop the planner's current planning (kill it and start it again)."""
+        """Kill the planner and start it again: its planning under way, if any, is dropped (Fig 3.2
+        line 13), and a planner judged failed starts afresh (§3.2.2.2)."""
         ...
 
 
@@ -98,7 +100,7 @@ class Event:
 
     time: float
     kind: str  # plan-request, plan, watchdog, invalid-plan, execute, report, action-failed, goal-met,
-    # goal-missed, safe-state, operator, mission-failure, mission-end
+    # goals-open, goal-missed, safe-state, operator, mission-failure, mission-end
     text: str
     planner: str = ""
 
@@ -110,10 +112,14 @@ class MissionResult:
     failure: str  # the mission exception's message, "" when none was raised
     now: float  # mission time at the end
     plannings: int  # planning requests sent
-    replannings: int  # requests after the first
     planner_failures: int  # watchdog expiries, crashes, plan-less answers, invalid plans
     events: list[Event]
     trace: list[tuple[int, str]]  # (line of Fig 3.1 / 3.2, what happened)
+
+    @property
+    def replannings(self) -> int:
+        """Requests after the first."""
+        return max(0, self.plannings - 1)
 
     @property
     def success(self) -> bool:
@@ -172,8 +178,8 @@ class FtPlan:
         return MissionResult(
             met=[by_line[line] for line in sorted(self.state.met)],
             missed={by_line[line]: why for line, why in sorted(self.state.missed.items())},
-            failure=failure, now=self.now, plannings=self.plannings, replannings=max(0, self.plannings - 1),
-            planner_failures=self.planner_failures, events=self.events, trace=self.trace)
+            failure=failure, now=self.now, plannings=self.plannings, planner_failures=self.planner_failures,
+            events=self.events, trace=self.trace)
 
     # ------------------------------------------------------------ Fig 3.1
     def successive(self) -> None:
@@ -197,14 +203,12 @@ class FtPlan:
                 self.request(k)
                 self.step(9, f"request a plan from {k}")
                 self.step(10, "wait for the plan or the watchdog")
-                answer = self.pool.next_answer([k], self.wall_seconds())
-                if answer is None:
-                    self.silent([k])
-                    self.now += self.config.watchdog
-                    plan = None
-                else:  # a late planner is killed when the watchdog fires: no later
-                    self.now += min(self.charge(answer), self.config.watchdog)
-                    plan = self.plan_of(answer, self.config.watchdog)
+                arrivals = self.arrivals([k])
+                answer = next(arrivals, None)
+                arrivals.close()
+                # None: the watchdog fired, and killed the planner then: no later.
+                self.now += self.config.watchdog if answer is None else self.charge(answer)
+                plan = None if answer is None else self.plan_of(answer)
                 if plan is not None:
                     self.step(11, f"plan found by {k}")
                     self.step(12, "disarm the watchdog")
@@ -264,8 +268,7 @@ class FtPlan:
                 self.step(9, f"candidates <- {', '.join(candidates) or '{}'}")
                 self.step(10, "pause the watchdog")
                 plan = self.plan_of(answer)
-                valid = plan is not None and not self.analyse(k, plan)
-                if plan is not None and valid:
+                if plan is not None and not self.analyse(k, plan):
                     self.step(11, f"analysis of {k}'s plan OK")
                     self.step(12, "disarm the watchdog")
                     arrivals.close()
@@ -279,6 +282,8 @@ class FtPlan:
                 else:
                     self.step(16, f"no valid plan from {k}")
                     self.step(17, "resume the watchdog")
+                    if plan is None:  # the analyzer told the operator of an invalid plan, not of this
+                        self.tell_operator(f"no plan from {k}")
                     self.step(18, f"tell the operator: invalid plan from {k}")
                     if not candidates:
                         self.step(19, "no candidate left")
@@ -289,46 +294,51 @@ class FtPlan:
                 return
 
     def arrivals(self, candidates: list[str]) -> Generator[Answer, None, None]:
-        """The answers of a concurrent planning in the order they count as found, within the
-        watchdog. Wall timing: as they arrive; the watchdog is paused while the consumer analyses
-        one (the time between two `next`). Model timing: all are collected, then given in the
-        order of their charge (ties: the planners' order); those charged beyond the watchdog
-        never count."""
-        waiting = list(candidates)
+        """The answers of the planners just asked, in the order they count as found, while the
+        watchdog lets them (Fig 3.1 line 20, Fig 3.2 line 23): a planner silent or late is killed
+        and restarted, and the answers end there.
+
+        Model timing: every answer is collected within `wall_limit` wall seconds of the requests,
+        then given in the order of its charge (ties: the candidates' order) up to the first one
+        charged beyond the watchdog. Wall timing: as they arrive, on a wall-clock watchdog that is
+        paused while the consumer analyses one (between two `next`, Fig 3.2 lines 10 and 17)."""
+        order, waiting = list(candidates), list(candidates)
+        expiry = self.now + self.config.watchdog  # the mission time the watchdog fires at
+        watchdog = Watchdog()
         if self.timing == "model":
+            watchdog.arm(self.wall_seconds())
             collected = []
             while waiting:
-                answer = self.pool.next_answer(waiting, self.wall_seconds())
+                answer = self.pool.next_answer(waiting, watchdog.remaining() or 0.0)
                 if answer is None:
-                    self.silent(waiting)
+                    self.silent(waiting, self.wall_seconds(), expiry)
                     break
                 waiting.remove(answer.planner)
                 collected.append(answer)
-            collected.sort(key=lambda a: (self.charge(a), candidates.index(a.planner)))
-            for answer in collected:
+            collected.sort(key=lambda a: (self.charge(a), order.index(a.planner)))
+            for rank, answer in enumerate(collected):
                 if self.charge(answer) > self.config.watchdog:
-                    self.pool.abandon(answer.planner)
-                    self.log("watchdog", f"{answer.planner} planned for {self.charge(answer):.3g} s, "
-                             f"beyond the {self.config.watchdog:g} s watchdog", answer.planner)
+                    for late in collected[rank:]:
+                        self.planner_failed(late.planner, f"{late.planner} planned for {self.charge(late):.3g} s, "
+                                            f"beyond the {self.config.watchdog:g} s watchdog", expiry)
                     return
                 yield answer
             return
-        remaining = self.wall_seconds()
+        budget = min(self.wall_seconds(), self.config.watchdog)
+        watchdog.arm(budget)
         while waiting:
-            asked = time.monotonic()
-            answer = self.pool.next_answer(waiting, max(0.0, remaining))
-            remaining -= time.monotonic() - asked  # paused while the consumer analyses
+            answer = self.pool.next_answer(waiting, watchdog.remaining() or 0.0)
             if answer is None:
-                self.silent(waiting)
+                self.silent(waiting, budget, expiry)
                 return
             waiting.remove(answer.planner)
+            watchdog.pause()
             yield answer
+            watchdog.resume()
 
-    def silent(self, names: list[str]) -> None:
+    def silent(self, names: list[str], seconds: float, expiry: float) -> None:
         for k in names:
-            self.pool.abandon(k)
-            self.planner_failures += 1
-            self.log("watchdog", f"{k} did not answer within {self.wall_seconds():g} s: killed, restarted", k)
+            self.planner_failed(k, f"{k} did not answer within {seconds:g} s", expiry)
 
     # ------------------------------------------------------------ the mechanisms
     def objectives(self) -> bool:
@@ -353,29 +363,27 @@ class FtPlan:
     def charge(self, answer: Answer) -> float:
         return self.cost.seconds(answer) if self.timing == "model" else answer.seconds
 
-    def plan_of(self, answer: Answer, watchdog: float = math.inf) -> Plan | None:
-        """The answer's plan, or None when the planner failed — late, crashed or plan-less —
-        and was killed and restarted (the watchdog's detection)."""
-        k, spent = answer.planner, self.charge(answer)
-        why = ""
-        if spent > watchdog:
-            why = f"{k} planned for {spent:.3g} s, beyond the {watchdog:g} s watchdog"
-        elif answer.result is None:
-            why = f"{k} {answer.status}: {answer.error or answer.detail or 'no reason given'}"
-        elif answer.result.plan is None:
-            why = f"{k} found no plan: {answer.result.reason}"
-        if why:
-            self.pool.abandon(k)
-            self.planner_failures += 1
-            self.log("watchdog", f"{why}: killed, restarted", k)
+    def plan_of(self, answer: Answer) -> Plan | None:
+        """The answer's plan, or None when the planner crashed or found no plan: counted as a late
+        one, killed and restarted (§3.2.2.2)."""
+        k, result = answer.planner, answer.result
+        if result is None:
+            self.planner_failed(k, f"{k} {answer.status}: {answer.error or answer.detail or 'no reason given'}")
             return None
-        assert answer.result is not None and answer.result.plan is not None
-        dropped = "; ".join(f"{g.description}: {g.reason}" for g in answer.result.dropped)
-        self.log("plan", f"{k}: {len(answer.result.plan.actions)} actions"
-                 + (f", dropped {dropped}" if dropped else ""), k)
-        return answer.result.plan
+        if result.plan is None:
+            self.planner_failed(k, f"{k} found no plan: {result.reason}")
+            return None
+        dropped = "; ".join(f"{g.description}: {g.reason}" for g in result.dropped)
+        self.log("plan", f"{k}: {len(result.plan.actions)} actions" + (f", dropped {dropped}" if dropped else ""), k)
+        return result.plan
 
-    def analyse(self, k: str, plan: Plan) -> list[Violation] | list[str]:
+    def planner_failed(self, k: str, why: str, at: float | None = None) -> None:
+        """The watchdog's detection (and what counts as one): the planner is killed and restarted."""
+        self.pool.abandon(k)
+        self.planner_failures += 1
+        self.log("watchdog", f"{why}: killed, restarted", k, at)
+
+    def analyse(self, k: str, plan: Plan) -> list[Violation]:
         if not self.analyzer:
             return []
         violations = analyse(plan, self.config, self.state, self.problem)
@@ -388,7 +396,7 @@ class FtPlan:
 
     def execute(self, k: str, plan: Plan) -> str:
         """k.executer(plan): blocking; FTplan's state follows the reports, the goals are checked
-        after each action. `failed` (an action failed), `met` (it ended and met some goal) or
+        after each. `failed` (an action failed), `met` (it ended and met some goal) or
         `idle` (it ended, meeting none)."""
         met_before = len(self.state.met)
         self.log("execute", f"{k}'s plan of {len(plan.actions)} actions starts", k)
@@ -397,9 +405,10 @@ class FtPlan:
             self.state.report(self.config.state_rules, r.kind, r.name, r.args)
             self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
                      + (f": {r.why}" if r.why else ""), k, r.time)
-            if r.kind in ("ended", "report"):
-                for goal in self.state.check_goals(r.time):
-                    self.log("goal-met", goal.text(), k, r.time)
+            # After every report that may change a fact (a failure too): a goal is met when it
+            # comes true, by its deadline (`SystemState.check_goals`).
+            for goal in self.state.check_goals(r.time):
+                self.log("goal-met", goal.text(), k, r.time)
 
         outcome: Execution = self.executor.execute(plan, self.now, report)
         self.now = outcome.now
@@ -408,11 +417,10 @@ class FtPlan:
             self.now = self.executor.safe_state(self.now)
             self.log("safe-state", "running activities stopped before recovery", k)
             return "failed"
-        else:
-            self.state.check_goals(self.now)
-            left = ", ".join(g.text() for g in self.state.pending())
-            if left:
-                self.log("goals-open", f"{k}'s plan ended with goals open: {left}", k)
+        self.state.check_goals(self.now)
+        left = ", ".join(g.text() for g in self.state.pending())
+        if left:
+            self.log("goals-open", f"{k}'s plan ended with goals open: {left}", k)
         return "met" if len(self.state.met) > met_before else "idle"
 
     def give_up(self, why: str) -> None:

@@ -94,13 +94,6 @@ class FtPlanConfig:
     analyzer: tuple[AnalyzerRule, ...] = ()
     state_rules: tuple[StateRule, ...] = ()
 
-    def planner(self, name: str) -> PlannerConfig:
-        for planner in self.planners:
-            if planner.name == name:
-                return planner
-        raise KeyError(f"ftplan '{self.name}' has no planner '{name}' "
-                       f"(it has {', '.join(p.name for p in self.planners)})")
-
 
 def configurations(config: FtPlanConfig) -> dict[str, FtPlanConfig]:
     """The robot configurations of seed 004 §4.2.1.1, named as there: `Robot1`, `Robot2`... (each

@@ -13,7 +13,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Protocol
 
 from specc.runtime.planner.plan import Action, Plan, Value
@@ -78,18 +78,16 @@ class ScriptedExecutor:
     `world` decides each outcome. Reports come in the order of their dates."""
 
     world: World = nominal
-    executed: list[tuple[float, str, str]] = field(default_factory=list)  # (start, action text, outcome)
-    safe_states: list[float] = field(default_factory=list)
 
     def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
         waiting = plan.ordered()
         by_end = {a.end: a for a in plan.actions}
+        by_start = {a.start: a for a in plan.actions}
         after: dict[str, list[tuple[str, float]]] = {a.id: [] for a in plan.actions}  # action -> (predecessor, delay)
         for first, second, delay in plan.orderings:
-            before = by_end.get(first)
-            for action in plan.actions:
-                if action.start == second and before is not None and before is not action:
-                    after[action.id].append((before.id, delay))
+            before, action = by_end.get(first), by_start.get(second)
+            if before is not None and action is not None and before is not action:
+                after[action.id].append((before.id, delay))
         ended_at: dict[str, float] = {}
         running: list[tuple[float, int, Action, Outcome]] = []  # (end date, order, action, outcome)
         clock, order = now, 0
@@ -101,13 +99,11 @@ class ScriptedExecutor:
                 end, _, action, outcome = heapq.heappop(running)
                 clock = end
                 if not outcome.ended:
-                    self.executed.append((end, action.text(), "failed"))
                     report(Report("failed", action.task, action.args, end, action.id, outcome.why))
                     return Execution(False, end, action.id, outcome.why or f"{action.text()} failed")
                 for name, args in outcome.reports:
                     report(Report("report", name, args, end, action.id))
                 ended_at[action.id] = end
-                self.executed.append((end, action.text(), "ended"))
                 report(Report("ended", action.task, action.args, end, action.id))
                 continue
             if next_start is None:  # an ordering no action ends: the plan is malformed
@@ -132,5 +128,4 @@ class ScriptedExecutor:
         return Execution(True, clock)
 
     def safe_state(self, now: float) -> float:
-        self.safe_states.append(now)
-        return now
+        return now  # nothing of the plan runs past a failure here: the system is safe at once

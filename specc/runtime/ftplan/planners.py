@@ -72,7 +72,6 @@ PRELOAD = ["specc.runtime.planner", "specc.runtime.ftplan.planners", "casadi"]
 KILL_GRACE = 1.0  # seconds a planner has to exit on SIGTERM before it gets SIGKILL
 
 
-
 class SupportsPlan(Protocol):
     """What a factory builds: a planner answering one planning request at a time."""
 
@@ -106,11 +105,17 @@ def planning_domains(generated: Mapping[str, ModuleType]) -> dict[str, pm.Planni
     return {name: module.DOMAIN for name, module in generated.items()}
 
 
-def load_factory(reference: str) -> PlannerFactory:
-    """The callable "module:callable" names (the callable may be dotted: "module:Class.build")."""
+def factory_parts(reference: str) -> tuple[str, str]:
+    """The module and the (maybe dotted) callable "module:callable" names."""
     module_name, colon, attribute = reference.partition(":")
     if not colon or not module_name or not attribute:
-        raise ValueError(f"planner factory '{reference}' is not 'module:callable'")
+        raise ValueError(f"factory '{reference}' is not 'module:callable'")
+    return module_name, attribute
+
+
+def load_factory(reference: str) -> PlannerFactory:
+    """The callable "module:callable" names (the callable may be dotted: "module:Class.build")."""
+    module_name, attribute = factory_parts(reference)
     target: object = importlib.import_module(module_name)
     for part in attribute.split("."):
         target = getattr(target, part)
@@ -233,13 +238,6 @@ class Answer:
     def failed(self) -> bool:
         return self.status != "answered"
 
-    def charged_seconds(self, seconds_per_node: float | None = None) -> float:
-        """The mission time this planning costs: `nodes * seconds_per_node` (the same on every
-        run and machine), or the measured wall time when no cost per node is given."""
-        if seconds_per_node is None:
-            return self.seconds
-        return self.nodes * seconds_per_node
-
 
 def _exit_description(exitcode: int | None) -> str:
     if exitcode is None:
@@ -326,9 +324,10 @@ class PlannerProcess:
 
     def __init__(self, config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain], *,
                  kill_grace: float = KILL_GRACE) -> None:
-        module, colon, attribute = config.factory.partition(":")
-        if not colon or not module or not attribute:
-            raise ValueError(f"planner '{config.name}': factory '{config.factory}' is not 'module:callable'")
+        try:
+            factory_parts(config.factory)  # a typo is told now, not by the child
+        except ValueError as error:
+            raise ValueError(f"planner '{config.name}': {error}") from None
         self.config = config
         self.domains = dict(domains)
         self.kill_grace = kill_grace
@@ -524,7 +523,6 @@ class PlannerProcess:
         exitcode = process.exitcode
         return Answer(self.name, pending.id, "crashed", None, seconds, error=f"the planner's process "
                       f"{_exit_description(exitcode)}", exitcode=exitcode)
-
 
     def _reap(self, process: multiprocessing.process.BaseProcess) -> None:
         """Join a process whose pipe closed, so that it is no zombie and its exit code is known;

@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import time
 import traceback
 from collections.abc import Collection, Mapping
@@ -26,17 +27,15 @@ class ProcessPool:
                  ready_timeout: float = READY_TIMEOUT) -> None:
         self.processes = {config.name: PlannerProcess(config, domains) for config in planners}
         self.names = tuple(self.processes)
-        self.start_errors: dict[str, str] = {}  # planners that could not be built, and why
         for process in self.processes.values():
             process.start()
         # FTplan launches its planners before the mission (§3.2.2.2), so that their start-up is
-        # not counted in the first planning's time. A planner that cannot be built still answers
-        # every request with why: FTplan sees that as any other planner failure.
-        for name, process in self.processes.items():
-            try:
+        # not counted in the first planning's time. A planner that cannot be built (or is slow to)
+        # still answers every request with why (or late): FTplan sees that as any other planner
+        # failure, so it is not told here.
+        for process in self.processes.values():
+            with contextlib.suppress(PlannerStartError, TimeoutError):
                 process.wait_ready(ready_timeout)
-            except (PlannerStartError, TimeoutError) as error:
-                self.start_errors[name] = str(error)
 
     def request(self, name: str, problem: pm.Problem, now: float) -> None:
         self.processes[name].request(problem, now)
@@ -49,9 +48,9 @@ class ProcessPool:
         return None if found is None else found[1]
 
     def abandon(self, name: str) -> None:
-        process = self.processes[name]
-        if process.busy or not process.running:
-            process.restart()
+        # Whether it is planning, crashed, or answered without a plan: a planner FTplan gives up
+        # on is killed and relaunched (§3.2.2.2), so that it starts the next request afresh.
+        self.processes[name].restart()
 
     def close(self) -> None:
         for process in self.processes.values():

@@ -14,20 +14,13 @@ from dataclasses import dataclass, field
 
 from specc.runtime.ftplan.config import FactUpdate, StateRule, Term, Value, Var
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import format_value
 from specc.runtime.planner.replan import Fact
+from specc.runtime.planner.validate import normalise, same
 
 FactKey = tuple[str, tuple[Value, ...]]
 Bindings = dict[str, Value]
-
-
-def normalise(value: Value | int) -> Value:
-    return float(value) if isinstance(value, (int, float)) else value
-
-
-def same(a: Value, b: Value) -> bool:
-    if isinstance(a, float) and isinstance(b, float):
-        return math.isclose(a, b, rel_tol=0.0, abs_tol=1e-6)
-    return a == b
+Dates = tuple[float, float]  # [earliest, latest]
 
 
 def match(terms: tuple[Term, ...], values: tuple[Value, ...], bindings: Bindings | None = None) -> Bindings | None:
@@ -90,12 +83,8 @@ class Goal:
         return (self.attribute, self.args)
 
     def text(self) -> str:
-        args = ", ".join(_text(a) for a in self.args)
-        return f"{self.attribute}({args}) = {_text(self.value)} (line {self.line}, priority {self.priority:g})"
-
-
-def _text(value: Value) -> str:
-    return f"{value:g}" if isinstance(value, float) else str(value)
+        args = ", ".join(format_value(a) for a in self.args)
+        return f"{self.attribute}({args}) = {format_value(self.value)} (line {self.line}, priority {self.priority:g})"
 
 
 @dataclass
@@ -104,6 +93,10 @@ class SystemState:
 
     facts: dict[FactKey, Value]
     goals: tuple[Goal, ...]
+    # The [earliest, latest] date the problem's constraints allow each of its timepoints: the
+    # goals' deadlines and the windows the plan analyzer falls back on. The mission's problem does
+    # not change, so they are computed once, here.
+    dates: dict[str, Dates]
     met: set[int] = field(default_factory=set)  # goal lines
     missed: dict[int, str] = field(default_factory=dict)  # goal line -> why
 
@@ -119,7 +112,7 @@ class SystemState:
                 value = constant(a.after)
                 if key is not None and value is not None:
                     facts[key] = value
-        deadlines = latest_dates(problem)
+        dates = date_bounds(problem)
         goals = []
         for a in problem.assertions:
             if a.goal is None or isinstance(a, pm.Use):
@@ -130,26 +123,27 @@ class SystemState:
                 continue  # a goal over an open argument: left to the planner
             at = a.start if isinstance(a, pm.Hold) else a.time
             final = isinstance(a, pm.Hold) and a.end == problem.end
-            goals.append(Goal(a.line, key[0], key[1], value, a.goal.priority, deadlines.get(at, math.inf), final))
-        return cls(facts, tuple(goals))
+            deadline = dates[at][1] if at in dates else math.inf
+            goals.append(Goal(a.line, key[0], key[1], value, a.goal.priority, deadline, final))
+        return cls(facts, tuple(goals), dates)
 
     # ------------------------------------------------------------ updating
-    def apply(self, changes: Iterable[tuple[FactKey, Value]]) -> None:
-        for key, value in changes:
-            self.facts[key] = value
-
     def report(self, rules: Iterable[StateRule], report: str, name: str, args: tuple[Value, ...]) -> None:
-        self.apply(consequences(rules, report, name, tuple(normalise(a) for a in args)))
+        self.facts.update(consequences(rules, report, name, tuple(normalise(a) for a in args)))
 
     def check_goals(self, now: float, mission_over: bool = False) -> list[Goal]:
         """On-line goal verification: the goals newly met (a final goal only when the mission
-        is over), and those whose deadline has passed are marked missed. Returns the newly met."""
+        is over), and those whose deadline has passed are marked missed. Returns the newly met.
+
+        Called after every change of the facts, so a goal found holding here for the first time
+        came true `now`: after its deadline, that is too late."""
         newly = []
         for goal in self.open_goals():
-            if self.holds(goal) and (mission_over or not goal.final):
+            in_time = now <= goal.deadline + 1e-6
+            if self.holds(goal) and (mission_over if goal.final else in_time):
                 self.met.add(goal.line)
                 newly.append(goal)
-            elif mission_over or now > goal.deadline + 1e-6:
+            elif mission_over or not in_time:
                 self.missed[goal.line] = ("not met when the mission ended" if mission_over
                                           else f"its deadline {goal.deadline:g} s has passed")
         return newly
@@ -169,27 +163,15 @@ class SystemState:
     def facts_list(self) -> list[Fact]:
         return [Fact(attribute, args, value) for (attribute, args), value in sorted(self.facts.items(), key=repr)]
 
-    def value(self, attribute: str, *args: Value) -> Value | None:
-        return self.facts.get((attribute, tuple(normalise(a) for a in args)))
-
-    def copy(self) -> SystemState:
-        return SystemState(dict(self.facts), self.goals, set(self.met), dict(self.missed))
-
 
 def constant(e: pm.Expr) -> Value | None:
-    """The value of a constant expression of a problem (`4.0`, `W1`, `0 - 3.0`), None otherwise."""
+    """The value of a constant expression of a problem (`4.0`, `W1`), None otherwise. Constant
+    arithmetic (`0 - 3.0`, as Modele1 writes -3) was folded when the problem was lowered
+    (`specc.analysis.planning`)."""
     if isinstance(e, pm.Num):
         return float(e.value)
     if isinstance(e, pm.Sym):
         return e.name
-    if isinstance(e, pm.Op) and e.op == "-" and len(e.args) == 2:  # `0 - 3.0`, as Modele1 writes -3
-        left, right = constant(e.args[0]), constant(e.args[1])
-        if isinstance(left, float) and isinstance(right, float):
-            return left - right
-    if isinstance(e, pm.Op) and e.op == "neg" and len(e.args) == 1:
-        inner = constant(e.args[0])
-        if isinstance(inner, float):
-            return -inner
     return None
 
 
@@ -200,12 +182,7 @@ def constant_key(attribute: str, args: tuple[pm.Expr, ...]) -> FactKey | None:
     return (attribute, tuple(v for v in values if v is not None))
 
 
-def latest_dates(problem: pm.Problem) -> dict[str, float]:
-    """The latest date of each timepoint of the problem, measured from the mission's start."""
-    return {point: dates[1] for point, dates in date_bounds(problem).items()}
-
-
-def date_bounds(problem: pm.Problem) -> dict[str, tuple[float, float]]:
+def date_bounds(problem: pm.Problem) -> dict[str, Dates]:
     """[earliest, latest] date of each timepoint of the problem its temporal constraints allow
     (holds run forwards, every timepoint lies within the mission); (-inf, inf) for all when they
     contradict each other, which the planner would have refused."""

@@ -74,7 +74,22 @@ def fold(op: str, left: float, right: float) -> float | None:
     if op == "*":
         return left * right
     return left / right if op == "/" and right else None
+
+
 FUNCTIONS = ("max", "min", "abs")
+
+
+def describe(e: Expr) -> str:
+    """An expression as the specification writes it (`(?x2 - ?x1)`, `max(?a, ?b)`), for messages."""
+    if isinstance(e, Num):
+        return f"{e.value:g}"
+    if isinstance(e, (Sym, Var, Time)):
+        return e.name
+    if e.op in FUNCTIONS:
+        return f"{e.op}({', '.join(describe(a) for a in e.args)})"
+    if e.op == "neg":
+        return f"-{describe(e.args[0])}"
+    return f"({describe(e.args[0])} {e.op} {describe(e.args[1])})"
 
 
 # ---------------------------------------------------------------- domains
@@ -181,6 +196,11 @@ Assertion = Union[Event, Hold, Use]
 def subject(a: Assertion) -> str:
     """The attribute (or resource) an assertion is about."""
     return a.resource if isinstance(a, Use) else a.attribute
+
+
+def assertion_timepoints(a: Assertion) -> tuple[str, ...]:
+    """The timepoints an assertion is at: an event's instant, or a hold's or a use's two ends."""
+    return (a.time,) if isinstance(a, Event) else (a.start, a.end)
 
 
 # ---------------------------------------------------------------- declarations

@@ -17,9 +17,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import lru_cache, reduce
 
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.model import describe
 
 INF = math.inf
 Interval = tuple[float, float]
@@ -299,18 +300,6 @@ def has_time(e: pm.Expr) -> bool:
     return isinstance(e, pm.Op) and any(has_time(a) for a in e.args)
 
 
-def describe(e: pm.Expr) -> str:
-    if isinstance(e, pm.Num):
-        return f"{e.value:g}"
-    if isinstance(e, (pm.Sym, pm.Var, pm.Time)):
-        return e.name
-    if e.op in pm.FUNCTIONS:
-        return f"{e.op}({', '.join(describe(a) for a in e.args)})"
-    if e.op == "neg":
-        return f"-{describe(e.args[0])}"
-    return f"({describe(e.args[0])} {e.op} {describe(e.args[1])})"
-
-
 def show(d: Dom) -> str:
     if isinstance(d, frozenset):
         return "{" + ", ".join(sorted(d)) + "}"
@@ -438,7 +427,7 @@ def exact_duration(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> tuple[f
             xs = [term(a) for a in e.args]
             ops = {"+": lambda: xs[0] + xs[1], "-": lambda: xs[0] - xs[1], "*": lambda: xs[0] * xs[1],
                    "/": lambda: xs[0] / xs[1], "neg": lambda: -xs[0], "abs": lambda: casadi.fabs(xs[0]),
-                   "max": lambda: casadi.fmax(xs[0], xs[1]), "min": lambda: casadi.fmin(xs[0], xs[1])}
+                   "max": lambda: reduce(casadi.fmax, xs), "min": lambda: reduce(casadi.fmin, xs)}
             return ops[e.op]()
 
         try:

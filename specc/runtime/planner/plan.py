@@ -63,10 +63,13 @@ class Plan:
     controllability: str = "strong"  # the schedule holds for every contingent duration
     now: float = 0.0  # mission time the plan was made for (a replanning starts later)
 
+    def ends_by(self, action: Action) -> float:
+        """The latest date the action may end, whatever nature does."""
+        return self.uncontrolled.get(action.end, (0.0, action.dispatch + action.duration[1]))[1]
+
     @property
     def makespan(self) -> float:
-        ends = [self.uncontrolled.get(a.end, (0.0, a.dispatch + a.duration[1]))[1] for a in self.actions]
-        return max(ends, default=self.now)
+        return max((self.ends_by(a) for a in self.actions), default=self.now)
 
     def ordered(self) -> list[Action]:
         return sorted(self.actions, key=lambda a: (a.dispatch, a.id))

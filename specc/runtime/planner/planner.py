@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.numeric import describe, domain_of, exact_duration
+from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult
 from specc.runtime.planner.search import (
     EPS,
@@ -30,10 +30,10 @@ from specc.runtime.planner.search import (
     Node,
     Term,
     Threat,
-    as_term,
     differences,
     is_temporal,
     is_var,
+    producers_of,
     translate,
 )
 from specc.runtime.stn import STN, Inconsistent
@@ -55,8 +55,8 @@ class Goal:
     @property
     def text(self) -> str:
         a = self.hold
-        args = f"({', '.join(describe(x) for x in a.args)})"
-        value = describe(a.value) if isinstance(a, pm.Hold) else describe(a.after)
+        args = f"({', '.join(pm.describe(x) for x in a.args)})"
+        value = pm.describe(a.value) if isinstance(a, pm.Hold) else pm.describe(a.after)
         return f"{a.attribute}{args} = {value} (line {a.line}, priority {self.priority:g})"
 
 
@@ -138,8 +138,16 @@ def explain(attempt: Attempt) -> str:
     scope = "every partial plan failed" if attempt.exhausted else f"no plan within {attempt.nodes} partial plans"
     if not attempt.failures:
         return scope
-    common = ", ".join(f"{why}" for why, _ in attempt.failures.most_common(2))
+    common = ", ".join(why for why, _ in attempt.failures.most_common(2))
     return f"{scope}; most often: {common}"
+
+
+def _source(a: pm.Assertion) -> str:
+    """Where an assertion comes from: its line, or the fact a replanning was given (line 0)."""
+    if a.line:
+        return f"line {a.line}"
+    value = a.after if isinstance(a, pm.Event) else a.value if isinstance(a, pm.Hold) else a.amount
+    return f"fact {pm.subject(a)}({', '.join(pm.describe(x) for x in a.args)}) = {pm.describe(value)}"
 
 
 def _generic(message: str) -> str:
@@ -160,22 +168,20 @@ class Setup:
         self.domain = domain
         self.problem = problem
         self.now = now
-        self.limits = limits
         self.origin = problem.start
         self.goals = [Goal(i, a, a.goal.priority) for i, a in enumerate(problem.assertions)
                       if isinstance(a, (pm.Hold, pm.Event)) and a.goal is not None]
+        known = {x.name for x in domain.attributes} | {r.name for r in domain.resources}
         for a in problem.assertions:
-            if not isinstance(a, (pm.Hold, pm.Event, pm.Use)):
-                continue
             if isinstance(a, pm.Event) and a.kind == "" and a.goal is None:
                 continue
-            if pm.subject(a) not in {x.name for x in domain.attributes} | {r.name for r in domain.resources}:
-                raise PlanningInputError(f"line {a.line}: unknown attribute '{pm.subject(a)}' in problem "
+            if pm.subject(a) not in known:
+                raise PlanningInputError(f"{_source(a)}: unknown attribute '{pm.subject(a)}' in problem "
                                          f"'{problem.name}'")
             terms = a.args + ((a.value,) if isinstance(a, pm.Hold) else (a.before, a.after)
                               if isinstance(a, pm.Event) else (a.amount,))
             if any(isinstance(t, (pm.Op, pm.Time)) for t in terms):
-                raise PlanningInputError(f"line {a.line}: assertions take values and variables, not expressions")
+                raise PlanningInputError(f"{_source(a)}: assertions take values and variables, not expressions")
             declared = domain.attribute(pm.subject(a))
             # An explained event's former value is history: only what it sets must be a value.
             values: tuple[pm.Expr, ...] = (a.value,) if isinstance(a, pm.Hold) else () if not isinstance(
@@ -184,14 +190,15 @@ class Setup:
                 if (declared is not None and isinstance(declared.values, pm.Symbols) and isinstance(value, pm.Sym)
                         and value.name not in declared.values.values):
                     raise PlanningInputError(
-                        f"line {a.line}: '{value.name}' is not a value of {declared.name} "
+                        f"{_source(a)}: '{value.name}' is not a value of {declared.name} "
                         f"({', '.join(declared.values.values)}), in problem '{problem.name}'")
         # Nature's instants: the times of contingent events, bounded from the origin.
         self.contingent = sorted({a.time for a in problem.assertions
                                   if isinstance(a, pm.Event) and a.kind == "contingent" and a.time != self.origin})
         bounds: dict[str, tuple[float, float]] = {p: (-INF, INF) for p in self.contingent}
-        self.requirements: list[tuple[str, str, float, float, int]] = []
+        self.requirements: list[tuple[str, str, float, float]] = []
         self.nature_before: set[tuple[str, str]] = set()
+        natures = set(self.contingent) | {self.origin}
         for c in problem.constraints:
             if isinstance(c, pm.Implies) or not is_temporal(c):
                 if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
@@ -203,12 +210,12 @@ class Setup:
             except ValueError as error:
                 raise PlanningInputError(f"line {c.line}: {error}") from None
             for first, second, low, high in pieces:
-                nature = {first, second} <= set(self.contingent) | {self.origin}
+                nature = {first, second} <= natures
                 if nature and first == self.origin and second in bounds:
                     old = bounds[second]
                     bounds[second] = (max(old[0], low), min(old[1], high))
                 elif not nature:
-                    self.requirements.append((first, second, low, high, c.line))
+                    self.requirements.append((first, second, low, high))
                 elif low > 0:
                     self.nature_before.add((first, second))
                 elif high < 0:
@@ -222,7 +229,7 @@ class Setup:
         # A goal's own timepoints (used by no other assertion) leave with it.
         used_by: dict[str, set[int]] = {}
         for i, a in enumerate(problem.assertions):
-            for point in _points(a):
+            for point in pm.assertion_timepoints(a):
                 used_by.setdefault(point, set()).add(i)
         for point in problem.timepoints:
             if point not in used_by and point not in bounds:
@@ -230,11 +237,11 @@ class Setup:
         goal_indexes = {g.index for g in self.goals}
         self.owned = {point: owners for point, owners in used_by.items()
                       if owners <= goal_indexes and point not in (self.origin, problem.end)}
-        self.capacity = {r.name: r.capacity for r in domain.resources}
-        self.producers = Context(domain, problem.end, self.origin, now, limits, self.capacity).producers
+        self.context = Context(problem.end, self.origin, now, limits, {r.name: r.capacity for r in domain.resources},
+                               producers_of(domain), self.nature_before)
 
-    def root(self, active: list[Goal], ctx: Context) -> Node:
-        node = Node(ctx)
+    def root(self, active: list[Goal]) -> Node:
+        node = Node(self.context)
         problem = self.problem
         active_indexes = {g.index for g in active}
         dropped_points = {p for p, owners in self.owned.items() if not owners & active_indexes}
@@ -246,7 +253,7 @@ class Setup:
             if point not in self.bounds and point not in dropped_points:
                 node.require(self.origin, point, 0.0)
                 node.require(point, problem.end, 0.0)
-        for first, second, low, high, _line in self.requirements:
+        for first, second, low, high in self.requirements:
             if first in dropped_points or second in dropped_points:
                 continue
             node.require(first, second, low, high)
@@ -256,35 +263,19 @@ class Setup:
             if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
                 node.bindings.restrict(c.expr.name, domain_of(c.domain))
 
-        term = as_term
         for i, a in enumerate(problem.assertions):
             if a.goal is not None and i not in active_indexes:
                 continue
-            if isinstance(a, pm.Event):
-                new = node.add_assertion(kind="event", attribute=a.attribute, args=tuple(term(x) for x in a.args),
-                                         value=term(a.after), before=term(a.before), start=a.time, end=a.time,
-                                         owner="problem", given=a.kind in ("explained", "contingent"), line=a.line,
-                                         goal=a.goal)
-            elif isinstance(a, pm.Hold):
-                new = node.add_assertion(kind="hold", attribute=a.attribute, args=tuple(term(x) for x in a.args),
-                                         value=term(a.value), before=None, start=a.start, end=a.end,
-                                         owner="problem", given=False, line=a.line, goal=a.goal)
+            node.add_written(a, str, str, "problem")
+            if isinstance(a, pm.Hold):
                 node.require(a.start, a.end, 0.0)
-            else:
-                new = node.add_assertion(kind="use", attribute=a.resource, args=tuple(term(x) for x in a.args),
-                                         value=term(a.amount), before=None, start=a.start, end=a.end,
-                                         owner="problem", given=True, line=a.line)
-            if not new.given:
-                node.open.add(new.id)
         return node
 
     # ------------------------------------------------------------ search
     def search(self, active: list[Goal], budget: int, discrepancies: bool = True) -> Attempt:
-        ctx = Context(self.domain, self.problem.end, self.origin, self.now, self.limits, self.capacity,
-                      self.producers, nature_before=self.nature_before)
         failures: Counter[str] = Counter()
         try:
-            root = self.root(active, ctx)
+            root = self.root(active)
         except DeadEnd as error:
             failures[_generic(str(error))] += 1
             return Attempt(None, 1, True, failures)
@@ -335,10 +326,12 @@ class Setup:
         durations = dict(node.durations)
         if exact:
             for instance_id, spec in node.durations.items():
+                if not spec.contingent:
+                    continue
                 instance = node.instances[instance_id]
                 key = tuple(sorted((local, value) for local in instance.task.params + instance.task.variables
                                    if (value := node.bindings.value(instance.var(local))) is not None))
-                tight = exact_duration(instance.task, key) if spec.contingent else None
+                tight = exact_duration(instance.task, key)
                 if tight is not None and spec.low - 1e-6 <= tight[0] <= tight[1] <= spec.high + 1e-6:
                     # A duration only nature decides may be a little wider than the solver's optimum.
                     durations[instance_id] = replace(spec, low=max(spec.low, tight[0] - 1e-6),
@@ -363,10 +356,7 @@ class Setup:
             except Inconsistent:  # rounding only: the search's network, with its tolerance, took it
                 network.add(pa, pb, new_low - 1e-6 if new_low > -INF else -INF,
                             new_high + 1e-6 if new_high < INF else INF)
-        for instance_id, spec in durations.items():
-            if not spec.contingent:
-                instance = node.instances[instance_id]
-                network.add(instance.start, instance.end, spec.low, spec.high)
+        # (The controllable durations are among node.original: the search required them.)
         schedule = network.earliest_schedule()
         if exact:
             optimised = optimise_schedule(network, reduced, schedule)
@@ -500,13 +490,10 @@ class Resolver:
             node.link(node.assertions[self.producer], node.assertions[self.need])
         elif self.kind == "insert":
             assert self.task is not None
-            own_from = len(node.assertions)  # the instance's assertions follow, together
+            own_from = len(node.assertions)  # the instance's assertions follow, one for each of the task's
             node.insert(self.task)
-            mine = [a for a in node.assertions[own_from:] if a.kind == "event"]
-            event = self.task.assertions[self.index]
-            assert isinstance(event, pm.Event)
-            producer = next(a for a in mine if a.line == event.line and a.attribute == event.attribute)
-            node.link(producer, node.assertions[self.need])
+            # By position: two calls of one macro give a task events alike down to their line.
+            node.link(node.assertions[own_from + self.index], node.assertions[self.need])
         elif self.kind == "order":
             node.require(self.first, self.second, self.gap)
         elif self.kind == "apart":
@@ -674,11 +661,3 @@ def unbound(node: Node) -> list[Resolver] | None:
                 raise DeadEnd(f"{var} has no value to take")
             return [Resolver("bind", terms=(var, v)) for v in values]
     return None
-
-
-def _points(a: pm.Assertion) -> tuple[str, ...]:
-    if isinstance(a, pm.Event):
-        return (a.time,)
-    return (a.start, a.end)
-
-

@@ -79,7 +79,7 @@ def replanning_problem(problem: pm.Problem, facts: Iterable[Fact], remaining_goa
         assertions.append(pm.Event(fact.attribute, tuple(_expr(x) for x in fact.args), value, value,
                                    problem.start, kind="explained"))
     # The timepoints of the goals left out go with them, and so do the constraints on them.
-    used = {point for a in assertions for point in ((a.time,) if isinstance(a, pm.Event) else (a.start, a.end))}
+    used = {point for a in assertions for point in pm.assertion_timepoints(a)}
     gone = {point for point in problem.timepoints if point not in used}
     constraints = tuple(c for c in problem.constraints if not pm.timepoints_of(c) & gone)
     return replace(problem, name=f"{problem.name}@{now:g}", assertions=tuple(assertions), constraints=constraints,

@@ -58,6 +58,11 @@ def translate(anchors: Mapping[str, tuple[str, float, float]], a: str, b: str, l
     return (pa, pb) + for_every_offset(low, high, (la, ha), (lb, hb))
 
 
+def _seconds(value: float) -> str:
+    """A date or a delay in a message, to the millisecond."""
+    return f"{round(value, 3) + 0.0:g}"  # + 0.0: no "-0"
+
+
 def is_var(term: Term) -> bool:
     return isinstance(term, str) and "?" in term
 
@@ -323,27 +328,28 @@ class Limits:
     per_task: int = 20
 
 
-@dataclass
+@dataclass(frozen=True)
 class Context:
-    """What every node of one search shares."""
+    """What every node of the searches for one problem shares."""
 
-    domain: pm.PlanningDomain
     horizon_end: str
     origin: str
     now: float
     limits: Limits
     capacity: Mapping[str, float]
-    producers: dict[str, list[tuple[pm.Task, int]]] = field(default_factory=dict)  # attribute -> (task, event index)
+    producers: Mapping[str, list[tuple[pm.Task, int]]]  # attribute -> (task, event index), see producers_of
     # Orders nature promises between its own instants (`t_evisi1 < t_svisi2`): (earlier, later).
     nature_before: set[tuple[str, str]] = field(default_factory=set)
 
-    def __post_init__(self) -> None:
-        if self.producers:
-            return  # shared by the searches of one problem
-        for task in self.domain.tasks:
-            for i, a in enumerate(task.assertions):
-                if isinstance(a, pm.Event):
-                    self.producers.setdefault(a.attribute, []).append((task, i))
+
+def producers_of(domain: pm.PlanningDomain) -> dict[str, list[tuple[pm.Task, int]]]:
+    """The events of the domain's tasks by attribute: (task, index of the event in its assertions)."""
+    producers: dict[str, list[tuple[pm.Task, int]]] = {}
+    for task in domain.tasks:
+        for i, a in enumerate(task.assertions):
+            if isinstance(a, pm.Event):
+                producers.setdefault(a.attribute, []).append((task, i))
+    return producers
 
 
 class Node:
@@ -395,15 +401,11 @@ class Node:
         return other
 
     # ------------------------------------------------------------ time
-    def _translate(self, a: str, b: str, low: float, high: float) -> tuple[str, str, float, float]:
-        """`low <= t(b) - t(a) <= high` for every offset nature gives a and b."""
-        return translate(self.anchor, a, b, low, high)
-
     def require(self, a: str, b: str, low: float = -INF, high: float = INF, record: bool = True) -> None:
         """Require `low <= t(b) - t(a) <= high` (raises DeadEnd when the network refuses)."""
         if record:
             self.original.append((a, b, low, high))
-        pa, pb, new_low, new_high = self._translate(a, b, low, high)
+        pa, pb, new_low, new_high = translate(self.anchor, a, b, low, high)
         if pa == pb:
             if new_low > TOLERANCE or new_high < -TOLERANCE:
                 raise DeadEnd(f"{b} - {a} cannot stay in [{low:g}, {high:g}] whatever nature does")
@@ -411,12 +413,17 @@ class Node:
         try:
             self.stn.add(pa, pb, new_low - TOLERANCE if new_low > -INF else new_low,
                          new_high + TOLERANCE if new_high < INF else new_high)
-        except Inconsistent as error:
-            raise DeadEnd(str(error)) from None
+        except Inconsistent:
+            # Said without the tolerance the network adds, which would show as 29.999999 or -1e-06.
+            if new_low > new_high + 2 * TOLERANCE:
+                raise DeadEnd(f"{b} - {a} cannot stay in [{low:g}, {high:g}] whatever nature does") from None
+            back, ahead = self._span(self.stn.index[pa], self.stn.index[pb])
+            raise DeadEnd(f"{pb} - {pa} in [{_seconds(new_low)}, {_seconds(new_high)}] contradicts "
+                          f"[{_seconds(-back)}, {_seconds(ahead)}], which the plan already implies") from None
 
     def allows(self, a: str, b: str, low: float = -INF, high: float = INF) -> bool:
-        """Could `require(a, b, low, high)` succeed? (STN.allows on the points a and b hang from,
-        read here directly: the search asks it of every candidate producer.)"""
+        """Could `require(a, b, low, high)` succeed? (The network's distances between the points a
+        and b hang from, read here directly: the search asks it of every candidate producer.)"""
         i, la, ha = self._place(a)
         j, lb, hb = self._place(b)
         back, ahead = self._span(i, j)
@@ -570,45 +577,47 @@ class Node:
             self.require(instance.start, point(name), 0.0)
             self.require(point(name), instance.end, 0.0)
 
-        def term(e: pm.Expr) -> Term:
-            return as_term(e, instance.var)
-
         # Domains of the task's variables, what keeps them apart, and its temporal constraints.
         constraints = task_constraints(task)
         for local, domain in constraints.domains:
             self.bindings.restrict(instance.var(local), domain)
         for left, right in constraints.apart:
-            self.bindings.keep_apart(term(left), term(right))
+            self.bindings.keep_apart(as_term(left, instance.var), as_term(right, instance.var))
         for c in constraints.temporal:
             for first, second, low, high in differences(c, point, self.ctx.origin):
                 self.require(first, second, low, high)
-        start_events: dict[tuple[str, str], Assertion] = {}
         own_from = len(self.assertions)  # the instance's assertions follow, together
         for a in task.assertions:
-            if isinstance(a, pm.Event):
-                new = self.add_assertion(kind="event", attribute=a.attribute, args=tuple(term(x) for x in a.args),
-                                         value=term(a.after), before=term(a.before), start=point(a.time),
-                                         end=point(a.time), owner=instance.id, given=False, line=a.line)
-            elif isinstance(a, pm.Hold):
-                new = self.add_assertion(kind="hold", attribute=a.attribute, args=tuple(term(x) for x in a.args),
-                                         value=term(a.value), before=None, start=point(a.start), end=point(a.end),
-                                         owner=instance.id, given=False, line=a.line)
-            else:
-                new = self.add_assertion(kind="use", attribute=a.resource, args=tuple(term(x) for x in a.args),
-                                         value=term(a.amount), before=None, start=point(a.start), end=point(a.end),
-                                         owner=instance.id, given=True, line=a.line)
+            new = self.add_written(a, instance.var, point, instance.id)
+            if new.kind == "use":
                 self.require(new.start, new.end, 0.0)
-                continue
-            self.open.add(new.id)
-            key = (new.attribute, new.start)
-            if new.kind == "event":
-                # The task's own start event gives what its holds and its later events need.
-                own = start_events.get(key)
-                if own is None:
-                    start_events[key] = new
-            self._own_support(self.assertions[own_from:], instance)
+            else:
+                self._own_support(self.assertions[own_from:], instance)
         self.ground(instance.id)
         return instance
+
+    def add_written(self, a: pm.Assertion, variable: Callable[[str], str], point: Callable[[str], str],
+                    owner: str) -> Assertion:
+        """A task's or the problem's assertion added to the plan, its variables and timepoints named
+        by `variable` and `point`; an event or a hold needing support is an open condition (only
+        the problem's explained and contingent events are given)."""
+        args = tuple(as_term(x, variable) for x in a.args)
+        if isinstance(a, pm.Use):
+            return self.add_assertion(kind="use", attribute=a.resource, args=args, value=as_term(a.amount, variable),
+                                      before=None, start=point(a.start), end=point(a.end), owner=owner, given=True,
+                                      line=a.line)
+        if isinstance(a, pm.Event):
+            given = owner == "problem" and a.kind in ("explained", "contingent")
+            new = self.add_assertion(kind="event", attribute=a.attribute, args=args, value=as_term(a.after, variable),
+                                     before=as_term(a.before, variable), start=point(a.time), end=point(a.time),
+                                     owner=owner, given=given, line=a.line, goal=a.goal)
+        else:
+            new = self.add_assertion(kind="hold", attribute=a.attribute, args=args, value=as_term(a.value, variable),
+                                     before=None, start=point(a.start), end=point(a.end), owner=owner, given=False,
+                                     line=a.line, goal=a.goal)
+        if not new.given:
+            self.open.add(new.id)
+        return new
 
     def _own_support(self, mine: list[Assertion], instance: Instance) -> None:
         """Link the task's assertions (`mine`, so far, the newest last) the task itself explains
@@ -745,13 +754,13 @@ def _could_be(e: pm.Expr, wanted: Term, task: pm.Task, bindings: Bindings) -> bo
         value = bindings.resolve(wanted)
         if is_var(value):
             return True
-        for c in task.constraints:
-            if isinstance(c, pm.Member) and c.expr == e and not c.contingent:
-                if isinstance(c.domain, pm.Symbols) and value not in c.domain.values:
-                    return False
-                if isinstance(c.domain, pm.Interval) and not (
-                        is_number(value) and c.domain.low <= float(value) <= c.domain.high):
-                    return False
+        for local, domain in task_constraints(task).domains:
+            if local != e.name:
+                continue
+            if isinstance(domain, frozenset) and value not in domain:
+                return False
+            if isinstance(domain, tuple) and not (is_number(value) and domain[0] <= float(value) <= domain[1]):
+                return False
         return True
     return True
 

@@ -74,8 +74,10 @@ from specc.runtime.planner.model import (
     Time,
     Use,
     Var,
+    assertion_timepoints,
+    describe,
 )
-from specc.runtime.planner.plan import Action, Plan, Value
+from specc.runtime.planner.plan import Action, Plan, Value, format_value
 
 TOLERANCE = 1e-6
 INF = math.inf
@@ -105,27 +107,11 @@ def same(a: Value, b: Value) -> bool:
 
 
 def text(value: Value | None) -> str:
-    if value is None:
-        return "?"
-    if isinstance(value, float):
-        return f"{value:g}"
-    return str(value)
+    return "?" if value is None else format_value(value)
 
 
 def date_text(date: float) -> str:
     return f"{date:.2f}".rstrip("0").rstrip(".") if math.isfinite(date) else str(date)
-
-
-def expr_text(expr: Expr) -> str:
-    if isinstance(expr, Num):
-        return text(expr.value)
-    if isinstance(expr, (Sym, Var, Time)):
-        return expr.name
-    if expr.op in ("+", "-", "*", "/"):
-        return f"({expr_text(expr.args[0])} {expr.op} {expr_text(expr.args[1])})"
-    if expr.op == "neg":
-        return f"-{expr_text(expr.args[0])}"
-    return f"{expr.op}({', '.join(expr_text(a) for a in expr.args)})"
 
 
 def constraint_text(c: Constraint) -> str:
@@ -134,9 +120,9 @@ def constraint_text(c: Constraint) -> str:
             domain = "{" + ", ".join(c.domain.values) + "}"
         else:
             domain = f"[{text(c.domain.low)}, {text(c.domain.high)}]"
-        return f"{expr_text(c.expr)} in {domain}"
+        return f"{describe(c.expr)} in {domain}"
     if isinstance(c, Relation):
-        return f"{expr_text(c.left)} {c.op} {expr_text(c.right)}"
+        return f"{describe(c.left)} {c.op} {describe(c.right)}"
     return f"{constraint_text(c.condition)} => {constraint_text(c.consequence)}"
 
 
@@ -157,7 +143,7 @@ def evaluate(expr: Expr, env: Mapping[str, Value], time_of: Callable[[str], floa
     values = [evaluate(a, env, time_of) for a in expr.args]
     numbers = [v for v in values if isinstance(v, float)]
     if len(numbers) != len(values):
-        raise NotNumeric(expr_text(expr))
+        raise NotNumeric(describe(expr))
     return arithmetic(expr.op, numbers)
 
 
@@ -678,7 +664,7 @@ class Validator:
         uses: dict[str, list[bool]] = {}  # timepoint -> is each use a dropped goal's?
         for a in p.assertions:
             dropped = a.goal is not None and a.line in self.dropped if isinstance(a, (Event, Hold)) else False
-            for t in ((a.time,) if isinstance(a, Event) else (a.start, a.end)):
+            for t in assertion_timepoints(a):
                 uses.setdefault(t, []).append(dropped)
         self.optional = {t for t, flags in uses.items() if all(flags)}
         for name, date in self.plan.schedule.items():
@@ -740,7 +726,7 @@ class Validator:
             if isinstance(a, (Event, Hold)) and a.goal is not None and a.line in self.dropped:
                 continue
             owner = f"line {a.line}"
-            times = (a.time,) if isinstance(a, Event) else (a.start, a.end)
+            times = assertion_timepoints(a)
             if any(t in self.missing for t in times):
                 continue  # reported with the schedule
             try:
@@ -761,7 +747,7 @@ class Validator:
     def use(self, a: Use, env: Mapping[str, Value], owner: str, key: Callable[[str], str]) -> None:
         amount = evaluate(a.amount, env)
         if not isinstance(amount, float):
-            raise NotNumeric(expr_text(a.amount))
+            raise NotNumeric(describe(a.amount))
         instance = (a.resource, self.ground_args(a.args, env))
         self.uses.append(GroundUse(instance, amount, key(a.start), key(a.end), owner))
 
@@ -819,7 +805,7 @@ class Validator:
         env: dict[str, Value] = {**dict(zip(task.params, args, strict=True)), **dict(values)}
         choices = symbolic_domains(task)
         for a in task.assertions:
-            times = (a.time,) if isinstance(a, Event) else (a.start, a.end)
+            times = assertion_timepoints(a)
             if any(t in unscheduled for t in times):
                 continue
             try:

@@ -64,10 +64,6 @@ class Wheels:
         self._rover.forget_progress()
 
     @property
-    def max_speed(self) -> float:
-        return self._rover.config.max_wheel_speed
-
-    @property
     def blocked(self) -> bool:
         return self._rover.blocked
 
@@ -149,7 +145,6 @@ class Arm:
     def __init__(self, joints: int, speed: float) -> None:
         self.joints = [Axis(0.0, 0.0, speed) for _ in range(joints)]
         self.grip = "OPEN"
-        self.holding: int | None = None  # the object index the closed gripper holds
 
     def reset(self, q: list[float]) -> None:
         """The arm is at `q` (where it stands when the robot starts)."""

@@ -16,6 +16,8 @@ import numpy as np
 
 from specc.runtime.sim.world import World
 
+PARALLEL = 1e-12  # |cross(ray, edge)| (m) at or below which a ray runs along the edge
+
 
 def unit_directions(angles: np.ndarray) -> np.ndarray:
     """(N, 2) unit vectors at `angles`, the form `RayCaster.fan` takes."""
@@ -29,14 +31,16 @@ class RayCaster:
         ax, ay, ex, ey = s[:, 0], s[:, 1], s[:, 2] - s[:, 0], s[:, 3] - s[:, 1]
         self._edges = len(s)
         # Ray p + t d meets edge a + u e where t = cross(a - p, e) / cross(d, e) and
-        # u = cross(a - p, d) / cross(d, e). With the ray written (d_x, d_y, cross(d, p)):
-        #   cross(d, e)     = d_x e_y - d_y e_x
-        #   cross(a - p, d) = -d_x a_y + d_y a_x + cross(d, p)
+        # u = cross(a - p, d) / cross(d, e). u needs no division: with m = a + e / 2 the edge's
+        # middle (u = 1/2), u is in [0, 1] when |2 cross(m - p, d)| <= |cross(d, e)|.
+        # With the ray written (d_x, d_y, cross(d, p)):
+        #   cross(d, e)       = d_x e_y - d_y e_x
+        #   2 cross(m - p, d) = -2 m_y d_x + 2 m_x d_y + 2 cross(d, p)
         # both are rows of one product with this fixed (3, 2S) matrix.
-        zeros, ones = np.zeros(len(s)), np.ones(len(s))
-        self._across = np.block([[ey, -ay], [-ex, ax], [zeros, ones]])
-        self._a_cross_e = ax * ey - ay * ex  # cross(a - p, e) = this - x e_y + y e_x
-        self._e_yx = np.stack((ey, ex))  # (2, S)
+        mx, my = ax + ex / 2.0, ay + ey / 2.0
+        self._across = np.block([[ey, -2.0 * my], [-ex, 2.0 * mx], [np.zeros(len(s)), np.full(len(s), 2.0)]])
+        # cross(a - p, e) = cross(a, e) - x e_y + y e_x: (1, -x, y) times this (3, S) matrix.
+        self._t_rows = np.stack((ax * ey - ay * ex, ey, ex))
         c = np.asarray(circles, dtype=float).reshape(-1, 3)
         self._centres = c[:, 0:2].T.copy()  # (2, C)
         self._r2 = c[:, 2] ** 2
@@ -59,14 +63,18 @@ class RayCaster:
         rays = units @ np.array(((c, s, c * y - s * x), (-s, c, -s * y - c * x)))  # (N, 3)
         if self._edges:
             crosses = rays @ self._across  # (N, 2S)
-            denom, u_num = crosses[:, :self._edges], crosses[:, self._edges:]
-            t_num = self._a_cross_e + np.array((-x, y)) @ self._e_yx  # (S,)
-            # A parallel pair divides by zero into inf or nan, which no test below accepts.
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                t = t_num / denom
-                u = u_num / denom
+            denom, off_middle = crosses[:, :self._edges], crosses[:, self._edges:]
+            t_num = np.array((1.0, -x, y)) @ self._t_rows  # (S,)
+            span = np.abs(denom)
+            # A ray (nearly) parallel to an edge misses it: from a point on the edge's line,
+            # rounding alone would decide t and u (a ray from (2, 2) heading west met the edge
+            # (3, 2)-(4.6, 2) behind it, at t = -0). The edge's ends are its neighbours' too.
+            # Skipping those pairs also spares the division by zero its warning.
+            crossing = span > PARALLEL
+            t = np.divide(t_num, denom, out=None, where=crossing)  # undefined where not crossing
+            hits = crossing & (np.abs(off_middle) <= span) & (t >= 0.0)
             # the ufunc's own reduce: np.min's Python wrapper costs as much as the work here
-            best = np.minimum.reduce(t, axis=1, where=(t >= 0.0) & (u >= 0.0) & (u <= 1.0), initial=max_range)
+            best = np.minimum.reduce(t, axis=1, where=hits, initial=max_range)
         else:
             best = np.full(len(units), float(max_range))
         if len(self._r2):

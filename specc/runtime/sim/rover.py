@@ -192,13 +192,6 @@ class Rover:
         return float(x), float(y), math.remainder(float(self.body.angle), math.tau)
 
     @property
-    def speed(self) -> tuple[float, float]:
-        """Forward speed and turn rate of the body."""
-        velocity = self.body.velocity
-        heading = self.body.rotation_vector
-        return float(velocity.dot(heading)), float(self.body.angular_velocity)
-
-    @property
     def blocked(self) -> bool:
         """Asking for motion and hardly moving, for `blocked_after` seconds on end."""
         return self._stuck

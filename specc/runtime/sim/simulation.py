@@ -23,10 +23,11 @@ from specc.runtime.kernel import Kernel
 from specc.runtime.sim.devices import Antenna, Arm, Camera, Encoders, PanTilt, RangeSensor, Wheels
 from specc.runtime.sim.rays import RayCaster
 from specc.runtime.sim.rover import HILARE, RobotConfig, Rover
-from specc.runtime.sim.world import World
+from specc.runtime.sim.world import World, WorldError
 
 PHYSICS_PRIORITY = -1000  # before the exec tasks of the same instant
 OBJECT_CLEARANCE = 0.45  # m: random objects are placed at least this far from walls and obstacles
+SCATTER_TRIES = 1000  # random places tried in a row for one object before giving up
 
 
 @dataclass
@@ -81,7 +82,7 @@ class Simulation:
         self._steps = 0
         self._origin = self.kernel.now
         self._record()
-        self.kernel.call_at(self._origin + physics_period, self._tick, PHYSICS_PRIORITY)
+        self._schedule_tick()
 
     # ------------------------------------------------------------ set-up
     def attach(self, registry: Any) -> Simulation:
@@ -95,15 +96,17 @@ class Simulation:
     def _scatter(self, count: int, rng: np.random.Generator) -> list[tuple[float, float]]:
         xmin, xmax, ymin, ymax = self.world.bounds
         placed: list[tuple[float, float]] = []
-        for _ in range(1000 * max(count, 1)):
-            if len(placed) == count:
-                break
+        misses = 0  # in a row: a count the room cannot hold ends the search, however large it is
+        while len(placed) < count and misses < SCATTER_TRIES:
             x, y = float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax))
             if self.world.clearance(x, y) >= OBJECT_CLEARANCE and all(
                     math.hypot(x - px, y - py) >= OBJECT_CLEARANCE for px, py in placed):
                 placed.append((round(x, 3), round(y, 3)))
+                misses = 0
+            else:
+                misses += 1
         if len(placed) < count:
-            raise ValueError(f"{self.world.source or self.world.name}: no room for {count} objects "
+            raise WorldError(f"{self.world.source or self.world.name}: no room for {count} objects "
                              f"{OBJECT_CLEARANCE} m clear of the obstacles")
         return placed
 
@@ -119,8 +122,13 @@ class Simulation:
             self.trace.blocked_at = self.now
         if self._steps % self._trace_every == 0:
             self._record()
-        # On the grid origin + k * period, so that no rounding drift reorders it with the tasks.
-        self.kernel.call_at(round(self._origin + (self._steps + 1) * dt, 9), self._tick, PHYSICS_PRIORITY)
+        self._schedule_tick()
+
+    def _schedule_tick(self) -> None:
+        # On the grid origin + k * period, rounded to the nanosecond as the exec tasks' ticks are,
+        # so that no rounding drift reorders physics with the tasks of the same instant.
+        self.kernel.call_at(round(self._origin + (self._steps + 1) * self.physics_period, 9), self._tick,
+                            PHYSICS_PRIORITY)
 
     def _record(self) -> None:
         self.trace.times.append(self.kernel.now)

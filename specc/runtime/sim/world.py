@@ -171,60 +171,62 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     for key in data:
         if key not in known:
             raise WorldError(f"{source}: unknown section [{key}] (known: {', '.join(sorted(known))})")
-    header = where.table(data, "world")
+    header = where.table(data, "world", ("name", "description"))
     name = where.text(header, "name", "world", default_name)
     description = where.text(header, "description", "world", "")
     if "room" in data and "bounds" in data:
         raise WorldError(f"{source}: give [room] or [bounds], not both")
     if "room" in data:
-        room = where.table(data, "room")
+        room = where.table(data, "room", ("width", "height"))
         width, height = where.number(room, "width", "room"), where.number(room, "height", "room")
         if width <= 0 or height <= 0:
             raise WorldError(f"{source}: [room] width and height must be positive")
         bounds = (0.0, width, 0.0, height)
     elif "bounds" in data:
-        box = where.table(data, "bounds")
-        bounds = tuple(where.number(box, k, "bounds") for k in ("xmin", "xmax", "ymin", "ymax"))  # type: ignore[assignment]
+        corners = ("xmin", "xmax", "ymin", "ymax")
+        box = where.table(data, "bounds", corners)
+        bounds = tuple(where.number(box, k, "bounds") for k in corners)  # type: ignore[assignment]
         if not (bounds[0] < bounds[1] and bounds[2] < bounds[3]):
             raise WorldError(f"{source}: [bounds] needs xmin < xmax and ymin < ymax")
     else:
         raise WorldError(f"{source}: the world needs walls: a [room] (width, height) or [bounds] "
                          "(xmin, xmax, ymin, ymax)")
-    start_table = where.table(data, "start")
+    start_table = where.table(data, "start", ("x", "y", "theta"))
     start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
              where.number(start_table, "theta", "start", 0.0))
     obstacles: list[Obstacle] = []
-    for k, entry in enumerate(where.array(data, "obstacles")):
+    for k, entry in enumerate(where.array(data, "obstacles", ("polygon", "circle"))):
         label = f"obstacles[{k}]"
         if "polygon" in entry and "circle" not in entry:
             points = entry["polygon"]
             if not isinstance(points, list) or len(points) < 3 or not all(
-                    isinstance(p, list) and len(p) == 2 and all(isinstance(c, int | float) for c in p) for p in points):
-                raise WorldError(f"{source}: {label}: polygon must list at least 3 [x, y] corners")
+                    isinstance(p, list) and len(p) == 2 and all(_finite(c) for c in p) for p in points):
+                raise WorldError(f"{source}: {label}: polygon must list at least 3 [x, y] corners (finite numbers)")
             polygon = tuple((float(x), float(y)) for x, y in points)
-            if signed_area(polygon) < 0:
-                polygon = polygon[::-1]  # the rest of the simulator wants counter-clockwise corners
-            if abs(signed_area(polygon)) < 1e-9:
+            area = signed_area(polygon)
+            if abs(area) < 1e-9:
                 raise WorldError(f"{source}: {label}: the polygon has no area")
+            if area < 0:
+                polygon = polygon[::-1]  # the rest of the simulator wants counter-clockwise corners
             obstacles.append(Polygon(polygon))
         elif "circle" in entry and "polygon" not in entry:
             c = entry["circle"]
-            if not (isinstance(c, list) and len(c) == 3 and all(isinstance(v, int | float) for v in c) and c[2] > 0):
-                raise WorldError(f"{source}: {label}: circle must be [x, y, radius] with radius > 0")
+            if not (isinstance(c, list) and len(c) == 3 and all(_finite(v) for v in c) and c[2] > 0):
+                raise WorldError(f"{source}: {label}: circle must be [x, y, radius] (finite numbers) with radius > 0")
             obstacles.append(Circle(float(c[0]), float(c[1]), float(c[2])))
         else:
             raise WorldError(f"{source}: {label}: give either polygon = [[x, y], ...] or circle = [x, y, r]")
-    objects_table = where.table(data, "objects")
+    objects_table = where.table(data, "objects", ("count", "at"))
     count = where.number(objects_table, "count", "objects", 0.0)
     if count < 0 or count != int(count):
         raise WorldError(f"{source}: [objects] count must be a whole number >= 0")
     placed = tuple((where.number(o, "x", f"objects.at[{k}]"), where.number(o, "y", f"objects.at[{k}]"))
-                   for k, o in enumerate(where.array(objects_table, "at")))
+                   for k, o in enumerate(where.array(objects_table, "at", ("x", "y"), "objects.at")))
     targets = tuple(Target(where.text(t, "name", f"targets[{k}]", f"T{k + 1}"),
                            where.number(t, "x", f"targets[{k}]"), where.number(t, "y", f"targets[{k}]"))
-                    for k, t in enumerate(where.array(data, "targets")))
+                    for k, t in enumerate(where.array(data, "targets", ("name", "x", "y"))))
     windows = []
-    for k, w in enumerate(where.array(data, "windows")):
+    for k, w in enumerate(where.array(data, "windows", ("name", "start", "end"))):
         label = f"windows[{k}]"
         window = Window(where.text(w, "name", label, f"W{k + 1}"), where.number(w, "start", label),
                         where.number(w, "end", label))
@@ -243,16 +245,27 @@ class _Where:
     def __init__(self, source: str) -> None:
         self.source = source
 
-    def table(self, data: Mapping[str, Any], key: str) -> Mapping[str, Any]:
+    def only(self, table: Mapping[str, Any], label: str, known: tuple[str, ...]) -> None:
+        """A misspelt key would otherwise be ignored silently (`thetaa` leaving theta at 0)."""
+        for key in table:
+            if key not in known:
+                raise WorldError(f"{self.source}: {label}: unknown key '{key}' (known: {', '.join(known)})")
+
+    def table(self, data: Mapping[str, Any], key: str, known: tuple[str, ...]) -> Mapping[str, Any]:
         value = data.get(key, {})
         if not isinstance(value, dict):
             raise WorldError(f"{self.source}: [{key}] must be a table")
+        self.only(value, f"[{key}]", known)
         return value
 
-    def array(self, data: Mapping[str, Any], key: str) -> list[Mapping[str, Any]]:
+    def array(self, data: Mapping[str, Any], key: str, known: tuple[str, ...],
+              label: str = "") -> list[Mapping[str, Any]]:
+        label = label or key
         value = data.get(key, [])
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-            raise WorldError(f"{self.source}: {key} must be an array of tables ([[{key}]])")
+            raise WorldError(f"{self.source}: {label} must be an array of tables ([[{label}]])")
+        for k, entry in enumerate(value):
+            self.only(entry, f"{label}[{k}]", known)
         return value
 
     def number(self, table: Mapping[str, Any], key: str, label: str, default: float | None = None) -> float:
@@ -261,7 +274,7 @@ class _Where:
                 raise WorldError(f"{self.source}: {label}: missing '{key}' (a number)")
             return default
         value = table[key]
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        if not _finite(value):
             raise WorldError(f"{self.source}: {label}: '{key}' must be a finite number, not {value!r}")
         return float(value)
 
@@ -270,6 +283,10 @@ class _Where:
         if not isinstance(value, str):
             raise WorldError(f"{self.source}: {label}: '{key}' must be a string")
         return value
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def signed_area(points: Sequence[tuple[float, float]]) -> float:
