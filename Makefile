@@ -25,6 +25,7 @@ demo: $(STAMP)
 	$(BIN)/specc verify examples/hilare --goal '!(COLLECT-OBJECTS 1)' --fail ARM-OBJ --steps 4 \
 	    --reach 'Explore:254; TakeObject:236 ?(& (OBJ-FOUND @I) (> @I (+ @TAKEN 1)))'
 	$(BIN)/specc plan examples/atrv --problem M4 --domain model1 -o build/m4-plan.png
+	$(BIN)/python examples/atrv/run_ftplan.py --config Robot1/2c --mission M3
 	$(BIN)/python examples/hilare/run_sim.py --goal 9,7 --goal 2,7 -o build/hilare-run.png
 	$(BIN)/python examples/atrv/run_sim.py --world W3 --goal 2,1 --goal -1,2 --goal -2,-2 --goal 1,-3 \
 	    --goal 0,0 --photos -o build/atrv-w3.png

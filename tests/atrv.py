@@ -60,3 +60,16 @@ def optimistic_speed(domain: pm.PlanningDomain, factor: float = 10.0) -> pm.Plan
     assert constraints != move.constraints, "Modele1's MOVE no longer bounds its speed by [0.17, 0.35]"
     mutated = replace(move, constraints=constraints)
     return replace(domain, tasks=tuple(mutated if t.name == "MOVE" else t for t in domain.tasks))
+
+
+def mutation_1_592_modele2(domain: pm.PlanningDomain) -> pm.PlanningDomain:
+    """Modele2 with the seed's mutation 1-592 in its own terms: TAKE_SHOT holds the camera at the
+    moving tilt (-30) instead of the ground's (-45)."""
+    task = domain.task("TAKE_SHOT")
+    assert task is not None
+    moving = pm.Num(-30.0)
+    assertions = tuple(replace(a, value=moving) if isinstance(a, pm.Hold) and a.attribute == "PTU_TILT" else a
+                       for a in task.assertions)
+    assert assertions != task.assertions, "TAKE_SHOT no longer holds PTU_TILT"
+    mutated = replace(task, assertions=assertions)
+    return replace(domain, tasks=tuple(mutated if t.name == task.name else t for t in domain.tasks))

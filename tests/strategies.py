@@ -203,10 +203,19 @@ analyzer_rules = st.one_of(
               args=small(ixexprs), requirement=attr_values),
     st.builds(m.AnalyzerNoOverlap, tasks=small(upper, 2)),
     st.builds(m.AnalyzerMaxDuration, task=upper, limit=durations))
+view_facts = st.builds(m.ViewFact, attribute=upper, args=small(ixexprs),
+                       value=ixexprs | st.builds(m.Interval, low=ixexprs, high=ixexprs))
+correspondences = small(st.builds(m.Correspondence, planner_facts=small(view_facts, 1),
+                                  state_facts=small(view_facts, 1)))
 ftplans = st.builds(
     m.FtPlan, name=lower, order=small(refs), policy=st.none() | st.sampled_from(["successive", "concurrent"]),
     watchdog=st.none() | durations,
-    planners=small(st.builds(m.Planner, name=lower, domain=st.none() | refs, heuristic=st.none() | refs)),
+    planners=small(st.builds(m.Planner, name=lower, domain=st.none() | refs, heuristic=st.none() | refs,
+                             view=correspondences)),
+    missions=small(st.builds(
+        m.Mission, name=lower,
+        problems=small(st.builds(m.MissionProblem, planner=lower.map(lambda s: m.Ref(parts=(s,))), problem=refs)),
+        views=small(st.builds(m.MissionView, planner=refs, correspondences=correspondences)))),
     analyzer=small(analyzer_rules),
     state_updates=small(st.builds(
         m.StateUpdate, report=st.sampled_from(["ended", "failed", "report"]), task=upper, args=small(ixexprs),

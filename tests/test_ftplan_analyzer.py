@@ -14,6 +14,7 @@ from specc.model import nodes as m
 from specc.runtime.ftplan.analyzer import Violation, analyse
 from specc.runtime.ftplan.config import FtPlanConfig, Requirement, Var
 from specc.runtime.ftplan.state import SystemState
+from specc.runtime.ftplan.view import View
 from specc.runtime.planner import Planner
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Action, Plan
@@ -25,7 +26,7 @@ MISSIONS = [f"M{k}_{model}" for model in ("model1", "model2") for k in (1, 2, 3,
 
 @cache
 def config() -> FtPlanConfig:
-    return ftplan_config(next(item for item in program().items if isinstance(item, m.FtPlan)))
+    return ftplan_config(next(item for item in program().items if isinstance(item, m.FtPlan)), program())
 
 
 def plan_of(domain: pm.PlanningDomain, problem: pm.Problem) -> Plan:
@@ -40,8 +41,14 @@ def planned(name: str) -> Plan:
 
 
 def check(plan: Plan, name: str, rules: FtPlanConfig | None = None) -> list[Violation]:
-    problem = atrv_models(name)[1]
-    return analyse(plan, rules or config(), SystemState.from_problem(problem), problem)
+    """The analyzer's verdict on a plan for problem `name` ("M1_model2"), as FTplan judges it: on
+    its own state (the mission's Modele1 problem), through p2's view for a Modele2 plan."""
+    mission, model = name.split("_")
+    problem = atrv_models(f"{mission}_model1")[1]
+    view = None
+    if model == "model2":
+        view = View(next(p for p in config().for_mission(mission).planners if p.name == "p2").view)
+    return analyse(plan, rules or config(), SystemState.from_problem(problem), problem, view)
 
 
 def rule_line(text: str) -> int:

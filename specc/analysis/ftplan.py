@@ -60,20 +60,75 @@ def state_rule(update: m.StateUpdate) -> fc.StateRule:
                         update.span.line)
 
 
-def ftplan_config(ftplan: m.FtPlan) -> fc.FtPlanConfig:
+def bound(e: m.IxExpr) -> float:
+    """An interval's bound: a number, `-oo` or `+oo`."""
+    try:
+        lowered: pm.Expr | None = _LOWERING.expr(e, Scope({}, {}))
+    except PlanningError:
+        lowered = None
+    if isinstance(lowered, pm.Num):
+        return float(lowered.value)
+    raise NotConstant("an interval's bounds are numbers")
+
+
+def view_value(e: m.IxExpr | m.Interval) -> fc.Term | fc.Interval:
+    if isinstance(e, m.Interval):
+        return fc.Interval(bound(e.low), bound(e.high))
+    return term(e)
+
+
+def fact_pattern(fact: m.ViewFact) -> fc.FactPattern:
+    return fc.FactPattern(fact.attribute, terms(fact.args), view_value(fact.value))
+
+
+def correspondence(c: m.Correspondence) -> fc.Correspondence:
+    return fc.Correspondence(tuple(fact_pattern(f) for f in c.planner_facts),
+                             tuple(fact_pattern(f) for f in c.state_facts), c.span.line)
+
+
+def planner_order(ftplan: m.FtPlan) -> list[m.Planner]:
+    """The planners in the order successive planning tries them (unlisted ones last)."""
     planners = {p.name: p for p in ftplan.planners}
-    order = [ref.text for ref in ftplan.order] or list(planners)
-    order += [name for name in planners if name not in order]  # unlisted planners come last
+    order = [ref.text for ref in ftplan.order if ref.text in planners] or list(planners)
+    order += [name for name in planners if name not in order]
+    return [planners[name] for name in order]
+
+
+def state_planner(ftplan: m.FtPlan) -> m.Planner | None:
+    """The first planner speaking FTplan's state vocabulary (without a view): its problem of a
+    mission gives FTplan's facts and goals."""
+    viewed = {v.planner.text for mission in ftplan.missions for v in mission.views}
+    return next((p for p in planner_order(ftplan) if not p.view and p.name not in viewed), None)
+
+
+def mission_config(ftplan: m.FtPlan, mission: m.Mission, program: m.Program) -> fc.Mission:
+    problems = {p.name: p for p in program.items if isinstance(p, m.Problem)}
+    entries = []
+    for entry in mission.problems:
+        problem = problems.get(entry.problem.text)
+        domain = problem.domain.text if problem is not None else ""
+        entries.append(fc.MissionProblem(entry.planner.text, entry.problem.text, domain))
+    own = state_planner(ftplan)
+    state_problem = next((e.problem for e in entries if own is not None and e.planner == own.name), "")
+    views = tuple((v.planner.text, tuple(correspondence(c) for c in v.correspondences)) for v in mission.views)
+    return fc.Mission(mission.name, tuple(entries), state_problem, views)
+
+
+def ftplan_config(ftplan: m.FtPlan, program: m.Program | None = None) -> fc.FtPlanConfig:
+    """The block's configuration; `program` (for the missions' problems) defaults to the block alone."""
+    program = program or m.Program()
     return fc.FtPlanConfig(
         name=ftplan.name,
-        planners=tuple(planner_config(planners[name]) for name in order),
+        planners=tuple(planner_config(p) for p in planner_order(ftplan)),
         policy=ftplan.policy or "successive",
         watchdog=ftplan.watchdog.seconds if ftplan.watchdog is not None else DEFAULT_WATCHDOG,
         analyzer=tuple(analyzer_rule(r) for r in ftplan.analyzer),
         state_rules=tuple(state_rule(u) for u in ftplan.state_updates),
+        missions=tuple(mission_config(ftplan, mission, program) for mission in ftplan.missions),
     )
 
 
 def planner_config(planner: m.Planner) -> fc.PlannerConfig:
     return fc.PlannerConfig(planner.name, planner.domain.text if planner.domain is not None else "",
-                            planner.heuristic.text if planner.heuristic is not None else None)
+                            planner.heuristic.text if planner.heuristic is not None else None,
+                            view=tuple(correspondence(c) for c in planner.view))

@@ -31,17 +31,19 @@ class FtPlanView:
     @property
     def summary(self) -> str:
         planners = ", ".join(f"{p.name} ({p.domain})" for p in self.config.planners)
+        missions = ", ".join(m.name for m in self.config.missions) or "none"
         return (f"planners {planners}; {self.config.policy} planning; watchdog {self.config.watchdog:g} s; "
-                f"{len(self.config.analyzer)} analyzer rules, {len(self.config.state_rules)} state rules")
+                f"{len(self.config.analyzer)} analyzer rules, {len(self.config.state_rules)} state rules; "
+                f"missions {missions}")
 
     def source(self, value: object) -> str:
-        return literal(value, (fc.Var,), 0)
+        return literal(value, (fc.Var, fc.Interval), 0)
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> None:
     blocks = sorted((i for i in program.items if isinstance(i, m.FtPlan)), key=lambda b: b.name)
     for block in blocks:
-        view = FtPlanView(block, ftplan_config(block))
+        view = FtPlanView(block, ftplan_config(block, program))
         output.add(BACKEND, f"ftplan/{python_name(block.name)}.py", render("ftplan/block.py.j2", view=view))
     if blocks:
         output.add(BACKEND, "ftplan/__init__.py", render(

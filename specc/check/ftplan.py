@@ -3,7 +3,7 @@ updates speak of tasks and attributes that some planner's domain defines."""
 
 from __future__ import annotations
 
-from specc.analysis.ftplan import NotConstant, term
+from specc.analysis.ftplan import NotConstant, bound, term
 from specc.check.context import Context
 from specc.check.planning import DomainTables, tables
 from specc.model import nodes as m
@@ -13,8 +13,15 @@ from specc.runtime.ftplan.config import HEURISTICS
 def check(ctx: Context) -> None:
     for ftplan in ctx.items(m.FtPlan):
         ctx.duplicates(ftplan.planners, "planner")
+        ctx.duplicates(ftplan.missions, "mission")
         planners = {p.name: p for p in ftplan.planners}
+        viewed = {p.name for p in ftplan.planners if p.view} | {
+            v.planner.text for mission in ftplan.missions for v in mission.views}
+        # FTplan's state speaks the vocabulary of the planners without a view; each planner with
+        # one speaks its own domain's, which its state rules and correspondences are checked in.
         known = DomainTables()
+        own: dict[str, DomainTables] = {}
+        domains: dict[str, m.Domain] = {}
         for planner in ftplan.planners:
             if planner.domain is None:
                 ctx.report("missing-property", f"planner '{planner.name}' needs 'domain: <domain>;'", planner.span)
@@ -25,22 +32,34 @@ def check(ctx: Context) -> None:
                            f"(it knows {choices})", planner.heuristic.span)
             domain = ctx.lookup(m.Domain, planner.domain, planner.domain.span, "undefined-domain")
             if domain is not None:
+                domains[planner.name] = domain
                 found = tables(_quiet(ctx), domain.members)
-                known.tasks.update(found.tasks)
-                known.attributes.update(found.attributes)
+                if planner.name in viewed:
+                    own[planner.name] = found
+                else:
+                    known.tasks.update(found.tasks)
+                    known.attributes.update(found.attributes)
+        everything = DomainTables()
+        for found in (known, *own.values()):
+            everything.tasks.update(found.tasks)
+            everything.attributes.update(found.attributes)
         for ref in ftplan.order:
             if ref.text not in planners:
                 ctx.unknown("undefined-planner", "planner", ref.text, planners, ref.span)
         if not ftplan.planners:
             ctx.report("missing-property", f"ftplan '{ftplan.name}' declares no 'planner' block", ftplan.span)
+        elif not set(planners) - viewed:
+            ctx.report("missing-property", f"every planner of ftplan '{ftplan.name}' has a view: FTplan's state "
+                       "speaks the vocabulary of a planner without one", ftplan.span)
         if ftplan.watchdog is not None and ftplan.watchdog.seconds <= 0:
             ctx.report("bad-duration", "the watchdog must be longer than zero", ftplan.watchdog.span)
         for rule in ftplan.analyzer:
             tasks = (rule.tasks if isinstance(rule, m.AnalyzerNoOverlap)
                      else (rule.task,))
             for task in tasks:
-                check_task(ctx, known, task, rule.span, getattr(rule, "args", None))
+                check_task(ctx, everything, task, rule.span, getattr(rule, "args", None))
             if isinstance(rule, m.AnalyzerCondition):
+                # judged on FTplan's state, whichever planner's task it is about
                 check_attribute(ctx, known, rule.requirement.attribute, len(rule.requirement.args), rule.span)
                 value = rule.requirement.value
                 if isinstance(value, m.Transition):
@@ -50,13 +69,95 @@ def check(ctx: Context) -> None:
                     check_terms(ctx, (*rule.args, *rule.requirement.args, value))
                     check_bound(ctx, rule.args, (*rule.requirement.args, value), f"task '{rule.task}'")
         for update in ftplan.state_updates:
+            vocabulary = known
             if update.report != "report":
-                check_task(ctx, known, update.task, update.span, update.args)
+                check_task(ctx, everything, update.task, update.span, update.args)
+                if update.task not in known.tasks:  # a viewed planner's task: its vocabulary
+                    vocabulary = next((t for t in own.values() if update.task in t.tasks), known)
             for fact in update.updates:
-                check_attribute(ctx, known, fact.attribute, len(fact.args), fact.span)
+                check_attribute(ctx, vocabulary, fact.attribute, len(fact.args), fact.span)
                 check_terms(ctx, (*fact.args, fact.value))
                 check_bound(ctx, update.args, (*fact.args, fact.value), f"{update.report} '{update.task}'")
             check_terms(ctx, update.args)
+        for planner in ftplan.planners:
+            check_view(ctx, planner.view, own.get(planner.name), known)
+        for mission in ftplan.missions:
+            check_mission(ctx, ftplan, mission, planners, domains, own, known)
+
+
+def check_mission(ctx: Context, ftplan: m.FtPlan, mission: m.Mission, planners: dict[str, m.Planner],
+                  domains: dict[str, m.Domain], own: dict[str, DomainTables], known: DomainTables) -> None:
+    named: set[str] = set()
+    for entry in mission.problems:
+        planner = entry.planner.text
+        if planner not in planners:
+            ctx.unknown("undefined-planner", "planner", planner, planners, entry.planner.span)
+            continue
+        if planner in named:
+            ctx.report("duplicate-definition", f"mission '{mission.name}' names planner '{planner}' twice",
+                       entry.span)
+        named.add(planner)
+        problem = ctx.lookup(m.Problem, entry.problem, entry.problem.span, "undefined-problem")
+        domain = domains.get(planner)
+        if problem is None or domain is None:
+            continue
+        if problem.domain.text != domain.name:
+            other = ctx.lookup(m.Domain, problem.domain, problem.domain.span, "undefined-domain")
+            tasks = set(tables(_quiet(ctx), domain.members).tasks)
+            if other is not None and set(tables(_quiet(ctx), other.members).tasks) != tasks:
+                ctx.report("domain-mismatch", f"problem '{problem.name}' is for domain '{other.name}', whose tasks "
+                           f"are not those of planner '{planner}''s domain '{domain.name}': name a problem for "
+                           f"'{domain.name}' or a domain with the same tasks", entry.problem.span)
+    for planner in planners:
+        if planner not in named:
+            ctx.report("missing-property", f"mission '{mission.name}' names no problem for planner '{planner}': "
+                       f"add '{planner}: <problem>;'", mission.span)
+    for view in mission.views:
+        if view.planner.text not in planners:
+            ctx.unknown("undefined-planner", "planner", view.planner.text, planners, view.planner.span)
+            continue
+        check_view(ctx, view.correspondences, own.get(view.planner.text), known)
+
+
+def check_view(ctx: Context, correspondences: tuple[m.Correspondence, ...], planner: DomainTables | None,
+               state: DomainTables) -> None:
+    """Each side in its vocabulary; constant arguments; usable to read FTplan's state or to write it."""
+    for c in correspondences:
+        for facts, vocabulary in ((c.planner_facts, planner), (c.state_facts, state)):
+            for fact in facts:
+                if vocabulary is not None:
+                    check_attribute(ctx, vocabulary, fact.attribute, len(fact.args), fact.span)
+                value = fact.value
+                check_terms(ctx, fact.args if isinstance(value, m.Interval) else (*fact.args, value))
+                if isinstance(value, m.Interval) and not all(_is_bound(b) for b in (value.low, value.high)):
+                    ctx.report("bad-rule-argument", "an interval's bounds are numbers, -oo or +oo", value.span)
+                if isinstance(value, m.Interval) and facts is c.planner_facts:
+                    ctx.report("bad-rule-argument", "an interval reads FTplan's state: it belongs on the right of "
+                               "`<=>`, the planner's facts name one value", value.span)
+        left, right = _variables(c.planner_facts), _variables(c.state_facts)
+        readable = left <= right
+        writable = right <= left and not any(isinstance(f.value, m.Interval) for f in c.state_facts)
+        if not readable and not writable:
+            ctx.report("unusable-correspondence", "this correspondence can neither read FTplan's state (a ?variable "
+                       "of the left is not on the right) nor write it (a ?variable or an interval of the right "
+                       "is not bound by the left): bind the ?variables on both sides", c.span)
+
+
+def _variables(facts: tuple[m.ViewFact, ...]) -> set[str]:
+    names = set()
+    for fact in facts:
+        for e in (*fact.args, fact.value):
+            if isinstance(e, m.IxVar):
+                names.add(e.name)
+    return names
+
+
+def _is_bound(e: m.IxExpr) -> bool:
+    try:
+        bound(e)
+    except NotConstant:
+        return False
+    return True
 
 
 def check_terms(ctx: Context, exprs: tuple[m.IxExpr, ...]) -> None:

@@ -813,11 +813,52 @@ class Fragment(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class ViewFact(Node):
+    """`ATTRIBUTE(args): value` in a correspondence; on FTplan's side the value may be an interval."""
+
+    attribute: str
+    args: tuple[IxExpr, ...] = ()
+    value: IxExpr | Interval
+
+
+@dataclass(frozen=True, kw_only=True)
+class Correspondence(Node):
+    """`planner facts <=> FTplan's facts`: how a planner's vocabulary reads FTplan's state."""
+
+    planner_facts: tuple[ViewFact, ...]
+    state_facts: tuple[ViewFact, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
 class Planner(Node):
     name: str
     domain: Ref | None = prop("domain", "ref", doc="planning domain the planner uses")
     heuristic: Ref | None = prop("heuristic", "ref", doc="flaw/resolver ordering heuristic")
     doc: String | None = prop("doc", "string")
+    view: tuple[Correspondence, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class MissionProblem(Node):
+    """`planner: problem;` in a mission: the planner's statement of the mission."""
+
+    planner: Ref
+    problem: Ref
+
+
+@dataclass(frozen=True, kw_only=True)
+class MissionView(Node):
+    """`view planner { ... }` in a mission: correspondences that hold for this mission only."""
+
+    planner: Ref
+    correspondences: tuple[Correspondence, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Mission(Node):
+    name: str
+    problems: tuple[MissionProblem, ...] = ()
+    views: tuple[MissionView, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -867,6 +908,7 @@ class FtPlan(Node):
     planners: tuple[Planner, ...] = ()
     analyzer: tuple[AnalyzerRule, ...] = ()
     state_updates: tuple[StateUpdate, ...] = ()
+    missions: tuple[Mission, ...] = ()
 
 
 # ---------------------------------------------------------------- system

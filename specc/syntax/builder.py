@@ -813,11 +813,42 @@ class Builder(Transformer[Token, Any]):
                 updates.extend(member.updates)
         return self.apply_props(m.FtPlan, self.span(meta), props, name=str(name),
                                 planners=self.of(rest, m.Planner), analyzer=tuple(analyzer),
-                                state_updates=tuple(updates))
+                                state_updates=tuple(updates), missions=self.of(rest, m.Mission))
 
     def planner(self, meta: Meta, children: list[Any]) -> m.Planner:
-        name, *props = children
-        return self.apply_props(m.Planner, self.span(meta), props, name=str(name))
+        name, *members = children
+        props, rest = self.split(members)
+        view = tuple(c for block in rest for c in block.correspondences)
+        return self.apply_props(m.Planner, self.span(meta), props, name=str(name), view=view)
+
+    def view(self, meta: Meta, children: list[Any]) -> ViewBlock:
+        return ViewBlock(tuple(children))
+
+    def correspondence(self, meta: Meta, children: list[Any]) -> m.Correspondence:
+        planner_facts, state_facts = children
+        return m.Correspondence(planner_facts=planner_facts, state_facts=state_facts, span=self.span(meta))
+
+    def view_side(self, meta: Meta, children: list[Any]) -> tuple[m.ViewFact, ...]:
+        return tuple(children)
+
+    def view_fact(self, meta: Meta, children: list[Any]) -> m.ViewFact:
+        name, *rest = _present(children)
+        value = rest.pop()
+        return m.ViewFact(attribute=str(name), args=tuple(rest), value=value, span=self.span(meta))
+
+    def mission(self, meta: Meta, children: list[Any]) -> m.Mission:
+        name, *members = children
+        return m.Mission(name=str(name), problems=self.of(members, m.MissionProblem),
+                         views=self.of(members, m.MissionView), span=self.span(meta))
+
+    def mission_problem(self, meta: Meta, children: list[Any]) -> m.MissionProblem:
+        planner, problem = children
+        return m.MissionProblem(planner=m.Ref(parts=(str(planner),), span=self.tspan(planner)),
+                                problem=problem, span=self.span(meta))
+
+    def mission_view(self, meta: Meta, children: list[Any]) -> m.MissionView:
+        planner, *correspondences = children
+        return m.MissionView(planner=planner, correspondences=tuple(correspondences), span=self.span(meta))
 
     def analyzer(self, meta: Meta, children: list[Any]) -> AnalyzerBlock:
         return AnalyzerBlock(tuple(children))
@@ -882,6 +913,11 @@ class AnalyzerBlock:
 @dataclass(frozen=True)
 class StateBlock:
     updates: tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class ViewBlock:
+    correspondences: tuple[Any, ...]
 
 
 def parse_number(text: str) -> int | float:

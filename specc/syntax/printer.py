@@ -649,6 +649,9 @@ class Printer:
             for p in node.planners:
                 with self.block(f"planner {p.name}", p.span):
                     self.props(p)
+                    if p.view:
+                        with self.block("view", None):
+                            self.correspondences(p.view)
             if node.analyzer:
                 with self.block("analyzer", None):
                     for rule in node.analyzer:
@@ -657,6 +660,22 @@ class Printer:
                 with self.block("state", None):
                     for update in node.state_updates:
                         self.state_update(update)
+            for mission in node.missions:
+                with self.block(f"mission {mission.name}", mission.span):
+                    for problem in mission.problems:
+                        self.line(f"{problem.planner.text}: {problem.problem.text};", problem.span)
+                    for view in mission.views:
+                        with self.block(f"view {view.planner.text}", view.span):
+                            self.correspondences(view.correspondences)
+
+    def correspondences(self, correspondences: Iterable[m.Correspondence]) -> None:
+        def side(facts: tuple[m.ViewFact, ...]) -> str:
+            return ", ".join(f"{f.attribute}({ix_args(f.args)}): "
+                             + (domain_value(f.value) if isinstance(f.value, m.Interval) else ixexpr(f.value))
+                             for f in facts)
+
+        for c in correspondences:
+            self.line(f"{side(c.planner_facts)} <=> {side(c.state_facts)};", c.span)
 
     def analyzer_rule(self, r: m.AnalyzerRule) -> None:
         if isinstance(r, m.AnalyzerCondition):

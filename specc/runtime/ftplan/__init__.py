@@ -2,9 +2,10 @@
 their own processes, a planning watchdog, a plan analyzer, action-failure detection, on-line goal
 verification, successive (Fig 3.1) and concurrent (Fig 3.2) recovery.
 
-    from specc.runtime.ftplan import FtPlan, ProcessPool, ScriptedExecutor
-    with ProcessPool(config.planners, domains) as pool:
-        result = FtPlan(config, problem, pool, ScriptedExecutor()).run()
+    from specc.runtime.ftplan import FtPlan, ProcessPool, ScriptedExecutor, mission_setup
+    setup = mission_setup(rover.CONFIGURATIONS, "Robot1/2", "M1", atrv.planner)
+    with ProcessPool(setup.config.planners, setup.domains) as pool:
+        result = FtPlan(setup.config, setup.problem, pool, ScriptedExecutor(), problems=setup.problems).run()
 """
 
 from __future__ import annotations
@@ -12,7 +13,9 @@ from __future__ import annotations
 from specc.runtime.ftplan.component import CostModel, FtPlan, MissionFailure, MissionResult
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig, configurations
 from specc.runtime.ftplan.execution import Executor, Outcome, Report, ScriptedExecutor
+from specc.runtime.ftplan.missions import MissionSetup, UnknownName, mission_setup
 from specc.runtime.ftplan.pools import LocalPool, ProcessPool
 
 __all__ = ["CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure", "MissionResult",
-           "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor", "configurations"]
+           "MissionSetup", "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor", "UnknownName",
+           "configurations", "mission_setup"]

@@ -34,6 +34,7 @@ from specc.runtime.ftplan.state import (
     match,
     substitute,
 )
+from specc.runtime.ftplan.view import View
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
 from specc.runtime.planner.validate import same
@@ -77,10 +78,12 @@ class Possibility:
     source: str
 
 
-def analyse(plan: Plan, config: FtPlanConfig, state: SystemState, problem: pm.Problem) -> list[Violation]:
-    """What in `plan` breaks the rules of `config`'s analyzer, FTplan believing `state` now.
-    A rule whose task the plan does not use (another planner's vocabulary) does not apply."""
-    projection = Projection(plan, config, state, problem)
+def analyse(plan: Plan, config: FtPlanConfig, state: SystemState, problem: pm.Problem,
+            view: View | None = None) -> list[Violation]:
+    """What in `plan` breaks the rules of `config`'s analyzer, FTplan believing `state` now;
+    `view` is the correspondences of the planner that made the plan, if it speaks another
+    vocabulary. A rule whose task the plan does not use (another planner's) does not apply."""
+    projection = Projection(plan, config, state, problem, view)
     violations: list[Violation] = []
     for rule in config.analyzer:
         if isinstance(rule, Requirement):
@@ -99,12 +102,13 @@ class Projection:
     """The attribute instances along the plan: FTplan's state changed by the actions' ends, and
     the problem's contingent events for the attributes nature changes."""
 
-    def __init__(self, plan: Plan, config: FtPlanConfig, state: SystemState, problem: pm.Problem) -> None:
+    def __init__(self, plan: Plan, config: FtPlanConfig, state: SystemState, problem: pm.Problem,
+                 view: View | None = None) -> None:
         self.facts = state.facts
         self.effects: dict[FactKey, list[Change]] = {}
         for action in plan.actions:
             ends = end_dates(plan, action)
-            for key, value in consequences(config.state_rules, "ended", action.task, action.args):
+            for key, value in consequences(config.state_rules, "ended", action.task, action.args, view):
                 self.effects.setdefault(key, []).append(Change(value, ends, f"set when {action.id} ends", action.id))
         self.events = _contingent_events(problem, _timepoint_dates(plan, state))
 

@@ -35,7 +35,7 @@ Two departures from the figures, both where they are silent:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Generator
+from collections.abc import Callable, Collection, Generator, Mapping
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -44,9 +44,10 @@ from specc.runtime.ftplan.config import FtPlanConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
 from specc.runtime.ftplan.planners import Answer, Watchdog
 from specc.runtime.ftplan.state import SystemState
+from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Plan, format_value
-from specc.runtime.planner.replan import replanning_problem
+from specc.runtime.planner.replan import Fact, replanning_problem
 
 MISSION_FAILED_IN_TIME = "mission failure: no valid plan found in time"  # Fig 3.1 line 24, Fig 3.2 line 24
 MISSION_FAILED = "mission failure: no valid plan found"  # Fig 3.2 line 20
@@ -141,6 +142,9 @@ class FtPlan:
     wall_limit: float | None = None  # wall seconds before a silent planner is killed (default: the watchdog)
     policy: str | None = None  # overrides the block's policy (the Robot1/2c configuration)
     operator: Callable[[str], None] | None = None  # messages to the operator
+    # Each planner's own statement of the mission, when it is not `problem` (a planner with
+    # another vocabulary: `config.for_mission`, `view.View`).
+    problems: Mapping[str, pm.Problem] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.timing not in ("model", "wall"):
@@ -150,6 +154,14 @@ class FtPlan:
             raise ValueError(f"policy is 'successive' or 'concurrent', not '{policy}'")
         self.policy = policy
         self.state = SystemState.from_problem(self.problem)
+        self.views = {p.name: View(p.view) for p in self.config.planners if p.view}
+        missing = [k for k in self.views if k not in self.problems]
+        if missing:
+            raise ValueError(f"planner(s) {', '.join(missing)} speak another vocabulary than FTplan's state: "
+                             "give their own problems (`problems=`)")
+        # Each such planner's problem as a ledger: its goals, to tell which are still FTplan's,
+        # and its timepoints' dates.
+        self.planner_ledgers = {k: SystemState.from_problem(self.problems[k]) for k in self.views}
         self.now = 0.0
         self.events: list[Event] = []
         self.trace: list[tuple[int, str]] = []
@@ -246,9 +258,9 @@ class FtPlan:
             candidates = list(planners)
             self.step(3, f"candidates <- {', '.join(candidates)}")
             self.step(4, f"arm the watchdog ({self.config.watchdog:g} s)")
-            problem = self.planning_problem()
+            first = self.plannings == 0
             for k in candidates:
-                self.request(k, problem)
+                self.request(k, self.planning_problem(k, first))
             self.step(5, f"request a plan from {', '.join(candidates)}")
             started = self.now
             arrivals = self.arrivals(candidates)
@@ -346,15 +358,34 @@ class FtPlan:
         self.state.check_goals(self.now)
         return bool(self.state.pending())
 
-    def planning_problem(self) -> pm.Problem:
-        """What FTplan sends: its own facts, the goals still open, the mission time (§3.2.2.3)."""
-        if self.plannings == 0:
-            return self.problem
-        return replanning_problem(self.problem, self.state.facts_list(), [g.line for g in self.state.open_goals()],
-                                  self.now)
+    def planning_problem(self, k: str, first: bool) -> pm.Problem:
+        """What FTplan sends k: its own facts, the goals still open, the mission time (§3.2.2.3),
+        in k's vocabulary. The mission's first planning sends k's statement of the mission."""
+        own = self.problems.get(k, self.problem)
+        if first:
+            return own
+        view = self.views.get(k)
+        if view is None:
+            return replanning_problem(own, self.state.facts_list(), [g.line for g in self.state.open_goals()],
+                                      self.now, self.state.dates)
+        facts = [Fact(attribute, args, value) for (attribute, args), value in sorted(
+            view.read(self.state.facts).items(), key=repr)]
+        return replanning_problem(own, facts, self.open_planner_goals(k, view), self.now,
+                                  self.planner_ledgers[k].dates)
+
+    def open_planner_goals(self, k: str, view: View) -> list[int]:
+        """The lines of k's goals standing for a goal FTplan still has open; a goal no
+        correspondence names is kept."""
+        open_facts = [(g.key, g.value) for g in self.state.open_goals()]
+        lines = []
+        for goal in self.planner_ledgers[k].goals:
+            stands_for = view.state_facts_of(goal.key, goal.value)
+            if not stands_for or any(same_fact(f, o) for f in stands_for for o in open_facts):
+                lines.append(goal.line)
+        return lines
 
     def request(self, k: str, problem: pm.Problem | None = None) -> None:
-        problem = problem or self.planning_problem()
+        problem = problem or self.planning_problem(k, self.plannings == 0)
         self.plannings += 1
         goals = ", ".join(g.text() for g in self.state.open_goals())
         self.log("plan-request", f"{k} asked to plan at {self.now:g} s for: {goals}", k)
@@ -386,7 +417,7 @@ class FtPlan:
     def analyse(self, k: str, plan: Plan) -> list[Violation]:
         if not self.analyzer:
             return []
-        violations = analyse(plan, self.config, self.state, self.problem)
+        violations = analyse(plan, self.config, self.state, self.problem, self.views.get(k))
         if violations:
             self.planner_failures += 1
             text = f"invalid plan from {k}: " + "; ".join(v.message for v in violations)
@@ -402,7 +433,7 @@ class FtPlan:
         self.log("execute", f"{k}'s plan of {len(plan.actions)} actions starts", k)
 
         def report(r: Report) -> None:
-            self.state.report(self.config.state_rules, r.kind, r.name, r.args)
+            self.state.report(self.config.state_rules, r.kind, r.name, r.args, self.views.get(k))
             self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
                      + (f": {r.why}" if r.why else ""), k, r.time)
             # After every report that may change a fact (a failure too): a goal is met when it

@@ -26,6 +26,34 @@ Term = Var | float | str
 
 
 @dataclass(frozen=True)
+class Interval:
+    """`[low, high]`: a value of FTplan's state a correspondence reads within these bounds."""
+
+    low: float
+    high: float
+
+
+@dataclass(frozen=True)
+class FactPattern:
+    """`ATTRIBUTE(args): value` in a correspondence."""
+
+    attribute: str
+    args: tuple[Term, ...]
+    value: Term | Interval
+
+
+@dataclass(frozen=True)
+class Correspondence:
+    """`planner facts <=> state facts`: where FTplan's state holds the state facts, the planner
+    reads the planner facts (`view.View.read`); where a planner-vocabulary rule sets the planner
+    facts, FTplan's state gets the state facts (`view.View.write`)."""
+
+    planner_facts: tuple[FactPattern, ...]
+    state_facts: tuple[FactPattern, ...]
+    line: int = 0
+
+
+@dataclass(frozen=True)
 class PlannerConfig:
     name: str
     domain: str  # the planning domain's name (a module of the generated `planner` package)
@@ -33,6 +61,8 @@ class PlannerConfig:
     # "module:callable" building, inside the planner's own process, the object whose
     # `plan(problem, now)` answers a planning request; the default is specc's planner on `domain`.
     factory: str = "specc.runtime.ftplan.planners:standard_planner"
+    # How this planner's vocabulary reads FTplan's state; empty: it speaks the state's vocabulary.
+    view: tuple[Correspondence, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -86,6 +116,26 @@ class StateRule:
 
 
 @dataclass(frozen=True)
+class MissionProblem:
+    planner: str
+    problem: str  # the planner's statement of the mission
+    domain: str  # the problem's domain: the one the planner plans it in
+
+
+@dataclass(frozen=True)
+class Mission:
+    """A mission as each planner states it, and the correspondences that depend on it."""
+
+    name: str
+    problems: tuple[MissionProblem, ...]
+    state_problem: str  # the problem in FTplan's state vocabulary: its facts and goals are FTplan's
+    views: tuple[tuple[str, tuple[Correspondence, ...]], ...] = ()  # planner -> correspondences
+
+    def problem_of(self, planner: str) -> MissionProblem | None:
+        return next((p for p in self.problems if p.planner == planner), None)
+
+
+@dataclass(frozen=True)
 class FtPlanConfig:
     name: str
     planners: tuple[PlannerConfig, ...]  # in the order successive planning tries them
@@ -93,6 +143,29 @@ class FtPlanConfig:
     watchdog: float = 10.0  # seconds of planning before a planner is judged failed
     analyzer: tuple[AnalyzerRule, ...] = ()
     state_rules: tuple[StateRule, ...] = ()
+    missions: tuple[Mission, ...] = ()
+
+    def mission(self, name: str) -> Mission:
+        found = next((m for m in self.missions if m.name == name), None)
+        if found is None:
+            known = ", ".join(m.name for m in self.missions) or "none"
+            raise KeyError(f"ftplan '{self.name}' has no mission '{name}' (it has: {known})")
+        return found
+
+    def for_mission(self, name: str) -> FtPlanConfig:
+        """This configuration on mission `name`: each planner plans in its problem's domain and
+        reads FTplan's state through the mission's correspondences first, then its own."""
+        mission = self.mission(name)
+        views = dict(mission.views)
+        planners = []
+        for planner in self.planners:
+            problem = mission.problem_of(planner.name)
+            if problem is None:
+                raise KeyError(f"mission '{name}' of ftplan '{self.name}' names no problem for planner "
+                               f"'{planner.name}'")
+            planners.append(replace(planner, domain=problem.domain,
+                                    view=views.get(planner.name, ()) + planner.view))
+        return replace(self, planners=tuple(planners))
 
 
 def configurations(config: FtPlanConfig) -> dict[str, FtPlanConfig]:

@@ -58,7 +58,7 @@ class Outcome:
 
     ended: bool = True
     duration: float | None = None  # None: the planned duration's upper bound; beyond it, a failure
-    reports: tuple[tuple[str, tuple[Value, ...]], ...] = ()  # measurements sent when it ends
+    reports: tuple[tuple[str, tuple[Value, ...]], ...] = ()  # measurements sent when it ends or fails
     why: str = ""
 
 
@@ -98,11 +98,12 @@ class ScriptedExecutor:
             if running and (next_start is None or running[0][0] <= next_start[0]):
                 end, _, action, outcome = heapq.heappop(running)
                 clock = end
+                # The measurements first: where a failed move left the robot matters to recovery.
+                for name, args in outcome.reports:
+                    report(Report("report", name, args, end, action.id))
                 if not outcome.ended:
                     report(Report("failed", action.task, action.args, end, action.id, outcome.why))
                     return Execution(False, end, action.id, outcome.why or f"{action.text()} failed")
-                for name, args in outcome.reports:
-                    report(Report("report", name, args, end, action.id))
                 ended_at[action.id] = end
                 report(Report("ended", action.task, action.args, end, action.id))
                 continue

@@ -11,12 +11,16 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from specc.runtime.ftplan.config import FactUpdate, StateRule, Term, Value, Var
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import format_value
 from specc.runtime.planner.replan import Fact
 from specc.runtime.planner.validate import normalise, same
+
+if TYPE_CHECKING:
+    from specc.runtime.ftplan.view import View
 
 FactKey = tuple[str, tuple[Value, ...]]
 Bindings = dict[str, Value]
@@ -54,15 +58,20 @@ def ground(updates: Iterable[FactUpdate], bindings: Mapping[str, Value]) -> list
             for u in updates]
 
 
-def consequences(rules: Iterable[StateRule], report: str, name: str,
-                 args: tuple[Value, ...]) -> list[tuple[FactKey, Value]]:
-    """What the rules say changes when `report` (ended, failed, report) comes for name(args)."""
+def consequences(rules: Iterable[StateRule], report: str, name: str, args: tuple[Value, ...],
+                 view: View | None = None) -> list[tuple[FactKey, Value]]:
+    """What the rules say changes in FTplan's state when `report` (ended, failed, report) comes
+    for name(args). The rules about a task of a planner with a `view` speak that planner's
+    vocabulary: their updates are written through it. Reports from the supervisor (`report`)
+    speak FTplan's."""
     changes: list[tuple[FactKey, Value]] = []
     for rule in rules:
         if rule.report == report and rule.name == name:
             bindings = match(rule.args, args)
             if bindings is not None:
                 changes.extend(ground(rule.updates, bindings))
+    if view is not None and report != "report":
+        return view.write(changes)
     return changes
 
 
@@ -128,8 +137,9 @@ class SystemState:
         return cls(facts, tuple(goals), dates)
 
     # ------------------------------------------------------------ updating
-    def report(self, rules: Iterable[StateRule], report: str, name: str, args: tuple[Value, ...]) -> None:
-        self.facts.update(consequences(rules, report, name, tuple(normalise(a) for a in args)))
+    def report(self, rules: Iterable[StateRule], report: str, name: str, args: tuple[Value, ...],
+               view: View | None = None) -> None:
+        self.facts.update(consequences(rules, report, name, tuple(normalise(a) for a in args), view))
 
     def check_goals(self, now: float, mission_over: bool = False) -> list[Goal]:
         """On-line goal verification: the goals newly met (a final goal only when the mission

@@ -660,4 +660,16 @@ def unbound(node: Node) -> list[Resolver] | None:
             if not values:
                 raise DeadEnd(f"{var} has no value to take")
             return [Resolver("bind", terms=(var, v)) for v in values]
+    # A task whose duration its parameters leave open (Modele2's distance symbol ?D when a
+    # distance table says nothing of a place) takes a value for its free symbolic variables:
+    # a plan has no action of unbounded duration.
+    for instance in node.instances.values():
+        if instance.id in node.durations:
+            continue
+        for local in instance.task.variables:
+            var = instance.var(local)
+            domain = node.bindings.domain[node.bindings.root(var)]
+            if node.bindings.value(var) is None and isinstance(domain, frozenset):
+                return [Resolver("bind", terms=(var, v)) for v in sorted(domain)]
+        raise DeadEnd(f"{instance.id}'s duration is not bounded by its task's constraints")
     return None

@@ -11,7 +11,8 @@ outcome sent as facts; a preemptible one (latePreemptive) is stopped first.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import math
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 
 from specc.runtime.planner import model as pm
@@ -62,9 +63,11 @@ def _matches(event: pm.Event, fact: Fact) -> bool:
 
 
 def replanning_problem(problem: pm.Problem, facts: Iterable[Fact], remaining_goals: Iterable[int],
-                       now: float) -> pm.Problem:
+                       now: float, dates: Mapping[str, tuple[float, float]] | None = None) -> pm.Problem:
     """The problem FTplan sends at `now`: `facts` as the initial values, only the goals whose
-    source lines are in `remaining_goals`."""
+    source lines are in `remaining_goals`. With the [earliest, latest] `dates` of the problem's
+    timepoints, the required holds that surely ended by `now` are left out: they speak of the past,
+    which the facts now tell (Modele2's `COMMUNICATION(W2): FALSE` until W1 closes)."""
     facts = list(facts)
     remaining = set(remaining_goals)
     assertions: list[pm.Assertion] = []
@@ -72,6 +75,9 @@ def replanning_problem(problem: pm.Problem, facts: Iterable[Fact], remaining_goa
         if isinstance(a, pm.Event) and a.kind == "explained" and any(_matches(a, f) for f in facts):
             continue  # the present replaces what the problem said of the start
         if a.goal is not None and a.line not in remaining:
+            continue
+        if (a.goal is None and isinstance(a, pm.Hold) and dates is not None
+                and dates.get(a.end, (0.0, math.inf))[1] <= now):
             continue
         assertions.append(a)
     for fact in facts:
