@@ -16,7 +16,12 @@ PERIOD = 0.1  # s, ShotTask period
 EXPOSURE = 2.0  # s per image: annex A's TAKE_PICTURE lasts [2, 6] s (INVENTED within it)
 FEET_TILT = -0.5  # rad: at or below this tilt the camera looks at the ground near the robot
 CAMERA_HEIGHT = 1.0  # m above the ground (INVENTED)
-FEET_RADIUS = 0.8  # m: the patch of ground an image at the robot's feet covers (INVENTED)
+# m: the patch of ground an image at the robot's feet covers, around the point the camera aims at
+# (INVENTED). It holds the robot's own position at both models' AT_MY_FEET: the codels' tilt
+# (platine.AT_MY_FEET, aimed 0.39 m ahead) and Modele2's 45 degrees (annex A.2, aimed 1 m ahead),
+# where a mission's first photo is taken (M1's target under the lander); not at Modele2's moving
+# tilt of 30 degrees (aimed 1.73 m ahead), so a photo taken with the camera there still misses.
+FEET_RADIUS = 1.2
 
 
 def initCamera(sdi):

@@ -18,6 +18,10 @@ K_AHEAD, K_ASIDE, K_HEADING = 1.5, 6.0, 3.0  # Kanayama's gains (tuned in simula
 ARRIVED = 0.01  # m: closer than this, the servo only turns to the setpoint's heading
 BACK_UP = 0.3  # m: a still setpoint nearer than this behind the robot is reached backwards
 DRIFT = 1e-3  # m² of variance per metre travelled on x and y, rad² per radian turned (invented)
+HALF_TRACK = 0.3  # m, half the distance between the drive wheels (invented, as the simulator's)
+STILL = 0.005  # m/s at the wheel rims: slower than this, the robot stands still
+STILL_CYCLES = 4  # still for 4 cycles (0.1 s) on end: at rest, not at the turning point of a last swing
+STOP_LIMIT = 80  # cycles (2 s): a smooth stop that has not brought the robot to rest by then ends anyway
 
 
 def controlRef(sdi, request):
@@ -35,6 +39,7 @@ def findTrackedPoster(sdi, request):
     if sdi.read_poster(request.trackedPoster) is None:
         return "POSTER_NOT_FOUND"
     sdi.trackedPoster = request.trackedPoster
+    sdi.stopCycles = sdi.stillCycles = 0
     return "exec"
 
 
@@ -56,9 +61,17 @@ def pumpReference(sdi, request):
 
 
 def smoothStopTrack(sdi, request):
-    """End and inter phases of Track: stabilise the robot on its current position."""
+    """End and inter phases of Track: stabilise the robot on its current position. The setpoint
+    follows the robot until the wheels have stopped, and only then does Track end: whoever asked
+    for the motion (PILO, and the executive above it) hears of its end once the robot stands
+    still, as taking an object requires (§5.1: "la prise d'un objet [...] exige l'immobilité du
+    robot"; Fig 5.6: ARM-OBJ waits for "l'interruption effective du mouvement"). `inter` runs
+    this codel again next cycle (in the end phase too: the inter codel is this one)."""
     _hold_position(sdi)
-    return "ether"
+    sdi.stopCycles += 1
+    still = abs(sdi.speed.v) + abs(sdi.speed.w) * HALF_TRACK < STILL
+    sdi.stillCycles = sdi.stillCycles + 1 if still else 0
+    return "ether" if sdi.stillCycles >= STILL_CYCLES or sdi.stopCycles >= STOP_LIMIT else "inter"
 
 
 def stopRobot(sdi, request):
@@ -89,13 +102,16 @@ def odoAndAsserv(sdi):
         left, right = hardware.encoders.read()
         dl, dr = left - sdi.encoders.left, right - sdi.encoders.right
         sdi.encoders.left, sdi.encoders.right = left, right
-        _integrate(sdi, (dl + dr) / 2.0, (dr - dl) / hardware.encoders.wheel_base)
+        ds, dtheta = (dl + dr) / 2.0, (dr - dl) / hardware.encoders.wheel_base
+        _integrate(sdi, ds, dtheta)
+        sdi.speed.v, sdi.speed.w = ds / PERIOD, dtheta / PERIOD
     v, w = servo(r.x, r.y, r.theta, sdi.ref)
     if hardware is not None:
         hardware.wheels.drive(v, w)
         hardware.trace.estimated.append((hardware.now, r.x, r.y, r.theta))
     else:
         _integrate(sdi, v * PERIOD, w * PERIOD)
+        sdi.speed.v, sdi.speed.w = v, w
     return "exec"
 
 

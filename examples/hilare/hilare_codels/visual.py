@@ -7,6 +7,7 @@ f(r, θ). Without one, VISUAL simulates them itself, as the thesis' module did.
 
 from __future__ import annotations
 
+import copy
 import math
 import pathlib
 import random
@@ -22,6 +23,11 @@ R_MIN, R_MAX = 0.5, 4.0  # m, invented perception range
 THETA_OPEN = math.radians(60)  # invented field of view
 MAX_OBJECTS = 16
 N_WORLD_OBJECTS = 10  # §5.6: 10 objects scattered in the room
+# A sighting this near an object the model holds is that object seen again: the simulated camera
+# places what it sees from the pose odometry believes, which drifts a few centimetres, so the
+# same object may fall in the next cell. The room's objects stand farther apart than this (the
+# simulator keeps them 0.45 m apart; VISUAL's own ones are a cell apart at least).
+SAME_OBJECT = 0.3  # m
 
 
 def reliability(r, theta):
@@ -58,17 +64,10 @@ def markObstacleCells(sdi, request):
         room = load_world(sdi.modelFile)
     except WorldError:
         return "FILE_NOT_FOUND"
-    sdi.model.free = [True] * (NX * NY)
-    for polygon in room.polygons():
-        xs = [p[0] for p in polygon.points]
-        ys = [p[1] for p in polygon.points]
-        for i in range(int(min(xs) / CELL), int(max(xs) / CELL) + 1):
-            for j in range(int(min(ys) / CELL), int(max(ys) / CELL) + 1):
-                if 0 <= i < NX and 0 <= j < NY:
-                    sdi.model.free[j * NX + i] = False
+    sdi.model.free = free_cells(room)
     wanted = 0 if sdi.hardware is not None else N_WORLD_OBJECTS  # the simulator has its own objects
-    free_cells = _standing_cells(sdi.model.free, room.bounds) if wanted else []
-    chosen = random.sample(free_cells, min(wanted, len(free_cells), MAX_OBJECTS))
+    cells = standing_cells(sdi.model.free, room.bounds) if wanted else []
+    chosen = random.sample(cells, min(wanted, len(cells), MAX_OBJECTS))
     for slot, k in zip(sdi.worldObjects, chosen, strict=False):
         slot.i, slot.j = k % NX, k // NX
         slot.x, slot.y = (slot.i + 0.5) * CELL, (slot.j + 0.5) * CELL
@@ -77,9 +76,24 @@ def markObstacleCells(sdi, request):
     return "ether"
 
 
-def _standing_cells(free, bounds):
-    """The cells where the robot can stand, as EXPLOR's calcObj requires of an object's cell
-    (its centre on the cell's): inside the room, clear of the grown obstacles."""
+def free_cells(room):
+    """The model's free flags (row-major, NX x NY): a cell meeting an obstacle's bounding box is
+    not free (§5.2.4: "les cellules qui ont une intersection avec les obstacles polygonaux")."""
+    free = [True] * (NX * NY)
+    for polygon in room.polygons():
+        xs = [p[0] for p in polygon.points]
+        ys = [p[1] for p in polygon.points]
+        for i in range(int(min(xs) / CELL), int(max(xs) / CELL) + 1):
+            for j in range(int(min(ys) / CELL), int(max(ys) / CELL) + 1):
+                if 0 <= i < NX and 0 <= j < NY:
+                    free[j * NX + i] = False
+    return free
+
+
+def standing_cells(free, bounds):
+    """The cells (row-major indices) where the robot can stand, as EXPLOR's calcObj requires of
+    an object's cell (its centre on the cell's, §5.2.5): inside the room, clear of the grown
+    obstacles. Objects are placed on them, here and by the object hunt (specc.run.hunt)."""
     from hilare_codels.explor import candidate_cells, cells_in_box  # EXPLOR imports this module: import late
 
     xmin, xmax, ymin, ymax = bounds
@@ -136,7 +150,7 @@ def analyseImage(sdi, request):
         if f > 0.0:
             c = sdi.model.certainty[k]
             sdi.model.certainty[k] = c + (1.0 - c) * f
-    detected = {(o.i, o.j) for o in sdi.objects[: sdi.nbObjects]}
+    known = [(o.x, o.y) for o in sdi.objects[: sdi.nbObjects]]
     if sdi.hardware is not None:
         seen = sdi.image.seen[: sdi.image.nbSeen]  # the camera's detections, at takeImage
     else:
@@ -147,10 +161,12 @@ def analyseImage(sdi, request):
             if random.random() < reliability(r, bearing):
                 seen.append(obj)
     for obj in seen:
-        if (obj.i, obj.j) not in detected and sdi.nbObjects < MAX_OBJECTS:
-            sdi.objects[sdi.nbObjects] = obj
+        if sdi.nbObjects < MAX_OBJECTS and all(math.hypot(obj.x - x, obj.y - y) >= SAME_OBJECT for x, y in known):
+            # A copy: the image's slots are written again by the next takeImage (a C struct
+            # assignment copies; a Python one would leave the model pointing at the slot).
+            sdi.objects[sdi.nbObjects] = copy.copy(obj)
             sdi.nbObjects += 1
-            detected.add((obj.i, obj.j))
+            known.append((obj.x, obj.y))
             found += 1
     sdi.image.valid = False
     request.nbFound = found
@@ -179,13 +195,18 @@ def nearestObject(sdi, request):
             sdi.worldObjects[n] = world[-1]
             sdi.nbWorldObjects -= 1
             break
+    # Nor in the image taken before and not analysed yet: searchObject would count it anew.
+    # (Copies, so that no two slots share a record that takeImage writes in place.)
+    kept = [copy.copy(o) for o in sdi.image.seen[: sdi.image.nbSeen]
+            if math.hypot(o.x - sdi.nearest.x, o.y - sdi.nearest.y) >= SAME_OBJECT]
+    sdi.image.seen[: len(kept)], sdi.image.nbSeen = kept, len(kept)
     hardware = sdi.hardware
-    if hardware is not None:  # the simulator's object nearest to the believed one
+    if hardware is not None:  # the simulator's object where VISUAL believes this one is, if any
         left = [n for n in range(len(hardware.objects)) if n not in hardware.trace.taken]
-        if left:
-            k = min(left, key=lambda n: math.hypot(hardware.objects[n][0] - sdi.nearest.x,
-                                                   hardware.objects[n][1] - sdi.nearest.y))
-            hardware.trace.taken.add(k)
+        distance = {n: math.hypot(hardware.objects[n][0] - sdi.nearest.x, hardware.objects[n][1] - sdi.nearest.y)
+                    for n in left}
+        if left and min(distance.values()) < SAME_OBJECT:
+            hardware.trace.taken.add(min(left, key=distance.__getitem__))
     request.object = sdi.nearest
     return "end"
 

@@ -37,6 +37,12 @@ class WheelTravel:
 
 
 @dataclass
+class Speed:
+    v: float = 0.0
+    w: float = 0.0
+
+
+@dataclass
 class LocoData(rt.InternalData):
     """The internal data (SDI) of module loco."""
 
@@ -45,6 +51,9 @@ class LocoData(rt.InternalData):
     ref: Ref = field(default_factory=Ref)
     trackedPoster: str = ""
     encoders: WheelTravel = field(default_factory=WheelTravel)
+    speed: Speed = field(default_factory=Speed)
+    stopCycles: int = 0
+    stillCycles: int = 0
 
 
 @dataclass
@@ -75,7 +84,8 @@ Posit.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", 
 PosError.__specc_fields__ = (("cov", "float", 9),)  # type: ignore[attr-defined]
 Ref.__specc_fields__ = (("x", "float", None), ("y", "float", None), ("theta", "float", None), ("v", "float", None), ("w", "float", None),)  # type: ignore[attr-defined]
 WheelTravel.__specc_fields__ = (("left", "float", None), ("right", "float", None),)  # type: ignore[attr-defined]
-LocoData.__specc_fields__ = (("robot", Posit, None), ("odoError", PosError, None), ("ref", Ref, None), ("trackedPoster", "str", None), ("encoders", WheelTravel, None),)  # type: ignore[attr-defined]
+Speed.__specc_fields__ = (("v", "float", None), ("w", "float", None),)  # type: ignore[attr-defined]
+LocoData.__specc_fields__ = (("robot", Posit, None), ("odoError", PosError, None), ("ref", Ref, None), ("trackedPoster", "str", None), ("encoders", WheelTravel, None), ("speed", Speed, None), ("stopCycles", "int", None), ("stillCycles", "int", None),)  # type: ignore[attr-defined]
 GoToInput.__specc_fields__ = (("ref", Ref, None),)  # type: ignore[attr-defined]
 TrackInput.__specc_fields__ = (("trackedPoster", "str", None),)  # type: ignore[attr-defined]
 RobotPoster.__specc_fields__ = (("robot", Posit, None), ("odoError", PosError, None), ("ref", Ref, None),)  # type: ignore[attr-defined]

@@ -261,7 +261,7 @@ KAS = (
                                     condition=Goal(
                                         op='?',
                                         expr=Compound('<=', (Compound('+', (Var('@N'), Var('@NB'))), 5)),
-                                        line=277,
+                                        line=280,
                                     ),
                                     then=(
                                         Step(
@@ -271,14 +271,15 @@ KAS = (
                                                     head='OBJ-FOUND',
                                                     args=(Compound('+', (Var('@N'), Var('@NB'))),),
                                                 ),
-                                                line=278,
+                                                line=281,
                                             ),
                                         ),
                                     ),
-                                    line=277,
+                                    orelse=(Step(Goal('=>', Compound('OBJ-FOUND', (5,)), 283)),),
+                                    line=280,
                                 ),
                             ),
-                            (Step(Goal('!', Compound('EXEC-REQUEST', ('TURN-CAMERA', Var('@RT'))), 282)),),
+                            (Step(Goal('!', Compound('EXEC-REQUEST', ('TURN-CAMERA', Var('@RT'))), 287)),),
                         ),
                         line=272,
                     ),

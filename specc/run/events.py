@@ -1,0 +1,130 @@
+"""The event log of a run: one JSON object per line (JSONL), stamped with simulated time.
+
+    with EventLog("hunt.jsonl") as log:
+        log.emit(12.5, "reply", service="SEARCH-OBJ", id=312, result=1)
+    read_events("hunt.jsonl")   # [{"t": 12.5, "kind": "reply", "service": "SEARCH-OBJ", ...}]
+
+Every event has `t`, the simulated time in seconds (rounded to the microsecond), and `kind`; the
+other keys depend on the kind. The log is deterministic: keys sorted, floats as Python writes
+them (shortest round-trip form), no wall-clock time anywhere, so one seed gives one file. Events
+stay in memory too (`EventLog.events`), exactly as `read_events` gives them back.
+
+Kinds written by the runners (a runner may add its own; a reader ignores the kinds it does not
+know):
+
+| kind | when | fields |
+| --- | --- | --- |
+| `mission-start` | the run begins | what the run was asked (e.g. `seed`, `horizon`, `goal`, the `objects` placed) |
+| `goal` | a goal is posted to the supervisor, and when it ends | `goal`, `status` (posted, succeeded, failed) |
+| `request` | the task level asks the executive for a service (RQST EXEC, §3.9) | `service`, `id` |
+| `activity` | an executive activity changes phase (Fig 3.3; WAIT→INIT is its start) | `service`, `id`, `from`, `to` |
+| `reply` | the executive answers `(REPLY id result)` | `service`, `id`, `result`, `detail` |
+| `warning` | the executive sends `(WARNING service id type)` | `service`, `id`, `type`, `detail` |
+| `fact` | a fact of the supervisor's database is concluded or retracted | `fact`, `change` |
+| `operator` | a procedure tells the operator something (WARN-OPERATOR) | `text` |
+| `robot-motion` | the robot starts or stops moving (true motion, from the simulator) | `moving`, `x`, `y`, `theta` |
+| `arm-motion` | the arm starts or stops moving | `moving`, `service` (the arm service driving it) |
+| `object-detected` | the camera sees an object for the first time | `object`, `x`, `y` |
+| `object-retrieved` | GET-NEAR-OBJ hands an object over | `object`, `x`, `y` (null: none there), `seen_x`, `seen_y` |
+| `object-taken` | a take cycle ends with the object on the robot | `object`, `x`, `y`, `taken` |
+| `alarm` | trouble the procedures miss (robot blocked, executive ERROR, empty take, ...) | `what`, `detail` |
+| `mission-end` | the run ends | `outcome` (succeeded, failed, horizon), `why`, and the run's figures |
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from types import TracebackType
+from typing import IO, Any
+
+from specc.run import RunError
+
+RESERVED = ("t", "kind")  # every event's own keys: no field may take their names
+TIME_DIGITS = 6  # simulated time is written to the microsecond
+
+
+def encode(event: dict[str, Any]) -> str:
+    """One event as its line of the log (without the newline)."""
+    return json.dumps(event, sort_keys=True, separators=(",", ":"), allow_nan=False, ensure_ascii=False)
+
+
+class EventLog:
+    """Events in memory, and written to `path` as they come when a path is given."""
+
+    def __init__(self, path: str | Path | None = None) -> None:
+        self.path = Path(path) if path is not None else None
+        self.events: list[dict[str, Any]] = []
+        self._file: IO[str] | None = None
+        self._closed = False
+        if self.path is not None:
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                self._file = self.path.open("w", encoding="utf-8", newline="\n")
+            except OSError as error:
+                raise RunError(f"{self.path}: cannot write the event log ({error.strerror or error})") from None
+
+    def emit(self, time: float, kind: str, **fields: Any) -> dict[str, Any]:
+        """Record one event at simulated time `time`; returns it as the log holds it."""
+        if self._closed:
+            raise RunError(f"event '{kind}' at {time} s: the event log is closed")
+        if not isinstance(kind, str) or not kind:
+            raise RunError(f"an event's kind must be a non-empty string, not {kind!r}")
+        if not isinstance(time, int | float) or isinstance(time, bool) or not math.isfinite(time):
+            raise RunError(f"event '{kind}': its time must be a finite number of seconds, not {time!r}")
+        clash = [name for name in RESERVED if name in fields]
+        if clash:
+            raise RunError(f"event '{kind}': field '{clash[0]}' is reserved (every event has t and kind)")
+        try:
+            line = encode({"t": round(float(time), TIME_DIGITS), "kind": kind, **fields})
+        except (TypeError, ValueError) as error:
+            raise RunError(f"event '{kind}' at {time} s cannot be written as JSON: {error}") from None
+        # What the log holds is what a reader gets back: tuples become lists, keys strings.
+        event: dict[str, Any] = json.loads(line)
+        self.events.append(event)
+        if self._file is not None:
+            self._file.write(line + "\n")
+        return event
+
+    def of_kind(self, *kinds: str) -> list[dict[str, Any]]:
+        """The events of these kinds, in order."""
+        return [e for e in self.events if e["kind"] in kinds]
+
+    def close(self) -> None:
+        """Flush and close the file (the events stay in memory); closing twice is harmless."""
+        self._closed = True
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> EventLog:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
+                 traceback: TracebackType | None) -> None:
+        self.close()
+
+
+def read_events(path: str | Path) -> list[dict[str, Any]]:
+    """The events of a log file, in order (blank lines are skipped)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise RunError(f"{path}: cannot read the event log ({error.strerror or error})") from None
+    except UnicodeDecodeError:
+        raise RunError(f"{path}: not an event log (not UTF-8 text)") from None
+    events = []
+    for number, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            event = json.loads(line)
+        except json.JSONDecodeError as error:
+            raise RunError(f"{path}:{number}: not a JSON event ({error.msg})") from None
+        if not isinstance(event, dict) or not isinstance(event.get("kind"), str) \
+                or not isinstance(event.get("t"), int | float):
+            raise RunError(f"{path}:{number}: an event must be a JSON object with a time 't' and a 'kind'")
+        events.append(event)
+    return events

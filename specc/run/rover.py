@@ -1,0 +1,879 @@
+"""The rover missions of seed 004 (§4.1, §4.2), end to end on the simulated ATRV (issue #9).
+
+    run = run_rover_mission("Robot1/2", "M1", "W2", seed=0, log=EventLog("m1w2.jsonl"))
+    run.result.success, run.photos, run.communications, run.actions   # what happened
+    measure(run)                                  # specc.run.measures: the figures of §4.1.4
+    run.draw("m1w2.png")                          # the world, the path, the windows
+
+FTplan (`specc.runtime.ftplan`) plans the mission with the configuration's planners, each in its
+own process, and hands every valid plan to `SimExecutor`. The executor carries it out through the
+ATRV's six generated modules (RFLEX, SICK, NDD, PLATINE, CAMERA, ANTENNA) on the simulated rover,
+on one kernel whose clock is the mission time: planning time charged by FTplan passes on it too,
+the robot standing still meanwhile.
+
+How a plan's tasks become module requests (the OpenPRS procedures of §4.1.1, which both models
+share, in their simplest form; Modele1's task, then Modele2's):
+
+- MOVE, MOVE_NOMINAL, MOVE_RECOV: ndd.GotoTarget(x, y, 0.3) to where FTplan's state rules put
+  the robot when the move ends: (x2, y2) for MOVE, the mission's place for Modele2 (its `view`);
+- MOVE_PAN_TILT_UNIT, MOVE_PTU: platine.MoveTo(pan, tilt), to the codels' STRAIGHT and
+  AT_MY_FEET, or to Modele2's own angles (degrees);
+- TAKE_PICTURE, TAKE_SHOT: camera.TakePicture(target), the world's target (`M2_OBJ1`) of the
+  PICTURE fact the photo's end makes DONE;
+- COMMUNICATE, COMMUNICATE_ANTENNA: antenna.Communicate(the task's shortest duration);
+- INIT_PTU_DRIVER, INIT_PTU: platine.Init;
+- INIT_MVT_GENERATION, INIT_FRAME: ndd.Stop, then rflex.Stop.
+
+The modules judge the outcome: NDD fails a move it cannot finish (BLOCKED, NO_PROGRESS when the
+robot is trapped, as in W4's pocket), CAMERA a photo whose target is not in the image, ANTENNA a
+communication no visibility window holds. The executor adds temporal execution control: an
+action still running at its start plus its planned longest duration has failed, and is stopped.
+Every move reports `ROBOT_POSITION(x, y)`, the odometry where the robot stands, before its end or
+its failure (FTplan's state rules then place the robot, and a replanning starts from there).
+
+What the log holds (`specc.run.events`), each event at its mission time: `mission-start` (the
+configuration, planners, seed, timing, the windows as drawn, the photo targets), every event of
+FTplan's own log as `ftplan` (`event`: plan-request, plan, execute, report, goal-met, watchdog,
+invalid-plan, action-failed, safe-state, operator, mission-failure, mission-end; `text`,
+`planner`), every `action` as it starts and as it ends, fails or is stopped (`status`, `plan`,
+`id`, `task`, `args`, `latest_end` at its start, `why`), every `photo` (`target`, `ok`, `seen`,
+where the robot stood, the pan-tilt unit's angles) and `communication` (`window`, `ok`, `start`,
+`link`: the window that held it), then `mission-end` (`outcome`, `why`, goals, plannings,
+planner failures, distance).
+
+Where the thesis is silent (INVENTED):
+- the visibility windows' real opening and closing instants are drawn with the seed, uniformly in
+  the bounds of the mission's contingent events (missions.md: "W1 [125..127, 154..156]");
+- a communication asks ANTENNA for the task's shortest duration (18 s): the module's 0.5 s period
+  lengthens it a little, and asking for the longest would always overrun the plan's bound;
+- the initialisations are control requests: they take no time.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import math
+import sys
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from specc.run import RunError
+from specc.run.events import EventLog
+from specc.runtime import functional as rt
+from specc.runtime.ftplan import (
+    FtPlan,
+    MissionResult,
+    MissionSetup,
+    ProcessPool,
+    Report,
+    UnknownName,
+    mission_setup,
+)
+from specc.runtime.ftplan.config import FtPlanConfig
+from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution
+from specc.runtime.ftplan.state import FactKey, SystemState, consequences, constant, constant_key
+from specc.runtime.ftplan.view import View
+from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import Action, Plan, Value, format_value
+from specc.runtime.sim import ATRV, Simulation, Target, Window, World, WorldError, load_world
+
+ROOT = Path(__file__).resolve().parents[2]
+GENERATED = ROOT / "generated"  # where `specc compile examples/atrv -o generated` writes the package
+EXAMPLE = ROOT / "examples" / "atrv"  # the codels (atrv_codels) and the worlds
+WORLDS = EXAMPLE / "worlds"
+ROBOT = "atrv"
+CODELS = "atrv_codels"
+FTPLAN_BLOCK = "rover"  # the `ftplan` block of examples/atrv/ftplan.spec
+TIMINGS = ("model", "wall")  # FtPlan's: a deterministic planning charge, or the measured wall time
+
+MOVE_TOLERANCE = 0.3  # m around a move's target that NDD counts as there (run_sim.py's)
+# Pan-tilt positions of Modele1 that the codels do not name. OTHER_POSITION is a position that is
+# neither (INVENTED: looking up); a plan asks for it only through a faulty model.
+OTHER_POSITION = (0.0, 0.5)
+SETTLE_LIMIT = 2.0  # s a stopped robot is given to come to rest (the motors ramp at 1 m/s²)
+STILL_SPEED = 1e-3  # m/s at the wheel rims: slower than this, the robot stands still
+# An action whose plan gives it no finite longest duration is stopped after this long (no task
+# of Modele1 or Modele2 is unbounded: a faulty model's action must not run for ever).
+UNBOUNDED_ACTION_LIMIT = 600.0
+WINDOW_STREAM = 0x57A7E11  # mixed with the seed for the windows' instants, apart from the simulator's streams
+POSITION_DIGITS = 2  # the odometry reported to FTplan, to the centimetre
+
+# The state attributes FTplan's rules use for where the robot is and which photo is done.
+ROBOT_X, ROBOT_Y = "AT_ROBOT_X", "AT_ROBOT_Y"
+PICTURE = "PICTURE"
+COMMUNICATION = "COMMUNICATION"
+
+# What each task of Modele1 and Modele2 is, for the executor.
+MOVE, PAN_TILT, PHOTO, LINK, PTU_INIT, MOTION_INIT = "move", "pan-tilt", "photo", "communication", \
+    "pan-tilt init", "motion init"
+TASK_KINDS = {
+    "MOVE": MOVE, "MOVE_NOMINAL": MOVE, "MOVE_RECOV": MOVE,
+    "MOVE_PAN_TILT_UNIT": PAN_TILT, "MOVE_PTU": PAN_TILT,
+    "TAKE_PICTURE": PHOTO, "TAKE_SHOT": PHOTO,
+    "COMMUNICATE": LINK, "COMMUNICATE_ANTENNA": LINK,
+    "INIT_PTU_DRIVER": PTU_INIT, "INIT_PTU": PTU_INIT,
+    "INIT_MVT_GENERATION": MOTION_INIT, "INIT_FRAME": MOTION_INIT,
+}
+# NDD's failures, as a person reads them (examples/atrv/modules/ndd.spec).
+NAVIGATION_FAILURES = {
+    "NO_PROGRESS": "the goal came no closer for {progress:g} s: the robot is trapped",
+    "BLOCKED": "the wheels turned and the robot did not move",
+    "LASER_FAILURE": "the laser scanner returned no echo",
+    "POSE_NOT_FOUND": "no odometry to navigate with",
+    "BAD_GOAL": "the target is not a valid goal",
+}
+
+
+# ---------------------------------------------------------------- what a run leaves
+
+
+@dataclass(frozen=True)
+class MissionGoal:
+    """A goal of the mission, as FTplan stated and judged it. The return home is one goal (FTplan
+    has one for each coordinate)."""
+
+    kind: str  # photo | communication | return
+    name: str  # the world's photo target (M1_OBJ2), the window (W1), or "home"
+    point: tuple[float, float] | None  # where the photo or the return is asked
+    text: str  # FTplan's statement of it
+    met: bool  # in FTplan's ledger
+    why: str = ""  # why FTplan counts it missed
+
+
+@dataclass(frozen=True)
+class Photo:
+    """A photograph CAMERA took or failed to take."""
+
+    time: float
+    x: float  # the robot's true position
+    y: float
+    pan: float  # rad, the pan-tilt unit's true position
+    tilt: float
+    target: str  # the target asked for ("" for any)
+    seen: tuple[str, ...]  # the targets in the image
+    ok: bool
+    why: str = ""
+
+
+@dataclass(frozen=True)
+class Communication:
+    """A communication ANTENNA attempted for a window of the mission."""
+
+    window: str  # the window the plan meant it for
+    start: float
+    end: float
+    ok: bool
+    link: str = ""  # the window that held it (when ok)
+    why: str = ""
+
+
+@dataclass(frozen=True)
+class ExecutedAction:
+    """An action of a plan as it ran: for a Gantt chart."""
+
+    plan: int  # which plan FTplan executed, from 1
+    id: str  # the plan's id ("MOVE#3")
+    task: str
+    args: tuple[Value, ...]
+    start: float
+    end: float
+    outcome: str  # ended | failed | stopped (running when another action failed)
+    why: str = ""
+
+    def text(self) -> str:
+        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+
+
+@dataclass(frozen=True)
+class PlannedTask:
+    """An action of a plan FTplan executed, as planned."""
+
+    plan: int
+    domain: str  # the planning model that made the plan
+    id: str
+    text: str
+    dispatch: float
+    latest_end: float
+
+
+@dataclass(frozen=True)
+class RoverRun:
+    configuration: str
+    mission: str
+    world: str
+    seed: int
+    timing: str
+    policy: str  # FTplan's recovery: successive (Fig 3.1) or concurrent (Fig 3.2)
+    result: MissionResult  # FTplan's: goals met and missed, plannings, planner failures, events, trace
+    goals: tuple[MissionGoal, ...]
+    windows: tuple[Window, ...]  # the visibility windows as nature opened and closed them
+    photos: tuple[Photo, ...]
+    communications: tuple[Communication, ...]
+    actions: tuple[ExecutedAction, ...]
+    planned: tuple[PlannedTask, ...]
+    path: tuple[tuple[float, float, float, float], ...]  # t, true x, y, theta every 0.1 s
+    distance: float  # m the robot really travelled
+    simulated_time: float  # s: the mission time at the end
+    wall_time: float  # s
+    events: tuple[dict[str, Any], ...]  # the event log
+    simulation: Simulation = field(compare=False, repr=False)
+
+    @property
+    def final_position(self) -> tuple[float, float]:
+        _, x, y, _ = self.path[-1]
+        return x, y
+
+    def draw(self, path: str | Path) -> Path:
+        """A PNG of the run: the world, the robot's path, the photo targets, the windows."""
+        from specc.runtime.sim.render import draw
+
+        outcome = "success" if self.result.success else f"{len(self.result.missed)} goal(s) missed"
+        return draw(self.simulation, path, title=f"{self.configuration} on {self.mission} in {self.world}: {outcome}")
+
+
+class RoverProgress(NamedTuple):
+    """What `progress` receives at every action's start and end, and at the mission's end."""
+
+    time: float  # mission time
+    goals_met: int  # so far, in FTplan's ledger
+    goals: int
+    what: str  # "started MOVE(0, 0, 4, 0)"
+
+
+Emit = Callable[..., Any]  # EventLog.emit's signature: (time, kind, **fields)
+
+
+# ---------------------------------------------------------------- the generated package
+
+
+class AtrvPackage(NamedTuple):
+    modules: ModuleType  # atrv.modules
+    planner: ModuleType  # atrv.planner
+    ftplan: ModuleType  # atrv.ftplan.rover
+
+
+def load_package(generated: Path = GENERATED, example: Path = EXAMPLE) -> AtrvPackage:
+    """The compiled atrv package imported from `generated`, the codels from `example` (a package
+    of the same name imported from elsewhere is forgotten first, so the one asked for runs)."""
+    generated, example = Path(generated).resolve(), Path(example).resolve()
+    if not (generated / ROBOT / "__init__.py").is_file():
+        raise RunError(f"{generated}: no compiled {ROBOT} package in this folder; "
+                       f"run `specc compile examples/{ROBOT} -o {generated}` first")
+    if not (example / CODELS / "__init__.py").is_file():
+        raise RunError(f"{example}: not the {ROBOT} example folder (no {CODELS}/ with the codels in it)")
+    for folder, package in ((example, CODELS), (generated, ROBOT)):
+        while str(folder) in sys.path:
+            sys.path.remove(str(folder))
+        sys.path.insert(0, str(folder))
+        loaded = sys.modules.get(package)
+        origin = getattr(loaded, "__file__", None)
+        if loaded is not None and (origin is None or not Path(origin).resolve().is_relative_to(folder)):
+            for name in [n for n in sys.modules if n == package or n.startswith(package + ".")]:
+                del sys.modules[name]
+    try:
+        return AtrvPackage(importlib.import_module(f"{ROBOT}.modules"), importlib.import_module(f"{ROBOT}.planner"),
+                           importlib.import_module(f"{ROBOT}.ftplan.{FTPLAN_BLOCK}"))
+    except ImportError as error:
+        raise RunError(f"{generated}/{ROBOT}: the compiled package is incomplete or stale ({error}); "
+                       f"run `specc compile examples/{ROBOT} -o {generated}` again") from None
+
+
+def resolve_world(world: str | Path | World) -> World:
+    """W1..W4 name the worlds of examples/atrv/worlds; a path names a world file; a World is
+    used as it is."""
+    if isinstance(world, World):
+        return world
+    text = str(world)
+    if text.upper() in {f"W{k}" for k in range(1, 5)}:
+        path = WORLDS / f"{text.upper()}.toml"
+    elif text.endswith(".toml") or Path(text).exists():
+        path = Path(text)
+    else:
+        raise RunError(f"unknown world '{text}': give W1, W2, W3, W4 (examples/atrv/worlds) or a world file (.toml)")
+    try:
+        return load_world(path)
+    except WorldError as error:
+        raise RunError(str(error)) from None
+
+
+# ---------------------------------------------------------------- the rover on the kernel
+
+
+class Clients(NamedTuple):
+    """A client per module of the ATRV, on one registry with the simulation."""
+
+    rflex: Any
+    sick: Any
+    ndd: Any
+    platine: Any
+    camera: Any
+    antenna: Any
+
+
+@dataclass
+class Rover:
+    registry: rt.Registry
+    sim: Simulation
+    clients: Clients
+
+    @property
+    def kernel(self) -> Any:
+        return self.registry.kernel
+
+    def client(self, module: str) -> Any:
+        return getattr(self.clients, module)
+
+
+def build_rover(modules: ModuleType, world: World, seed: int) -> Rover:
+    """The six generated modules with the simulated ATRV in `world` (run_sim.py's `build`)."""
+    registry = rt.Registry()
+    try:
+        sim = Simulation(world, ATRV, seed=seed, kernel=registry.kernel).attach(registry)
+    except WorldError as error:  # what the world asks cannot be built (objects without room)
+        raise RunError(str(error)) from None
+    made = modules.create_all(registry)
+    clients = Clients(*(modules.MODULES[name].client(made[name]) for name in Clients._fields))
+    return Rover(registry, sim, clients)
+
+
+# ---------------------------------------------------------------- the mission on the rover
+
+
+@dataclass(frozen=True)
+class Request:
+    """One request of an action to a module, with its inputs."""
+
+    module: str
+    name: str
+    args: tuple[float | str, ...] = ()
+
+    def text(self) -> str:
+        args = ", ".join(f"{a:g}" if isinstance(a, float) else repr(a) for a in self.args)
+        return f"{self.module}.{self.name}({args})"
+
+
+@dataclass(frozen=True)
+class RoverTasks:
+    """How the tasks of one mission's plans become the ATRV's requests: where a move goes and
+    which target a photo is of, read from FTplan's own state rules and each planner's view (a
+    Modele2 place is where the mission's view puts it), so that nothing of a mission is written
+    twice."""
+
+    mission: str
+    config: FtPlanConfig  # the configuration on the mission (`FtPlanConfig.for_mission`)
+    targets: Mapping[str, Target]  # the world's photo target of each PICTURE object ("OBJ1")
+
+    @classmethod
+    def of(cls, config: FtPlanConfig, problem: pm.Problem, mission: str, world: World) -> RoverTasks:
+        """The mission's photo targets must be in the world, where the mission asks for them."""
+        in_world = {t.name: t for t in world.targets}
+        targets = {}
+        for goal in SystemState.from_problem(problem).goals:
+            if goal.attribute != PICTURE or len(goal.args) != 3:
+                continue
+            obj, x, y = goal.args
+            name = target_name(mission, str(obj))
+            target = in_world.get(name)
+            if target is None or not (math.isclose(target.x, float(x), abs_tol=1e-6)
+                                      and math.isclose(target.y, float(y), abs_tol=1e-6)):
+                raise RunError(f"world {world.name} ({world.source or 'no file'}) has no photo target {name} at "
+                               f"({format_value(x)}, {format_value(y)}), which mission {mission} photographs")
+            targets[str(obj)] = target
+        return cls(mission, config, targets)
+
+    def view(self, plan: Plan) -> View | None:
+        """The correspondences of the planner whose model made `plan` (None: FTplan's vocabulary)."""
+        planner = next((p for p in self.config.planners if p.domain == plan.domain), None)
+        return View(planner.view) if planner is not None and planner.view else None
+
+    def effects(self, plan: Plan, action: Action) -> dict[FactKey, Value]:
+        """What FTplan's state becomes when the action ends, in FTplan's vocabulary."""
+        return dict(consequences(self.config.state_rules, "ended", action.task, action.args, self.view(plan)))
+
+    def requests(self, plan: Plan, action: Action) -> tuple[Request, ...]:
+        """The requests that carry `action` out, one after the other. Raises RunError for a task
+        the rover cannot carry out (the message is the action's failure)."""
+        from atrv_codels.platine import AT_MY_FEET, STRAIGHT  # importable once the package is loaded
+
+        kind = TASK_KINDS.get(action.task)
+        if kind == MOVE:
+            effects = self.effects(plan, action)
+            x, y = effects.get((ROBOT_X, ())), effects.get((ROBOT_Y, ()))
+            if not isinstance(x, float) or not isinstance(y, float):
+                raise RunError(f"FTplan's state rules and views do not say where {action.text()} goes")
+            return (Request("ndd", "GotoTarget", (x, y, MOVE_TOLERANCE)),)
+        if kind == PAN_TILT:
+            if action.task == "MOVE_PTU":  # Modele2's angles, in degrees
+                pan, tilt = (math.radians(float(a)) for a in action.args[2:4])
+            else:
+                named = {"STRAIGHT": STRAIGHT, "AT_MY_FEET": AT_MY_FEET, "OTHER_POSITION": OTHER_POSITION}
+                if str(action.args[-1]) not in named:
+                    raise RunError(f"{action.text()}: no pan-tilt position is called {format_value(action.args[-1])}")
+                pan, tilt = named[str(action.args[-1])]
+            return (Request("platine", "MoveTo", (pan, tilt)),)
+        if kind == PHOTO:
+            # The photo of the PICTURE(obj, x, y) its end makes DONE; a photo that makes none (a
+            # Modele2 SHOT of a place no target stands at) is of whatever target the image shows.
+            done = [args for (attribute, args) in self.effects(plan, action) if attribute == PICTURE and args]
+            target = target_name(self.mission, format_value(done[0][0])) if done else ""
+            return (Request("camera", "TakePicture", (target,)),)
+        if kind == LINK:
+            return (Request("antenna", "Communicate", (max(action.duration[0], 1.0),)),)
+        if kind == PTU_INIT:
+            return (Request("platine", "Init"),)
+        if kind == MOTION_INIT:
+            return (Request("ndd", "Stop"), Request("rflex", "Stop"))
+        raise RunError(f"the ATRV has no procedure for task {action.task}")
+
+
+def target_name(mission: str, obj: str) -> str:
+    """The world's name of a mission's photo target: OBJ2 of M1 is M1_OBJ2."""
+    return f"{mission}_{obj}"
+
+
+def mission_windows(problem: pm.Problem, seed: int) -> tuple[Window, ...]:
+    """The visibility windows of the mission, each opening and closing at an instant nature draws
+    (with the seed) uniformly within the bounds of its contingent events."""
+    dates = SystemState.from_problem(problem).dates
+    opening: dict[str, tuple[float, float]] = {}
+    closing: dict[str, tuple[float, float]] = {}
+    for a in problem.assertions:
+        if not (isinstance(a, pm.Event) and a.kind == "contingent" and a.attribute == "VISIBILITY_WINDOW"):
+            continue
+        key, before, after = constant_key(a.attribute, a.args), constant(a.before), constant(a.after)
+        if key is None or a.time == problem.start or a.time not in dates or len(key[1]) != 1:
+            continue
+        if (before, after) == ("OUT", "IN"):
+            opening[str(key[1][0])] = dates[a.time]
+        elif (before, after) == ("IN", "OUT"):
+            closing[str(key[1][0])] = dates[a.time]
+    rng = np.random.default_rng([WINDOW_STREAM, seed])
+    windows = []
+    for name in sorted(opening, key=lambda n: opening[n]):
+        if name not in closing:
+            continue
+        start = round(float(rng.uniform(*opening[name])), 3)
+        end = round(float(rng.uniform(*closing[name])), 3)
+        windows.append(Window(name, start, max(end, start)))
+    return tuple(windows)
+
+
+def mission_goals(problem: pm.Problem, mission: str, state: SystemState | None = None) -> tuple[MissionGoal, ...]:
+    """The mission's goals by kind, as FTplan judged them in `state` (its ledger at the end)."""
+    ledger = state or SystemState.from_problem(problem)
+    goals: list[MissionGoal] = []
+    home: list[Any] = []
+    for goal in ledger.goals:
+        met = goal.line in ledger.met
+        why = ledger.missed.get(goal.line, "")
+        if goal.attribute == PICTURE and len(goal.args) == 3:
+            obj, x, y = goal.args
+            goals.append(MissionGoal("photo", target_name(mission, str(obj)), (float(x), float(y)), goal.text(), met,
+                                     why))
+        elif goal.attribute == COMMUNICATION and len(goal.args) == 1:
+            goals.append(MissionGoal("communication", str(goal.args[0]), None, goal.text(), met, why))
+        elif goal.attribute in (ROBOT_X, ROBOT_Y) and not goal.args:
+            home.append((goal, met, why))
+    if home:
+        point = {g.attribute: float(g.value) for g, _, _ in home if isinstance(g.value, float)}
+        goals.append(MissionGoal("return", "home", (point.get(ROBOT_X, 0.0), point.get(ROBOT_Y, 0.0)),
+                                 "; ".join(g.text() for g, _, _ in home), all(met for _, met, _ in home),
+                                 "; ".join(why for _, _, why in home if why)))
+    return tuple(goals)
+
+
+# ---------------------------------------------------------------- the executor
+
+
+@dataclass
+class _Running:
+    """An action under way: its requests, sent one after the other."""
+
+    plan: int
+    action: Action
+    requests: tuple[Request, ...]
+    started: float
+    deadline: float  # its start plus its planned longest duration
+    step: int = 0
+    rqst_id: int | None = None
+    finished: float | None = None  # when it ended or failed
+    ok: bool = False
+    why: str = ""
+
+
+class _Precedences:
+    """The plan's orderings between actions, as ScriptedExecutor reads them: an action starts at
+    its dispatch date, or later when an action ordered before it ends late (plus the delay)."""
+
+    def __init__(self, plan: Plan) -> None:
+        by_end = {a.end: a for a in plan.actions}
+        by_start = {a.start: a for a in plan.actions}
+        self.after: dict[str, list[tuple[str, float]]] = {a.id: [] for a in plan.actions}
+        for first, second, delay in plan.orderings:
+            before, action = by_end.get(first), by_start.get(second)
+            if before is not None and action is not None and before is not action:
+                self.after[action.id].append((before.id, delay))
+
+    def start_date(self, action: Action, ended_at: Mapping[str, float], now: float) -> float | None:
+        """When the action may start, None while an action before it has not ended."""
+        if not all(p in ended_at for p, _ in self.after[action.id]):
+            return None
+        return max(now, action.dispatch, *(ended_at[p] + d for p, d in self.after[action.id]))
+
+
+class SimExecutor:
+    """FTplan's `Executor` on the simulated ATRV: each action of a plan is carried out by the
+    generated modules on the simulation's kernel (see the module's docstring), in mission time.
+
+    Actions start at their dispatch date, or when the actions the plan orders before them end;
+    those the plan lets overlap run together on the kernel. The first action to fail ends the
+    execution; `safe_state` then stops whatever still runs and lets the robot come to rest."""
+
+    def __init__(self, rover: Rover, tasks: RoverTasks, emit: Emit | None = None) -> None:
+        self.rover = rover
+        self.tasks = tasks
+        self.emit = emit
+        self.kernel = rover.kernel
+        self.plans = 0
+        self.photos: list[Photo] = []
+        self.communications: list[Communication] = []
+        self.actions: list[ExecutedAction] = []
+        self.planned: list[PlannedTask] = []
+        self._live: list[_Running] = []  # actions under way, also after a failure ended the execution
+        self._stopping: list[tuple[Any, int]] = []  # (client, request) interrupted, not yet ended
+
+    # ------------------------------------------------------------ Executor
+    def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
+        self.plans += 1
+        number = self.plans
+        self._catch_up(now)
+        for action in plan.ordered():
+            self.planned.append(PlannedTask(number, plan.domain, action.id, action.text(), action.dispatch,
+                                            plan.ends_by(action)))
+        precedences = _Precedences(plan)
+        waiting = plan.ordered()
+        ended_at: dict[str, float] = {}
+        while True:
+            for run in sorted((r for r in self._live if r.finished is not None), key=lambda r: (r.finished, r.started)):
+                self._live.remove(run)
+                self._conclude(run, report)
+                if not run.ok:
+                    return Execution(False, self.kernel.now, run.action.id, run.why)
+                assert run.finished is not None
+                ended_at[run.action.id] = run.finished
+            now = self.kernel.now
+            dates = [(date, a) for a in waiting if (date := precedences.start_date(a, ended_at, now)) is not None]
+            for date, action in sorted(dates, key=lambda d: (d[0], d[1].dispatch, d[1].id)):
+                if date <= now + OVERRUN_TOLERANCE:
+                    waiting.remove(action)
+                    self._start(number, plan, action, report)
+            if not waiting and not self._live:
+                return Execution(True, self.kernel.now)
+            if any(r.finished is not None for r in self._live):
+                continue  # an action that ended as it started (a control request)
+            upcoming = [date for date, action in dates if action in waiting]
+            if not upcoming and not self._live:  # an ordering no action ends: the plan is malformed
+                stuck = ", ".join(a.text() for a in waiting)
+                return Execution(False, now, waiting[0].id, f"{stuck} wait for actions that never end")
+            wake = min(upcoming + [r.deadline for r in self._live])
+            # Every action advanced after each kernel event (no short cut: each sends its next
+            # request at the instant the one before ended).
+            self.kernel.run_while(lambda: not any([self._advance(r) for r in self._live]), wake)
+            for run in self._live:
+                if run.finished is None and self.kernel.now >= run.deadline - OVERRUN_TOLERANCE:
+                    self._overrun(run)
+
+    def safe_state(self, now: float) -> float:
+        """Interrupt every request still running, stop the wheels, and wait for the robot to stand
+        and the requests to end."""
+        self._catch_up(now)
+        for run in list(self._live):  # what ran beside the failed action: FTplan hears no more of it
+            self._live.remove(run)
+            if run.finished is not None:
+                self._record(run, "ended" if run.ok else "failed", run.why, run.finished)
+            else:
+                self._interrupt(run)
+                self._record(run, "stopped", "stopped: the system was brought to a safe state")
+        self._come_to_rest()
+        return self.kernel.now
+
+    # ------------------------------------------------------------ one action
+    def _start(self, number: int, plan: Plan, action: Action, report: Callable[[Report], None]) -> None:
+        now = self.kernel.now
+        longest = action.duration[1] if math.isfinite(action.duration[1]) else UNBOUNDED_ACTION_LIMIT
+        run = _Running(number, action, (), now, now + longest)
+        report(Report("started", action.task, action.args, now, action.id))
+        self._event(now, "action", status="started", plan=number, id=action.id, task=action.task,
+                    args=list(action.args), latest_end=round(run.deadline, 6))
+        try:
+            run.requests = self.tasks.requests(plan, action)
+        except RunError as error:
+            run.finished, run.why = now, f"{action.text()} cannot be carried out: {error}"
+        self._live.append(run)
+        self._advance(run)
+
+    def _advance(self, run: _Running) -> bool:
+        """Send the action's next request when the one before has ended well; True when the
+        action is over (ended or failed). Called after every kernel event while it runs."""
+        if run.finished is not None:
+            return True
+        while True:
+            request = run.requests[run.step]
+            client = self.rover.client(request.module)
+            if run.rqst_id is None:
+                run.rqst_id = getattr(client, request.name)(*request.args)
+            reply = client.reply(run.rqst_id)
+            if reply.status is rt.Status.WAITING:
+                return False
+            self._replied(run, request, reply)
+            # Over when the executor has the reply (a module replies once its children have ended).
+            if not reply.ok:
+                run.finished, run.why = self.kernel.now, self._failure(run, request, reply)
+                return True
+            run.step, run.rqst_id = run.step + 1, None
+            if run.step == len(run.requests):
+                run.finished, run.ok = self.kernel.now, True
+                return True
+
+    def _overrun(self, run: _Running) -> None:
+        """Temporal execution control (seed 004 §3.2.2.2, IxTeT's): an action still running past
+        its planned latest end has failed; it is stopped then."""
+        low, high = run.action.duration
+        run.finished = self.kernel.now
+        run.why = (f"{run.action.text()} overran its planned duration [{low:.3g}, {high:.3g}] s: still running "
+                   f"{self.kernel.now - run.started:.3g} s after it started")
+        self._interrupt(run)
+
+    def _conclude(self, run: _Running, report: Callable[[Report], None]) -> None:
+        """The action's reports to FTplan: where the robot stands after a move (once it has
+        come to rest when the move failed), then its end or its failure."""
+        action = run.action
+        moved = TASK_KINDS.get(action.task) == MOVE
+        if moved and not run.ok:
+            self._come_to_rest()
+        now = run.finished if run.ok and run.finished is not None else self.kernel.now
+        if moved:
+            x, y = self._odometry()
+            report(Report("report", "ROBOT_POSITION", (x, y), now, action.id))
+        status = "ended" if run.ok else "failed"
+        report(Report(status, action.task, action.args, now, action.id, "" if run.ok else run.why))
+        self._record(run, status, run.why, now)
+
+    def _record(self, run: _Running, outcome: str, why: str, end: float | None = None) -> None:
+        end = self.kernel.now if end is None else end
+        action = run.action
+        self.actions.append(ExecutedAction(run.plan, action.id, action.task, action.args, run.started, end, outcome,
+                                           why))
+        self._event(end, "action", status=outcome, plan=run.plan, id=action.id, task=action.task,
+                    args=list(action.args), **({"why": why} if why else {}))
+
+    def _interrupt(self, run: _Running) -> None:
+        """Abort the action's request under way; `_come_to_rest` waits for it to wind down."""
+        if run.rqst_id is not None and run.step < len(run.requests):
+            client = self.rover.client(run.requests[run.step].module)
+            if client.reply(run.rqst_id).status is rt.Status.WAITING:
+                client.abort(run.rqst_id)
+                self._stopping.append((client, run.rqst_id))
+
+    # ------------------------------------------------------------ what the modules answered
+    def _replied(self, run: _Running, request: Request, reply: rt.Reply) -> None:
+        """Keep the photos and the communications as the modules report them."""
+        if request.name == "TakePicture":
+            x, y, _ = self.rover.sim.pose
+            unit = self.rover.sim.pan_tilt
+            seen = tuple(t for t in reply.output.photo.targets.split(",") if t) if reply.ok else ()
+            photo = Photo(reply.time, round(x, 3), round(y, 3), round(unit.pan.position, 4),
+                          round(unit.tilt.position, 4), str(request.args[0]), seen, reply.ok,
+                          "" if reply.ok else _reply_text(reply))
+            self.photos.append(photo)
+            self._event(reply.time, "photo", target=photo.target, ok=photo.ok, seen=list(seen), x=photo.x, y=photo.y,
+                        pan=photo.pan, tilt=photo.tilt, **({"why": photo.why} if photo.why else {}))
+        elif request.name == "Communicate":
+            window = format_value(run.action.args[0]) if run.action.args else ""
+            link = reply.output.window if reply.ok else ""
+            communication = Communication(window, run.started, reply.time, reply.ok, link,
+                                          "" if reply.ok else _reply_text(reply))
+            self.communications.append(communication)
+            self._event(reply.time, "communication", window=window, ok=reply.ok, start=round(run.started, 6),
+                        link=link, **({"why": communication.why} if communication.why else {}))
+
+    def _failure(self, run: _Running, request: Request, reply: rt.Reply) -> str:
+        """Why the action failed, in one line."""
+        text = f"{run.action.text()} failed: {request.text()} -> {_reply_text(reply)}"
+        if request.name == "GotoTarget":
+            arrival = reply.output.arrival if reply.output is not None else None
+            explained = NAVIGATION_FAILURES.get(reply.report.code, "")
+            if explained:
+                progress = self.rover.clients.ndd.module.sdi.params.progressTime
+                text += f" ({explained.format(progress=progress)})"
+            if arrival is not None and reply.report.code != "BAD_GOAL":
+                text += f", at ({arrival.x:.2f}, {arrival.y:.2f}) {arrival.distance:.2f} m from the goal"
+        return text
+
+    # ------------------------------------------------------------ the robot
+    def _odometry(self) -> tuple[float, float]:
+        """Where the robot believes it stands (RFLEX's odometry, POM's position)."""
+        snapshot = self.rover.clients.rflex.poster_Robot()
+        if snapshot is None:
+            x, y, _ = self.rover.sim.world.start
+        else:
+            x, y = snapshot.data.pose.x, snapshot.data.pose.y
+        return round(x, POSITION_DIGITS) + 0.0, round(y, POSITION_DIGITS) + 0.0
+
+    def _come_to_rest(self) -> None:
+        """Stop the navigation and the wheels; wait (SETTLE_LIMIT at most) for the robot to stand
+        and for the interrupted requests to end."""
+        self.rover.clients.ndd.Stop()
+        self.rover.clients.rflex.Stop()
+        rover = self.rover.sim.rover
+
+        def busy() -> bool:
+            self._stopping = [(c, k) for c, k in self._stopping if c.reply(k).status is rt.Status.WAITING]
+            return bool(self._stopping) or abs(rover.left_speed) + abs(rover.right_speed) > STILL_SPEED
+
+        self.kernel.run_while(busy, self.kernel.now + SETTLE_LIMIT)
+
+    def _catch_up(self, now: float) -> None:
+        """The kernel at mission time `now`: time FTplan spent planning passes for the robot too."""
+        if now > self.kernel.now:
+            self.kernel.run_until(now)
+
+    # ------------------------------------------------------------ telling
+    def _event(self, time_: float, kind: str, **fields: Any) -> None:
+        if self.emit is not None:
+            self.emit(time_, kind, **fields)
+
+
+def _reply_text(reply: rt.Reply) -> str:
+    detail = f" ({reply.report.detail})" if reply.report.detail else ""
+    return f"{reply.status.value} {reply.report.code}{detail}"
+
+
+# ---------------------------------------------------------------- the run
+
+
+class _Journal:
+    """The run's event log: FTplan's own events as they come (kind `ftplan`), then the
+    executor's (actions, photos, communications), each at its mission time; and the progress."""
+
+    def __init__(self, log: EventLog, progress: Callable[[RoverProgress], None] | None, goals: int) -> None:
+        self.log = log
+        self.progress = progress
+        self.goals = goals
+        self.ftplan: FtPlan | None = None
+        self._forwarded = 0
+
+    def emit(self, time_: float, kind: str, **fields: Any) -> None:
+        self.catch_up()
+        self.log.emit(time_, kind, **fields)
+        if kind == "action" and self.progress is not None:
+            args = ", ".join(format_value(a) for a in fields.get("args", ()))
+            self.report_progress(time_, f"{fields.get('status')} {fields.get('task')}({args})")
+
+    def catch_up(self) -> None:
+        if self.ftplan is None:
+            return
+        events = self.ftplan.events
+        for event in events[self._forwarded:]:
+            self.log.emit(event.time, "ftplan", event=event.kind, text=event.text,
+                          **({"planner": event.planner} if event.planner else {}))
+        self._forwarded = len(events)
+
+    def report_progress(self, time_: float, what: str) -> None:
+        if self.progress is not None:
+            met = len(self.ftplan.state.met) if self.ftplan is not None else 0
+            self.progress(RoverProgress(time_, met, self.goals, what))
+
+
+@dataclass
+class PreparedMission:
+    """A mission ready to run, nothing started yet: FTplan's side (the configuration on the
+    mission, the problems and domains) and the rover's (the modules on the simulated rover in
+    the world, with the windows nature drew)."""
+
+    configuration: str
+    mission: str
+    seed: int
+    setup: MissionSetup
+    world: World
+    rover: Rover
+    tasks: RoverTasks
+
+
+def prepare_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
+                    generated: Path = GENERATED) -> PreparedMission:
+    """Check the names and build what `run_rover_mission` runs (see there); RunError when a name
+    is unknown or the package is not compiled."""
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise RunError(f"seed {seed!r}: give a whole number >= 0")
+    package = load_package(generated)
+    try:
+        setup = mission_setup(package.ftplan.CONFIGURATIONS, configuration, mission, package.planner)
+    except UnknownName as error:
+        raise RunError(str(error)) from None
+    ground = resolve_world(world)
+    tasks = RoverTasks.of(setup.config, setup.problem, mission, ground)
+    # The antenna's windows, and those the picture's time strip shows.
+    ground = dataclasses.replace(ground, windows=mission_windows(setup.problem, seed))
+    return PreparedMission(configuration, mission, seed, setup, ground, build_rover(package.modules, ground, seed),
+                           tasks)
+
+
+def run_rover_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
+                      log: EventLog | None = None, progress: Callable[[RoverProgress], None] | None = None,
+                      generated: Path = GENERATED, timing: str = "model") -> RoverRun:
+    """Run `mission` (M1..M4) with the robot `configuration` of seed 004 §4.2.1.1 (Robot1,
+    Robot2, Robot1/2, Robot1/2c) in `world` (W1..W4, a world file or a World), the simulation and the
+    visibility windows drawn from `seed`.
+
+    `generated` holds the compiled atrv package (`specc compile examples/atrv -o generated`);
+    `timing` is FTplan's planning charge ("model": deterministic, "wall": measured). Events go to
+    `log` (one in memory when none is given) and to the result. Anything the caller can get wrong
+    raises RunError, whose message is one line."""
+    if timing not in TIMINGS:
+        raise RunError(f"timing '{timing}': give {' or '.join(TIMINGS)}")
+    prepared = prepare_mission(configuration, mission, world, seed, generated=generated)
+    setup, rover, windows = prepared.setup, prepared.rover, prepared.world.windows
+    log = log if log is not None else EventLog()
+    journal = _Journal(log, progress, len(SystemState.from_problem(setup.problem).goals))
+    executor = SimExecutor(rover, prepared.tasks, journal.emit)
+    started = time.perf_counter()
+    log.emit(rover.kernel.now, "mission-start", robot=ROBOT, configuration=configuration, mission=mission,
+             world=prepared.world.name, seed=seed, timing=timing, policy=setup.config.policy,
+             planners=[f"{p.name} ({p.domain})" for p in setup.config.planners],
+             windows=[[w.name, w.start, w.end] for w in windows],
+             targets=[[t.name, t.x, t.y] for t in prepared.tasks.targets.values()])
+    with ProcessPool(setup.config.planners, setup.domains) as pool:
+        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems)
+        journal.ftplan = ftplan
+        result = ftplan.run()
+    journal.catch_up()
+    executor.safe_state(result.now)  # nothing runs past the mission's end; the robot idles to its last instant
+    goals = mission_goals(setup.problem, mission, ftplan.state)
+    sim = rover.sim
+    if result.failure:
+        outcome, why = "failed", result.failure
+    elif result.missed:
+        outcome, why = "failed", f"{len(result.missed)} goal(s) missed: " + "; ".join(
+            f"{goal}: {reason}" for goal, reason in result.missed.items())
+    else:
+        outcome, why = "succeeded", f"every goal met ({len(result.met)})"
+    log.emit(rover.kernel.now, "mission-end", outcome=outcome, why=why, goals_met=len(result.met),
+             goals=len(result.met) + len(result.missed), plannings=result.plannings,
+             planner_failures=result.planner_failures, distance=round(sim.rover.distance, 3))
+    journal.report_progress(rover.kernel.now, f"mission {outcome}")
+    path = tuple((round(t, 3), round(x, 3), round(y, 3), round(theta, 4))
+                 for t, (x, y, theta) in zip(sim.trace.times, sim.trace.poses, strict=True))
+    return RoverRun(
+        configuration=configuration, mission=mission, world=prepared.world.name, seed=seed, timing=timing,
+        policy=setup.config.policy, result=result, goals=goals, windows=windows, photos=tuple(executor.photos),
+        communications=tuple(executor.communications), actions=tuple(executor.actions),
+        planned=tuple(executor.planned), path=path, distance=sim.rover.distance, simulated_time=rover.kernel.now,
+        wall_time=time.perf_counter() - started, events=tuple(log.events), simulation=sim)
