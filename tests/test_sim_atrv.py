@@ -48,7 +48,7 @@ def rover(run_sim: ModuleType, name: str = "W1", seed: int = 0, **changes: Any) 
 
 
 def goto(r: Any, x: float, y: float, timeout: float = 200.0) -> rt.Reply:
-    return r.ndd.final(r.ndd.GotoTarget(x, y, TOLERANCE), timeout=timeout)
+    return r.clients.ndd.final(r.clients.ndd.GotoTarget(x, y, TOLERANCE), timeout=timeout)
 
 
 def clearance(obstacle: Circle | Polygon, pose: tuple[float, float, float]) -> float:
@@ -83,7 +83,7 @@ def test_rover_reaches_a_goal_in_the_empty_world(run_sim: ModuleType) -> None:
     assert reply.ok, reply
     x, y, _ = r.sim.pose
     assert math.hypot(x - 3.0, y + 3.0) < TOLERANCE + 0.1
-    odometry = r.rflex.poster_Robot().data.pose
+    odometry = r.clients.rflex.poster_Robot().data.pose
     assert math.hypot(odometry.x - x, odometry.y - y) < 0.1  # odometry from the encoders, not the truth
     assert reply.output.arrival.distance <= TOLERANCE
     assert r.sim.trace.blocked_at is None
@@ -126,7 +126,7 @@ def test_w4_pocket_traps_the_rover_for_good(run_sim: ModuleType) -> None:
     u, v = (x + y) / math.sqrt(2), (y - x) / math.sqrt(2)  # along the pocket's axis, across it
     assert 2.4 < u < 6.0 and abs(v) < 1.6, (x, y)  # still inside the pocket
     # The wheels are stopped once the navigation gave up.
-    assert r.rflex.poster_Robot().data.speed.v == 0.0
+    assert r.clients.rflex.poster_Robot().data.speed.v == 0.0
 
 
 def test_blocked_wheels_end_the_speed_tracking(run_sim: ModuleType) -> None:
@@ -135,7 +135,7 @@ def test_blocked_wheels_end_the_speed_tracking(run_sim: ModuleType) -> None:
     ndd = r.modules["ndd"]
     ndd.sdi.speed.v = 0.3  # what NDD would export, written by hand: RFLEX alone drives into the wall
     ndd.update_poster("Speed")
-    reply = r.rflex.final(r.rflex.TrackSpeed("ndd.Speed"), timeout=30.0)
+    reply = r.clients.rflex.final(r.clients.rflex.TrackSpeed("ndd.Speed"), timeout=30.0)
     assert (reply.status, reply.report.code) == (rt.Status.END, "BLOCKED")
     assert r.sim.trace.blocked_at is not None and r.sim.trace.blocked_at <= reply.time
     assert r.sim.pose[0] < 1.5 - 0.5  # the wall held
@@ -146,7 +146,7 @@ def test_laser_without_echo_stops_the_navigation(run_sim: ModuleType) -> None:
     assert r.modules["sick"].sdi.scan.echo is False  # no scan yet
     r.kernel.run_for(0.2)
     assert r.modules["sick"].sdi.scan.echo is True  # the far walls at 20 m (note 3)
-    assert r.sick.final(r.sick.Configure(1.0)).ok  # nothing within 1 m: no beam comes back
+    assert r.clients.sick.final(r.clients.sick.Configure(1.0)).ok  # nothing within 1 m: no beam comes back
     r.kernel.run_for(0.2)
     reply = goto(r, 3.0, 0.0)
     assert (reply.status, reply.report.code) == (rt.Status.END, "LASER_FAILURE")
@@ -158,55 +158,55 @@ def test_laser_without_echo_stops_the_navigation(run_sim: ModuleType) -> None:
 def test_pan_tilt_reaches_its_target(run_sim: ModuleType) -> None:
     r = rover(run_sim)
     started = r.kernel.now
-    reply = r.platine.final(r.platine.MoveTo(1.0, -0.4))
+    reply = r.clients.platine.final(r.clients.platine.MoveTo(1.0, -0.4))
     assert reply.ok, reply
     unit = r.sim.pan_tilt
     assert unit.pan.position == pytest.approx(1.0) and unit.tilt.position == pytest.approx(-0.4)
     assert not unit.moving
     assert reply.time - started >= 1.0 / unit.pan.speed - 1e-6  # it waited for the unit
-    assert r.platine.poster_Position().data.position.pan == pytest.approx(1.0)
-    refused = r.platine.final(r.platine.MoveTo(0.0, 3.0))
+    assert r.clients.platine.poster_Position().data.position.pan == pytest.approx(1.0)
+    refused = r.clients.platine.final(r.clients.platine.MoveTo(0.0, 3.0))
     assert (refused.status, refused.report.code) == (rt.Status.FINAL_ERROR, "BAD_POSITION")
 
 
 def test_photo_of_a_target_in_view_succeeds_and_out_of_view_fails(run_sim: ModuleType) -> None:
     r = rover(run_sim)  # at the start (0, 0) facing +x: M1_OBJ2 (4, 0) straight ahead
-    ok = r.camera.final(r.camera.TakePicture("M1_OBJ2"))
+    ok = r.clients.camera.final(r.clients.camera.TakePicture("M1_OBJ2"))
     assert ok.ok, ok
     assert "M1_OBJ2" in ok.output.photo.targets.split(",")
     assert (ok.time, "M1_OBJ2", True) in r.sim.trace.photos
-    assert r.platine.final(r.platine.MoveTo(math.pi, 0.0)).ok  # looking back: nothing in view
-    failed = r.camera.final(r.camera.TakePicture("M1_OBJ2"))
+    assert r.clients.platine.final(r.clients.platine.MoveTo(math.pi, 0.0)).ok  # looking back: nothing in view
+    failed = r.clients.camera.final(r.clients.camera.TakePicture("M1_OBJ2"))
     assert (failed.status, failed.report.code) == (rt.Status.END, "NO_TARGET_IN_VIEW")
     assert r.sim.trace.photos[-1] == (failed.time, "M1_OBJ2", False)
     from atrv_codels.platine import AT_MY_FEET
 
-    assert r.platine.final(r.platine.MoveTo(*AT_MY_FEET)).ok  # annex A's AT_MY_FEET
-    feet = r.camera.final(r.camera.TakePicture("M1_OBJ1"))  # the target under the robot
+    assert r.clients.platine.final(r.clients.platine.MoveTo(*AT_MY_FEET)).ok  # annex A's AT_MY_FEET
+    feet = r.clients.camera.final(r.clients.camera.TakePicture("M1_OBJ1"))  # the target under the robot
     assert feet.ok and feet.output.photo.targets == "M1_OBJ1"
 
 
 def test_photo_while_the_pan_tilt_unit_moves_fails(run_sim: ModuleType) -> None:
     r = rover(run_sim)
-    r.platine.MoveTo(2.0, 0.0)
+    r.clients.platine.MoveTo(2.0, 0.0)
     r.kernel.run_for(0.2)
-    reply = r.camera.final(r.camera.TakePicture(""))
+    reply = r.clients.camera.final(r.clients.camera.TakePicture(""))
     assert reply.report.code == "PTU_MOVING"
 
 
 def test_communication_inside_a_window_succeeds_and_outside_fails(run_sim: ModuleType) -> None:
     r = rover(run_sim)
     r.sim.antenna.windows = (Window("W1", 5.0, 30.0),)
-    early = r.antenna.final(r.antenna.Communicate(5.0))
+    early = r.clients.antenna.final(r.clients.antenna.Communicate(5.0))
     assert (early.status, early.report.code) == (rt.Status.END, "NO_VISIBILITY")
     r.kernel.run_until(6.0)
-    inside = r.antenna.final(r.antenna.Communicate(10.0))
+    inside = r.clients.antenna.final(r.clients.antenna.Communicate(10.0))
     assert inside.ok and inside.output.window == "W1"
     assert len(r.sim.antenna.sent) == 1
     start, end, name = r.sim.antenna.sent[0]
     assert name == "W1" and 5.0 <= start and end <= 30.0 and end - start == pytest.approx(10.0)
     r.kernel.run_until(25.0)
-    cut = r.antenna.final(r.antenna.Communicate(10.0))  # the window closes at 30 s
+    cut = r.clients.antenna.final(r.clients.antenna.Communicate(10.0))  # the window closes at 30 s
     assert (cut.status, cut.report.code) == (rt.Status.END, "LINK_LOST")
     assert 30.0 <= cut.time < 31.0
     assert len(r.sim.antenna.sent) == 1
@@ -218,7 +218,7 @@ def test_communication_inside_a_window_succeeds_and_outside_fails(run_sim: Modul
 def test_same_seed_same_trace_and_another_seed_another(run_sim: ModuleType) -> None:
     def path(seed: int) -> list[tuple[float, float, float]]:
         r = rover(run_sim, "W2", seed)
-        r.ndd.GotoTarget(4.0, 0.0, TOLERANCE)
+        r.clients.ndd.GotoTarget(4.0, 0.0, TOLERANCE)
         r.kernel.run_for(12.0)
         return r.sim.trace.poses
 

@@ -19,7 +19,6 @@ import math
 import re
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -37,50 +36,27 @@ class UsageError(Exception):
     """A bad command line: reported in one line, exit status 2."""
 
 
-@dataclass
-class Rover:
-    """The modules, their clients and the simulation, on one registry."""
-
-    registry: Any
-    sim: Any
-    modules: dict[str, Any]
-    rflex: Any
-    sick: Any
-    ndd: Any
-    platine: Any
-    camera: Any
-    antenna: Any
-
-    @property
-    def kernel(self) -> Any:
-        return self.registry.kernel
-
-
 def import_generated() -> Any:
-    """The generated package `atrv.modules` and the codels, found from this folder."""
-    for path in (str(HERE), str(ROOT / "generated")):
-        if path not in sys.path:
-            sys.path.insert(0, path)
+    """The generated package `atrv.modules`, with the codels of this folder."""
+    from specc.run import RunError
+    from specc.run.rover import load_package
+
     try:
-        from atrv import modules  # type: ignore[import-not-found]
-    except ImportError as exc:
-        raise UsageError(f"cannot import the generated modules ({exc}); "
-                         "run `specc compile examples/atrv -o generated` first") from None
-    return modules
+        return load_package(ROOT / "generated", HERE).modules
+    except RunError as exc:
+        raise UsageError(str(exc)) from None
 
 
-def build(world: Any, seed: int = 0) -> Rover:
-    """The ATRV's six modules and the simulated rover in `world`, with a client per module."""
-    from specc.runtime import functional as rt
-    from specc.runtime.sim import ATRV, Simulation
+def build(world: Any, seed: int = 0) -> Any:
+    """The ATRV's six modules and the simulated rover in `world`, a client per module
+    (`specc.run.rover.Rover`: `.sim`, `.kernel`, `.clients.ndd` ...)."""
+    from specc.run import RunError
+    from specc.run.rover import build_rover
 
-    modules = import_generated()
-    registry = rt.Registry()
-    sim = Simulation(world, ATRV, seed=seed, kernel=registry.kernel).attach(registry)
-    made = modules.create_all(registry)
-    clients = {name: modules.MODULES[name].client(module) for name, module in made.items()}
-    return Rover(registry, sim, made, clients["rflex"], clients["sick"], clients["ndd"], clients["platine"],
-                 clients["camera"], clients["antenna"])
+    try:
+        return build_rover(import_generated(), world, seed)
+    except RunError as exc:  # what the world asks cannot be built (objects without room)
+        raise UsageError(str(exc)) from None
 
 
 def world_path(name: str) -> Path:
@@ -142,7 +118,7 @@ def describe(reply: Any) -> str:
 class Mission:
     """Sends the requests one after the other and prints each final reply."""
 
-    def __init__(self, rover: Rover, deadline: float) -> None:
+    def __init__(self, rover: Any, deadline: float) -> None:
         self.rover = rover
         self.deadline = deadline
         self.failed = False
@@ -169,13 +145,13 @@ class Mission:
         return reply
 
     def goto(self, x: float, y: float, tolerance: float) -> bool:
-        ndd = self.rover.ndd
+        ndd = self.rover.clients.ndd
         return self.call(ndd, f"ndd.GotoTarget({x:g}, {y:g}, {tolerance:g})", ndd.GotoTarget(x, y, tolerance)).ok
 
     def photograph(self, target: str) -> bool:
         from atrv_codels.platine import AT_MY_FEET, STRAIGHT  # importable once the rover is built
 
-        platine, camera = self.rover.platine, self.rover.camera
+        platine, camera = self.rover.clients.platine, self.rover.clients.camera
         steps = [(platine, f"platine.MoveTo{AT_MY_FEET}", lambda: platine.MoveTo(*AT_MY_FEET)),
                  (camera, f"camera.TakePicture({target!r})", lambda: camera.TakePicture(target)),
                  (platine, f"platine.MoveTo{STRAIGHT}", lambda: platine.MoveTo(*STRAIGHT))]
@@ -213,10 +189,7 @@ def run(argv: list[str] | None = None) -> int:
         raise UsageError(f"--duration {args.duration:g}: must be a positive number of seconds")
     output = args.output or ROOT / "build" / f"atrv-{world.name}.png"
 
-    try:
-        rover = build(world, args.seed)
-    except WorldError as exc:  # what the world asks cannot be built (objects without room)
-        raise UsageError(str(exc)) from None
+    rover = build(world, args.seed)
     sim = rover.sim
     print(f"world {world.name} ({world.description or path}), seed {args.seed}, "
           f"{len(goals)} goal(s), at most {args.duration:g} s")
@@ -232,7 +205,7 @@ def run(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - started
 
     x, y, theta = sim.pose
-    odo = rover.rflex.poster_Robot()
+    odo = rover.clients.rflex.poster_Robot()
     print(f"true pose ({x:.2f}, {y:.2f}, {math.degrees(theta):.0f} deg)", end="")
     if odo is not None:
         pose = odo.data.pose

@@ -21,7 +21,7 @@ def check(ctx: Context) -> None:
         # one speaks its own domain's, which its state rules and correspondences are checked in.
         known = DomainTables()
         own: dict[str, DomainTables] = {}
-        domains: dict[str, m.Domain] = {}
+        domains: dict[str, tuple[m.Domain, DomainTables]] = {}
         for planner in ftplan.planners:
             if planner.domain is None:
                 ctx.report("missing-property", f"planner '{planner.name}' needs 'domain: <domain>;'", planner.span)
@@ -32,8 +32,8 @@ def check(ctx: Context) -> None:
                            f"(it knows {choices})", planner.heuristic.span)
             domain = ctx.lookup(m.Domain, planner.domain, planner.domain.span, "undefined-domain")
             if domain is not None:
-                domains[planner.name] = domain
                 found = tables(_quiet(ctx), domain.members)
+                domains[planner.name] = (domain, found)
                 if planner.name in viewed:
                     own[planner.name] = found
                 else:
@@ -86,7 +86,8 @@ def check(ctx: Context) -> None:
 
 
 def check_mission(ctx: Context, ftplan: m.FtPlan, mission: m.Mission, planners: dict[str, m.Planner],
-                  domains: dict[str, m.Domain], own: dict[str, DomainTables], known: DomainTables) -> None:
+                  domains: dict[str, tuple[m.Domain, DomainTables]], own: dict[str, DomainTables],
+                  known: DomainTables) -> None:
     named: set[str] = set()
     for entry in mission.problems:
         planner = entry.planner.text
@@ -98,13 +99,12 @@ def check_mission(ctx: Context, ftplan: m.FtPlan, mission: m.Mission, planners: 
                        entry.span)
         named.add(planner)
         problem = ctx.lookup(m.Problem, entry.problem, entry.problem.span, "undefined-problem")
-        domain = domains.get(planner)
-        if problem is None or domain is None:
+        if problem is None or planner not in domains:
             continue
+        domain, found = domains[planner]
         if problem.domain.text != domain.name:
             other = ctx.lookup(m.Domain, problem.domain, problem.domain.span, "undefined-domain")
-            tasks = set(tables(_quiet(ctx), domain.members).tasks)
-            if other is not None and set(tables(_quiet(ctx), other.members).tasks) != tasks:
+            if other is not None and set(tables(_quiet(ctx), other.members).tasks) != set(found.tasks):
                 ctx.report("domain-mismatch", f"problem '{problem.name}' is for domain '{other.name}', whose tasks "
                            f"are not those of planner '{planner}''s domain '{domain.name}': name a problem for "
                            f"'{domain.name}' or a domain with the same tasks", entry.problem.span)

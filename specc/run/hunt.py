@@ -33,10 +33,8 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import importlib
 import math
 import re
-import sys
 import time
 from collections import Counter
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -49,6 +47,7 @@ import numpy as np
 
 from specc.run import RunError
 from specc.run.events import EventLog
+from specc.run.package import import_generated
 from specc.run.pictures import draw_hunt
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
@@ -271,43 +270,15 @@ def _check_arguments(seed: int, objects_wanted: int, horizon: float) -> None:
 
 def load_package(generated: Path, example: Path) -> Any:
     """The compiled package's modules, executive and supervisor, imported from `generated`,
-    with the codels from `example` (a package of the same name imported from elsewhere is
-    forgotten first, so the one asked for is the one run)."""
-    generated = Path(generated).resolve()
-    example = Path(example).resolve()
-    if not (generated / ROBOT / "__init__.py").is_file():
-        raise RunError(f"{generated}: no compiled {ROBOT} package in this folder; "
-                       f"run `specc compile examples/{ROBOT} -o {generated}` first")
-    if not (example / CODELS / "__init__.py").is_file():
-        raise RunError(f"{example}: not the {ROBOT} example folder (no {CODELS}/ with the codels in it)")
-    for folder, package in ((example, CODELS), (generated, ROBOT)):
-        while str(folder) in sys.path:
-            sys.path.remove(str(folder))
-        sys.path.insert(0, str(folder))
-        _forget_unless_from(package, folder)
-    try:
-        modules = importlib.import_module(f"{ROBOT}.modules")
-        executive = importlib.import_module(f"{ROBOT}.executive.{ROBOT}")
-        supervisor = importlib.import_module(f"{ROBOT}.supervisor.{ROBOT}_tasks")
-    except ImportError as error:
-        raise RunError(f"{generated}/{ROBOT}: the compiled package is incomplete or stale ({error}); "
-                       f"run `specc compile examples/{ROBOT} -o {generated}` again") from None
-    return _Package(modules, executive, supervisor)
+    with the codels from `example`."""
+    return _Package(*import_generated(generated, example, ROBOT, CODELS,
+                                      ("modules", f"executive.{ROBOT}", f"supervisor.{ROBOT}_tasks")))
 
 
 class _Package(NamedTuple):
     modules: ModuleType
     executive: ModuleType
     supervisor: ModuleType
-
-
-def _forget_unless_from(package: str, folder: Path) -> None:
-    loaded = sys.modules.get(package)
-    origin = getattr(loaded, "__file__", None)
-    if loaded is None or (origin is not None and Path(origin).resolve().is_relative_to(folder)):
-        return
-    for name in [n for n in sys.modules if n == package or n.startswith(package + ".")]:
-        del sys.modules[name]
 
 
 def _load_room(example: Path) -> World:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib
 import keyword
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -67,14 +68,55 @@ def _reads(path: Path) -> str | None:
 
 def import_package(compiled: Compiled, name: str = "") -> ModuleType:
     """`<robot>` (or `<robot>.<name>`) from the compiled package's folder."""
-    parent = str(compiled.folder.parent.resolve())
-    if parent not in sys.path:
-        sys.path.insert(0, parent)
+    parent = compiled.folder.parent.resolve()
+    _put_first(parent)
     if compiled.rewritten:  # a package imported before its rewrite would be the old one
-        for loaded in [m for m in sys.modules if m == compiled.robot or m.startswith(compiled.robot + ".")]:
-            del sys.modules[loaded]
+        _forget(compiled.robot)
+    else:
+        forget_unless_from(compiled.robot, parent)
     target = f"{compiled.robot}.{name}" if name else compiled.robot
     try:
         return importlib.import_module(target)
     except ImportError as exc:
         raise RunError(f"cannot import {target} from {parent} ({exc})") from None
+
+
+def import_generated(generated: Path, example: Path, robot: str, codels: str,
+                     names: Sequence[str]) -> tuple[ModuleType, ...]:
+    """`<robot>.<name>` for each of `names`, the compiled package imported from `generated` and
+    its codels (the package `codels`) from the example folder `example`. A package of the same
+    name imported from elsewhere is forgotten first, so the one asked for is the one run."""
+    generated, example = Path(generated).resolve(), Path(example).resolve()
+    if not (generated / robot / "__init__.py").is_file():
+        raise RunError(f"{generated}: no compiled {robot} package in this folder; "
+                       f"run `specc compile examples/{robot} -o {generated}` first")
+    if not (example / codels / "__init__.py").is_file():
+        raise RunError(f"{example}: not the {robot} example folder (no {codels}/ with the codels in it)")
+    for folder, package in ((example, codels), (generated, robot)):
+        _put_first(folder)
+        forget_unless_from(package, folder)
+    try:
+        return tuple(importlib.import_module(f"{robot}.{name}") for name in names)
+    except ImportError as error:
+        raise RunError(f"{generated}/{robot}: the compiled package is incomplete or stale ({error}); "
+                       f"run `specc compile examples/{robot} -o {generated}` again") from None
+
+
+def _put_first(folder: Path) -> None:
+    while str(folder) in sys.path:
+        sys.path.remove(str(folder))
+    sys.path.insert(0, str(folder))
+
+
+def forget_unless_from(package: str, folder: Path) -> None:
+    """Forget `package` (and its submodules) when it was imported from outside `folder`."""
+    loaded = sys.modules.get(package)
+    origin = getattr(loaded, "__file__", None)
+    if loaded is None or (origin is not None and Path(origin).resolve().is_relative_to(folder)):
+        return
+    _forget(package)
+
+
+def _forget(package: str) -> None:
+    for name in [n for n in sys.modules if n == package or n.startswith(package + ".")]:
+        del sys.modules[name]

@@ -52,9 +52,7 @@ Where the thesis is silent (INVENTED):
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import math
-import sys
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -66,6 +64,7 @@ import numpy as np
 
 from specc.run import RunError
 from specc.run.events import EventLog
+from specc.run.package import import_generated
 from specc.runtime import functional as rt
 from specc.runtime.ftplan import (
     FtPlan,
@@ -77,7 +76,7 @@ from specc.runtime.ftplan import (
     mission_setup,
 )
 from specc.runtime.ftplan.config import FtPlanConfig
-from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution
+from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precedences
 from specc.runtime.ftplan.state import FactKey, SystemState, consequences, constant, constant_key
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner import model as pm
@@ -260,29 +259,9 @@ class AtrvPackage(NamedTuple):
 
 
 def load_package(generated: Path = GENERATED, example: Path = EXAMPLE) -> AtrvPackage:
-    """The compiled atrv package imported from `generated`, the codels from `example` (a package
-    of the same name imported from elsewhere is forgotten first, so the one asked for runs)."""
-    generated, example = Path(generated).resolve(), Path(example).resolve()
-    if not (generated / ROBOT / "__init__.py").is_file():
-        raise RunError(f"{generated}: no compiled {ROBOT} package in this folder; "
-                       f"run `specc compile examples/{ROBOT} -o {generated}` first")
-    if not (example / CODELS / "__init__.py").is_file():
-        raise RunError(f"{example}: not the {ROBOT} example folder (no {CODELS}/ with the codels in it)")
-    for folder, package in ((example, CODELS), (generated, ROBOT)):
-        while str(folder) in sys.path:
-            sys.path.remove(str(folder))
-        sys.path.insert(0, str(folder))
-        loaded = sys.modules.get(package)
-        origin = getattr(loaded, "__file__", None)
-        if loaded is not None and (origin is None or not Path(origin).resolve().is_relative_to(folder)):
-            for name in [n for n in sys.modules if n == package or n.startswith(package + ".")]:
-                del sys.modules[name]
-    try:
-        return AtrvPackage(importlib.import_module(f"{ROBOT}.modules"), importlib.import_module(f"{ROBOT}.planner"),
-                           importlib.import_module(f"{ROBOT}.ftplan.{FTPLAN_BLOCK}"))
-    except ImportError as error:
-        raise RunError(f"{generated}/{ROBOT}: the compiled package is incomplete or stale ({error}); "
-                       f"run `specc compile examples/{ROBOT} -o {generated}` again") from None
+    """The compiled atrv package imported from `generated`, the codels from `example`."""
+    return AtrvPackage(*import_generated(generated, example, ROBOT, CODELS,
+                                         ("modules", "planner", f"ftplan.{FTPLAN_BLOCK}")))
 
 
 def resolve_world(world: str | Path | World) -> World:
@@ -322,6 +301,7 @@ class Rover:
     registry: rt.Registry
     sim: Simulation
     clients: Clients
+    modules: dict[str, Any]  # the module instances, by name (their SDI, for tests and pictures)
 
     @property
     def kernel(self) -> Any:
@@ -340,7 +320,7 @@ def build_rover(modules: ModuleType, world: World, seed: int) -> Rover:
         raise RunError(str(error)) from None
     made = modules.create_all(registry)
     clients = Clients(*(modules.MODULES[name].client(made[name]) for name in Clients._fields))
-    return Rover(registry, sim, clients)
+    return Rover(registry, sim, clients, dict(made))
 
 
 # ---------------------------------------------------------------- the mission on the rover
@@ -508,26 +488,6 @@ class _Running:
     why: str = ""
 
 
-class _Precedences:
-    """The plan's orderings between actions, as ScriptedExecutor reads them: an action starts at
-    its dispatch date, or later when an action ordered before it ends late (plus the delay)."""
-
-    def __init__(self, plan: Plan) -> None:
-        by_end = {a.end: a for a in plan.actions}
-        by_start = {a.start: a for a in plan.actions}
-        self.after: dict[str, list[tuple[str, float]]] = {a.id: [] for a in plan.actions}
-        for first, second, delay in plan.orderings:
-            before, action = by_end.get(first), by_start.get(second)
-            if before is not None and action is not None and before is not action:
-                self.after[action.id].append((before.id, delay))
-
-    def start_date(self, action: Action, ended_at: Mapping[str, float], now: float) -> float | None:
-        """When the action may start, None while an action before it has not ended."""
-        if not all(p in ended_at for p, _ in self.after[action.id]):
-            return None
-        return max(now, action.dispatch, *(ended_at[p] + d for p, d in self.after[action.id]))
-
-
 class SimExecutor:
     """FTplan's `Executor` on the simulated ATRV: each action of a plan is carried out by the
     generated modules on the simulation's kernel (see the module's docstring), in mission time.
@@ -557,7 +517,7 @@ class SimExecutor:
         for action in plan.ordered():
             self.planned.append(PlannedTask(number, plan.domain, action.id, action.text(), action.dispatch,
                                             plan.ends_by(action)))
-        precedences = _Precedences(plan)
+        precedences = Precedences(plan)
         waiting = plan.ordered()
         ended_at: dict[str, float] = {}
         while True:

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from specc.runtime.planner.model import Interval as Interval  # re-exported: the generated modules name it here
+
 Value = float | str
 
 # Heuristics specc's planner can be configured with. It has a single search order so far: a
@@ -26,20 +28,12 @@ Term = Var | float | str
 
 
 @dataclass(frozen=True)
-class Interval:
-    """`[low, high]`: a value of FTplan's state a correspondence reads within these bounds."""
-
-    low: float
-    high: float
-
-
-@dataclass(frozen=True)
 class FactPattern:
     """`ATTRIBUTE(args): value` in a correspondence."""
 
     attribute: str
     args: tuple[Term, ...]
-    value: Term | Interval
+    value: Term | Interval  # an interval: a value of FTplan's state read within these bounds
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import heapq
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -63,6 +63,26 @@ class Outcome:
 
 
 World = Callable[[Action, float], Outcome]
+
+
+class Precedences:
+    """The plan's orderings between actions, as every executor reads them: an action starts at
+    its dispatch date, or later when an action ordered before it ends late (plus the delay)."""
+
+    def __init__(self, plan: Plan) -> None:
+        by_end = {a.end: a for a in plan.actions}
+        by_start = {a.start: a for a in plan.actions}
+        self.after: dict[str, list[tuple[str, float]]] = {a.id: [] for a in plan.actions}  # -> (predecessor, delay)
+        for first, second, delay in plan.orderings:
+            before, action = by_end.get(first), by_start.get(second)
+            if before is not None and action is not None and before is not action:
+                self.after[action.id].append((before.id, delay))
+
+    def start_date(self, action: Action, ended_at: Mapping[str, float], now: float) -> float | None:
+        """When the action may start, None while an action before it has not ended."""
+        if not all(p in ended_at for p, _ in self.after[action.id]):
+            return None
+        return max(now, action.dispatch, *(ended_at[p] + d for p, d in self.after[action.id]))
 OVERRUN_TOLERANCE = 1e-6  # seconds
 
 
@@ -81,19 +101,12 @@ class ScriptedExecutor:
 
     def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
         waiting = plan.ordered()
-        by_end = {a.end: a for a in plan.actions}
-        by_start = {a.start: a for a in plan.actions}
-        after: dict[str, list[tuple[str, float]]] = {a.id: [] for a in plan.actions}  # action -> (predecessor, delay)
-        for first, second, delay in plan.orderings:
-            before, action = by_end.get(first), by_start.get(second)
-            if before is not None and action is not None and before is not action:
-                after[action.id].append((before.id, delay))
+        precedences = Precedences(plan)
         ended_at: dict[str, float] = {}
         running: list[tuple[float, int, Action, Outcome]] = []  # (end date, order, action, outcome)
         clock, order = now, 0
         while waiting or running:
-            ready = [a for a in waiting if all(p in ended_at for p, _ in after[a.id])]
-            starts = [(max(clock, a.dispatch, *(ended_at[p] + d for p, d in after[a.id])), a) for a in ready]
+            starts = [(date, a) for a in waiting if (date := precedences.start_date(a, ended_at, clock)) is not None]
             next_start = min(starts, key=lambda s: (s[0], s[1].dispatch, s[1].id), default=None)
             if running and (next_start is None or running[0][0] <= next_start[0]):
                 end, _, action, outcome = heapq.heappop(running)
