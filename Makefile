@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 EXAMPLES := examples/hilare examples/generic examples/atrv
 
-.PHONY: demo test test-slow goldens bench style install clean
+.PHONY: demo tour test test-slow goldens bench style install clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -18,6 +18,11 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/specc check $(EXAMPLES)
 	$(BIN)/specc compile examples/hilare -o generated
+	$(BIN)/specc run examples/hilare --seed 0
+	$(BIN)/specc run examples/atrv --mission M1 --world W2 --config Robot1/2
+
+# The rest of the tour: each level on its own, the formal checks, the planner, the simulator.
+tour: $(STAMP)
 	$(BIN)/python examples/hilare/run_modules.py
 	$(BIN)/python examples/hilare/run_executive.py
 	$(BIN)/python examples/hilare/run_supervisor.py
@@ -29,6 +34,8 @@ demo: $(STAMP)
 	$(BIN)/python examples/hilare/run_sim.py --goal 9,7 --goal 2,7 -o build/hilare-run.png
 	$(BIN)/python examples/atrv/run_sim.py --world W3 --goal 2,1 --goal -1,2 --goal -2,-2 --goal 1,-3 \
 	    --goal 0,0 --photos -o build/atrv-w3.png
+	$(BIN)/specc table examples/atrv --mission M1 --mission M2 --world W1 --world W2 --world W3 \
+	    --config Robot1 --config Robot1/2
 
 test: $(STAMP)
 	$(BIN)/ruff check specc tests

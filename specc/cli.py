@@ -7,6 +7,7 @@ import keyword
 import os
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Optional
 
@@ -106,6 +107,10 @@ def compile(paths: PathsArg,
         raise typer.Exit(1) from None
     for warning in result.warnings:
         err.print(render(warning, loaded.sources), markup=False)
+    if len(paths) == 1 and robot is None:  # what `specc run` would compile: it need not do it again
+        from specc.run.package import remember_compilation
+
+        remember_compilation(paths[0], output, name, result.files)
     out.print(f"wrote {len(written)} file(s) to {folder}", markup=False)
 
 
@@ -562,6 +567,179 @@ def skeleton(paths: PathsArg) -> None:
             out.print(f"{verb} {change.path}: {', '.join(change.functions)}", markup=False)
     if not wrote:
         out.print("every codel named by the specs already exists", markup=False)
+
+
+def _run_error(error: Exception, code: int = 1) -> typer.Exit:
+    """One clear line (or a spec's diagnostics) for a run that cannot go on."""
+    err.print(f"error: {error}" if "error:" not in str(error) else str(error), markup=False)
+    return typer.Exit(code)
+
+
+@app.command()
+def run(specs: Annotated[Path, typer.Argument(help="The robot's spec folder (its codels and worlds beside the "
+                                                   "specs), e.g. examples/atrv or examples/hilare.",
+                                              show_default=False)],
+        mission: Annotated[Optional[str], typer.Option(help="M1, M2, M3, M4 for the rover; hunt (the default) "
+                                                            "for Hilare.")] = None,
+        world: Annotated[Optional[str], typer.Option(help="W1..W4 (or a world file) for the rover; room (the "
+                                                          "default) for Hilare.")] = None,
+        config: Annotated[Optional[str], typer.Option(help="The rover's configuration: Robot1, Robot2, Robot1/2 "
+                                                           "(default), Robot1/2c.")] = None,
+        seed: Annotated[int, typer.Option(min=0, help="Draws the run's randomness: one seed, one event log.")] = 0,
+        generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to (compiled "
+                                                "first when stale).")] = Path("generated"),
+        runs: Annotated[Path, typer.Option(help="Where run folders go.")] = Path("runs"),
+        folder: Annotated[Optional[Path], typer.Option("--folder", "-o", help="The run folder (default: "
+                                                       "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>).")] = None,
+        timing: Annotated[str, typer.Option(help="FTplan's planning time: model (deterministic) or wall "
+                                                 "(measured).")] = "model",
+        objects: Annotated[int, typer.Option(help="The hunt's objects to take (0-5).")] = 5,
+        horizon: Annotated[float, typer.Option(help="The hunt's horizon, s of simulated time.")] = 900.0,
+        pictures: Annotated[bool, typer.Option(help="Draw the map and timeline now (else: specc replay "
+                                                    "RUN).")] = True,
+        quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
+    """Run a mission end to end (modules on the simulated robot, executive, supervisor, FTplan and its
+    planners) and write a run folder: events.jsonl, report.json, summary.txt, map.png, timeline.png.
+    Exits 0 when the mission succeeded, 1 when it failed (the report says why), 2 on bad input."""
+    from specc.run import RunError
+    from specc.run.session import RunCrashed, RunRequest, run_in_folder
+
+    request = RunRequest(specs, mission, world, config, seed, generated, runs, folder, timing, objects, horizon,
+                         pictures)
+    try:
+        with _progress_display(quiet) as progress:
+            outcome = run_in_folder(request, progress, compiled_note=lambda text: err.print(text, markup=False))
+    except RunCrashed as crash:
+        raise _run_error(crash, 1) from None
+    except RunError as error:
+        raise _run_error(error, 2) from None
+    out.print(outcome.summary, markup=False)
+    out.print(f"run folder: {outcome.folder}", markup=False)
+    if not outcome.succeeded:
+        raise typer.Exit(1)
+
+
+class _progress_display:
+    """A live line on stderr: mission time (against the horizon when there is one) and the
+    latest step; nothing when quiet or when stderr is not a terminal."""
+
+    def __init__(self, quiet: bool) -> None:
+        from rich.progress import BarColumn, Progress, TextColumn
+
+        self.live = not quiet and err.is_terminal
+        self.progress = Progress(TextColumn("[bold]{task.fields[clock]}"), BarColumn(),
+                                 TextColumn("{task.description}"), console=err, transient=True)
+        self.task = self.progress.add_task("starting", total=None, clock="t =     0.0 s")
+
+    def __enter__(self) -> Callable[[float, float | None, str], None] | None:
+        if not self.live:
+            return None
+        self.progress.start()
+        return self.update
+
+    def __exit__(self, *exc: object) -> None:
+        if self.live:
+            self.progress.stop()
+
+    def update(self, now: float, horizon: float | None, what: str) -> None:
+        self.progress.update(self.task, completed=now, total=horizon, description=what,
+                             clock=f"t = {now:7.1f} s")
+
+
+@app.command()
+def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run folder (or its events.jsonl).",
+                                                    show_default=False)],
+           kind: Annotated[Optional[list[str]], typer.Option(help="Show only events of this kind (repeatable; "
+                                                                  "pose samples only when named).")] = None,
+           start: Annotated[Optional[float], typer.Option("--from", help="From this mission time (s).")] = None,
+           end: Annotated[Optional[float], typer.Option("--to", help="Up to this mission time (s).")] = None,
+           speed: Annotated[float, typer.Option(min=0.0, help="Play back at this many simulated seconds per "
+                                                              "second (0: at once).")] = 0.0,
+           render: Annotated[bool, typer.Option(help="Draw the pictures again from the log.")] = True,
+           output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Where the pictures go "
+                                                          "(default: the run folder).")] = None) -> None:
+    """Play a run's event log back, then draw its pictures again from the log alone."""
+    from specc.run import RunError
+    from specc.run.replay import describe, load_run, select
+
+    try:
+        folder, events = load_run(run_path)
+    except RunError as error:
+        raise _run_error(error, 2) from None
+    previous: float | None = None
+    for event in select(events, kind or (), start, end):
+        if speed > 0 and previous is not None and event["t"] > previous:
+            time.sleep((event["t"] - previous) / speed)
+        previous = event["t"]
+        out.print(describe(event), markup=False)
+    if not render:
+        return
+    from specc.run.render import render_run
+
+    try:
+        written = render_run(events, output or folder)
+    except RunError as error:
+        raise _run_error(error, 1) from None
+    for path in written:
+        out.print(f"picture: {path}", markup=False)
+
+
+@app.command()
+def table(specs: Annotated[Path, typer.Argument(help="The robot's spec folder, e.g. examples/atrv.",
+                                                show_default=False)],
+          mission: Annotated[Optional[list[str]], typer.Option(help="A rover mission (repeatable; default: "
+                                                                    "M1-M4).")] = None,
+          world: Annotated[Optional[list[str]], typer.Option(help="A world (repeatable; default: W1-W4).")] = None,
+          config: Annotated[Optional[list[str]], typer.Option(help="A configuration (repeatable; default: all "
+                                                                   "four).")] = None,
+          seeds: Annotated[int, typer.Option(min=1, help="Seeds 0..N-1 for every combination.")] = 1,
+          generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
+          = Path("generated"),
+          runs: Annotated[Path, typer.Option(help="Where the run folders go.")] = Path("runs"),
+          output: Annotated[Optional[Path], typer.Option("--output", "-o", help="The table (Markdown; JSON "
+                                                         "beside it). Default: RUNS/<robot>-table.md")] = None,
+          pictures: Annotated[bool, typer.Option(help="Draw every run's pictures.")] = False,
+          quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
+    """Run every mission x world x configuration (x seed), one run folder each, and print the table of
+    the measures of seed 004 §4.1.4 (for Hilare: the hunt's success rate over the seeds)."""
+    from specc.run import RunError
+    from specc.run.measures import rich_table
+    from specc.run.package import ensure_compiled
+    from specc.run.session import RunRequest
+    from specc.run.sweep import CONFIGURATIONS, MISSIONS, WORLDS, sweep, write_table
+
+    try:
+        if not specs.is_dir():
+            raise RunError(f"'{specs}' is not a robot's spec folder: give e.g. examples/atrv")
+        compiled = ensure_compiled(specs, generated)
+        if compiled.rewritten:
+            err.print(f"compiled {specs} into {compiled.folder} (it was stale)", markup=False)
+        if compiled.robot != "atrv" and (mission or world or config):
+            raise RunError(f"{compiled.robot} has one mission: --mission, --world and --config are the rover's")
+        base = RunRequest(specs, generated=generated, runs=runs, pictures=pictures)
+        with _progress_display(quiet) as progress:
+            def step(done: int, total: int, label: str) -> None:
+                if progress is not None:
+                    progress(done, total, label)
+                elif not quiet and label:
+                    err.print(f"[{done + 1}/{total}] {label}", markup=False)
+
+            result = sweep(compiled.robot, base, missions=mission or MISSIONS, worlds=world or WORLDS,
+                           configurations=config or CONFIGURATIONS, seeds=range(seeds), step=step)
+        written = write_table(result, output or runs / f"{compiled.robot}-table.md")
+    except RunError as error:
+        raise _run_error(error, 2) from None
+    if result.hunt is not None:
+        h = result.hunt
+        out.print(f"hilare's hunt: {h.succeeded} of {h.seeds} seed(s) succeeded ({100 * h.success_rate:.0f} %), "
+                  f"{h.objects_taken:.2f} objects taken on average, {h.simulated_time:.0f} s per successful hunt",
+                  markup=False)
+    else:
+        out.print(rich_table(result.rows))
+    for failure in result.failures:
+        out.print(f"failed: {failure.name}: {failure.why}", markup=False)
+    for path in written:
+        out.print(f"wrote {path}", markup=False)
 
 
 def main() -> None:

@@ -30,3 +30,31 @@ def test_specs_with_errors_or_missing_are_one_clear_error(tmp_path: Path) -> Non
     broken.write_text("module m { request R { type: exec; task: T; } }\n", encoding="utf-8")
     with pytest.raises(RunError, match=r"do not compile \(\d+ error"):
         ensure_compiled(broken, tmp_path / "out")
+
+
+def test_a_stamped_package_is_current_without_compiling_until_a_spec_changes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import shutil
+
+    import specc.pipeline
+
+    specs = tmp_path / "generic"
+    shutil.copytree(GENERIC, specs, ignore=shutil.ignore_patterns("__pycache__"))
+    assert ensure_compiled(specs, tmp_path / "out").rewritten
+
+    def no_compiling(paths: list[Path], **_: object) -> None:
+        raise AssertionError("compiled although the stamp says the package is current")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(specc.pipeline, "load", no_compiling)
+        assert not ensure_compiled(specs, tmp_path / "out").rewritten
+        # A changed spec is another input: the stamp no longer holds, so it compiles.
+        spec = next(specs.rglob("*.spec"))
+        spec.write_text(spec.read_text() + "\n// a comment changes nothing generated\n")
+        with pytest.raises(AssertionError, match="compiled although"):
+            ensure_compiled(specs, tmp_path / "out")
+    again = ensure_compiled(specs, tmp_path / "out")
+    assert not again.rewritten  # compiled, and found the same files on disk
+    # A generated file deleted behind the stamp's back is rewritten.
+    next(p for p in sorted(again.folder.rglob("*.py")) if p.name != "__init__.py").unlink()
+    assert ensure_compiled(specs, tmp_path / "out").rewritten

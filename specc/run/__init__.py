@@ -3,7 +3,13 @@
 - `specc.run.events`: the JSONL event log every run writes, stamped with simulated time.
 - `specc.run.hunt`: Hilare's object hunt of seed 000 ch. 5 (`run_hunt`) and the §5.5 checks
   read from its log.
-- `specc.run.pictures`: the hunt's picture and the state of Fig 5.11 (`draw_hunt`).
+- `specc.run.rover`: the rover missions of seed 004 on the simulated ATRV (`run_rover_mission`).
+- `specc.run.measures`: the measures of seed 004 §4.1.4 and their tables.
+- `specc.run.render`: every picture of a run, drawn from its event log alone (`render_run`);
+  `specc.run.pictures`: the state of Fig 5.11.
+- `specc.run.session`: `specc run` (compile if stale, run, write the run folder);
+  `specc.run.replay` and `specc.run.sweep`: `specc replay` and `specc table`.
+- `specc.run.package`: compile-if-stale and the import of the generated package.
 
 What a user can get wrong (a bad seed, an unreadable log, a package that is not compiled) is a
 `RunError`, whose message the command line prints as it is.

@@ -14,7 +14,7 @@ know):
 
 | kind | when | fields |
 | --- | --- | --- |
-| `mission-start` | the run begins | what the run was asked (e.g. `seed`, `horizon`, `goal`, the `objects` placed) |
+| `mission-start` | the run begins | what the run was asked (`seed`, `goal`, ...), `world`, `world_data` (*) |
 | `goal` | a goal is posted to the supervisor, and when it ends | `goal`, `status` (posted, succeeded, failed) |
 | `request` | the task level asks the executive for a service (RQST EXEC, §3.9) | `service`, `id` |
 | `activity` | an executive activity changes phase (Fig 3.3; WAIT→INIT is its start) | `service`, `id`, `from`, `to` |
@@ -27,8 +27,14 @@ know):
 | `object-detected` | the camera sees an object for the first time | `object`, `x`, `y` |
 | `object-retrieved` | GET-NEAR-OBJ hands an object over | `object`, `x`, `y` (null: none there), `seen_x`, `seen_y` |
 | `object-taken` | a take cycle ends with the object on the robot | `object`, `x`, `y`, `taken` |
+| `pose` | every 0.5 s of simulated time | `x`, `y`, `theta`: the robot's true pose |
+| `trajectory` | a trajectory is planned (CALC-TRAJ-GOAL, CALC-TRAJ-OBJ) | `service`, `points` ([x, y] ...) |
+| `model` | the hunt ends: EXPLOR's model (Fig 5.11) | `goal` ([x, y] or null), `certainty` (**) |
 | `alarm` | trouble the procedures miss (robot blocked, executive ERROR, empty take, ...) | `what`, `detail` |
 | `mission-end` | the run ends | `outcome` (succeeded, failed, horizon), `why`, and the run's figures |
+
+(*) the world whole, as `specc.runtime.sim.parse_world` reads it, so a log can be redrawn alone.
+(**) `cell`, `nx`, `ny` and `values`, the certainty per cell row by row from (0, 0).
 """
 
 from __future__ import annotations

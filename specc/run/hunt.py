@@ -49,6 +49,7 @@ from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
 from specc.run.pictures import draw_hunt
+from specc.run.recording import PoseRecorder, world_fields
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
 from specc.runtime.sim import HILARE, Simulation, World, WorldError, load_world
@@ -73,6 +74,7 @@ OBJECT_STREAM = 0x0B1EC7  # mixed with the seed for the objects' places, apart f
 OBJECT_JITTER = 0.1  # m: an object lies within this of its cell's centre, on each axis
 ROBOT_MOVING = 0.005  # m/s at the wheel rims: slower than this, the robot stands still
 SAMPLE_PRIORITY = 1000  # the motion sampler runs after the physics and codels of its instant
+CERTAINTY_DIGITS = 3  # the model's certainty per cell, as the log keeps it
 PROGRESS_PERIOD = 10.0  # s of simulated time between two progress reports
 
 # The services of the take-object cycle, in TakeObject's order (procedures.spec).
@@ -218,11 +220,13 @@ def run_hunt(seed: int, objects_wanted: int = MAX_OBJECTS_WANTED, horizon: float
         supervisor = package.supervisor.create(kernel=kernel, executive=executive, seed=seed,
                                                log=recorder.operator)
         recorder.watch_facts(supervisor.database)
-        log.emit(kernel.now, "mission-start", robot=ROBOT, seed=seed, goal=goal, objects_wanted=objects_wanted,
-                 horizon=horizon, world=WORLD, objects=[[x, y] for x, y in sim.objects])
+        log.emit(kernel.now, "mission-start", robot=ROBOT, mission="hunt", seed=seed, goal=goal,
+                 objects_wanted=objects_wanted, horizon=horizon, objects=[[x, y] for x, y in sim.objects],
+                 **world_fields(world))
         intention = supervisor.post(goal)
         log.emit(kernel.now, "goal", goal=goal, status="posted")
         recorder.start()
+        PoseRecorder(log.emit, sim).start()
 
         def running() -> bool:
             recorder.poll_facts()
@@ -420,6 +424,7 @@ class _Recorder:
         points = tuple((round(float(x), 3), round(float(y), 3))
                        for x, y in zip(traj.x[: traj.nbPoints], traj.y[: traj.nbPoints], strict=True))
         self.planned.append(PlannedPath(now, service, points))
+        self.log.emit(now, "trajectory", service=service, points=[list(p) for p in points])
 
     # ------------------------------------------------------------ the supervisor
     def operator(self, text: str) -> None:
@@ -516,6 +521,12 @@ class _Recorder:
         self._check_detections()
         self.poll_facts()
         self._check_incidents()
+        certainty = _certainty(self.sim)
+        goal = self.sim.trace.goal
+        self.log.emit(self.kernel.now, "model", goal=list(goal) if goal is not None else None,
+                      certainty=None if certainty is None else {
+                          "cell": certainty.cell, "nx": certainty.nx, "ny": certainty.ny,
+                          "values": [round(v, CERTAINTY_DIGITS) for v in certainty.values]})
 
     def objects(self) -> tuple[HuntObject, ...]:
         return tuple(HuntObject(k, x, y, self._detected.get(k), self._retrieved.get(k), self._taken.get(k))
@@ -670,8 +681,8 @@ def arm_motion_overlaps(events: Iterable[Mapping[str, Any]], services: Sequence[
     so the default looks at ARM-OBJ only; ARM-BACK during an exploration move is §5.5's
     scenario ("pendant son dépôt sur le robot [...] la tâche d'exploration peut redémarrer")."""
     ordered = list(events)
-    robot = _intervals(ordered, "robot-motion")
-    arm = _intervals(ordered, "arm-motion", services)
+    robot = motion_stretches(ordered, "robot-motion")
+    arm = motion_stretches(ordered, "arm-motion", services)
     overlaps = []
     for service, start, end in arm:
         for _, moving_from, moving_to in robot:
@@ -681,7 +692,7 @@ def arm_motion_overlaps(events: Iterable[Mapping[str, Any]], services: Sequence[
     return overlaps
 
 
-def _intervals(events: Iterable[Mapping[str, Any]], kind: str,
+def motion_stretches(events: Iterable[Mapping[str, Any]], kind: str,
                services: Sequence[str] | None = None) -> list[tuple[str, float, float]]:
     """(service, start, end) of each stretch of `kind` events from moving to still; a stretch
     still open at the end of the log ends with its last event."""

@@ -32,7 +32,7 @@ world, or grouped over any of them: "*" stands for all, as the thesis' M*, W*), 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -108,6 +108,20 @@ class Measures:
         data.update(mu=self.mu, nu=self.nu, activity_time=round(self.activity_time, 3),
                     distance=round(self.distance, 3), mission_time=round(self.mission_time, 3))
         return data
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Measures:
+        """The measures `to_json` wrote (a run folder's report.json keeps them)."""
+        try:
+            counts = {name: GoalCount(int(data[name]["asked"]), int(data[name]["met"]))
+                      for name in ("photos", "communications", "home", "believed")}
+            return cls(configuration=str(data["configuration"]), mission=str(data["mission"]),
+                       world=str(data["world"]), seed=int(data["seed"]), kappa=int(data["kappa"]),
+                       replannings=int(data["replannings"]), activity_time=float(data["activity_time"]),
+                       distance=float(data["distance"]), mission_time=float(data["mission_time"]),
+                       planner_failures=int(data["planner_failures"]), **counts)
+        except (KeyError, TypeError, ValueError) as error:
+            raise RunError(f"not the measures of a rover run ({type(error).__name__}: {error})") from None
 
     def summary(self) -> str:
         outcome = "succeeded" if self.success else "failed"

@@ -2,16 +2,23 @@
 
 "Stale" is decided by content, not by dates (a fresh clone gives every file the same date): the
 specs are compiled in memory and the package on disk is rewritten only when some file differs.
-That costs a compilation per run (about a second for the rover, a few for Hilare, whose
-controller is the longest to build) and can never run an outdated package.
+A compilation takes about a second for the rover and several for Hilare (whose controller is
+the longest to build), so each one leaves a stamp (in the user's cache): the digests of
+the specs, of the compiler and of every file written. While all three still match, the package
+is current without compiling; anything else compiles again, so an outdated package never runs.
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import hashlib
 import importlib
+import json
 import keyword
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -36,6 +43,10 @@ def ensure_compiled(specs: Path, output: Path) -> Compiled:
 
     if not specs.exists():
         raise RunError(f"no spec file or folder '{specs}': name a robot's spec folder, e.g. examples/atrv")
+    stamp = _Stamp(specs, output)
+    stamped = stamp.still_current()
+    if stamped is not None:
+        return stamped
     loaded = load([specs])
     if loaded.errors or loaded.program is None:
         shown = "\n".join(render(d, loaded.sources) for d in loaded.errors[:20])
@@ -49,14 +60,90 @@ def ensure_compiled(specs: Path, output: Path) -> Compiled:
     except KheopsError as exc:
         raise RunError(f"{exc.node.span}: error: {exc} [not-propositional]") from None
     folder = output / robot
-    current = all(_reads(folder / relative) == text for relative, text in result.files.items())
-    if current:
+    up_to_date = all(_reads(folder / relative) == text for relative, text in result.files.items())
+    if not up_to_date:
+        try:
+            result.write(folder)
+        except OSError as exc:
+            raise RunError(f"cannot write the package into '{folder}': {exc.strerror}") from None
+    stamp.write(robot, folder, result.files)
+    return Compiled(robot, folder, not up_to_date)
+
+
+def remember_compilation(specs: Path, output: Path, robot: str, files: Mapping[str, str]) -> None:
+    """Stamp a compilation `specc compile` made, so that the next run need not compile again."""
+    _Stamp(specs, output).write(robot, output / robot, files)
+
+
+class _Stamp:
+    """What a compilation of `specs` into `output` was made from, and what it wrote."""
+
+    def __init__(self, specs: Path, output: Path) -> None:
+        from specc.syntax.parser import spec_files
+
+        files, problems = spec_files([specs])
+        where = _digest([str(specs.resolve()), str(output.resolve())])[:24]
+        self.path = stamps_folder() / f"{where}.json"
+        # Problems finding the specs: no digest, so `load` reports them as it does for `check`.
+        self.inputs = None if problems else _digest([_compiler_digest()] + [
+            f"{file.name}:{_file_digest(file)}" for file in files])
+
+    def still_current(self) -> Compiled | None:
+        if self.inputs is None:
+            return None
+        try:
+            data = json.loads(self.path.read_text(encoding="utf-8"))
+            robot, folder, written = data["robot"], Path(data["folder"]), data["files"]
+            if data["inputs"] != self.inputs or not isinstance(written, dict):
+                return None
+        except (OSError, ValueError, KeyError, TypeError):
+            return None
+        if not all(_file_digest(folder / relative) == digest for relative, digest in written.items()):
+            return None  # a file edited or deleted since
         return Compiled(robot, folder, False)
-    try:
-        result.write(folder)
-    except OSError as exc:
-        raise RunError(f"cannot write the package into '{folder}': {exc.strerror}") from None
-    return Compiled(robot, folder, True)
+
+    def write(self, robot: str, folder: Path, files: Mapping[str, str]) -> None:
+        if self.inputs is None:
+            return
+        data = {"robot": robot, "folder": str(folder), "inputs": self.inputs,
+                "files": {relative: _digest([text]) for relative, text in sorted(files.items())}}
+        with contextlib.suppress(OSError):  # without a stamp the next run compiles again: slower, still right
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.path.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+
+
+def stamps_folder() -> Path:
+    """The user's cache (XDG), not the output folder: that one holds the package and nothing else."""
+    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(cache) / "specc" / "stamps"
+
+
+_COMPILER = Path(__file__).resolve().parents[1]  # the specc package: its sources, grammar and templates
+# make the generated code
+
+
+def _digest(parts: Sequence[str]) -> str:
+    sha = hashlib.sha256()
+    for part in parts:
+        sha.update(part.encode("utf-8", "surrogateescape"))
+        sha.update(b"\0")
+    return sha.hexdigest()
+
+
+def _file_digest(path: Path) -> str | None:
+    text = _reads(path)
+    return None if text is None else _digest([text])
+
+
+@functools.cache
+def _compiler_digest() -> str:
+    """Every source of the compiler (runtimes included: cheaper than telling which feed the
+    generator, and a change there recompiles at worst)."""
+    from specc.resources import grammar_path, templates_dir
+
+    sources = sorted(p for p in _COMPILER.rglob("*.py") if p.is_file())
+    sources += [grammar_path(), *sorted(p for p in templates_dir().rglob("*") if p.is_file())]
+    return _digest([f"{p.name}:{_file_digest(p)}" for p in sources])
 
 
 def _reads(path: Path) -> str | None:

@@ -31,8 +31,8 @@ action still running at its start plus its planned longest duration has failed, 
 Every move reports `ROBOT_POSITION(x, y)`, the odometry where the robot stands, before its end or
 its failure (FTplan's state rules then place the robot, and a replanning starts from there).
 
-What the log holds (`specc.run.events`), each event at its mission time: `mission-start` (the
-configuration, planners, seed, timing, the windows as drawn, the photo targets), every event of
+What the log holds (`specc.run.events`), each event at its mission time: `mission-start` (the world,
+configuration, planners, seed, timing, the windows as drawn, the photo targets), `pose` every 0.5 s, every event of
 FTplan's own log as `ftplan` (`event`: plan-request, plan, execute, report, goal-met, watchdog,
 invalid-plan, action-failed, safe-state, operator, mission-failure, mission-end; `text`,
 `planner`), every `action` as it starts and as it ends, fails or is stopped (`status`, `plan`,
@@ -65,6 +65,7 @@ import numpy as np
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
+from specc.run.recording import PoseRecorder, world_fields
 from specc.runtime import functional as rt
 from specc.runtime.ftplan import (
     FtPlan,
@@ -230,11 +231,11 @@ class RoverRun:
         return x, y
 
     def draw(self, path: str | Path) -> Path:
-        """A PNG of the run: the world, the robot's path, the photo targets, the windows."""
-        from specc.runtime.sim.render import draw
+        """A PNG of the run: the world, the robot's path, the photo targets, the windows. Drawn
+        from the events, as `specc replay` draws the run folder's map.png."""
+        from specc.run.render import draw_map  # here: render imports this module
 
-        outcome = "success" if self.result.success else f"{len(self.result.missed)} goal(s) missed"
-        return draw(self.simulation, path, title=f"{self.configuration} on {self.mission} in {self.world}: {outcome}")
+        return draw_map(self.events, path)
 
 
 class RoverProgress(NamedTuple):
@@ -264,18 +265,20 @@ def load_package(generated: Path = GENERATED, example: Path = EXAMPLE) -> AtrvPa
                                          ("modules", "planner", f"ftplan.{FTPLAN_BLOCK}")))
 
 
-def resolve_world(world: str | Path | World) -> World:
-    """W1..W4 name the worlds of examples/atrv/worlds; a path names a world file; a World is
-    used as it is."""
+def resolve_world(world: str | Path | World, worlds: Path = WORLDS) -> World:
+    """A name of the worlds in `worlds` (W1..W4 in examples/atrv/worlds), a path to a world
+    file, or a World used as it is."""
     if isinstance(world, World):
         return world
     text = str(world)
-    if text.upper() in {f"W{k}" for k in range(1, 5)}:
-        path = WORLDS / f"{text.upper()}.toml"
-    elif text.endswith(".toml") or Path(text).exists():
+    named = {p.stem.upper(): p for p in sorted(worlds.glob("*.toml"))}
+    if text.upper() in named:
+        path = named[text.upper()]
+    elif text.endswith(".toml") or Path(text).is_file():
         path = Path(text)
     else:
-        raise RunError(f"unknown world '{text}': give W1, W2, W3, W4 (examples/atrv/worlds) or a world file (.toml)")
+        raise RunError(f"unknown world '{text}': give {', '.join(p.stem for p in named.values()) or 'a world name'} "
+                       f"({worlds}) or a world file (.toml)")
     try:
         return load_world(path)
     except WorldError as error:
@@ -437,12 +440,17 @@ def mission_windows(problem: pm.Problem, seed: int) -> tuple[Window, ...]:
     rng = np.random.default_rng([WINDOW_STREAM, seed])
     windows = []
     for name in sorted(opening, key=lambda n: opening[n]):
-        if name not in closing:
-            continue
+        if name not in closing or not (_drawable(opening[name]) and _drawable(closing[name])):
+            continue  # an inconsistent problem leaves nature no instant: no window, and no plan either
         start = round(float(rng.uniform(*opening[name])), 3)
         end = round(float(rng.uniform(*closing[name])), 3)
         windows.append(Window(name, start, max(end, start)))
     return tuple(windows)
+
+
+def _drawable(bounds: tuple[float, float]) -> bool:
+    low, high = bounds
+    return math.isfinite(low) and math.isfinite(high) and low <= high
 
 
 def mission_goals(problem: pm.Problem, mission: str, state: SystemState | None = None) -> tuple[MissionGoal, ...]:
@@ -731,20 +739,23 @@ class _Journal:
         self._forwarded = 0
 
     def emit(self, time_: float, kind: str, **fields: Any) -> None:
-        self.catch_up()
+        self.catch_up(time_)
         self.log.emit(time_, kind, **fields)
         if kind == "action" and self.progress is not None:
             args = ", ".join(format_value(a) for a in fields.get("args", ()))
             self.report_progress(time_, f"{fields.get('status')} {fields.get('task')}({args})")
 
-    def catch_up(self) -> None:
+    def catch_up(self, until: float = math.inf) -> None:
+        """Forward FTplan's events up to `until`: FTplan notes a plan's execution at the end of
+        its planning time before the kernel (and its pose samples) has caught up with it."""
         if self.ftplan is None:
             return
         events = self.ftplan.events
-        for event in events[self._forwarded:]:
+        while self._forwarded < len(events) and events[self._forwarded].time <= until:
+            event = events[self._forwarded]
             self.log.emit(event.time, "ftplan", event=event.kind, text=event.text,
                           **({"planner": event.planner} if event.planner else {}))
-        self._forwarded = len(events)
+            self._forwarded += 1
 
     def report_progress(self, time_: float, what: str) -> None:
         if self.progress is not None:
@@ -768,17 +779,17 @@ class PreparedMission:
 
 
 def prepare_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
-                    generated: Path = GENERATED) -> PreparedMission:
+                    generated: Path = GENERATED, example: Path = EXAMPLE) -> PreparedMission:
     """Check the names and build what `run_rover_mission` runs (see there); RunError when a name
     is unknown or the package is not compiled."""
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise RunError(f"seed {seed!r}: give a whole number >= 0")
-    package = load_package(generated)
+    package = load_package(generated, example)
     try:
         setup = mission_setup(package.ftplan.CONFIGURATIONS, configuration, mission, package.planner)
     except UnknownName as error:
         raise RunError(str(error)) from None
-    ground = resolve_world(world)
+    ground = resolve_world(world, example / "worlds")
     tasks = RoverTasks.of(setup.config, setup.problem, mission, ground)
     # The antenna's windows, and those the picture's time strip shows.
     ground = dataclasses.replace(ground, windows=mission_windows(setup.problem, seed))
@@ -788,28 +799,30 @@ def prepare_mission(configuration: str, mission: str, world: str | Path | World,
 
 def run_rover_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
                       log: EventLog | None = None, progress: Callable[[RoverProgress], None] | None = None,
-                      generated: Path = GENERATED, timing: str = "model") -> RoverRun:
+                      generated: Path = GENERATED, example: Path = EXAMPLE, timing: str = "model") -> RoverRun:
     """Run `mission` (M1..M4) with the robot `configuration` of seed 004 §4.2.1.1 (Robot1,
     Robot2, Robot1/2, Robot1/2c) in `world` (W1..W4, a world file or a World), the simulation and the
     visibility windows drawn from `seed`.
 
-    `generated` holds the compiled atrv package (`specc compile examples/atrv -o generated`);
+    `generated` holds the compiled atrv package (`specc compile examples/atrv -o generated`),
+    `example` the codels (atrv_codels) and the worlds;
     `timing` is FTplan's planning charge ("model": deterministic, "wall": measured). Events go to
     `log` (one in memory when none is given) and to the result. Anything the caller can get wrong
     raises RunError, whose message is one line."""
     if timing not in TIMINGS:
         raise RunError(f"timing '{timing}': give {' or '.join(TIMINGS)}")
-    prepared = prepare_mission(configuration, mission, world, seed, generated=generated)
+    prepared = prepare_mission(configuration, mission, world, seed, generated=generated, example=example)
     setup, rover, windows = prepared.setup, prepared.rover, prepared.world.windows
     log = log if log is not None else EventLog()
     journal = _Journal(log, progress, len(SystemState.from_problem(setup.problem).goals))
     executor = SimExecutor(rover, prepared.tasks, journal.emit)
     started = time.perf_counter()
     log.emit(rover.kernel.now, "mission-start", robot=ROBOT, configuration=configuration, mission=mission,
-             world=prepared.world.name, seed=seed, timing=timing, policy=setup.config.policy,
+             **world_fields(prepared.world), seed=seed, timing=timing, policy=setup.config.policy,
              planners=[f"{p.name} ({p.domain})" for p in setup.config.planners],
              windows=[[w.name, w.start, w.end] for w in windows],
              targets=[[t.name, t.x, t.y] for t in prepared.tasks.targets.values()])
+    PoseRecorder(journal.emit, rover.sim).start()
     with ProcessPool(setup.config.planners, setup.domains) as pool:
         ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems)
         journal.ftplan = ftplan

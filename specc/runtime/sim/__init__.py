@@ -10,7 +10,17 @@ from __future__ import annotations
 from specc.runtime.sim.devices import reliability
 from specc.runtime.sim.rover import ATRV, HILARE, ROBOTS, RobotConfig, Rover
 from specc.runtime.sim.simulation import Simulation, Trace
-from specc.runtime.sim.world import Circle, Polygon, Target, Window, World, WorldError, load_world, parse_world
+from specc.runtime.sim.world import (
+    Circle,
+    Polygon,
+    Target,
+    Window,
+    World,
+    WorldError,
+    load_world,
+    parse_world,
+    world_data,
+)
 
 __all__ = ["ATRV", "HILARE", "ROBOTS", "Circle", "Polygon", "RobotConfig", "Rover", "Simulation", "Target",
-           "Trace", "Window", "World", "WorldError", "load_world", "parse_world", "reliability"]
+           "Trace", "Window", "World", "WorldError", "load_world", "parse_world", "reliability", "world_data"]

@@ -241,6 +241,23 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     return world
 
 
+def world_data(world: World) -> dict[str, Any]:
+    """The world as `parse_world` reads it (TOML's tables as dicts), so a run's log can carry
+    its world and be redrawn without the file: parse_world(world_data(w)) == w."""
+    xmin, xmax, ymin, ymax = world.bounds
+    data: dict[str, Any] = {
+        "world": {"name": world.name, "description": world.description},
+        "bounds": {"xmin": xmin, "xmax": xmax, "ymin": ymin, "ymax": ymax},
+        "start": dict(zip(("x", "y", "theta"), world.start, strict=True)),
+        "obstacles": [{"polygon": [list(p) for p in o.points]} if isinstance(o, Polygon)
+                      else {"circle": [o.x, o.y, o.radius]} for o in world.obstacles],
+        "objects": {"count": world.random_objects, "at": [{"x": x, "y": y} for x, y in world.objects]},
+        "targets": [{"name": t.name, "x": t.x, "y": t.y} for t in world.targets],
+        "windows": [{"name": w.name, "start": w.start, "end": w.end} for w in world.windows],
+    }
+    return data
+
+
 class _Where:
     def __init__(self, source: str) -> None:
         self.source = source

@@ -1,0 +1,584 @@
+"""The pictures of a run, drawn from its event log alone (issue #9: `specc run` writes them into
+the run's folder, `specc replay RUN` draws them again from the run's JSONL log).
+
+    render_run(read_events("runs/m1w1/events.jsonl"), Path("runs/m1w1"))   # [map.png, timeline.png]
+
+The `mission-start` event says what the run was, and so which pictures it gets:
+
+- a rover mission of seed 004 (`robot` atrv, `specc.run.rover`):
+  - map.png: the world, the robot's path from start to end, the mission's photo targets (green
+    once a photo of them succeeded), where photos were taken, where actions failed, and the
+    visibility windows on a time strip with the communications and photos done;
+  - timeline.png: a Gantt chart, one row per kind of task, each executed action a bar from its
+    start to its end coloured by outcome inside the hollow bar of its planned bound (start to
+    `latest_end`); the visibility windows; FTplan's events (plan requests, plans, invalid plans,
+    watchdogs, failures, safe states...) as markers, and the plans' starts and planner switches
+    as vertical lines.
+- Hilare's object hunt of seed 000 ch. 5 (`robot` hilare, `mission` hunt, `specc.run.hunt`):
+  - map.png: the room, EXPLOR's certainty cells, the planned trajectories, the path, the objects
+    by what became of them (numbered in the order taken), the last observation goal, and where a
+    detection interrupted an exploration move (§5.5);
+  - timeline.png: one row per executive service, each activity a bar from its start (WAIT to
+    INIT) to its end coloured by its reply (its wait for the controller thinner before it); the
+    robot's and the arm's motion; detections, objects taken, alarms;
+  - state.png: the state at the end as the interface of §5.6 shows it (Fig 5.11,
+    `specc.run.pictures`).
+
+The world comes whole in mission-start's `world_data`. A log cut short (a run that crashed or was
+interrupted has no `mission-end`) is drawn as far as it goes. The functions that read the log
+(`action_bars`, `service_bars`, `path_of`, `hunt_objects`, ...) draw nothing: tests and other
+tools can use them alone.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import textwrap
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from specc.run import RunError, pictures
+from specc.run.hunt import HuntObject, detection_interruptions, motion_stretches
+from specc.run.rover import TASK_KINDS
+from specc.runtime.planner.plan import Value, format_value
+from specc.runtime.sim import ROBOTS, Target, Window, World, WorldError, parse_world
+from specc.runtime.sim.render import (
+    OBJECT_COLOURS,
+    Certainty,
+    Link,
+    Mark,
+    Scene,
+    Shot,
+    map_figure,
+    position_at,
+    pyplot,
+)
+
+Events = Sequence[Mapping[str, Any]]
+
+MAP, TIMELINE, STATE = "map.png", "timeline.png", "state.png"
+ROVER, HUNT = "rover", "hunt"
+TITLE_WIDTH = 130  # characters of a title line before it wraps
+SHORTEST_AXIS = 1.0  # s: a timeline's time axis spans at least this (a log cut at its start)
+
+# An action's outcome (specc.run.rover's ExecutedAction.outcome; running: the log ends first).
+ACTION_COLOURS = {"ended": "#16a34a", "failed": "#dc2626", "stopped": "#f97316", "running": "#9ca3af"}
+# FTplan's events worth a marker (`report` repeats the actions, `execute` is drawn as a line, its
+# `mission-end` as the run's), on two rows, each kind a little above or below the row's middle so
+# that events of one instant (a failure and the safe state it brings) stay apart.
+PLANNING, EXECUTION = "FTplan planning", "FTplan execution"
+FTPLAN_MARKERS = {  # kind: (row, offset, marker, colour)
+    "plan-request": (PLANNING, -0.2, ">", "#6b7280"),
+    "plan": (PLANNING, 0.2, "o", "#2563eb"),
+    "invalid-plan": (PLANNING, 0.2, "X", "#b91c1c"),
+    "watchdog": (PLANNING, 0.2, "v", "#ea580c"),
+    "action-failed": (EXECUTION, -0.2, "X", "#dc2626"),
+    "safe-state": (EXECUTION, 0.2, "s", "#f97316"),
+    "goal-met": (EXECUTION, 0.0, "^", "#16a34a"),
+    "goal-missed": (EXECUTION, 0.0, "v", "#dc2626"),
+    "goals-open": (EXECUTION, 0.0, "d", "#ca8a04"),
+    "operator": (EXECUTION, 0.0, "d", "#6b7280"),
+    "mission-failure": (EXECUTION, -0.2, "*", "#7f1d1d"),
+}
+PLAN_LINE, SWITCH_LINE = "#9ca3af", "#7c3aed"
+
+# A service's activity, by its reply (specc.runtime.executive): OK, or what its output function
+# returns (SEARCH-OBJ's count of objects seen), is a success; INT an interruption; any other
+# word (TIMEOUT, REFUSED, the module's report code...) a failure.
+SERVICE_COLOURS = {"ok": "#16a34a", "interrupted": "#f97316", "failed": "#dc2626", "running": "#9ca3af"}
+INTERRUPTED = "INT"
+ENDED = ("ETHER",)  # the phase an activity leaves the executive's list for (Fig 3.3)
+STARTED = ("WAIT", "INIT")  # the controller let it start
+WAIT_COLOUR = "#cbd5e1"
+MOTION_COLOUR = "#1d4ed8"
+ARM_COLOURS = ("#0891b2", "#a855f7", "#64748b")  # one per arm service, in order of first motion
+
+
+# ---------------------------------------------------------------- what every run says
+
+
+def mission_start(events: Events) -> Mapping[str, Any]:
+    """The run's `mission-start` event; RunError when the log has none or it lacks the world."""
+    start = next((e for e in events if e.get("kind") == "mission-start"), None)
+    if start is None:
+        raise RunError("the log has no mission-start event: it is not a run's log, or it lost its first line")
+    if not isinstance(start.get("world_data"), Mapping):
+        raise RunError("the log's mission-start carries no world_data: the run was made by an older specc; "
+                       "run it again to draw it")
+    return start
+
+
+def run_world(events: Events) -> World:
+    """The world the run took place in, from mission-start (with the visibility windows as the
+    seed drew them, when the mission has any)."""
+    start = mission_start(events)
+    try:
+        world = parse_world(start["world_data"], "the log's world_data", str(start.get("world") or "world"))
+    except WorldError as error:
+        raise RunError(str(error)) from None
+    windows = start.get("windows")
+    if windows:
+        world = dataclasses.replace(world, windows=tuple(Window(str(n), float(a), float(b)) for n, a, b in windows))
+    return world
+
+
+def run_kind(events: Events) -> str:
+    """ROVER or HUNT, from what mission-start says the robot and the mission are."""
+    start = mission_start(events)
+    if start.get("robot") == "atrv":
+        return ROVER
+    if start.get("robot") == "hilare" or start.get("mission") == HUNT:
+        return HUNT
+    raise RunError(f"cannot draw a run of robot '{start.get('robot')}', mission '{start.get('mission')}': "
+                   "known are the ATRV's missions (robot atrv) and Hilare's hunt (robot hilare)")
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What a picture's title says of the run."""
+
+    robot: str
+    configuration: str  # the rover's (Robot1...); "" for the hunt
+    mission: str
+    world: str
+    seed: Any
+    outcome: str  # mission-end's, or "" when the log has no end
+    why: str
+    end: float  # s: the last instant the log reaches
+    distance: float | None = None  # m the robot travelled, as mission-end says
+
+    def title(self) -> str:
+        who = f"{self.robot} {self.configuration}" if self.configuration else self.robot
+        what = f"{self.outcome}: {self.why}" if self.outcome else f"no mission-end: the log stops at {self.end:.1f} s"
+        if self.distance is not None:
+            what += f", {self.distance:.1f} m travelled"
+        return textwrap.fill(f"{who}, mission {self.mission}, world {self.world}, seed {self.seed} — {what}",
+                             TITLE_WIDTH)
+
+
+def run_info(events: Events) -> RunInfo:
+    start = mission_start(events)
+    end = next((e for e in reversed(events) if e.get("kind") == "mission-end"), None)
+    return RunInfo(str(start.get("robot", "?")), str(start.get("configuration", "")),
+                   str(start.get("mission", "?")), str(start.get("world", "?")), start.get("seed", "?"),
+                   str(end.get("outcome", "")) if end else "", str(end.get("why", "")) if end else "",
+                   last_time(events), float(end["distance"]) if end and end.get("distance") is not None else None)
+
+
+def last_time(events: Events) -> float:
+    return max((float(e["t"]) for e in events), default=0.0)
+
+
+def path_of(events: Events) -> np.ndarray:
+    """The robot's true path from the `pose` events: rows t, x, y, theta."""
+    rows = [(e["t"], e["x"], e["y"], e["theta"]) for e in events if e.get("kind") == "pose"]
+    return np.asarray(rows, dtype=float).reshape(-1, 4)
+
+
+def robot_of(events: Events) -> Any:
+    name = mission_start(events).get("robot")
+    if name not in ROBOTS:
+        raise RunError(f"the log's robot '{name}' is none the simulator knows ({', '.join(sorted(ROBOTS))})")
+    return ROBOTS[name]
+
+
+# ---------------------------------------------------------------- the rover's log
+
+
+@dataclass(frozen=True)
+class ActionBar:
+    """An action as it ran, from its `action` events: started, then ended, failed or stopped."""
+
+    plan: int
+    id: str
+    task: str
+    args: tuple[Value, ...]
+    start: float
+    end: float  # the log's end while it was still running
+    outcome: str  # ended | failed | stopped | running
+    latest_end: float | None  # its planned bound: start + its longest duration
+    why: str = ""
+
+    @property
+    def kind(self) -> str:
+        """What the task is for the executor (a move, a photo...); its name when unknown."""
+        return TASK_KINDS.get(self.task, self.task)
+
+    def text(self) -> str:
+        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+
+
+def action_bars(events: Events) -> list[ActionBar]:
+    """Every action of the log, in the order started. An action's start and its end share its
+    plan number and id (ids restart with each plan)."""
+    started: dict[tuple[int, str], Mapping[str, Any]] = {}
+    bars: dict[tuple[int, str], ActionBar] = {}
+    for event in events:
+        if event.get("kind") != "action":
+            continue
+        key = (int(event["plan"]), str(event["id"]))
+        if event["status"] == "started":
+            started[key] = event
+            continue
+        begun = started.get(key, event)
+        latest = begun.get("latest_end")
+        bars[key] = ActionBar(key[0], key[1], str(event["task"]), tuple(event.get("args", ())), float(begun["t"]),
+                              float(event["t"]), str(event["status"]), float(latest) if latest is not None else None,
+                              str(event.get("why", "")))
+    end = last_time(events)
+    for key, event in started.items():
+        if key not in bars:
+            latest = event.get("latest_end")
+            bars[key] = ActionBar(key[0], key[1], str(event["task"]), tuple(event.get("args", ())), float(event["t"]),
+                                  end, "running", float(latest) if latest is not None else None)
+    return sorted(bars.values(), key=lambda b: (b.start, b.plan, b.id))
+
+
+class FtplanMark(NamedTuple):
+    time: float
+    event: str  # FTplan's kind: plan-request, plan, watchdog...
+    planner: str
+    text: str
+
+
+def ftplan_marks(events: Events) -> list[FtplanMark]:
+    """FTplan's events worth a marker on the timeline (FTPLAN_MARKERS), in order."""
+    return [FtplanMark(float(e["t"]), str(e["event"]), str(e.get("planner", "")), str(e.get("text", "")))
+            for e in events if e.get("kind") == "ftplan" and e.get("event") in FTPLAN_MARKERS]
+
+
+class PlanStart(NamedTuple):
+    time: float
+    number: int  # from 1, as the actions' `plan`
+    planner: str
+    switched_from: str  # the planner whose plan ran before, when another one ("" otherwise)
+
+
+def plan_starts(events: Events) -> list[PlanStart]:
+    """When each plan's execution started, by which planner, and where the planner changed (a
+    planner switch: FTplan's recovery by another model, seed 004 §3.2.2)."""
+    starts: list[PlanStart] = []
+    for event in events:
+        if event.get("kind") == "ftplan" and event.get("event") == "execute":
+            planner = str(event.get("planner", ""))
+            before = starts[-1].planner if starts else planner
+            starts.append(PlanStart(float(event["t"]), len(starts) + 1, planner, before if before != planner else ""))
+    return starts
+
+
+def shots_of(events: Events) -> tuple[Shot, ...]:
+    return tuple(Shot(float(e["t"]), str(e.get("target", "")), bool(e["ok"]), float(e["x"]), float(e["y"]))
+                 for e in events if e.get("kind") == "photo")
+
+
+def links_of(events: Events) -> tuple[Link, ...]:
+    return tuple(Link(float(e.get("start", e["t"])), float(e["t"]), bool(e["ok"]))
+                 for e in events if e.get("kind") == "communication")
+
+
+def rover_scene(events: Events) -> Scene:
+    """The map of a rover mission, from its log."""
+    start = mission_start(events)
+    world = run_world(events)
+    path = path_of(events)
+    targets = tuple(Target(str(n), float(x), float(y)) for n, x, y in start["targets"]) \
+        if start.get("targets") is not None else world.targets
+    failed = tuple(position_at(path, world, bar.end) for bar in action_bars(events) if bar.outcome == "failed")
+    return Scene(world, robot_of(events), path, objects=world.objects,
+                 object_states=("undetected",) * len(world.objects), targets=targets, shots=shots_of(events),
+                 marks=(Mark("action failed", failed),), links=links_of(events), now=last_time(events))
+
+
+# ---------------------------------------------------------------- the hunt's log
+
+
+def hunt_objects(events: Events) -> tuple[HuntObject, ...]:
+    """The room's objects (mission-start's `objects`) and when each was detected, retrieved and
+    taken; a retrieval of nothing (VISUAL saw a ghost) is no object's."""
+    start = mission_start(events)
+    placed = start.get("objects")
+    if placed is None:
+        placed = run_world(events).objects
+    when: dict[str, dict[int, float]] = {"object-detected": {}, "object-retrieved": {}, "object-taken": {}}
+    for event in events:
+        seen = when.get(str(event.get("kind")))
+        if seen is not None and event.get("object") is not None:
+            seen.setdefault(int(event["object"]), float(event["t"]))
+    return tuple(HuntObject(k, float(x), float(y), when["object-detected"].get(k), when["object-retrieved"].get(k),
+                            when["object-taken"].get(k)) for k, (x, y) in enumerate(placed))
+
+
+def taken_order(events: Events) -> tuple[int, ...]:
+    """The objects taken, in the order taken."""
+    return tuple(int(e["object"]) for e in events if e.get("kind") == "object-taken" and e.get("object") is not None)
+
+
+@dataclass(frozen=True)
+class ServiceBar:
+    """One activity of the executive: requested, started (left WAIT for INIT), ended (left the
+    list), with its reply."""
+
+    service: str
+    id: int
+    requested: float
+    started: float | None  # None: it never left WAIT (a start timeout, an interruption, a refusal)
+    ended: float  # the log's end while it was still under way
+    result: Any  # the reply's result; None without a reply
+    outcome: str  # ok | interrupted | failed | running
+
+
+def reply_outcome(result: Any) -> str:
+    if result == "OK" or (isinstance(result, int | float) and not isinstance(result, bool)):
+        return "ok"
+    return "interrupted" if result == INTERRUPTED else "failed"
+
+
+def service_bars(events: Events) -> list[ServiceBar]:
+    """Every activity the task level asked the executive for, in the order requested."""
+    requested: dict[int, tuple[str, float]] = {}
+    started: dict[int, float] = {}
+    ended: dict[int, float] = {}
+    results: dict[int, Any] = {}
+    for event in events:
+        kind = event.get("kind")
+        if kind == "request":
+            requested[int(event["id"])] = (str(event["service"]), float(event["t"]))
+        elif kind == "activity":
+            ident = int(event["id"])
+            if (event["from"], event["to"]) == STARTED:
+                started[ident] = float(event["t"])
+            if event["to"] in ENDED:
+                ended[ident] = float(event["t"])
+        elif kind == "reply":
+            results[int(event["id"])] = event.get("result")
+    end = last_time(events)
+    bars = []
+    for ident, (service, at) in requested.items():
+        result = results.get(ident)
+        closed = ident in ended or ident in results
+        bars.append(ServiceBar(service, ident, at, started.get(ident), ended.get(ident, end),
+                               result, reply_outcome(result) if closed else "running"))
+    return bars
+
+
+class Span(NamedTuple):
+    label: str  # the arm's service; "" for the robot
+    start: float
+    end: float
+
+
+def motion_spans(events: Events, kind: str) -> list[Span]:
+    """When the robot (`robot-motion`) or the arm (`arm-motion`) moved; a motion still under way
+    when the log ends lasts to its last event."""
+    return [Span(*stretch) for stretch in motion_stretches(events, kind)]
+
+
+def hunt_model(events: Events) -> tuple[Certainty | None, tuple[float, float] | None]:
+    """EXPLOR's model at the end (the `model` event): the certainty grid and the last
+    observation goal; nothing when the log ends before it."""
+    model = next((e for e in reversed(events) if e.get("kind") == "model"), None)
+    if model is None:
+        return None, None
+    data, goal = model.get("certainty"), model.get("goal")
+    certainty = Certainty(float(data["cell"]), int(data["nx"]), int(data["ny"]), tuple(data["values"])) \
+        if data else None
+    return certainty, (float(goal[0]), float(goal[1])) if goal else None
+
+
+def trajectories(events: Events) -> tuple[tuple[tuple[float, float], ...], ...]:
+    """The trajectories PLAN computed, in the order planned."""
+    return tuple(tuple((float(x), float(y)) for x, y in e["points"]) for e in events if e.get("kind") == "trajectory")
+
+
+def hunt_scene(events: Events) -> Scene:
+    """The map of the hunt, from its log."""
+    world = run_world(events)
+    path = path_of(events)
+    objects = hunt_objects(events)
+    certainty, goal = hunt_model(events)
+    interrupted = tuple(position_at(path, world, i.interrupted_at)
+                        for i in detection_interruptions(events).interruptions)
+    blocked = tuple(position_at(path, world, float(e["t"])) for e in events
+                    if e.get("kind") == "alarm" and e.get("what") == "blocked")
+    return Scene(world, robot_of(events), path, objects=tuple((o.x, o.y) for o in objects),
+                 object_states=tuple(o.state for o in objects), taken_order=taken_order(events),
+                 planned=trajectories(events), certainty=certainty, goal=goal,
+                 marks=(Mark("exploration move interrupted", interrupted), Mark("blocked", blocked, "P")),
+                 now=last_time(events))
+
+
+# ---------------------------------------------------------------- the pictures
+
+
+def render_run(events: Events, folder: Path) -> list[Path]:
+    """Draw the run's pictures into `folder` from its events alone; returns the files written.
+    RunError (one line) when the log cannot be drawn."""
+    kind = run_kind(events)
+    run_world(events)  # a log that cannot be drawn fails before any file is written
+    drawers: tuple[tuple[str, Callable[[Events, Path], Path]], ...] = (
+        (MAP, draw_map), (TIMELINE, draw_rover_timeline if kind == ROVER else draw_hunt_timeline))
+    if kind == HUNT:
+        drawers += ((STATE, draw_state),)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise RunError(f"{folder}: cannot make the run's folder ({error.strerror or error})") from None
+    try:
+        return [draw(events, folder / name) for name, draw in drawers]
+    except RunError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError) as error:  # a log edited or written by hand
+        raise RunError(f"the log cannot be drawn: an event lacks a field or has one of the wrong type "
+                       f"({type(error).__name__}: {error})") from None
+
+
+def draw_map(events: Events, path: str | Path) -> Path:
+    """The run's map (see the module's docstring) as a PNG at `path`."""
+    scene = rover_scene(events) if run_kind(events) == ROVER else hunt_scene(events)
+    figure = map_figure(scene, run_info(events).title())
+    try:
+        return pictures.save(figure, path)
+    finally:
+        pyplot().close(figure)
+
+
+def draw_state(events: Events, path: str | Path) -> Path:
+    """The hunt's state at the end (Fig 5.11) as a PNG at `path`."""
+    return pictures.write_state(hunt_scene(events), path, run_info(events).title())
+
+
+def draw_rover_timeline(events: Events, path: str | Path) -> Path:
+    """The rover mission's Gantt chart (see the module's docstring) as a PNG at `path`."""
+    bars = action_bars(events)
+    kinds = list(dict.fromkeys(bar.kind for bar in bars))
+    windows = run_world(events).windows
+    rows = [PLANNING, EXECUTION, *(["windows"] if windows else []), *kinds]
+    row = {name: k for k, name in enumerate(rows)}
+    end = max([last_time(events), SHORTEST_AXIS] + [b.latest_end or 0.0 for b in bars] + [w.end for w in windows])
+    plt = pyplot()
+    from matplotlib.patches import Patch
+
+    figure, ax = plt.subplots(figsize=(14.0, 2.2 + 0.55 * len(rows)), dpi=110)
+    try:
+        seconds_per_char = end / 200  # about 200 characters of 6-point text across the axes
+        for bar in bars:
+            y = row[bar.kind]
+            if bar.latest_end is not None and bar.latest_end > bar.start:
+                ax.barh(y, bar.latest_end - bar.start, left=bar.start, height=0.8, fill=False, ec="#6b7280", lw=0.8,
+                        ls="--", zorder=2)
+            width = max(bar.end - bar.start, end * 0.002)  # an instantaneous action stays visible
+            ax.barh(y, width, left=bar.start, height=0.5, color=ACTION_COLOURS.get(bar.outcome, "#9ca3af"),
+                    ec="#111827", lw=0.4, zorder=3)
+            label = ", ".join(format_value(a) for a in bar.args)
+            if label and len(label) * seconds_per_char < width:
+                ax.text(bar.start + seconds_per_char, y, label, va="center", fontsize=6, clip_on=True, zorder=4)
+        for window in windows:
+            ax.barh(row["windows"], window.end - window.start, left=window.start, height=0.6, color="#bfdbfe",
+                    ec="#1d4ed8", zorder=2)
+            ax.text((window.start + window.end) / 2, row["windows"], window.name, ha="center", va="center",
+                    fontsize=7, zorder=4)
+        marks = ftplan_marks(events)
+        for event, (name, offset, marker, colour) in FTPLAN_MARKERS.items():
+            times = [m.time for m in marks if m.event == event]
+            if times:
+                ax.plot(times, [row[name] + offset] * len(times), marker=marker, ls="", ms=6, color=colour,
+                        label=event, zorder=5)
+        for start in plan_starts(events):
+            switch = bool(start.switched_from)
+            ax.axvline(start.time, color=SWITCH_LINE if switch else PLAN_LINE, lw=1.2 if switch else 0.8,
+                       ls="-" if switch else ":", zorder=1)
+            text = f"plan {start.number}: {start.switched_from} → {start.planner}" if switch \
+                else f"plan {start.number} ({start.planner})"
+            ax.text(start.time, -0.6, text, rotation=90, ha="right", va="bottom", fontsize=6,
+                    color=SWITCH_LINE if switch else "#4b5563")
+        keys = [Patch(color=colour, label=f"action {outcome}") for outcome, colour in ACTION_COLOURS.items()]
+        keys.append(Patch(fill=False, ec="#6b7280", ls="--", label="planned bound (start to latest end)"))
+        ax.plot([], [], color=PLAN_LINE, ls=":", label="a plan starts")
+        ax.plot([], [], color=SWITCH_LINE, label="planner switch")
+        _finish_timeline(ax, events, rows, keys, top=-1.6, right=end * 1.02, xlabel="mission time (s)")
+        return pictures.save(figure, path)
+    finally:
+        plt.close(figure)
+
+
+def draw_hunt_timeline(events: Events, path: str | Path) -> Path:
+    """The hunt's chart of services and motions (see the module's docstring) as a PNG at `path`."""
+    bars = service_bars(events)
+    services = list(dict.fromkeys(bar.service for bar in bars))
+    motions, objects, alarms = "robot motion", "objects", "alarms"
+    arm = motion_spans(events, "arm-motion")
+    rows = [*services, motions, *(["arm motion"] if arm else []), objects, alarms]
+    row = {name: k for k, name in enumerate(rows)}
+    end = max(last_time(events), SHORTEST_AXIS)
+    plt = pyplot()
+    from matplotlib.patches import Patch
+
+    figure, ax = plt.subplots(figsize=(15.0, 2.0 + 0.3 * len(rows)), dpi=110)
+    try:
+        for service in services:
+            mine = [b for b in bars if b.service == service]
+            waits = [(b.requested, (b.started if b.started is not None else b.ended) - b.requested) for b in mine]
+            ax.broken_barh(waits, (row[service] - 0.12, 0.24), color=WAIT_COLOUR, zorder=2)
+            for outcome, colour in SERVICE_COLOURS.items():
+                spans = [(b.started, max(b.ended - b.started, end * 0.0005)) for b in mine
+                         if b.started is not None and b.outcome == outcome]
+                if spans:
+                    ax.broken_barh(spans, (row[service] - 0.3, 0.6), color=colour, zorder=3)
+            # An activity that never started failed or was interrupted while it waited.
+            for b in mine:
+                if b.started is None and b.outcome != "ok":
+                    ax.plot(b.ended, row[service], marker="x", ms=5, color=SERVICE_COLOURS[b.outcome], zorder=4)
+        robot = motion_spans(events, "robot-motion")
+        ax.broken_barh([(s.start, s.end - s.start) for s in robot], (row[motions] - 0.3, 0.6), color=MOTION_COLOUR)
+        arm_services = dict.fromkeys(s.label for s in arm)
+        colours = {label: ARM_COLOURS[k % len(ARM_COLOURS)] for k, label in enumerate(arm_services)}
+        for label, colour in colours.items():
+            ax.broken_barh([(s.start, s.end - s.start) for s in arm if s.label == label],
+                           (row["arm motion"] - 0.3, 0.6), color=colour, label=f"arm moving for {label or '?'}")
+        for kind, colour, label in (("object-detected", OBJECT_COLOURS["detected"], "object detected"),
+                                    ("object-retrieved", OBJECT_COLOURS["retrieved"], "object retrieved"),
+                                    ("object-taken", OBJECT_COLOURS["taken"], "object taken")):
+            times = [e["t"] for e in events if e.get("kind") == kind]
+            if times:
+                ax.plot(times, [row[objects]] * len(times), marker="o", ls="", ms=6, mfc=colour, mec="#111827",
+                        mew=0.5, label=label, zorder=5)
+        for alarm in (e for e in events if e.get("kind") == "alarm"):
+            ax.plot(alarm["t"], row[alarms], marker="X", ms=8, color="#dc2626", zorder=5)
+            ax.annotate(str(alarm.get("what", "")), (alarm["t"], row[alarms]), textcoords="offset points",
+                        xytext=(4, 4), fontsize=6, color="#dc2626")
+        keys = [Patch(color=colour, label=f"activity {outcome}") for outcome, colour in SERVICE_COLOURS.items()]
+        keys += [Patch(color=WAIT_COLOUR, label="waiting to start"), Patch(color=MOTION_COLOUR, label="robot moving")]
+        ax.plot([], [], marker="x", ls="", color=SERVICE_COLOURS["failed"], label="ended before it started")
+        _finish_timeline(ax, events, rows, keys, top=-0.6, right=end * 1.01, xlabel="simulated time (s)",
+                         fontsize=7)
+        return pictures.save(figure, path)
+    finally:
+        plt.close(figure)
+
+
+def _finish_timeline(ax: Any, events: Events, rows: Sequence[str], keys: list[Any], *, top: float, right: float,
+                     xlabel: str, fontsize: float | None = None) -> None:
+    """What both timelines share: the end line, one row per name top down, the title, the legend."""
+    _end_line(ax, events)
+    ax.set_yticks(range(len(rows)), rows, fontsize=fontsize)
+    ax.set_ylim(len(rows) - 0.4, top)
+    ax.set_xlim(0, right)
+    ax.set_xlabel(xlabel)
+    ax.grid(axis="x", alpha=0.3)
+    ax.set_title(run_info(events).title(), fontsize=9)
+    ax.legend(handles=keys + ax.get_legend_handles_labels()[0], loc="upper left", bbox_to_anchor=(1.01, 1.0),
+              fontsize=7, framealpha=0.9)
+
+
+def _end_line(ax: Any, events: Events) -> None:
+    """The mission's end, or where the log stops when it has none."""
+    end = next((e for e in reversed(events) if e.get("kind") == "mission-end"), None)
+    if end is not None:
+        ax.axvline(end["t"], color="#111827", lw=1.0, ls="--", label="mission end", zorder=1)
+    else:
+        ax.axvline(last_time(events), color="#dc2626", lw=1.0, ls="--", label="the log stops (no mission-end)",
+                   zorder=1)

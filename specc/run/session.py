@@ -1,0 +1,272 @@
+"""One run of a compiled robot, as `specc run` does it: compile if stale, run the mission, and
+leave a run folder behind.
+
+    outcome = run_in_folder(RunRequest(Path("examples/atrv"), mission="M1", world="W2",
+                                       configuration="Robot1/2"))
+    outcome.folder            # runs/atrv-M1-W2-Robot1-2-s0/
+    outcome.report["outcome"], outcome.summary, outcome.pictures
+
+The folder holds `events.jsonl` (the event log, written as the run goes, so a run that crashes
+keeps what it logged), `report.json` (the request, the outcome, the measures), `summary.txt`
+(the same for a person) and the pictures `specc.run.render` draws from the log alone (the map,
+the timeline; the state of Fig 5.11 for the hunt).
+
+Two kinds of mission run today, chosen by the robot the specs compile to:
+- `atrv`: the rover missions of seed 004 (M1..M4 in W1..W4, configurations Robot1, Robot2,
+  Robot1/2, Robot1/2c; `specc.run.rover`), measured as §4.1.4 says (`specc.run.measures`);
+- `hilare`: the object hunt of seed 000 ch. 5 (`specc.run.hunt`), mission `hunt` in its room.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from specc.run import RunError
+from specc.run.events import EventLog
+
+LOG = "events.jsonl"
+REPORT = "report.json"
+SUMMARY = "summary.txt"
+RUNS = Path("runs")  # where run folders go by default, under the working directory
+GENERATED = Path("generated")  # where the specs compile to by default (`specc compile -o generated`)
+DEFAULT_CONFIGURATION = "Robot1/2"  # seed 004's fault-tolerant configuration (two models, successive)
+HUNT = "hunt"
+HUNT_WORLD = "room"
+ROBOTS = {"atrv": "the rover missions of seed 004 (examples/atrv)",
+          "hilare": "the object hunt of seed 000 ch. 5 (examples/hilare)"}
+
+PLANNER_FAILURES = ("watchdog", "invalid-plan")  # FTplan's events for a planner that gave no usable plan
+Progress = Callable[[float, float | None, str], None]  # mission time, horizon (None: unknown), what
+
+
+class RunCrashed(RunError):
+    """The run broke half-way; its folder holds the log so far and a report saying so."""
+
+    def __init__(self, message: str, outcome: RunOutcome) -> None:
+        super().__init__(message)
+        self.outcome = outcome
+
+
+@dataclass(frozen=True)
+class RunRequest:
+    specs: Path  # the robot's spec folder (its codels and worlds beside the specs)
+    mission: str | None = None  # M1..M4, or `hunt`
+    world: str | None = None  # W1..W4 or a world file; `room` for the hunt
+    configuration: str | None = None  # the rover's; default DEFAULT_CONFIGURATION
+    seed: int = 0
+    generated: Path = GENERATED
+    runs: Path = RUNS
+    folder: Path | None = None  # the run folder itself, instead of runs/<name>
+    timing: str = "model"  # FTplan's planning charge (the rover): model (deterministic) or wall
+    objects: int = 5  # the hunt's objects to take
+    horizon: float = 900.0  # the hunt's, s of simulated time
+    pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
+
+
+@dataclass
+class RunOutcome:
+    folder: Path
+    robot: str
+    report: dict[str, Any]
+    summary: str
+    pictures: list[Path] = field(default_factory=list)
+    compiled: bool = False  # the package was stale and has been rewritten
+
+    @property
+    def succeeded(self) -> bool:
+        return bool(self.report.get("outcome") == "succeeded")
+
+
+def folder_name(robot: str, mission: str, world: str, configuration: str | None, seed: int) -> str:
+    """runs/<robot>-<mission>-<world>[-<configuration>]-s<seed>, readable and safe as a path."""
+    parts = [robot, mission, Path(world).stem if world.endswith(".toml") else world]
+    if configuration:
+        parts.append(configuration)
+    return re.sub(r"[^A-Za-z0-9_.-]+", "-", "-".join(parts)) + f"-s{seed}"
+
+
+def run_in_folder(request: RunRequest, progress: Progress | None = None,
+                  compiled_note: Callable[[str], None] | None = None) -> RunOutcome:
+    """Compile `request.specs` if stale, run its mission and write the run folder. Bad input is a
+    RunError before anything runs; a run that breaks half-way still leaves its log and a report
+    saying so, then raises RunError."""
+    from specc.run.package import ensure_compiled
+
+    specs = request.specs
+    if not specs.is_dir():
+        raise RunError(f"'{specs}' is not a robot's spec folder: give the folder holding its specs, codels "
+                       "and worlds, e.g. examples/atrv")
+    compiled = ensure_compiled(specs, request.generated)
+    if compiled.rewritten and compiled_note is not None:
+        compiled_note(f"compiled {specs} into {compiled.folder} (it was stale)")
+    outcome = run_compiled(compiled.robot, request, progress)
+    outcome.compiled = compiled.rewritten
+    return outcome
+
+
+def runnable_robot(robot: str) -> str:
+    """`robot` when specc run has a mission runner for it, else a RunError naming those it has."""
+    if robot not in ROBOTS:
+        known = "; ".join(f"{name}: {what}" for name, what in ROBOTS.items())
+        raise RunError(f"robot '{robot}' has no mission runner: specc run knows {known}")
+    return robot
+
+
+def run_compiled(robot: str, request: RunRequest, progress: Progress | None = None) -> RunOutcome:
+    """`run_in_folder` once the specs are compiled into `request.generated`/<robot>."""
+    plan = _plan_rover(request) if runnable_robot(robot) == "atrv" else _plan_hunt(request)
+    folder = request.folder or request.runs / folder_name(robot, *plan.name_parts, request.seed)
+    outcome = RunOutcome(folder, robot, {}, "")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise RunError(f"cannot make the run folder '{folder}': {error.strerror or error}") from None
+    started = time.perf_counter()
+    with EventLog(folder / LOG) as log:
+        try:
+            report, summary = plan.run(log, progress)
+        except RunError:
+            raise
+        except Exception as error:  # a runtime failure half-way: keep what the log holds, say what broke
+            report = {"outcome": "crashed", "why": f"{type(error).__name__}: {error}"}
+            summary = f"the run crashed at {log.events[-1]['t'] if log.events else 0.0:.1f} s: {report['why']}"
+            _finish(outcome, request, plan, report, summary, log, started)
+            raise RunCrashed(f"the run crashed: {report['why']} (what it logged is in {folder / LOG}, the "
+                             f"report in {folder / REPORT}; rerun with SPECC_DEBUG=1 for the traceback)",
+                             outcome) from error
+    _finish(outcome, request, plan, report, summary, log, started)
+    return outcome
+
+
+def _finish(outcome: RunOutcome, request: RunRequest, plan: _Plan, report: dict[str, Any], summary: str,
+            log: EventLog, started: float) -> None:
+    folder = outcome.folder
+    if request.pictures and log.events:
+        from specc.run.render import render_run
+
+        try:
+            outcome.pictures = render_run(log.events, folder)
+        except RunError as error:  # a log too short to draw: the report says so, nothing is lost
+            summary += f"\nno pictures: {error}"
+    outcome.report = {
+        "robot": outcome.robot, "mission": plan.name_parts[0], "world": plan.name_parts[1],
+        "configuration": plan.name_parts[2], "seed": request.seed, **report,
+        "wall_time": round(time.perf_counter() - started, 3),
+        "log": LOG, "pictures": [p.name for p in outcome.pictures]}
+    outcome.summary = summary + "".join(f"\n  picture: {p}" for p in outcome.pictures) + f"\n  log: {folder / LOG}"
+    try:
+        (folder / REPORT).write_text(json.dumps(outcome.report, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+        (folder / SUMMARY).write_text(outcome.summary + "\n", encoding="utf-8")
+    except OSError as error:
+        raise RunError(f"cannot write the report into '{folder}': {error.strerror or error}") from None
+
+
+# ---------------------------------------------------------------- the two kinds of mission
+
+
+@dataclass(frozen=True)
+class _Plan:
+    name_parts: tuple[str, str, str | None]  # mission, world, configuration
+    run: Callable[[EventLog, Progress | None], tuple[dict[str, Any], str]]
+
+
+def _plan_rover(request: RunRequest) -> _Plan:
+    from specc.run.measures import measure
+    from specc.run.rover import TIMINGS, prepare_mission, run_rover_mission
+
+    if request.mission is None or request.world is None:
+        raise RunError("the rover needs --mission (M1, M2, M3, M4) and --world (W1, W2, W3, W4 or a world file)")
+    if request.timing not in TIMINGS:
+        raise RunError(f"timing '{request.timing}': give {' or '.join(TIMINGS)}")
+    configuration = request.configuration or DEFAULT_CONFIGURATION
+    example = request.specs.resolve()
+    # Every name checked before the run folder is made: a typo leaves nothing behind.
+    prepared = prepare_mission(configuration, request.mission, request.world, request.seed,
+                               generated=request.generated, example=example)
+
+    def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
+        def tell(step: Any) -> None:
+            if progress is not None:
+                progress(step.time, None, f"goals {step.goals_met}/{step.goals}: {step.what}")
+
+        rover_run = run_rover_mission(configuration, request.mission or "", request.world or "", request.seed,
+                                      log=log, progress=tell, generated=request.generated, example=example,
+                                      timing=request.timing)
+        measures = measure(rover_run)
+        result = rover_run.result
+        why = result.failure or ("; ".join(f"{goal}: {reason}" for goal, reason in result.missed.items())
+                                 or f"every goal met ({len(result.met)})")
+        planners_said = [e.text for e in result.events if e.kind in PLANNER_FAILURES]
+        if result.failure and planners_said:  # what the planner itself said is the useful part
+            why += f" (last planner failure: {planners_said[-1]})"
+        report = {"outcome": "succeeded" if measures.success else "failed", "why": why,
+                  "simulated_time": round(rover_run.simulated_time, 3), "measures": measures.to_json(),
+                  "photos": [[p.target, p.ok] for p in rover_run.photos],
+                  "communications": [[c.window, c.ok] for c in rover_run.communications]}
+        return report, measures.summary() + ("" if measures.success else f"\n  why: {why}") + \
+            f"\n  {rover_run.simulated_time:.0f} s of mission in {rover_run.wall_time:.1f} s of wall time"
+
+    return _Plan((request.mission, prepared.world.name, configuration), run)
+
+
+def _plan_hunt(request: RunRequest) -> _Plan:
+    from specc.run.hunt import arm_motion_overlaps, detection_interruptions, run_hunt
+
+    mission = request.mission or HUNT
+    world = request.world or HUNT_WORLD
+    if mission.lower() != HUNT:
+        raise RunError(f"unknown mission '{mission}' for hilare: its mission is '{HUNT}' (seed 000 ch. 5)")
+    if world.lower() != HUNT_WORLD and Path(world).stem != HUNT_WORLD:
+        raise RunError(f"unknown world '{world}' for hilare: the hunt takes place in '{HUNT_WORLD}' "
+                       "(examples/hilare/worlds/room.toml)")
+    if request.configuration is not None:
+        raise RunError(f"configuration '{request.configuration}': hilare has none (configurations are the "
+                       "rover's: Robot1, Robot2, Robot1/2, Robot1/2c)")
+
+    def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
+        def tell(step: Any) -> None:
+            if progress is not None:
+                progress(step.time, step.horizon, f"{step.objects_taken}/{step.objects_wanted} objects taken")
+
+        result = run_hunt(request.seed, request.objects, request.horizon, log, tell,
+                          generated=request.generated, example=request.specs.resolve())
+        detections = detection_interruptions(result.events)
+        overlaps = arm_motion_overlaps(result.events)
+        report = {"outcome": result.outcome, "why": result.why, "simulated_time": round(result.simulated_time, 3),
+                  "measures": {"objects_taken": result.objects_taken, "objects_wanted": result.objects_wanted,
+                               "distance": round(result.distance, 3),
+                               "explored_fraction": round(result.explored_fraction, 4),
+                               "detections_interrupting_exploration": len(detections.interruptions),
+                               "detections_not_interrupting": len(detections.missed),
+                               "arm_moves_while_robot_moves": len(overlaps),
+                               "replies": dict(result.replies)}}
+        summary = "\n".join([
+            f"hilare's hunt (seed {request.seed}): {result.outcome}: {result.why}",
+            f"  {result.objects_taken} of {result.objects_wanted} objects taken, {result.distance:.1f} m travelled, "
+            f"{100 * result.explored_fraction:.0f} % of the room explored",
+            f"  §5.5: {len(detections.interruptions)} detection(s) interrupted an exploration move, "
+            f"{len(detections.missed)} did not; the arm took while the robot moved {len(overlaps)} time(s)",
+            f"  {result.simulated_time:.0f} s of mission in {result.wall_time:.1f} s of wall time"])
+        return report, summary
+
+    return _Plan((HUNT, HUNT_WORLD, None), run)
+
+
+def load_report(folder: Path) -> Mapping[str, Any]:
+    """A run folder's report.json."""
+    path = folder / REPORT
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise RunError(f"{path}: cannot read the report ({error.strerror or error})") from None
+    except json.JSONDecodeError as error:
+        raise RunError(f"{path}: not a report (line {error.lineno}: {error.msg})") from None
+    if not isinstance(data, dict):
+        raise RunError(f"{path}: not a report (a JSON object is expected)")
+    return data

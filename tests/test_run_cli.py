@@ -1,0 +1,242 @@
+"""`specc run`, `specc replay` and `specc table` as a user meets them: real missions end to end
+(compiled package, modules on the simulated robot, executive or FTplan and its planners), run
+folders, exit codes, one clear line for bad input, never a traceback."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from specc.run import RunError
+from specc.run.events import read_events
+from specc.run.session import RunCrashed, RunRequest, run_compiled
+from specc.runtime.sim import Polygon, World, load_world
+from tests.conftest import EXAMPLES, ROOT
+
+ATRV = EXAMPLES / "atrv"
+HILARE = EXAMPLES / "hilare"
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def specc(*args: str | Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "specc.cli", *map(str, args)], cwd=ROOT, capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def assert_clean_failure(result: subprocess.CompletedProcess[str], code: int, message: str) -> None:
+    assert result.returncode == code, result.stderr
+    assert "Traceback" not in result.stderr and "internal error" not in result.stderr
+    assert message in result.stderr, result.stderr
+
+
+@pytest.fixture(scope="module")
+def m1_w2(tmp_path_factory: pytest.TempPathFactory) -> tuple[subprocess.CompletedProcess[str], Path]:
+    runs = tmp_path_factory.mktemp("runs")
+    return specc("run", ATRV, "--mission", "M1", "--world", "W2", "--config", "Robot1/2", "--runs", runs), runs
+
+
+def test_a_rover_mission_leaves_a_run_folder_with_log_report_and_pictures(m1_w2: tuple) -> None:
+    result, runs = m1_w2
+    assert result.returncode == 0, result.stderr
+    folder = runs / "atrv-M1-W2-Robot1-2-s0"
+    assert f"run folder: {folder}" in result.stdout
+    report = json.loads((folder / "report.json").read_text())
+    assert report["outcome"] == "succeeded" and report["configuration"] == "Robot1/2"
+    measures = report["measures"]
+    assert measures["nu"] == 1 and measures["kappa"] == 0
+    assert (measures["photos"], measures["communications"], measures["home"]) == (
+        {"asked": 3, "met": 3}, {"asked": 2, "met": 2}, {"asked": 1, "met": 1})
+    events = read_events(folder / "events.jsonl")
+    assert events[0]["kind"] == "mission-start" and events[-1]["kind"] == "mission-end"
+    # The report agrees with the log it was measured from.
+    assert report["simulated_time"] == pytest.approx(events[-1]["t"], abs=1e-3)
+    assert measures["distance"] == pytest.approx(events[-1]["distance"], abs=1e-3)
+    summary = (folder / "summary.txt").read_text()
+    assert "mission succeeded" in summary and "photos 3/3" in summary
+    for picture in report["pictures"]:
+        path = folder / picture
+        assert path.read_bytes().startswith(PNG) and f"picture: {path}" in result.stdout
+    assert {"map.png", "timeline.png"} <= set(report["pictures"])
+
+
+def test_the_same_seed_gives_the_same_log_through_the_command_line(m1_w2: tuple, tmp_path: Path) -> None:
+    _, runs = m1_w2
+    again = specc("run", ATRV, "--mission", "M1", "--world", "W2", "--config", "Robot1/2", "--folder",
+                  tmp_path / "again", "--no-pictures")
+    assert again.returncode == 0, again.stderr
+    first = (runs / "atrv-M1-W2-Robot1-2-s0" / "events.jsonl").read_bytes()
+    assert (tmp_path / "again" / "events.jsonl").read_bytes() == first
+
+
+def test_replay_plays_the_log_back_and_draws_it_again(m1_w2: tuple, tmp_path: Path) -> None:
+    _, runs = m1_w2
+    folder = runs / "atrv-M1-W2-Robot1-2-s0"
+    events = read_events(folder / "events.jsonl")
+    result = specc("replay", folder, "--kind", "action", "--output", tmp_path)
+    assert result.returncode == 0, result.stderr
+    lines = [line for line in result.stdout.splitlines() if not line.startswith("picture: ")]
+    actions = [e for e in events if e["kind"] == "action"]
+    assert len(lines) == len(actions) and all(" action " in line for line in lines)
+    assert lines[0].split()[0] == f"{actions[0]['t']:.3f}" and "started" in lines[0]
+    drawn = sorted(p.name for p in tmp_path.iterdir())
+    assert drawn == sorted(json.loads((folder / "report.json").read_text())["pictures"])
+    window = specc("replay", folder, "--from", "100", "--to", "110", "--no-render")
+    times = [float(line.split()[0]) for line in window.stdout.splitlines()]
+    assert times and all(100 <= t <= 110 for t in times)
+
+
+def test_the_hunt_runs_from_the_command_line(tmp_path: Path) -> None:
+    result = specc("run", HILARE, "--seed", "2", "--runs", tmp_path)
+    assert result.returncode == 0, result.stderr
+    folder = tmp_path / "hilare-hunt-room-s2"
+    report = json.loads((folder / "report.json").read_text())
+    assert report["outcome"] == "succeeded" and report["measures"]["objects_taken"] == 5
+    assert report["measures"]["arm_moves_while_robot_moves"] == 0
+    assert report["measures"]["detections_interrupting_exploration"] >= 1
+    assert {"map.png", "timeline.png", "state.png"} <= set(report["pictures"])
+    assert "5 of 5 objects taken" in result.stdout
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (("--mission", "M9", "--world", "W2"), "error: ftplan 'rover' has no mission 'M9' (it has: M1, M2, M3, M4)"),
+    (("--mission", "M1", "--world", "W9"), "error: unknown world 'W9': give W1, W2, W3, W4"),
+    (("--mission", "M1", "--world", "W1", "--config", "Robot3"), "error: no robot configuration 'Robot3'"),
+    (("--mission", "M1",), "error: the rover needs --mission (M1, M2, M3, M4) and --world"),
+])
+def test_unknown_names_are_one_line_and_leave_no_run_folder(args: tuple[str, ...], message: str,
+                                                            tmp_path: Path) -> None:
+    result = specc("run", ATRV, *args, "--runs", tmp_path)
+    assert_clean_failure(result, 2, message)
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_hunt_refuses_the_rovers_options(tmp_path: Path) -> None:
+    assert_clean_failure(specc("run", HILARE, "--config", "Robot1", "--runs", tmp_path), 2,
+                         "error: configuration 'Robot1': hilare has none")
+    assert_clean_failure(specc("run", EXAMPLES / "generic", "--runs", tmp_path), 2,
+                         "error: robot 'generic' has no mission runner")
+    assert_clean_failure(specc("run", tmp_path / "nowhere"), 2, "is not a robot's spec folder")
+
+
+def atrv_copy(tmp_path: Path) -> Path:
+    copy = tmp_path / "atrv"
+    shutil.copytree(ATRV, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    return copy
+
+
+def test_a_spec_that_does_not_compile_is_reported_gcc_style(tmp_path: Path) -> None:
+    robot = atrv_copy(tmp_path)
+    mission = robot / "missions" / "M1_model1.spec"
+    mission.write_text(mission.read_text().replace("include model1_goals_M1;", "include model1_goals_M9;"))
+    result = specc("run", robot, "--mission", "M1", "--world", "W1", "-g", tmp_path / "gen")
+    assert_clean_failure(result, 2, "do not compile")
+    assert f"{mission}:" in result.stderr and ": error: " in result.stderr and "model1_goals_M9" in result.stderr
+
+
+def test_a_planner_that_finds_nothing_ends_the_mission_with_a_report(tmp_path: Path) -> None:
+    robot = atrv_copy(tmp_path)
+    mission = robot / "missions" / "M1_model1.spec"
+    horizon = "  (t_end - t_start) in [330, 800];\n"
+    mission.write_text(mission.read_text().replace(horizon, horizon + "  (t_end - t_start) in [10, 20];\n"))
+    result = specc("run", robot, "--mission", "M1", "--world", "W1", "--config", "Robot1", "-g", tmp_path / "gen",
+                   "--runs", tmp_path / "runs", "--no-pictures")
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    report = json.loads((tmp_path / "runs" / "atrv-M1-W1-Robot1-s0" / "report.json").read_text())
+    assert report["outcome"] == "failed" and report["measures"]["kappa"] == 1
+    # The planner's own words say which constraints contradict each other.
+    assert "no valid plan" in report["why"] and "[10, 20] contradicts [330, 800]" in report["why"]
+    assert "mission failed" in result.stdout
+
+
+def toml_world(w: World, path: Path) -> Path:
+    """A world with polygon obstacles and targets, written as its TOML file."""
+    xmin, xmax, ymin, ymax = w.bounds
+    lines = [f'[world]\nname = "{w.name}"', f"[bounds]\nxmin = {xmin}\nxmax = {xmax}\nymin = {ymin}\nymax = {ymax}"]
+    lines += [f"[[obstacles]]\npolygon = {[list(p) for p in o.points]}" for o in w.obstacles if isinstance(o, Polygon)]
+    lines += [f'[[targets]]\nname = "{t.name}"\nx = {t.x}\ny = {t.y}' for t in w.targets]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_a_robot_stuck_in_a_pocket_fails_its_mission_with_a_report(tmp_path: Path) -> None:
+    """W4's pocket turned to open towards (-5, 3) on the way to (5, 5): Modele1's M2 drives in."""
+    w4 = load_world(ATRV / "worlds" / "W4.toml")
+    turn = math.atan2(5.0 - 3.0, 5.0 + 5.0) - math.atan2(5.0, 5.0)
+    c, s = math.cos(turn), math.sin(turn)
+    pocket = tuple(Polygon(tuple((5.0 + c * (x - 5.0) - s * (y - 5.0), 5.0 + s * (x - 5.0) + c * (y - 5.0))
+                                 for x, y in o.points)) for o in w4.obstacles[:3] if isinstance(o, Polygon))
+    trap = toml_world(dataclasses.replace(w4, name="W4-trap", obstacles=pocket), tmp_path / "trap.toml")
+    result = specc("run", ATRV, "--mission", "M2", "--world", trap, "--config", "Robot1", "--runs", tmp_path)
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    folder = tmp_path / "atrv-M2-W4-trap-Robot1-s0"  # named after the world's own name
+    report = json.loads((folder / "report.json").read_text())
+    assert report["outcome"] == "failed" and report["measures"]["photos"]["met"] < 3
+    failed = [e for e in read_events(folder / "events.jsonl") if e["kind"] == "action" and e["status"] == "failed"]
+    assert failed and "NO_PROGRESS" in failed[0]["why"]
+    assert "map.png" in report["pictures"]
+
+
+def test_a_run_that_crashes_keeps_its_log_and_says_so(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A fault inside the runtime half-way through (the rover's executor breaks at its third
+    action): the run folder keeps the log up to there and a report saying what broke."""
+    from specc.run import rover
+
+    started = rover.SimExecutor._start
+    calls = []
+
+    def breaking(self: rover.SimExecutor, *args: object) -> None:
+        calls.append(args)
+        if len(calls) == 3:
+            raise ZeroDivisionError("injected")
+        started(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(rover.SimExecutor, "_start", breaking)
+    request = RunRequest(ATRV, "M1", "W1", "Robot1", folder=tmp_path / "run", pictures=False)
+    with pytest.raises(RunCrashed, match="the run crashed: ZeroDivisionError: injected") as crash:
+        run_compiled("atrv", request)
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "crashed" and "injected" in report["why"]
+    events = read_events(tmp_path / "run" / "events.jsonl")
+    assert events[0]["kind"] == "mission-start" and sum(
+        e["kind"] == "action" and e["status"] == "started" for e in events) == 2
+    assert crash.value.outcome.report == report
+
+
+def test_the_table_of_measures_comes_from_one_command(tmp_path: Path) -> None:
+    result = specc("table", ATRV, "--mission", "M1", "--world", "W1", "--world", "W3", "--config", "Robot1",
+                   "--runs", tmp_path, "--quiet")
+    assert result.returncode == 0, result.stderr
+    table = (tmp_path / "atrv-table.md").read_text()
+    rows = [line for line in table.splitlines() if line.startswith("| Robot1 ")]
+    assert [row.split("|")[3].strip() for row in rows] == ["W1", "W3"]
+    assert all(row.split("|")[5].strip() == "100 %" for row in rows)  # nu: every goal met
+    data = json.loads((tmp_path / "atrv-table.json").read_text())
+    assert [run["world"] for run in data["runs"]] == ["W1", "W3"]
+    assert all((Path(run["folder"]) / "events.jsonl").is_file() for run in data["runs"])
+
+
+def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
+    result = specc("table", ATRV, "--mission", "M7", "--runs", tmp_path)
+    assert_clean_failure(result, 2, "error: ftplan 'rover' has no mission 'M7'")
+    assert_clean_failure(specc("table", HILARE, "--world", "W1"), 2, "hilare has one mission")
+
+
+def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:
+    assert_clean_failure(specc("replay", tmp_path / "nothing"), 2, "no run folder or event log")
+    assert_clean_failure(specc("replay", tmp_path), 2, "holds no events.jsonl")
+    (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\nnot json\n')
+    assert_clean_failure(specc("replay", tmp_path), 2, "events.jsonl")
+
+
+def test_run_request_names_are_checked_before_anything_runs(tmp_path: Path) -> None:
+    with pytest.raises(RunError, match="timing 'fast'"):
+        run_compiled("atrv", RunRequest(ATRV, "M1", "W1", timing="fast", folder=tmp_path / "run"))
+    assert not (tmp_path / "run").exists()

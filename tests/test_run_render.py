@@ -1,0 +1,247 @@
+"""The pictures of a run drawn from its event log alone (specc.run.render, issue #9's run folder and
+`specc replay`): what the pure readers extract from real logs agrees with what the runners kept
+(actions, activities, objects, path, model), logs cut short still draw, logs that cannot be drawn
+say why in one line, and `render_run` writes exactly the PNGs it returns."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from specc.run import RunError
+from specc.run.hunt import HuntResult, draw_hunt, run_hunt
+from specc.run.render import (
+    MAP,
+    STATE,
+    TIMELINE,
+    action_bars,
+    draw_map,
+    ftplan_marks,
+    hunt_model,
+    hunt_objects,
+    hunt_scene,
+    motion_spans,
+    path_of,
+    plan_starts,
+    render_run,
+    reply_outcome,
+    run_info,
+    run_world,
+    service_bars,
+    trajectories,
+)
+from specc.run.rover import RoverRun, run_rover_mission
+
+PNG = b"\x89PNG\r\n\x1a\n"
+HUNT_SEED = 0  # five objects taken, exploration moves interrupted by detections (test_hunt.py's)
+POSE_TOLERANCE = 0.03  # m between a pose event and the simulator's trace at the same instant
+
+
+@pytest.fixture(scope="module")
+def hunt() -> HuntResult:
+    return run_hunt(HUNT_SEED)
+
+
+@pytest.fixture(scope="module")
+def rover() -> RoverRun:
+    """A mission with failures and replanning: three moves overrun their bound in W3's clutter."""
+    return run_rover_mission("Robot1/2c", "M3", "W3", seed=0)
+
+
+def is_png(path: Path) -> bool:
+    return path.read_bytes()[:8] == PNG
+
+
+def cut(events: Sequence[Mapping[str, Any]], keep: Any) -> list[Mapping[str, Any]]:
+    """The log up to (not including) the first event for which `keep` is false."""
+    kept = []
+    for event in events:
+        if not keep(event):
+            break
+        kept.append(event)
+    return kept
+
+
+# ---------------------------------------------------------------- the rover
+
+
+def test_the_gantt_bars_are_the_actions_the_executor_ran(rover: RoverRun) -> None:
+    bars = action_bars(rover.events)
+    assert {a.outcome for a in rover.actions} >= {"ended", "failed"}  # the log exercises both
+    expected = sorted(rover.actions, key=lambda a: (a.start, a.plan, a.id))
+    assert [(b.plan, b.id, b.task, b.args, b.outcome, b.why) for b in bars] == \
+        [(a.plan, a.id, a.task, a.args, a.outcome, a.why) for a in expected]
+    for bar, action in zip(bars, expected, strict=True):
+        assert bar.start == pytest.approx(action.start, abs=1e-6)
+        assert bar.end == pytest.approx(action.end, abs=1e-6)
+        assert bar.latest_end is not None and bar.latest_end >= bar.start
+    # A move failed by overrunning its planned bound: its bar reaches that bound.
+    overran = [b for b in bars if b.outcome == "failed" and "overran" in b.why]
+    assert overran and all(b.end >= b.latest_end - 0.5 for b in overran if b.latest_end is not None)
+
+
+def test_each_plan_and_ftplan_event_is_on_the_timeline(rover: RoverRun) -> None:
+    starts = plan_starts(rover.events)
+    assert [s.number for s in starts] == sorted({a.plan for a in rover.actions})
+    for start in starts:
+        first = min(a.start for a in rover.actions if a.plan == start.number)
+        assert start.time <= first + 1e-6
+    marks = ftplan_marks(rover.events)
+    failed = [a for a in rover.actions if a.outcome == "failed"]
+    assert [m.time for m in marks if m.event == "action-failed"] == pytest.approx([a.end for a in failed])
+    assert not {"report", "execute"} & {m.event for m in marks}  # the actions and plan lines say those
+
+
+def test_a_planner_switch_is_where_another_planner_s_plan_starts() -> None:
+    events = [{"t": t, "kind": "ftplan", "event": "execute", "planner": p, "text": ""}
+              for t, p in ((1.0, "p1"), (50.0, "p1"), (80.0, "p2"), (90.0, "p2"))]
+    starts = plan_starts(events)
+    assert [(s.number, s.planner, s.switched_from) for s in starts] == \
+        [(1, "p1", ""), (2, "p1", ""), (3, "p2", "p1"), (4, "p2", "")]
+
+
+def test_the_path_from_pose_events_follows_the_simulator(rover: RoverRun) -> None:
+    poses = path_of(rover.events)
+    traced = {round(t, 3): (x, y) for t, x, y, _ in rover.path}
+    assert len(poses) > 100 and poses[0, 0] == 0.0
+    compared = 0
+    for t, x, y, _ in poses:
+        if round(t, 3) in traced:
+            compared += 1
+            assert math.dist((x, y), traced[round(t, 3)]) < POSE_TOLERANCE, t
+    assert compared >= 0.9 * len(poses)
+    assert poses[-1, 0] <= rover.simulated_time
+
+
+def test_the_rover_run_folder_holds_its_map_and_timeline(rover: RoverRun, tmp_path: Path) -> None:
+    folder = tmp_path / "run"
+    written = render_run(rover.events, folder)
+    assert written == [folder / MAP, folder / TIMELINE]
+    assert sorted(folder.iterdir()) == sorted(written) and all(is_png(p) for p in written)
+    world = run_world(rover.events)
+    assert world.name == "W3" and [w.start for w in world.windows] == [w.start for w in rover.windows]
+    info = run_info(rover.events)
+    assert (info.configuration, info.mission, info.world, info.seed, info.outcome) == \
+        ("Robot1/2c", "M3", "W3", 0, "succeeded")
+
+
+def test_rover_run_draw_is_the_map_of_its_events(rover: RoverRun, tmp_path: Path) -> None:
+    picture = rover.draw(tmp_path / "m3w3.png")
+    assert is_png(picture)
+    with pytest.raises(RunError, match="must end in .png"):
+        draw_map(rover.events, tmp_path / "m3w3.jpg")
+
+
+def test_a_rover_log_cut_inside_an_action_still_draws(rover: RoverRun, tmp_path: Path) -> None:
+    failing = next(a for a in rover.actions if a.outcome == "failed")
+    middle = (failing.start + failing.end) / 2
+    events = cut(rover.events, lambda e: e["t"] <= middle)
+    bars = action_bars(events)
+    assert bars[-1].outcome == "running" and bars[-1].id == failing.id and bars[-1].end == events[-1]["t"]
+    assert all(b.outcome != "running" for b in bars[:-1])
+    assert "no mission-end" in run_info(events).title()
+    written = render_run(events, tmp_path / "cut")
+    assert [p.name for p in written] == [MAP, TIMELINE] and all(is_png(p) for p in written)
+
+
+# ---------------------------------------------------------------- the hunt
+
+
+def test_the_objects_states_from_the_log_are_the_hunt_s(hunt: HuntResult) -> None:
+    assert hunt_objects(hunt.events) == hunt.objects
+    assert {o.state for o in hunt.objects} >= {"taken", "undetected"}
+
+
+def test_the_service_bars_pair_each_request_with_its_reply(hunt: HuntResult) -> None:
+    bars = service_bars(hunt.events)
+    requests = [e for e in hunt.events if e["kind"] == "request"]
+    replies = {e["id"]: e for e in hunt.events if e["kind"] == "reply"}
+    assert [(b.service, b.id, b.requested) for b in bars] == [(e["service"], e["id"], e["t"]) for e in requests]
+    for bar in bars:
+        reply = replies[bar.id]
+        assert bar.ended == reply["t"] and bar.result == reply["result"]
+        assert bar.outcome == reply_outcome(reply["result"])
+        assert bar.started is None or bar.requested <= bar.started <= bar.ended
+    outcomes = {(b.service, b.outcome) for b in bars}
+    assert ("SEARCH-OBJ", "ok") in outcomes  # a count of objects seen is a success
+    assert ("EXEC-TRAJ-GOAL", "interrupted") in outcomes  # §5.5: a detection stops the exploration move
+    assert reply_outcome("OK") == reply_outcome(2) == "ok" and reply_outcome("INT") == "interrupted"
+    assert reply_outcome("TIMEOUT") == reply_outcome("BLOCKED") == "failed"
+
+
+def test_motions_alternate_and_the_arm_moves_for_its_services(hunt: HuntResult) -> None:
+    robot = motion_spans(hunt.events, "robot-motion")
+    assert robot and all(a.end <= b.start for a, b in zip(robot, robot[1:], strict=False))
+    arm = motion_spans(hunt.events, "arm-motion")
+    assert {s.label for s in arm} == {"ARM-OBJ", "ARM-BACK"}
+
+
+def test_the_map_shows_the_model_and_trajectories_the_hunt_ended_with(hunt: HuntResult) -> None:
+    certainty, goal = hunt_model(hunt.events)
+    assert certainty is not None and hunt.certainty is not None
+    assert (certainty.cell, certainty.nx, certainty.ny) == (hunt.certainty.cell, hunt.certainty.nx, hunt.certainty.ny)
+    assert np.allclose(certainty.grid(), hunt.certainty.grid(), atol=1e-3)
+    assert goal == hunt.goal
+    assert trajectories(hunt.events) == tuple(p.points for p in hunt.planned)
+    scene = hunt_scene(hunt.events)
+    assert scene.object_states == tuple(o.state for o in hunt.objects)
+    assert scene.taken_order == tuple(sorted((o.index for o in hunt.objects if o.taken_at is not None),
+                                             key=lambda k: hunt.objects[k].taken_at or 0.0))
+    assert any(mark.points for mark in scene.marks if "interrupted" in mark.label)
+
+
+def test_the_hunt_run_folder_holds_map_timeline_and_state(hunt: HuntResult, tmp_path: Path) -> None:
+    folder = tmp_path / "hunt"
+    written = render_run(hunt.events, folder)
+    assert written == [folder / MAP, folder / TIMELINE, folder / STATE]
+    assert sorted(folder.iterdir()) == sorted(written) and all(is_png(p) for p in written)
+    assert is_png(draw_hunt(hunt, tmp_path / "hunt.png"))  # the same drawing, from the result's events
+
+
+def test_a_hunt_log_cut_in_the_middle_still_draws(hunt: HuntResult, tmp_path: Path) -> None:
+    events = list(hunt.events[: len(hunt.events) // 2])
+    assert not any(e["kind"] in ("mission-end", "model") for e in events)
+    assert hunt_model(events) == (None, None)
+    open_bars = [b for b in service_bars(events) if b.outcome == "running"]
+    assert open_bars and all(b.ended == events[-1]["t"] for b in open_bars)
+    states = [o.state for o in hunt_objects(events)]
+    assert states.count("taken") < 5
+    written = render_run(events, tmp_path / "cut")
+    assert [p.name for p in written] == [MAP, TIMELINE, STATE] and all(is_png(p) for p in written)
+    # Cut right after its first line: the room, the objects where they lie, empty rows.
+    written = render_run(hunt.events[:1], tmp_path / "start")
+    assert [p.name for p in written] == [MAP, TIMELINE, STATE] and all(is_png(p) for p in written)
+
+
+# ---------------------------------------------------------------- logs that cannot be drawn
+
+
+def test_a_log_without_mission_start_cannot_be_drawn(hunt: HuntResult, tmp_path: Path) -> None:
+    headless = [e for e in hunt.events if e["kind"] != "mission-start"]
+    with pytest.raises(RunError, match="no mission-start") as error:
+        render_run(headless, tmp_path / "none")
+    assert "\n" not in str(error.value)
+    assert not (tmp_path / "none").exists()
+
+
+def test_a_log_without_the_world_or_of_an_unknown_robot_cannot_be_drawn(hunt: HuntResult, tmp_path: Path) -> None:
+    start = {k: v for k, v in hunt.events[0].items() if k != "world_data"}
+    with pytest.raises(RunError, match="no world_data"):
+        render_run([start, *hunt.events[1:]], tmp_path / "old")
+    stranger = {**hunt.events[0], "robot": "r2d2", "mission": "rescue"}
+    with pytest.raises(RunError, match="r2d2"):
+        render_run([stranger, *hunt.events[1:]], tmp_path / "r2d2")
+    broken = {**hunt.events[0], "world_data": {"room": {"width": -1, "height": 2}}}
+    with pytest.raises(RunError, match="positive"):
+        render_run([broken, *hunt.events[1:]], tmp_path / "broken")
+    assert not list(tmp_path.iterdir())
+    # An event edited by hand: the message names what is wrong, in one line.
+    edited = [{k: v for k, v in e.items() if k != "y"} if e["kind"] == "pose" else e for e in hunt.events]
+    with pytest.raises(RunError, match="the log cannot be drawn.*KeyError.*'y'") as error:
+        render_run(edited, tmp_path / "edited")
+    assert "\n" not in str(error.value)
