@@ -569,6 +569,9 @@ def skeleton(paths: PathsArg) -> None:
         out.print("every codel named by the specs already exists", markup=False)
 
 
+TABLE_WIDTH = 140  # columns of `specc table` when it does not print to a terminal
+
+
 def _run_error(error: Exception, code: int = 1) -> typer.Exit:
     """One clear line (or a spec's diagnostics) for a run that cannot go on."""
     err.print(f"error: {error}" if "error:" not in str(error) else str(error), markup=False)
@@ -576,8 +579,8 @@ def _run_error(error: Exception, code: int = 1) -> typer.Exit:
 
 
 @app.command()
-def run(specs: Annotated[Path, typer.Argument(help="The robot's spec folder (its codels and worlds beside the "
-                                                   "specs), e.g. examples/atrv or examples/hilare.",
+def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder (its codels and "
+                                                   "worlds beside the specs), e.g. examples/atrv or examples/hilare.",
                                               show_default=False)],
         mission: Annotated[Optional[str], typer.Option(help="M1, M2, M3, M4 for the rover; hunt (the default) "
                                                             "for Hilare.")] = None,
@@ -593,8 +596,10 @@ def run(specs: Annotated[Path, typer.Argument(help="The robot's spec folder (its
                                                        "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>).")] = None,
         timing: Annotated[str, typer.Option(help="FTplan's planning time: model (deterministic) or wall "
                                                  "(measured).")] = "model",
-        objects: Annotated[int, typer.Option(help="The hunt's objects to take (0-5).")] = 5,
-        horizon: Annotated[float, typer.Option(help="The hunt's horizon, s of simulated time.")] = 900.0,
+        objects: Annotated[Optional[int], typer.Option(help="The hunt's objects to take (0-5; default 5).")]
+        = None,
+        horizon: Annotated[Optional[float], typer.Option(help="The hunt's horizon, s of simulated time (default "
+                                                              "900).")] = None,
         pictures: Annotated[bool, typer.Option(help="Draw the map and timeline now (else: specc replay "
                                                     "RUN).")] = True,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
@@ -685,7 +690,7 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
 
 
 @app.command()
-def table(specs: Annotated[Path, typer.Argument(help="The robot's spec folder, e.g. examples/atrv.",
+def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder, e.g. examples/atrv.",
                                                 show_default=False)],
           mission: Annotated[Optional[list[str]], typer.Option(help="A rover mission (repeatable; default: "
                                                                     "M1-M4).")] = None,
@@ -735,7 +740,8 @@ def table(specs: Annotated[Path, typer.Argument(help="The robot's spec folder, e
                   f"{h.objects_taken:.2f} objects taken on average, {h.simulated_time:.0f} s per successful hunt",
                   markup=False)
     else:
-        out.print(rich_table(result.rows))
+        # A file or pipe gets the whole table, not one squeezed into 80 columns.
+        (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(rich_table(result.rows))
     for failure in result.failures:
         out.print(f"failed: {failure.name}: {failure.why}", markup=False)
     for path in written:

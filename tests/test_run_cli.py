@@ -109,6 +109,7 @@ def test_the_hunt_runs_from_the_command_line(tmp_path: Path) -> None:
     (("--mission", "M1", "--world", "W9"), "error: unknown world 'W9': give W1, W2, W3, W4"),
     (("--mission", "M1", "--world", "W1", "--config", "Robot3"), "error: no robot configuration 'Robot3'"),
     (("--mission", "M1",), "error: the rover needs --mission (M1, M2, M3, M4) and --world"),
+    (("--mission", "M1", "--world", "W1", "--horizon", "60"), "error: --horizon: the hunt's (Hilare's)"),
 ])
 def test_unknown_names_are_one_line_and_leave_no_run_folder(args: tuple[str, ...], message: str,
                                                             tmp_path: Path) -> None:

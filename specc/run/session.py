@@ -64,8 +64,8 @@ class RunRequest:
     runs: Path = RUNS
     folder: Path | None = None  # the run folder itself, instead of runs/<name>
     timing: str = "model"  # FTplan's planning charge (the rover): model (deterministic) or wall
-    objects: int = 5  # the hunt's objects to take
-    horizon: float = 900.0  # the hunt's, s of simulated time
+    objects: int | None = None  # the hunt's objects to take (default: 5)
+    horizon: float | None = None  # the hunt's, s of simulated time (default: 900)
     pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
 
 
@@ -184,6 +184,10 @@ def _plan_rover(request: RunRequest) -> _Plan:
         raise RunError("the rover needs --mission (M1, M2, M3, M4) and --world (W1, W2, W3, W4 or a world file)")
     if request.timing not in TIMINGS:
         raise RunError(f"timing '{request.timing}': give {' or '.join(TIMINGS)}")
+    hunts = [name for name, value in (("--objects", request.objects), ("--horizon", request.horizon))
+             if value is not None]
+    if hunts:
+        raise RunError(f"{' and '.join(hunts)}: the hunt's (Hilare's); a rover mission ends with its plan")
     configuration = request.configuration or DEFAULT_CONFIGURATION
     example = request.specs.resolve()
     # Every name checked before the run folder is made: a typo leaves nothing behind.
@@ -216,7 +220,7 @@ def _plan_rover(request: RunRequest) -> _Plan:
 
 
 def _plan_hunt(request: RunRequest) -> _Plan:
-    from specc.run.hunt import arm_motion_overlaps, detection_interruptions, run_hunt
+    from specc.run.hunt import HORIZON, MAX_OBJECTS_WANTED, arm_motion_overlaps, detection_interruptions, run_hunt
 
     mission = request.mission or HUNT
     world = request.world or HUNT_WORLD
@@ -234,7 +238,8 @@ def _plan_hunt(request: RunRequest) -> _Plan:
             if progress is not None:
                 progress(step.time, step.horizon, f"{step.objects_taken}/{step.objects_wanted} objects taken")
 
-        result = run_hunt(request.seed, request.objects, request.horizon, log, tell,
+        wanted = MAX_OBJECTS_WANTED if request.objects is None else request.objects
+        result = run_hunt(request.seed, wanted, HORIZON if request.horizon is None else request.horizon, log, tell,
                           generated=request.generated, example=request.specs.resolve())
         detections = detection_interruptions(result.events)
         overlaps = arm_motion_overlaps(result.events)
