@@ -615,6 +615,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         with _progress_display(quiet) as progress:
             outcome = run_in_folder(request, progress, compiled_note=lambda text: err.print(text, markup=False))
     except RunCrashed as crash:
+        if os.environ.get("SPECC_DEBUG") and crash.__cause__ is not None:
+            raise crash.__cause__ from crash  # the traceback the one-line message offers
         raise _run_error(crash, 1) from None
     except RunError as error:
         raise _run_error(error, 2) from None
@@ -665,10 +667,11 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
                                                           "(default: the run folder).")] = None) -> None:
     """Play a run's event log back, then draw its pictures again from the log alone."""
     from specc.run import RunError
-    from specc.run.replay import describe, load_run, select
+    from specc.run.replay import check_kinds, describe, load_run, select
 
     try:
         folder, events = load_run(run_path)
+        check_kinds(events, kind or ())
     except RunError as error:
         raise _run_error(error, 2) from None
     previous: float | None = None

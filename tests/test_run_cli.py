@@ -68,9 +68,12 @@ def test_a_rover_mission_leaves_a_run_folder_with_log_report_and_pictures(m1_w2:
 
 def test_the_same_seed_gives_the_same_log_through_the_command_line(m1_w2: tuple, tmp_path: Path) -> None:
     _, runs = m1_w2
+    (tmp_path / "again").mkdir()
+    (tmp_path / "again" / "state.png").write_bytes(PNG)  # an earlier run's picture, not this one's
     again = specc("run", ATRV, "--mission", "M1", "--world", "W2", "--config", "Robot1/2", "--folder",
                   tmp_path / "again", "--no-pictures")
     assert again.returncode == 0, again.stderr
+    assert sorted(p.name for p in (tmp_path / "again").iterdir()) == ["events.jsonl", "report.json", "summary.txt"]
     first = (runs / "atrv-M1-W2-Robot1-2-s0" / "events.jsonl").read_bytes()
     assert (tmp_path / "again" / "events.jsonl").read_bytes() == first
 
@@ -122,6 +125,10 @@ def test_unknown_names_are_one_line_and_leave_no_run_folder(args: tuple[str, ...
 def test_the_hunt_refuses_the_rovers_options(tmp_path: Path) -> None:
     assert_clean_failure(specc("run", HILARE, "--config", "Robot1", "--runs", tmp_path), 2,
                          "error: configuration 'Robot1': hilare has none")
+    assert_clean_failure(specc("run", HILARE, "--objects", "9", "--runs", tmp_path), 2,
+                         "error: 9 objects wanted: COLLECT-OBJECTS takes 0 to 5")
+    assert_clean_failure(specc("run", HILARE, "--horizon", "nan", "--runs", tmp_path), 2, "error: horizon nan")
+    assert not any(tmp_path.iterdir())  # checked before anything is written
     assert_clean_failure(specc("run", EXAMPLES / "generic", "--runs", tmp_path), 2,
                          "error: robot 'generic' has no mission runner")
     assert_clean_failure(specc("run", tmp_path / "nowhere"), 2, "is not a robot's spec folder")
@@ -225,14 +232,19 @@ def test_the_table_of_measures_comes_from_one_command(tmp_path: Path) -> None:
 
 
 def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
-    result = specc("table", ATRV, "--mission", "M7", "--runs", tmp_path)
+    result = specc("table", ATRV, "--mission", "M1", "--mission", "M7", "--world", "W1", "--config", "Robot1",
+                   "--runs", tmp_path)
     assert_clean_failure(result, 2, "error: ftplan 'rover' has no mission 'M7'")
+    assert not any(tmp_path.iterdir())  # every name is checked before the first run
     assert_clean_failure(specc("table", HILARE, "--world", "W1"), 2, "hilare has one mission")
 
 
 def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:
     assert_clean_failure(specc("replay", tmp_path / "nothing"), 2, "no run folder or event log")
     assert_clean_failure(specc("replay", tmp_path), 2, "holds no events.jsonl")
+    (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\n')
+    assert_clean_failure(specc("replay", tmp_path, "--kind", "actoin"), 2,
+                         "no event of kind 'actoin' in this log (it has: mission-start)")
     (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\nnot json\n')
     assert_clean_failure(specc("replay", tmp_path), 2, "events.jsonl")
 

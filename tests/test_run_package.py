@@ -58,3 +58,16 @@ def test_a_stamped_package_is_current_without_compiling_until_a_spec_changes(
     # A generated file deleted behind the stamp's back is rewritten.
     next(p for p in sorted(again.folder.rglob("*.py")) if p.name != "__init__.py").unlink()
     assert ensure_compiled(specs, tmp_path / "out").rewritten
+
+
+def test_a_stamp_judges_the_package_folder_it_was_made_for(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same relative output from two working directories names two packages: editing one is
+    seen even when the other was stamped last."""
+    for place in ("c1", "c2"):
+        (tmp_path / place).mkdir()
+        monkeypatch.chdir(tmp_path / place)
+        ensure_compiled(GENERIC, Path("g"))
+    edited = next(p for p in sorted((tmp_path / "c1" / "g").rglob("*.py")) if p.name != "__init__.py")
+    edited.write_text("# edited by hand\n", encoding="utf-8")
+    assert ensure_compiled(GENERIC, Path("../c1/g")).rewritten
+    assert "edited by hand" not in edited.read_text(encoding="utf-8")

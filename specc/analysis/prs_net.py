@@ -930,7 +930,10 @@ class Translator:
         nodes.append(target)
         mentioned = set(bound)
         for i, statement in enumerate(block):
-            self._statement(ka, statement, nodes[i], nodes[i + 1], fail, mentioned, live_after)
+            # What is live after this statement, not after the block: a parallel's join must keep
+            # the values its branches give to the statements that follow it in the block.
+            self._statement(ka, statement, nodes[i], nodes[i + 1], fail, mentioned,
+                            live_before(block[i + 1:], live_after))
             mentioned |= statement_vars(statement)
 
     def _enter(self, ka: rp.KA, statement: rp.Statement, place: str) -> str:

@@ -201,7 +201,7 @@ def run_hunt(seed: int, objects_wanted: int = MAX_OBJECTS_WANTED, horizon: float
     generated/), `example` the robot's folder with its codels and worlds (examples/hilare/);
     both go on sys.path. Events go to `log` (one in memory when none is given) and to the
     result. Bad arguments raise RunError."""
-    _check_arguments(seed, objects_wanted, horizon)
+    check_arguments(seed, objects_wanted, horizon)
     example = (example or EXAMPLE).resolve()
     package = load_package(generated or GENERATED, example)
     world = place_objects(_load_room(example), seed)
@@ -260,7 +260,7 @@ def run_hunt(seed: int, objects_wanted: int = MAX_OBJECTS_WANTED, horizon: float
         replies=dict(sorted(recorder.replies.items())), events=tuple(log.events))
 
 
-def _check_arguments(seed: int, objects_wanted: int, horizon: float) -> None:
+def check_arguments(seed: int, objects_wanted: int, horizon: float) -> None:
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise RunError(f"seed {seed!r}: give a whole number >= 0")
     if not isinstance(objects_wanted, int) or isinstance(objects_wanted, bool) \

@@ -83,18 +83,21 @@ class _Stamp:
 
         files, problems = spec_files([specs])
         where = _digest([str(specs.resolve()), str(output.resolve())])[:24]
-        self.path = stamps_folder() / f"{where}.json"
+        self.output = output
+        cache = stamps_folder()
+        self.path = cache / f"{where}.json" if cache is not None else None
         # Problems finding the specs: no digest, so `load` reports them as it does for `check`.
-        self.inputs = None if problems else _digest([_compiler_digest()] + [
+        self.inputs = None if problems or self.path is None else _digest([_compiler_digest()] + [
             f"{file.name}:{_file_digest(file)}" for file in files])
 
     def still_current(self) -> Compiled | None:
-        if self.inputs is None:
+        if self.inputs is None or self.path is None:
             return None
         try:
             data = json.loads(self.path.read_text(encoding="utf-8"))
             robot, folder, written = data["robot"], Path(data["folder"]), data["files"]
-            if data["inputs"] != self.inputs or not isinstance(written, dict):
+            if data["inputs"] != self.inputs or not isinstance(written, dict) \
+                    or folder != (self.output / robot).resolve():  # another package of that name elsewhere
                 return None
         except (OSError, ValueError, KeyError, TypeError):
             return None
@@ -103,18 +106,24 @@ class _Stamp:
         return Compiled(robot, folder, False)
 
     def write(self, robot: str, folder: Path, files: Mapping[str, str]) -> None:
-        if self.inputs is None:
+        if self.inputs is None or self.path is None:
             return
-        data = {"robot": robot, "folder": str(folder), "inputs": self.inputs,
+        data = {"robot": robot, "folder": str(folder.resolve()), "inputs": self.inputs,
                 "files": {relative: _digest([text]) for relative, text in sorted(files.items())}}
         with contextlib.suppress(OSError):  # without a stamp the next run compiles again: slower, still right
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.path.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n", encoding="utf-8")
 
 
-def stamps_folder() -> Path:
-    """The user's cache (XDG), not the output folder: that one holds the package and nothing else."""
-    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+def stamps_folder() -> Path | None:
+    """The user's cache (XDG), not the output folder: that one holds the package and nothing else.
+    None when the user has no home: every run then compiles, slower but right."""
+    cache = os.environ.get("XDG_CACHE_HOME")
+    if not cache:
+        try:
+            cache = str(Path.home() / ".cache")
+        except RuntimeError:
+            return None
     return Path(cache) / "specc" / "stamps"
 
 

@@ -35,6 +35,15 @@ def load_run(run: Path) -> tuple[Path, list[dict[str, Any]]]:
     return folder, events
 
 
+def check_kinds(events: Iterable[Mapping[str, Any]], kinds: Sequence[str]) -> None:
+    """RunError naming the kinds the log has when one asked for is not among them (a typo)."""
+    present = sorted({str(e["kind"]) for e in events})
+    missing = [k for k in kinds if k not in present]
+    if missing:
+        raise RunError(f"no event of kind {', '.join(repr(k) for k in missing)} in this log "
+                       f"(it has: {', '.join(present)})")
+
+
 def select(events: Iterable[Mapping[str, Any]], kinds: Sequence[str] = (), start: float | None = None,
            end: float | None = None) -> Iterator[Mapping[str, Any]]:
     """The events of `kinds` (default: every kind but the pose samples) between `start` and `end`."""

@@ -33,6 +33,7 @@ from specc.run.events import EventLog
 LOG = "events.jsonl"
 REPORT = "report.json"
 SUMMARY = "summary.txt"
+RUN_FILES = (LOG, REPORT, SUMMARY, "map.png", "timeline.png", "state.png")  # what a run writes in its folder
 RUNS = Path("runs")  # where run folders go by default, under the working directory
 GENERATED = Path("generated")  # where the specs compile to by default (`specc compile -o generated`)
 DEFAULT_CONFIGURATION = "Robot1/2"  # seed 004's fault-tolerant configuration (two models, successive)
@@ -118,22 +119,50 @@ def runnable_robot(robot: str) -> str:
     return robot
 
 
+@dataclass(frozen=True)
+class PlannedRun:
+    """A run whose names are all checked, ready to go into its folder."""
+
+    robot: str
+    request: RunRequest
+    plan: _Plan
+    folder: Path
+
+
+def plan_run(robot: str, request: RunRequest) -> PlannedRun:
+    """Check every name and option of `request` for `robot` (compiled into request.generated);
+    RunError when one is wrong. Nothing is written."""
+    plan = _plan_rover(request) if runnable_robot(robot) == "atrv" else _plan_hunt(request)
+    if request.folder is not None:
+        return PlannedRun(robot, request, plan, request.folder)
+    # Options that change what a run does name its folder too: it never holds another run's files.
+    variant = "".join(f"-{label}{value:g}" for label, value in (("objects", request.objects),
+                                                                ("horizon", request.horizon)) if value is not None)
+    variant += "-wall" if request.timing != "model" else ""
+    name = folder_name(robot, *plan.name_parts, request.seed)
+    return PlannedRun(robot, request, plan, request.runs / (name + variant))
+
+
 def run_compiled(robot: str, request: RunRequest, progress: Progress | None = None) -> RunOutcome:
     """`run_in_folder` once the specs are compiled into `request.generated`/<robot>."""
-    plan = _plan_rover(request) if runnable_robot(robot) == "atrv" else _plan_hunt(request)
-    folder = request.folder or request.runs / folder_name(robot, *plan.name_parts, request.seed)
-    outcome = RunOutcome(folder, robot, {}, "")
+    return run_planned(plan_run(robot, request), progress)
+
+
+def run_planned(planned: PlannedRun, progress: Progress | None = None) -> RunOutcome:
+    """Run what `plan_run` checked and write its folder (see `run_in_folder`)."""
+    request, plan, folder = planned.request, planned.plan, planned.folder
+    outcome = RunOutcome(folder, planned.robot, {}, "")
     try:
         folder.mkdir(parents=True, exist_ok=True)
+        for name in RUN_FILES:  # what an earlier run left here must not pass for this one's
+            (folder / name).unlink(missing_ok=True)
     except OSError as error:
         raise RunError(f"cannot make the run folder '{folder}': {error.strerror or error}") from None
     started = time.perf_counter()
     with EventLog(folder / LOG) as log:
         try:
             report, summary = plan.run(log, progress)
-        except RunError:
-            raise
-        except Exception as error:  # a runtime failure half-way: keep what the log holds, say what broke
+        except Exception as error:  # a failure half-way (even a RunError): keep what the log holds, say what broke
             report = {"outcome": "crashed", "why": f"{type(error).__name__}: {error}"}
             summary = f"the run crashed at {log.events[-1]['t'] if log.events else 0.0:.1f} s: {report['why']}"
             _finish(outcome, request, plan, report, summary, log, started)
@@ -220,7 +249,14 @@ def _plan_rover(request: RunRequest) -> _Plan:
 
 
 def _plan_hunt(request: RunRequest) -> _Plan:
-    from specc.run.hunt import HORIZON, MAX_OBJECTS_WANTED, arm_motion_overlaps, detection_interruptions, run_hunt
+    from specc.run.hunt import (
+        HORIZON,
+        MAX_OBJECTS_WANTED,
+        arm_motion_overlaps,
+        check_arguments,
+        detection_interruptions,
+        run_hunt,
+    )
 
     mission = request.mission or HUNT
     world = request.world or HUNT_WORLD
@@ -232,14 +268,18 @@ def _plan_hunt(request: RunRequest) -> _Plan:
     if request.configuration is not None:
         raise RunError(f"configuration '{request.configuration}': hilare has none (configurations are the "
                        "rover's: Robot1, Robot2, Robot1/2, Robot1/2c)")
+    if request.timing != "model":
+        raise RunError(f"timing '{request.timing}': the rover's (FTplan's planning time); the hunt has no planner")
+    wanted = MAX_OBJECTS_WANTED if request.objects is None else request.objects
+    horizon = HORIZON if request.horizon is None else request.horizon
+    check_arguments(request.seed, wanted, horizon)
 
     def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
         def tell(step: Any) -> None:
             if progress is not None:
                 progress(step.time, step.horizon, f"{step.objects_taken}/{step.objects_wanted} objects taken")
 
-        wanted = MAX_OBJECTS_WANTED if request.objects is None else request.objects
-        result = run_hunt(request.seed, wanted, HORIZON if request.horizon is None else request.horizon, log, tell,
+        result = run_hunt(request.seed, wanted, horizon, log, tell,
                           generated=request.generated, example=request.specs.resolve())
         detections = detection_interruptions(result.events)
         overlaps = arm_motion_overlaps(result.events)

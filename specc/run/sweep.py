@@ -22,7 +22,7 @@ from typing import Any
 
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
-from specc.run.session import RunCrashed, RunOutcome, RunRequest, run_compiled, runnable_robot
+from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned, runnable_robot
 
 MISSIONS = ("M1", "M2", "M3", "M4")
 WORLDS = ("W1", "W2", "W3", "W4")
@@ -72,6 +72,9 @@ class SweepResult:
                     f"{h.simulated_time:.0f} | {h.distance:.1f} |\n")
         else:
             text = markdown_table(self.rows)
+        crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
+        if crashed:
+            text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
         if self.failures:
             text += "\nFailures (each run's log is in its folder):\n\n" + "".join(
                 f"- {f.name}: {f.why}\n" for f in self.failures)
@@ -98,12 +101,13 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = MISSIONS, w
         requests = [replace(base, seed=s) for s in seeds]
     if not requests:
         raise RunError("nothing to run: give at least one mission, world and configuration")
+    planned = [plan_run(robot, request) for request in requests]  # a typo stops the table before any run
     result = SweepResult(robot)
-    for done, request in enumerate(requests):
+    for done, run in enumerate(planned):
         if step is not None:
-            step(done, len(requests), _label(robot, request))
+            step(done, len(requests), _label(robot, run.request))
         try:
-            result.outcomes.append(run_compiled(robot, request))
+            result.outcomes.append(run_planned(run))
         except RunCrashed as crash:  # one broken run is a failure of the table, not the end of it
             result.outcomes.append(crash.outcome)
     if step is not None:
