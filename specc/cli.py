@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import difflib
-import keyword
 import os
 import sys
 import time
@@ -87,11 +86,11 @@ def compile(paths: PathsArg,
     code = report(loaded)
     if code or loaded.program is None:
         raise typer.Exit(code or 1)
-    fallback = paths[0].resolve().name if paths[0].is_dir() else paths[0].stem
-    name = robot or package.robot_name(loaded.program, fallback)
-    if not name.isidentifier() or keyword.iskeyword(name):  # `import class` cannot be written
-        err.print(f"error: '{name}' is not a valid Python package name; pass --robot NAME", markup=False)
-        raise typer.Exit(1)
+    try:
+        name = package.package_name(loaded.program, paths[0], robot)
+    except ValueError as exc:
+        err.print(f"error: {exc}", markup=False)
+        raise typer.Exit(1) from None
     try:
         result = generate_all(loaded.program, name)
     except KheopsError as exc:
@@ -609,10 +608,10 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
     from specc.run import RunError
     from specc.run.session import RunCrashed, RunRequest, run_in_folder
 
-    request = RunRequest(specs, mission, world, config, seed, generated, runs, folder, timing, objects, horizon,
-                         pictures)
+    request = RunRequest(specs, mission=mission, world=world, configuration=config, seed=seed, generated=generated,
+                         runs=runs, folder=folder, timing=timing, objects=objects, horizon=horizon, pictures=pictures)
     try:
-        with _progress_display(quiet) as progress:
+        with ProgressDisplay(quiet) as progress:
             outcome = run_in_folder(request, progress, compiled_note=lambda text: err.print(text, markup=False))
     except RunCrashed as crash:
         if os.environ.get("SPECC_DEBUG") and crash.__cause__ is not None:
@@ -626,17 +625,18 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         raise typer.Exit(1)
 
 
-class _progress_display:
-    """A live line on stderr: mission time (against the horizon when there is one) and the
-    latest step; nothing when quiet or when stderr is not a terminal."""
+class ProgressDisplay:
+    """A live line on stderr: how far (mission time, or runs done; against the total when there
+    is one) and the latest step; nothing when quiet or when stderr is not a terminal."""
 
-    def __init__(self, quiet: bool) -> None:
+    def __init__(self, quiet: bool, clock: Callable[[float], str] = lambda now: f"t = {now:7.1f} s") -> None:
         from rich.progress import BarColumn, Progress, TextColumn
 
         self.live = not quiet and err.is_terminal
+        self.clock = clock
         self.progress = Progress(TextColumn("[bold]{task.fields[clock]}"), BarColumn(),
                                  TextColumn("{task.description}"), console=err, transient=True)
-        self.task = self.progress.add_task("starting", total=None, clock="t =     0.0 s")
+        self.task = self.progress.add_task("starting", total=None, clock=clock(0.0))
 
     def __enter__(self) -> Callable[[float, float | None, str], None] | None:
         if not self.live:
@@ -649,8 +649,7 @@ class _progress_display:
             self.progress.stop()
 
     def update(self, now: float, horizon: float | None, what: str) -> None:
-        self.progress.update(self.task, completed=now, total=horizon, description=what,
-                             clock=f"t = {now:7.1f} s")
+        self.progress.update(self.task, completed=now, total=horizon, description=what, clock=self.clock(now))
 
 
 @app.command()
@@ -712,29 +711,24 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
     the measures of seed 004 §4.1.4 (for Hilare: the hunt's success rate over the seeds)."""
     from specc.run import RunError
     from specc.run.measures import rich_table
-    from specc.run.package import ensure_compiled
-    from specc.run.session import RunRequest
+    from specc.run.session import RunRequest, compile_robot
     from specc.run.sweep import CONFIGURATIONS, MISSIONS, WORLDS, sweep, write_table
 
     try:
-        if not specs.is_dir():
-            raise RunError(f"'{specs}' is not a robot's spec folder: give e.g. examples/atrv")
-        compiled = ensure_compiled(specs, generated)
-        if compiled.rewritten:
-            err.print(f"compiled {specs} into {compiled.folder} (it was stale)", markup=False)
-        if compiled.robot != "atrv" and (mission or world or config):
-            raise RunError(f"{compiled.robot} has one mission: --mission, --world and --config are the rover's")
+        robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
+        if robot != "atrv" and (mission or world or config):
+            raise RunError(f"{robot} has one mission: --mission, --world and --config are the rover's")
         base = RunRequest(specs, generated=generated, runs=runs, pictures=pictures)
-        with _progress_display(quiet) as progress:
+        with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} run(s) done") as progress:
             def step(done: int, total: int, label: str) -> None:
                 if progress is not None:
                     progress(done, total, label)
                 elif not quiet and label:
                     err.print(f"[{done + 1}/{total}] {label}", markup=False)
 
-            result = sweep(compiled.robot, base, missions=mission or MISSIONS, worlds=world or WORLDS,
+            result = sweep(robot, base, missions=mission or MISSIONS, worlds=world or WORLDS,
                            configurations=config or CONFIGURATIONS, seeds=range(seeds), step=step)
-        written = write_table(result, output or runs / f"{compiled.robot}-table.md")
+        written = write_table(result, output or runs / f"{robot}-table.md")
     except RunError as error:
         raise _run_error(error, 2) from None
     if result.hunt is not None:

@@ -3,12 +3,19 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 EXAMPLE_ROBOTS = ("hilare", "generic", "atrv")
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+HUNT_SEED = 0  # five objects taken; its first exploration move is interrupted by a detection (§5.5, t2)
+
+
+def is_png(path: Path) -> bool:
+    return path.read_bytes()[:8] == PNG_MAGIC
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -27,3 +34,26 @@ def _stamps_in_a_temporary_cache(tmp_path_factory: pytest.TempPathFactory) -> It
 @pytest.fixture(scope="session")
 def root() -> Path:
     return ROOT
+
+
+@pytest.fixture
+def no_planner_left_behind() -> Iterator[None]:
+    """Every planner process FTplan started is gone when the test ends."""
+    import multiprocessing
+
+    yield
+    assert multiprocessing.active_children() == []
+
+
+@pytest.fixture(scope="session")
+def hunt_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, Path, list[Any]]:
+    """One full hunt of seed HUNT_SEED (about 4 s), its log file and its progress reports, shared
+    by the tests of the hunt and of its pictures."""
+    from specc.run.events import EventLog
+    from specc.run.hunt import run_hunt
+
+    path = tmp_path_factory.mktemp("hunt") / "hunt.jsonl"
+    reports: list[Any] = []
+    with EventLog(path) as log:
+        result = run_hunt(HUNT_SEED, log=log, progress=reports.append)
+    return result, path, reports

@@ -6,9 +6,7 @@ planner, a correct one; with every planner faulty the mission exception is raise
 
 from __future__ import annotations
 
-import multiprocessing
 import sys
-from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -44,10 +42,7 @@ def rover_world(action: Action, now: float) -> Outcome:
     return Outcome()
 
 
-@pytest.fixture(autouse=True)
-def no_planner_left_behind() -> Iterator[None]:
-    yield
-    assert multiprocessing.active_children() == []
+pytestmark = pytest.mark.usefixtures("no_planner_left_behind")
 
 
 def run(*planners: PlannerConfig, policy: str = "successive") -> tuple[MissionResult, list[str]]:

@@ -6,9 +6,7 @@ run the rover's missions."""
 
 from __future__ import annotations
 
-import multiprocessing
 import sys
-from collections.abc import Iterator
 from dataclasses import replace
 from functools import cache
 from pathlib import Path
@@ -149,15 +147,9 @@ def test_robot2_plans_and_meets_the_mission_in_modele2_with_ftplans_state(missio
     assert any(goal.startswith("AT_ROBOT_X() = 0") for goal in result.met)
 
 
-@pytest.fixture
-def no_planner_left_behind() -> Iterator[None]:
-    yield
-    assert multiprocessing.active_children() == []
-
-
 def run_in_processes(config: FtPlanConfig, mission: str) -> MissionResult:
     problems = mission_problems(mission)
-    with ProcessPool(config.planners, domains(mission), ) as pool:  # type: ignore[arg-type]
+    with ProcessPool(config.planners, domains(mission)) as pool:  # type: ignore[arg-type]
         return FtPlan(config, problems["p1"], pool, ScriptedExecutor(rover_world),  # type: ignore[arg-type]
                       wall_limit=5.0, problems=problems).run()  # type: ignore[arg-type]
 

@@ -17,6 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from specc.runtime.sim import load_world
 from tests.conftest import EXAMPLES, ROOT
 
 sys.path[:0] = [str(EXAMPLES / "hilare")]
@@ -24,7 +25,8 @@ from hilare_codels import explor, pilo, plan, visual  # type: ignore[import-not-
 
 sys.path.remove(str(EXAMPLES / "hilare"))
 
-ROOM = tomllib.loads((EXAMPLES / "hilare" / "worlds" / "room.toml").read_text())
+ROOM_FILE = EXAMPLES / "hilare" / "worlds" / "room.toml"
+ROOM = tomllib.loads(ROOM_FILE.read_text())
 OBSTACLES = [[tuple(p) for p in o["polygon"]] for o in ROOM["obstacles"]]
 ROOM_BOX = (0.0, 0.0, ROOM["room"]["width"], ROOM["room"]["height"])
 Point = tuple[float, float]
@@ -634,21 +636,16 @@ def test_the_full_algorithm_matches_the_literal_one(nx: int, ny: int, data: st.D
         assert best is None
 
 
-def visual_free_cells() -> np.ndarray:
-    """VISUAL's free cells (64 x 64 cells of 0.3 m; obstacles' bounding boxes not free), those
-    outside the room included."""
-    cell, n = visual.CELL, visual.NX
-    free = np.ones((n, n), dtype=bool)
-    for obstacle in OBSTACLES:
-        xs, ys = [p[0] for p in obstacle], [p[1] for p in obstacle]
-        free[int(min(ys) / cell):int(max(ys) / cell) + 1, int(min(xs) / cell):int(max(xs) / cell) + 1] = False
-    return free
+def visual_free_cells() -> list[bool]:
+    """VISUAL's free cells as readObstacles marks them (64 x 64 cells of 0.3 m, row-major;
+    obstacles' bounding boxes not free), those outside the room included."""
+    return visual.free_cells(load_world(ROOM_FILE))
 
 
 def room_model() -> tuple[np.ndarray, float]:
     """VISUAL's grid of the room less the cells outside the room (PLAN's Env box)."""
     cell, n = visual.CELL, visual.NX
-    model = SimpleNamespace(nx=n, ny=n, cellSize=cell, free=visual_free_cells().ravel().tolist(),
+    model = SimpleNamespace(nx=n, ny=n, cellSize=cell, free=visual_free_cells(),
                             certainty=[0.0] * (n * n))
     box = SimpleNamespace(xmin=ROOM_BOX[0], ymin=ROOM_BOX[1], xmax=ROOM_BOX[2], ymax=ROOM_BOX[3])
     return explor.model_grid(model, box)[0], cell
@@ -696,7 +693,7 @@ def explor_sdi(certainty: np.ndarray | None = None, robot: Point = (1.0, 1.0)): 
     free, cell = room_model()
     n = visual.NX
     # VISUAL's own model: the cells outside the room are free for VISUAL, EXPLOR masks them
-    model = vis.Model(nx=n, ny=n, cellSize=cell, free=visual_free_cells().ravel().tolist(),
+    model = vis.Model(nx=n, ny=n, cellSize=cell, free=visual_free_cells(),
                       certainty=(np.zeros(n * n) if certainty is None else certainty.ravel()).tolist())
     posters = {"visual.Model": SimpleNamespace(model=model, pan=0.0),
                "plan.Env": generated("plan").Box(*ROOM_BOX),

@@ -14,6 +14,7 @@ import pytest
 from specc.run import RunError
 from specc.run.events import EventLog, read_events
 from specc.run.hunt import (
+    EXAMPLE,
     EXPLORATION_MOVE,
     GENERATED,
     HORIZON,
@@ -29,20 +30,15 @@ from specc.run.hunt import (
     run_hunt,
 )
 from specc.runtime.sim import load_world
+from tests.conftest import HUNT_SEED, is_png
 
-ROOT = Path(__file__).resolve().parent.parent
-EXAMPLE = ROOT / "examples" / "hilare"
-SEED = 0  # its first exploration move has run for 8 s when the camera finds an object (§5.5, t2)
+SEED = HUNT_SEED  # its first exploration move has run for 8 s when the camera finds an object (§5.5, t2)
 
 
-@pytest.fixture(scope="module")
-def hunt(tmp_path_factory: pytest.TempPathFactory) -> tuple[HuntResult, Path, list[HuntProgress]]:
-    """One full hunt (5 objects), its log file and its progress reports, shared by the tests."""
-    path = tmp_path_factory.mktemp("hunt") / "hunt.jsonl"
-    reports: list[HuntProgress] = []
-    with EventLog(path) as log:
-        result = run_hunt(SEED, log=log, progress=reports.append)
-    return result, path, reports
+@pytest.fixture
+def hunt(hunt_run: tuple[HuntResult, Path, list[HuntProgress]]) -> tuple[HuntResult, Path, list[HuntProgress]]:
+    """One full hunt (5 objects), its log file and its progress reports (conftest's, shared)."""
+    return hunt_run
 
 
 def of_kind(events: Any, *kinds: str) -> list[dict[str, Any]]:
@@ -199,7 +195,7 @@ def test_the_log_file_round_trips(hunt: tuple[HuntResult, Path, list[HuntProgres
 
 def test_the_picture_is_drawn(hunt: tuple[HuntResult, Path, list[HuntProgress]], tmp_path: Path) -> None:
     picture = draw_hunt(hunt[0], tmp_path / "hunt.png")
-    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and picture.stat().st_size > 20_000
+    assert is_png(picture) and picture.stat().st_size > 20_000
     with pytest.raises(RunError, match="must end in .png"):
         draw_hunt(hunt[0], tmp_path / "hunt.gif")
 

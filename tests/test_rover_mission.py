@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -42,6 +43,15 @@ def timed(run: RoverRun) -> RoverRun:
     print(f"\n{run.configuration} on {run.mission} in {run.world} (seed {run.seed}): "
           f"{run.simulated_time:.0f} s of mission in {run.wall_time:.2f} s of wall time")
     return run
+
+
+def assert_position_reported_before(events: Sequence[Mapping[str, Any]], prefix: str) -> None:
+    """Each FTplan report starting with `prefix` (a move's end) comes right after the report of
+    where the robot stands."""
+    reports = [e["text"] for e in events if e["kind"] == "ftplan" and e["event"] == "report"]
+    for k, text in enumerate(reports):
+        if text.startswith(prefix):
+            assert reports[k - 1].startswith("report ROBOT_POSITION("), (reports[k - 1], text)
 
 
 @pytest.fixture(scope="module")
@@ -102,10 +112,7 @@ def test_every_action_is_logged_with_its_simulated_time(robot1_m1_w1: tuple[Rove
     forwarded = [(e["t"], e["event"], e["text"]) for e in events if e["kind"] == "ftplan"]
     assert forwarded == [(round(e.time, 6), e.kind, e.text) for e in run.result.events]
     # Every move's end reports where the robot stands, before its end.
-    reports = [e["text"] for e in events if e["kind"] == "ftplan" and e["event"] == "report"]
-    for k, text in enumerate(reports):
-        if text.startswith("ended MOVE("):
-            assert reports[k - 1].startswith("report ROBOT_POSITION(")
+    assert_position_reported_before(events, "ended MOVE(")
     assert len([e for e in events if e["kind"] == "photo"]) == 3
     assert progress[-1].what == "mission succeeded" and progress[-1].goals_met == progress[-1].goals == 7
 
@@ -202,10 +209,7 @@ def test_a_trapped_robot_fails_its_moves_cleanly_and_the_mission_ends() -> None:
     assert all("trapped" in a.why or "overran its planned duration" in a.why for a in failed)
     # Replanning starts where the robot stood, which it reported before each failure.
     assert len(failed) > 1 and all(a.args[:2] != (-5.0, 3.0) for a in failed[1:])
-    reports = [e["text"] for e in run.events if e["kind"] == "ftplan" and e["event"] == "report"]
-    for k, text in enumerate(reports):
-        if text.startswith("failed MOVE("):
-            assert reports[k - 1].startswith("report ROBOT_POSITION(")
+    assert_position_reported_before(run.events, "failed MOVE(")
     measures = measure(run)
     assert not run.result.success and not measures.success
     assert measures.photos.met < measures.photos.asked

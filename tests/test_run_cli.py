@@ -18,11 +18,10 @@ from specc.run import RunError
 from specc.run.events import read_events
 from specc.run.session import RunCrashed, RunRequest, run_compiled
 from specc.runtime.sim import Polygon, World, load_world
-from tests.conftest import EXAMPLES, ROOT
+from tests.conftest import EXAMPLES, PNG_MAGIC, ROOT, is_png
 
 ATRV = EXAMPLES / "atrv"
 HILARE = EXAMPLES / "hilare"
-PNG = b"\x89PNG\r\n\x1a\n"
 
 
 def specc(*args: str | Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
@@ -62,14 +61,14 @@ def test_a_rover_mission_leaves_a_run_folder_with_log_report_and_pictures(m1_w2:
     assert "mission succeeded" in summary and "photos 3/3" in summary
     for picture in report["pictures"]:
         path = folder / picture
-        assert path.read_bytes().startswith(PNG) and f"picture: {path}" in result.stdout
+        assert is_png(path) and f"picture: {path}" in result.stdout
     assert {"map.png", "timeline.png"} <= set(report["pictures"])
 
 
 def test_the_same_seed_gives_the_same_log_through_the_command_line(m1_w2: tuple, tmp_path: Path) -> None:
     _, runs = m1_w2
     (tmp_path / "again").mkdir()
-    (tmp_path / "again" / "state.png").write_bytes(PNG)  # an earlier run's picture, not this one's
+    (tmp_path / "again" / "state.png").write_bytes(PNG_MAGIC)  # an earlier run's picture, not this one's
     again = specc("run", ATRV, "--mission", "M1", "--world", "W2", "--config", "Robot1/2", "--folder",
                   tmp_path / "again", "--no-pictures")
     assert again.returncode == 0, again.stderr

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from specc.run import RunError
-from specc.run.hunt import HuntResult, draw_hunt, run_hunt
+from specc.run.hunt import HuntResult, draw_hunt, motion_stretches
 from specc.run.render import (
     MAP,
     STATE,
@@ -25,7 +25,6 @@ from specc.run.render import (
     hunt_model,
     hunt_objects,
     hunt_scene,
-    motion_spans,
     path_of,
     plan_starts,
     render_run,
@@ -36,15 +35,14 @@ from specc.run.render import (
     trajectories,
 )
 from specc.run.rover import RoverRun, run_rover_mission
+from tests.conftest import is_png
 
-PNG = b"\x89PNG\r\n\x1a\n"
-HUNT_SEED = 0  # five objects taken, exploration moves interrupted by detections (test_hunt.py's)
 POSE_TOLERANCE = 0.03  # m between a pose event and the simulator's trace at the same instant
 
 
-@pytest.fixture(scope="module")
-def hunt() -> HuntResult:
-    return run_hunt(HUNT_SEED)
+@pytest.fixture
+def hunt(hunt_run: tuple[HuntResult, Path, list]) -> HuntResult:
+    return hunt_run[0]
 
 
 @pytest.fixture(scope="module")
@@ -52,9 +50,6 @@ def rover() -> RoverRun:
     """A mission with failures and replanning: three moves overrun their bound in W3's clutter."""
     return run_rover_mission("Robot1/2c", "M3", "W3", seed=0)
 
-
-def is_png(path: Path) -> bool:
-    return path.read_bytes()[:8] == PNG
 
 
 def cut(events: Sequence[Mapping[str, Any]], keep: Any) -> list[Mapping[str, Any]]:
@@ -175,9 +170,9 @@ def test_the_service_bars_pair_each_request_with_its_reply(hunt: HuntResult) -> 
 
 
 def test_motions_alternate_and_the_arm_moves_for_its_services(hunt: HuntResult) -> None:
-    robot = motion_spans(hunt.events, "robot-motion")
+    robot = motion_stretches(hunt.events, "robot-motion")
     assert robot and all(a.end <= b.start for a, b in zip(robot, robot[1:], strict=False))
-    arm = motion_spans(hunt.events, "arm-motion")
+    arm = motion_stretches(hunt.events, "arm-motion")
     assert {s.label for s in arm} == {"ARM-OBJ", "ARM-BACK"}
 
 

@@ -298,7 +298,7 @@ def test_hilare_reaches_goals_among_obstacles_through_its_modules(hilare):
     finally:
         sys.path.remove(str(ROOT / "examples" / "hilare"))
     room = load_world(ROOM)
-    sim, log, _ = run_sim.run(ROOM, room, [(9.0, 7.0), (2.0, 7.0)], seed=1, budget=200.0)
+    sim, log, _ = run_sim.run(room, [(9.0, 7.0), (2.0, 7.0)], seed=1, budget=200.0)
     assert sum("execPosterTraj: END OK" in line for line in log) == 2, log
     assert math.hypot(sim.pose[0] - 2.0, sim.pose[1] - 7.0) < 0.3
     assert min(room.clearance(x, y) for x, y, _ in sim.trace.poses) > HILARE.radius - 0.01  # no collision

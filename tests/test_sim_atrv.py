@@ -34,12 +34,10 @@ def run_sim() -> Iterator[ModuleType]:
     spec = importlib.util.spec_from_file_location("atrv_run_sim", ATRV / "run_sim.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up
     spec.loader.exec_module(module)
     module.import_generated()
     yield module
     sys.path[:] = saved
-    del sys.modules[spec.name]
 
 
 def rover(run_sim: ModuleType, name: str = "W1", seed: int = 0, **changes: Any) -> Any:
@@ -261,6 +259,7 @@ def test_run_sim_drives_the_rover_and_draws_the_run(tmp_path: Any) -> None:
 
 @pytest.mark.parametrize("args, message", [
     (["--world", "nowhere.toml"], "nowhere.toml: cannot read the world file"),
+    (["--world", "W9"], "unknown world 'W9': give W1, W2, W3, W4"),
     (["--world", "W2", "--goal", "4;0"], "--goal '4;0': expected x,y"),
     (["--world", "W2", "--goal", "2.6,2.8"], "inside an obstacle"),
     (["--world", "W1", "--goal", "-30,0"], "outside the walls"),

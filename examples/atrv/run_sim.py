@@ -59,13 +59,6 @@ def build(world: Any, seed: int = 0) -> Any:
         raise UsageError(str(exc)) from None
 
 
-def world_path(name: str) -> Path:
-    """W1..W4 name the example worlds; anything else is a path."""
-    if re.fullmatch(r"[Ww][1-4]", name):
-        return WORLDS / f"{name.upper()}.toml"
-    return Path(name)
-
-
 def parse_goal(text: str) -> tuple[float, float]:
     parts = text.split(",")
     try:
@@ -163,14 +156,14 @@ class Mission:
 
 def run(argv: list[str] | None = None) -> int:
     args = parser().parse_args(_glue_negative_goals(list(sys.argv[1:] if argv is None else argv)))
-    from specc.runtime.sim import ATRV, WorldError, load_world
+    from specc.run import RunError
+    from specc.run.rover import resolve_world
+    from specc.runtime.sim import ATRV
 
-    path = world_path(args.world)
-    try:
-        world = load_world(path)
-    except WorldError as exc:
-        hint = "" if path.exists() else "; --world takes W1, W2, W3, W4 or a world file"
-        raise UsageError(f"{exc}{hint}") from None
+    try:  # W1..W4 name the example worlds; anything else is a world file
+        world = resolve_world(args.world, WORLDS)
+    except RunError as exc:
+        raise UsageError(str(exc)) from None
     goals = [parse_goal(g) for g in args.goal] or (TRAP if world.name == "W4" else TOUR)
     xmin, xmax, ymin, ymax = world.bounds
     for x, y in goals:
@@ -191,7 +184,7 @@ def run(argv: list[str] | None = None) -> int:
 
     rover = build(world, args.seed)
     sim = rover.sim
-    print(f"world {world.name} ({world.description or path}), seed {args.seed}, "
+    print(f"world {world.name} ({world.description or world.source}), seed {args.seed}, "
           f"{len(goals)} goal(s), at most {args.duration:g} s")
     started = time.perf_counter()
     mission = Mission(rover, rover.kernel.now + args.duration)

@@ -60,9 +60,10 @@ def check_goal(world: World, x: float, y: float) -> None:
                          f"(PLAN keeps Hilare's centre {CLEARANCE:g} m away)")
 
 
-def run(world_path: Path, world: World, goals: list[tuple[float, float]], seed: int,
-        budget: float) -> tuple[Simulation, list[str], bool]:
-    """Drive to the goals in turn; the log of replies, and whether every request succeeded."""
+def run(world: World, goals: list[tuple[float, float]], seed: int, budget: float) -> tuple[Simulation, list[str], bool]:
+    """Drive to the goals in turn in `world` (loaded from its file, which PLAN and VISUAL read
+    too); the log of replies, and whether every request succeeded."""
+    world_file = world.source
     registry = rt.Registry()
     sim = Simulation(world, HILARE, seed=seed, kernel=registry.kernel).attach(registry)
     made = modules.create_all(registry)
@@ -71,8 +72,8 @@ def run(world_path: Path, world: World, goals: list[tuple[float, float]], seed: 
     log = []
     ok = True
     for name, reply in (("plan.setPlannerEnv", plan.final(plan.setPlannerEnv(Box(xmin, ymin, xmax, ymax)))),
-                        ("plan.readModelFile", plan.final(plan.readModelFile(str(world_path)))),
-                        ("visual.readObstacles", visual.final(visual.readObstacles(str(world_path)))),
+                        ("plan.readModelFile", plan.final(plan.readModelFile(world_file))),
+                        ("visual.readObstacles", visual.final(visual.readObstacles(world_file))),
                         ("pilo.avoidOnOff", pilo.final(pilo.avoidOnOff(True)))):
         log.append(f"{registry.kernel.now:7.2f} s  {name}: {reply.status} {reply.report.code}")
         ok = ok and reply.ok
@@ -135,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     started = time.perf_counter()
     try:
-        sim, log, ok = run(args.world, world, goals, args.seed, args.duration)
+        sim, log, ok = run(world, goals, args.seed, args.duration)
     except WorldError as error:  # what the world asks cannot be built (objects without room)
         print(f"run_sim.py: error: {error}", file=sys.stderr)
         return 2

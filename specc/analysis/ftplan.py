@@ -21,12 +21,16 @@ class NotConstant(ValueError):
     """An argument of an analyzer or state rule that is neither a ?variable nor a constant."""
 
 
+def _lowered(e: m.IxExpr) -> pm.Expr | None:
+    try:
+        return _LOWERING.expr(e, Scope({}, {}))
+    except PlanningError:  # an unknown function
+        return None
+
+
 def term(e: m.IxExpr) -> fc.Term:
     """A rule argument: a ?variable, a symbol, or a number."""
-    try:
-        lowered: pm.Expr | None = _LOWERING.expr(e, Scope({}, {}))
-    except PlanningError:  # an unknown function
-        lowered = None
+    lowered = _lowered(e)
     if isinstance(lowered, pm.Var):
         return fc.Var(lowered.name)
     if isinstance(lowered, pm.Sym):
@@ -62,10 +66,7 @@ def state_rule(update: m.StateUpdate) -> fc.StateRule:
 
 def bound(e: m.IxExpr) -> float:
     """An interval's bound: a number, `-oo` or `+oo`."""
-    try:
-        lowered: pm.Expr | None = _LOWERING.expr(e, Scope({}, {}))
-    except PlanningError:
-        lowered = None
+    lowered = _lowered(e)
     if isinstance(lowered, pm.Num):
         return float(lowered.value)
     raise NotConstant("an interval's bounds are numbers")
@@ -94,29 +95,37 @@ def planner_order(ftplan: m.FtPlan) -> list[m.Planner]:
     return [planners[name] for name in order]
 
 
+def viewed_planners(ftplan: m.FtPlan) -> set[str]:
+    """The planners speaking another vocabulary than FTplan's state: those with a view, in their
+    block or in a mission."""
+    return {p.name for p in ftplan.planners if p.view} | {
+        v.planner.text for mission in ftplan.missions for v in mission.views}
+
+
 def state_planner(ftplan: m.FtPlan) -> m.Planner | None:
     """The first planner speaking FTplan's state vocabulary (without a view): its problem of a
     mission gives FTplan's facts and goals."""
-    viewed = {v.planner.text for mission in ftplan.missions for v in mission.views}
-    return next((p for p in planner_order(ftplan) if not p.view and p.name not in viewed), None)
+    viewed = viewed_planners(ftplan)
+    return next((p for p in planner_order(ftplan) if p.name not in viewed), None)
 
 
-def mission_config(ftplan: m.FtPlan, mission: m.Mission, program: m.Program) -> fc.Mission:
-    problems = {p.name: p for p in program.items if isinstance(p, m.Problem)}
+def mission_config(mission: m.Mission, problems: dict[str, m.Problem], state_planner: str | None) -> fc.Mission:
+    """One mission; `problems` are the program's by name, `state_planner` names the planner whose
+    problem states the mission in FTplan's vocabulary."""
     entries = []
     for entry in mission.problems:
         problem = problems.get(entry.problem.text)
         domain = problem.domain.text if problem is not None else ""
         entries.append(fc.MissionProblem(entry.planner.text, entry.problem.text, domain))
-    own = state_planner(ftplan)
-    state_problem = next((e.problem for e in entries if own is not None and e.planner == own.name), "")
+    state_problem = next((e.problem for e in entries if e.planner == state_planner), "")
     views = tuple((v.planner.text, tuple(correspondence(c) for c in v.correspondences)) for v in mission.views)
     return fc.Mission(mission.name, tuple(entries), state_problem, views)
 
 
 def ftplan_config(ftplan: m.FtPlan, program: m.Program | None = None) -> fc.FtPlanConfig:
     """The block's configuration; `program` (for the missions' problems) defaults to the block alone."""
-    program = program or m.Program()
+    problems = {p.name: p for p in (program or m.Program()).items if isinstance(p, m.Problem)}
+    own = state_planner(ftplan)
     return fc.FtPlanConfig(
         name=ftplan.name,
         planners=tuple(planner_config(p) for p in planner_order(ftplan)),
@@ -124,7 +133,8 @@ def ftplan_config(ftplan: m.FtPlan, program: m.Program | None = None) -> fc.FtPl
         watchdog=ftplan.watchdog.seconds if ftplan.watchdog is not None else DEFAULT_WATCHDOG,
         analyzer=tuple(analyzer_rule(r) for r in ftplan.analyzer),
         state_rules=tuple(state_rule(u) for u in ftplan.state_updates),
-        missions=tuple(mission_config(ftplan, mission, program) for mission in ftplan.missions),
+        missions=tuple(mission_config(mission, problems, own.name if own is not None else None)
+                       for mission in ftplan.missions),
     )
 
 

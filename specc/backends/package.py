@@ -6,7 +6,9 @@ Output; this one only needs the model.
 
 from __future__ import annotations
 
+import keyword
 from dataclasses import dataclass
+from pathlib import Path
 
 from specc.backends.env import render
 from specc.backends.manifest import HEADER, Output, describe_sources
@@ -48,6 +50,18 @@ def robot_name(program: m.Program, fallback: str) -> str:
     """The system's name when the spec has exactly one system block, else `fallback`."""
     systems = [item for item in program.items if isinstance(item, m.System)]
     return systems[0].name if len(systems) == 1 else fallback
+
+
+def package_name(program: m.Program, specs: Path, robot: str | None = None) -> str:
+    """The package `specs` (a spec folder or file) compiles to: `robot` when given, else the
+    system block's name, else the folder's (the file's stem). ValueError when Python cannot
+    import it under that name."""
+    fallback = specs.resolve().name if specs.is_dir() else specs.stem
+    name = robot or robot_name(program, fallback)
+    if not name.isidentifier() or keyword.iskeyword(name):  # `import class` cannot be written
+        raise ValueError(f"'{name}' is not a valid Python package name; pass --robot NAME or rename the system "
+                         "block")
+    return name
 
 
 def generate_package(program: m.Program, output: Output, robot: str) -> None:

@@ -3,7 +3,7 @@ updates speak of tasks and attributes that some planner's domain defines."""
 
 from __future__ import annotations
 
-from specc.analysis.ftplan import NotConstant, bound, term
+from specc.analysis.ftplan import NotConstant, bound, term, viewed_planners
 from specc.check.context import Context
 from specc.check.planning import DomainTables, tables
 from specc.model import nodes as m
@@ -15,8 +15,7 @@ def check(ctx: Context) -> None:
         ctx.duplicates(ftplan.planners, "planner")
         ctx.duplicates(ftplan.missions, "mission")
         planners = {p.name: p for p in ftplan.planners}
-        viewed = {p.name for p in ftplan.planners if p.view} | {
-            v.planner.text for mission in ftplan.missions for v in mission.views}
+        viewed = viewed_planners(ftplan)
         # FTplan's state speaks the vocabulary of the planners without a view; each planner with
         # one speaks its own domain's, which its state rules and correspondences are checked in.
         known = DomainTables()
@@ -82,10 +81,10 @@ def check(ctx: Context) -> None:
         for planner in ftplan.planners:
             check_view(ctx, planner.view, own.get(planner.name), known)
         for mission in ftplan.missions:
-            check_mission(ctx, ftplan, mission, planners, domains, own, known)
+            check_mission(ctx, mission, planners, domains, own, known)
 
 
-def check_mission(ctx: Context, ftplan: m.FtPlan, mission: m.Mission, planners: dict[str, m.Planner],
+def check_mission(ctx: Context, mission: m.Mission, planners: dict[str, m.Planner],
                   domains: dict[str, tuple[m.Domain, DomainTables]], own: dict[str, DomainTables],
                   known: DomainTables) -> None:
     named: set[str] = set()

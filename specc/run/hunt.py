@@ -49,15 +49,16 @@ from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
 from specc.run.pictures import draw_hunt
-from specc.run.recording import PoseRecorder, world_fields
+from specc.run.recording import PoseRecorder, true_path, world_fields
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
 from specc.runtime.sim import HILARE, Simulation, World, WorldError, load_world
+from specc.runtime.sim.render import Certainty
 from specc.runtime.sim.simulation import OBJECT_CLEARANCE
 
-__all__ = ["CertaintyMap", "DetectionReport", "HuntObject", "HuntProgress", "HuntResult", "Interruption",
-           "MissedDetection", "Overlap", "PlannedPath", "arm_motion_overlaps", "detection_interruptions", "draw_hunt",
-           "load_package", "place_objects", "run_hunt"]
+__all__ = ["DetectionReport", "HuntObject", "HuntProgress", "HuntResult", "Interruption", "MissedDetection", "Overlap",
+           "PlannedPath", "Span", "arm_motion_overlaps", "detection_interruptions", "draw_hunt", "load_package",
+           "motion_stretches", "place_objects", "run_hunt"]
 
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"  # where `specc compile examples/hilare -o generated` writes the package
@@ -120,19 +121,6 @@ class PlannedPath:
 
 
 @dataclass(frozen=True)
-class CertaintyMap:
-    """VISUAL's model at the end: certainty c in [0, 1] per cell (§5.2.4), row-major from (0, 0)."""
-
-    cell: float  # m
-    nx: int
-    ny: int
-    values: tuple[float, ...]
-
-    def grid(self) -> np.ndarray:
-        return np.asarray(self.values, dtype=float).reshape(self.ny, self.nx)
-
-
-@dataclass(frozen=True)
 class HuntResult:
     seed: int
     objects_wanted: int
@@ -147,7 +135,7 @@ class HuntResult:
     path: tuple[tuple[float, float, float, float], ...]  # t, true x, y, theta every 0.1 s
     planned: tuple[PlannedPath, ...]
     goal: tuple[float, float] | None  # the last observation position EXPLOR chose (Fig 5.11)
-    certainty: CertaintyMap | None
+    certainty: Certainty | None  # VISUAL's model at the end
     replies: Mapping[str, int]  # "SERVICE RESULT" -> how many
     events: tuple[dict[str, Any], ...]  # the event log
 
@@ -255,7 +243,7 @@ def run_hunt(seed: int, objects_wanted: int = MAX_OBJECTS_WANTED, horizon: float
     return HuntResult(
         seed=seed, objects_wanted=objects_wanted, objects_taken=taken, outcome=outcome, why=why,
         simulated_time=kernel.now, wall_time=time.perf_counter() - started, distance=sim.rover.distance,
-        world=world, objects=recorder.objects(), path=_path(sim), planned=tuple(recorder.planned),
+        world=world, objects=recorder.objects(), path=true_path(sim), planned=tuple(recorder.planned),
         goal=sim.trace.goal, certainty=_certainty(sim),
         replies=dict(sorted(recorder.replies.items())), events=tuple(log.events))
 
@@ -345,8 +333,6 @@ class _Recorder:
         self._arm_service: str | None = None
         self._blocked = False
         self._incidents = 0
-        self._samples = 0
-        self._origin = self.kernel.now
         self._next_progress = self.kernel.now + PROGRESS_PERIOD
         self._database: Any = None
         self._facts: dict[str, list[Any]] = {}
@@ -455,15 +441,10 @@ class _Recorder:
 
     # ------------------------------------------------------------ the simulator
     def start(self) -> None:
-        self._schedule()
-
-    def _schedule(self) -> None:
-        # On the physics grid, as the simulator's own ticks, so no rounding drift reorders them.
-        when = round(self._origin + (self._samples + 1) * self.sim.physics_period, 9)
-        self.kernel.call_at(when, self._sample, SAMPLE_PRIORITY)
+        # On the physics grid, as the simulator's own ticks, after them (SAMPLE_PRIORITY).
+        self.kernel.call_every(self.sim.physics_period, self._sample, SAMPLE_PRIORITY)
 
     def _sample(self) -> None:
-        self._samples += 1
         now = self.kernel.now
         x, y, theta = pose = self.sim.pose
         dt = self.sim.physics_period
@@ -488,7 +469,6 @@ class _Recorder:
         if now >= self._next_progress:
             self._next_progress += PROGRESS_PERIOD
             self._report(now)
-        self._schedule()
 
     def _arm_activity(self) -> str | None:
         """The arm service the executive is running (its module moves the arm)."""
@@ -557,16 +537,11 @@ def _why_failed(trace: Iterable[Any], events: Sequence[Mapping[str, Any]]) -> st
     return f"the goal failed ({failures[-1]})" if failures else "the goal failed"
 
 
-def _path(sim: Simulation) -> tuple[tuple[float, float, float, float], ...]:
-    return tuple((round(t, 3), round(x, 3), round(y, 3), round(theta, 4))
-                 for t, (x, y, theta) in zip(sim.trace.times, sim.trace.poses, strict=True))
-
-
-def _certainty(sim: Simulation) -> CertaintyMap | None:
+def _certainty(sim: Simulation) -> Certainty | None:
     if sim.trace.certainty is None:
         return None
     cell, nx, ny, values = sim.trace.certainty
-    return CertaintyMap(cell, nx, ny, tuple(float(v) for v in values))
+    return Certainty(cell, nx, ny, tuple(float(v) for v in values))
 
 
 # ---------------------------------------------------------------- the §5.5 properties, from the log
@@ -692,11 +667,20 @@ def arm_motion_overlaps(events: Iterable[Mapping[str, Any]], services: Sequence[
     return overlaps
 
 
+class Span(NamedTuple):
+    """A stretch of motion: the arm's service ("" for the robot), from start to end."""
+
+    label: str
+    start: float
+    end: float
+
+
 def motion_stretches(events: Iterable[Mapping[str, Any]], kind: str,
-               services: Sequence[str] | None = None) -> list[tuple[str, float, float]]:
-    """(service, start, end) of each stretch of `kind` events from moving to still; a stretch
-    still open at the end of the log ends with its last event."""
-    stretches: list[tuple[str, float, float]] = []
+                     services: Sequence[str] | None = None) -> list[Span]:
+    """Each stretch of `kind` events (`robot-motion`, `arm-motion`) from moving to still, for
+    `services` only when given; a stretch still open at the end of the log ends with its last
+    event."""
+    stretches: list[Span] = []
     opened: tuple[str, float] | None = None
     last = 0.0
     for event in events:
@@ -707,10 +691,10 @@ def motion_stretches(events: Iterable[Mapping[str, Any]], kind: str,
         if event["moving"] and opened is None:
             opened = (service, event["t"])
         elif not event["moving"] and opened is not None:
-            stretches.append((opened[0], opened[1], event["t"]))
+            stretches.append(Span(opened[0], opened[1], event["t"]))
             opened = None
     if opened is not None:
-        stretches.append((opened[0], opened[1], last))
+        stretches.append(Span(opened[0], opened[1], last))
     if services is None:
         return stretches
-    return [s for s in stretches if s[0] in services]
+    return [s for s in stretches if s.label in services]

@@ -150,7 +150,7 @@ def measure(run: RoverRun) -> Measures:
     return Measures(
         configuration=run.configuration, mission=run.mission, world=run.world, seed=run.seed,
         photos=counts["photo"], communications=counts["communication"], home=counts["return"],
-        kappa=int(bool(result.failure)), replannings=replannings(run), activity_time=activity_time(run),
+        kappa=int(bool(result.failure)), replannings=run.result.replannings, activity_time=activity_time(run),
         distance=run.distance, mission_time=run.simulated_time, planner_failures=result.planner_failures,
         believed=GoalCount(len(result.met) + len(result.missed), len(result.met)))
 
@@ -166,16 +166,6 @@ def achieved(run: RoverRun, goal: MissionGoal) -> bool:
         home = goal.point or (0.0, 0.0)
         return math.hypot(x - home[0], y - home[1]) <= HOME_TOLERANCE
     raise ValueError(f"no judgement for goals of kind '{goal.kind}'")
-
-
-# The line of Fig 3.1 / Fig 3.2 at which FTplan sends a round of planning requests.
-REQUEST_LINES = {"successive": 9, "concurrent": 5}
-
-
-def replannings(run: RoverRun) -> int:
-    """Planning rounds after the first (FTplan's trace, line by line of its figure)."""
-    line = REQUEST_LINES[run.policy]
-    return max(0, sum(1 for number, _ in run.result.trace if number == line) - 1)
 
 
 def activity_time(run: RoverRun) -> float:

@@ -15,7 +15,6 @@ import functools
 import hashlib
 import importlib
 import json
-import keyword
 import os
 import sys
 from collections.abc import Mapping, Sequence
@@ -51,10 +50,10 @@ def ensure_compiled(specs: Path, output: Path) -> Compiled:
     if loaded.errors or loaded.program is None:
         shown = "\n".join(render(d, loaded.sources) for d in loaded.errors[:20])
         raise RunError(f"the specs of '{specs}' do not compile ({len(loaded.errors)} error(s)):\n{shown}")
-    fallback = specs.resolve().name if specs.is_dir() else specs.stem
-    robot = package.robot_name(loaded.program, fallback)
-    if not robot.isidentifier() or keyword.iskeyword(robot):
-        raise RunError(f"'{robot}' is not a valid Python package name: rename the system block")
+    try:
+        robot = package.package_name(loaded.program, specs)
+    except ValueError as exc:
+        raise RunError(str(exc)) from None
     try:
         result = generate_all(loaded.program, robot)
     except KheopsError as exc:

@@ -22,9 +22,9 @@ from typing import TYPE_CHECKING, Any
 from specc.run import RunError
 from specc.runtime.sim.render import (
     PATH_COLOUR,
-    PLANNED_COLOUR,
     Scene,
     draw_certainty,
+    draw_last_planned,
     draw_objects,
     draw_scene,
     draw_world,
@@ -92,9 +92,7 @@ def draw_state(ax: Any, scene: Scene) -> None:
         gx, gy = (math.floor(scene.goal[0] / cell) * cell, math.floor(scene.goal[1] / cell) * cell)
         ax.add_patch(Rectangle((gx, gy), cell, cell, fill=False, ec="#dc2626", lw=2.0, zorder=6,
                                label="best observation cell"))
-    if scene.planned and len(scene.planned[-1]) > 1:
-        xs, ys = zip(*scene.planned[-1], strict=True)
-        ax.plot(xs, ys, color=PLANNED_COLOUR, lw=1.4, ls="--", label="last planned trajectory", zorder=5)
+    draw_last_planned(ax, scene, zorder=5)
     if len(scene.path):
         _, x, y, theta = (float(v) for v in scene.path[-1])
         radius = scene.robot.radius

@@ -15,6 +15,12 @@ POSE_DIGITS = 3  # mm, and mrad for theta
 Emit = Callable[..., Any]  # EventLog.emit's signature: (time, kind, **fields)
 
 
+def true_path(sim: Simulation) -> tuple[tuple[float, float, float, float], ...]:
+    """The simulator's trace of the true pose: t, x, y, theta rows (mm, ms and 0.1 mrad)."""
+    return tuple((round(t, 3), round(x, 3), round(y, 3), round(theta, 4))
+                 for t, (x, y, theta) in zip(sim.trace.times, sim.trace.poses, strict=True))
+
+
 def world_fields(world: World) -> dict[str, Any]:
     """The `mission-start` fields that name the world and carry it whole."""
     return {"world": world.name, "world_data": world_data(world)}
@@ -28,17 +34,13 @@ class PoseRecorder:
         self.emit = emit
         self.sim = sim
         self.period = period
-        self._origin = sim.kernel.now
-        self._samples = 0
 
     def start(self) -> PoseRecorder:
         self._record()
+        self.sim.kernel.call_every(self.period, self._record, POSE_PRIORITY)
         return self
 
     def _record(self) -> None:
         x, y, theta = self.sim.pose
         self.emit(self.sim.kernel.now, "pose", x=round(x, POSE_DIGITS), y=round(y, POSE_DIGITS),
                   theta=round(theta, POSE_DIGITS))
-        self._samples += 1
-        # On the grid origin + k * period, so that no rounding drift accumulates over a mission.
-        self.sim.kernel.call_at(round(self._origin + self._samples * self.period, 9), self._record, POSE_PRIORITY)

@@ -43,7 +43,7 @@ import numpy as np
 
 from specc.run import RunError, pictures
 from specc.run.hunt import HuntObject, detection_interruptions, motion_stretches
-from specc.run.rover import TASK_KINDS
+from specc.run.rover import TASK_KINDS, task_text
 from specc.runtime.planner.plan import Value, format_value
 from specc.runtime.sim import ROBOTS, Target, Window, World, WorldError, parse_world
 from specc.runtime.sim.render import (
@@ -209,33 +209,30 @@ class ActionBar:
         return TASK_KINDS.get(self.task, self.task)
 
     def text(self) -> str:
-        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+        return task_text(self.task, self.args)
 
 
 def action_bars(events: Events) -> list[ActionBar]:
     """Every action of the log, in the order started. An action's start and its end share its
     plan number and id (ids restart with each plan)."""
     started: dict[tuple[int, str], Mapping[str, Any]] = {}
-    bars: dict[tuple[int, str], ActionBar] = {}
+    over: dict[tuple[int, str], Mapping[str, Any]] = {}
     for event in events:
-        if event.get("kind") != "action":
-            continue
-        key = (int(event["plan"]), str(event["id"]))
-        if event["status"] == "started":
-            started[key] = event
-            continue
-        begun = started.get(key, event)
-        latest = begun.get("latest_end")
-        bars[key] = ActionBar(key[0], key[1], str(event["task"]), tuple(event.get("args", ())), float(begun["t"]),
-                              float(event["t"]), str(event["status"]), float(latest) if latest is not None else None,
-                              str(event.get("why", "")))
+        if event.get("kind") == "action":
+            key = (int(event["plan"]), str(event["id"]))
+            (started if event["status"] == "started" else over)[key] = event
     end = last_time(events)
-    for key, event in started.items():
-        if key not in bars:
-            latest = event.get("latest_end")
-            bars[key] = ActionBar(key[0], key[1], str(event["task"]), tuple(event.get("args", ())), float(event["t"]),
-                                  end, "running", float(latest) if latest is not None else None)
-    return sorted(bars.values(), key=lambda b: (b.start, b.plan, b.id))
+    bars = []
+    for key in started.keys() | over.keys():
+        last = over.get(key)
+        begun = started.get(key, last)
+        assert begun is not None
+        latest = begun.get("latest_end")
+        said = last or begun
+        bars.append(ActionBar(key[0], key[1], str(said["task"]), tuple(said.get("args", ())), float(begun["t"]),
+                              float(last["t"]) if last else end, str(last["status"]) if last else "running",
+                              float(latest) if latest is not None else None, str(last.get("why", "")) if last else ""))
+    return sorted(bars, key=lambda b: (b.start, b.plan, b.id))
 
 
 class FtplanMark(NamedTuple):
@@ -363,18 +360,6 @@ def service_bars(events: Events) -> list[ServiceBar]:
         bars.append(ServiceBar(service, ident, at, started.get(ident), ended.get(ident, end),
                                result, reply_outcome(result) if closed else "running"))
     return bars
-
-
-class Span(NamedTuple):
-    label: str  # the arm's service; "" for the robot
-    start: float
-    end: float
-
-
-def motion_spans(events: Events, kind: str) -> list[Span]:
-    """When the robot (`robot-motion`) or the arm (`arm-motion`) moved; a motion still under way
-    when the log ends lasts to its last event."""
-    return [Span(*stretch) for stretch in motion_stretches(events, kind)]
 
 
 def hunt_model(events: Events) -> tuple[Certainty | None, tuple[float, float] | None]:
@@ -510,7 +495,7 @@ def draw_hunt_timeline(events: Events, path: str | Path) -> Path:
     bars = service_bars(events)
     services = list(dict.fromkeys(bar.service for bar in bars))
     motions, objects, alarms = "robot motion", "objects", "alarms"
-    arm = motion_spans(events, "arm-motion")
+    arm = motion_stretches(events, "arm-motion")
     rows = [*services, motions, *(["arm motion"] if arm else []), objects, alarms]
     row = {name: k for k, name in enumerate(rows)}
     end = max(last_time(events), SHORTEST_AXIS)
@@ -532,7 +517,7 @@ def draw_hunt_timeline(events: Events, path: str | Path) -> Path:
             for b in mine:
                 if b.started is None and b.outcome != "ok":
                     ax.plot(b.ended, row[service], marker="x", ms=5, color=SERVICE_COLOURS[b.outcome], zorder=4)
-        robot = motion_spans(events, "robot-motion")
+        robot = motion_stretches(events, "robot-motion")
         ax.broken_barh([(s.start, s.end - s.start) for s in robot], (row[motions] - 0.3, 0.6), color=MOTION_COLOUR)
         arm_services = dict.fromkeys(s.label for s in arm)
         colours = {label: ARM_COLOURS[k % len(ARM_COLOURS)] for k, label in enumerate(arm_services)}

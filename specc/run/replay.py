@@ -14,8 +14,8 @@ from typing import Any
 
 from specc.run import RunError
 from specc.run.events import read_events
+from specc.run.session import LOG
 
-LOG = "events.jsonl"
 QUIET_KINDS = ("pose",)  # sampled at 2 Hz: shown only when asked for by name
 
 

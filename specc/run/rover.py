@@ -54,7 +54,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -65,7 +65,7 @@ import numpy as np
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
-from specc.run.recording import PoseRecorder, world_fields
+from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
 from specc.runtime import functional as rt
 from specc.runtime.ftplan import (
     FtPlan,
@@ -188,7 +188,12 @@ class ExecutedAction:
     why: str = ""
 
     def text(self) -> str:
-        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+        return task_text(self.task, self.args)
+
+
+def task_text(task: str, args: Sequence[Value]) -> str:
+    """An action as a plan writes it, TASK(arg, ...) (as `Action.text`)."""
+    return f"{task}({', '.join(format_value(a) for a in args)})"
 
 
 @dataclass(frozen=True)
@@ -245,9 +250,6 @@ class RoverProgress(NamedTuple):
     goals_met: int  # so far, in FTplan's ledger
     goals: int
     what: str  # "started MOVE(0, 0, 4, 0)"
-
-
-Emit = Callable[..., Any]  # EventLog.emit's signature: (time, kind, **fields)
 
 
 # ---------------------------------------------------------------- the generated package
@@ -742,8 +744,7 @@ class _Journal:
         self.catch_up(time_)
         self.log.emit(time_, kind, **fields)
         if kind == "action" and self.progress is not None:
-            args = ", ".join(format_value(a) for a in fields.get("args", ()))
-            self.report_progress(time_, f"{fields.get('status')} {fields.get('task')}({args})")
+            self.report_progress(time_, f"{fields.get('status')} {task_text(fields['task'], fields['args'])}")
 
     def catch_up(self, until: float = math.inf) -> None:
         """Forward FTplan's events up to `until`: FTplan notes a plan's execution at the end of
@@ -778,9 +779,9 @@ class PreparedMission:
     tasks: RoverTasks
 
 
-def prepare_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
-                    generated: Path = GENERATED, example: Path = EXAMPLE) -> PreparedMission:
-    """Check the names and build what `run_rover_mission` runs (see there); RunError when a name
+def check_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
+                  generated: Path = GENERATED, example: Path = EXAMPLE) -> CheckedMission:
+    """Check the names and read what the mission needs, nothing built yet; RunError when a name
     is unknown or the package is not compiled."""
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise RunError(f"seed {seed!r}: give a whole number >= 0")
@@ -793,8 +794,22 @@ def prepare_mission(configuration: str, mission: str, world: str | Path | World,
     tasks = RoverTasks.of(setup.config, setup.problem, mission, ground)
     # The antenna's windows, and those the picture's time strip shows.
     ground = dataclasses.replace(ground, windows=mission_windows(setup.problem, seed))
-    return PreparedMission(configuration, mission, seed, setup, ground, build_rover(package.modules, ground, seed),
-                           tasks)
+    return CheckedMission(setup, ground, tasks, package.modules)
+
+
+class CheckedMission(NamedTuple):
+    setup: MissionSetup
+    world: World  # with the windows nature drew
+    tasks: RoverTasks
+    modules: ModuleType  # the generated atrv.modules
+
+
+def prepare_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
+                    generated: Path = GENERATED, example: Path = EXAMPLE) -> PreparedMission:
+    """`check_mission`, then the modules on the simulated rover: what `run_rover_mission` runs."""
+    checked = check_mission(configuration, mission, world, seed, generated=generated, example=example)
+    return PreparedMission(configuration, mission, seed, checked.setup, checked.world,
+                           build_rover(checked.modules, checked.world, seed), checked.tasks)
 
 
 def run_rover_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
@@ -842,11 +857,10 @@ def run_rover_mission(configuration: str, mission: str, world: str | Path | Worl
              goals=len(result.met) + len(result.missed), plannings=result.plannings,
              planner_failures=result.planner_failures, distance=round(sim.rover.distance, 3))
     journal.report_progress(rover.kernel.now, f"mission {outcome}")
-    path = tuple((round(t, 3), round(x, 3), round(y, 3), round(theta, 4))
-                 for t, (x, y, theta) in zip(sim.trace.times, sim.trace.poses, strict=True))
     return RoverRun(
         configuration=configuration, mission=mission, world=prepared.world.name, seed=seed, timing=timing,
         policy=setup.config.policy, result=result, goals=goals, windows=windows, photos=tuple(executor.photos),
         communications=tuple(executor.communications), actions=tuple(executor.actions),
-        planned=tuple(executor.planned), path=path, distance=sim.rover.distance, simulated_time=rover.kernel.now,
-        wall_time=time.perf_counter() - started, events=tuple(log.events), simulation=sim)
+        planned=tuple(executor.planned), path=true_path(sim), distance=sim.rover.distance,
+        simulated_time=rover.kernel.now, wall_time=time.perf_counter() - started, events=tuple(log.events),
+        simulation=sim)

@@ -77,7 +77,6 @@ class RunOutcome:
     report: dict[str, Any]
     summary: str
     pictures: list[Path] = field(default_factory=list)
-    compiled: bool = False  # the package was stale and has been rewritten
 
     @property
     def succeeded(self) -> bool:
@@ -86,29 +85,30 @@ class RunOutcome:
 
 def folder_name(robot: str, mission: str, world: str, configuration: str | None, seed: int) -> str:
     """runs/<robot>-<mission>-<world>[-<configuration>]-s<seed>, readable and safe as a path."""
-    parts = [robot, mission, Path(world).stem if world.endswith(".toml") else world]
-    if configuration:
-        parts.append(configuration)
+    parts = [robot, mission, world, *([configuration] if configuration else [])]
     return re.sub(r"[^A-Za-z0-9_.-]+", "-", "-".join(parts)) + f"-s{seed}"
+
+
+def compile_robot(specs: Path, generated: Path, note: Callable[[str], None] | None = None) -> str:
+    """The robot `specs` (a robot's spec folder) compiles to, into `generated`, compiled only when
+    the package there is stale (`note` hears when it was)."""
+    from specc.run.package import ensure_compiled
+
+    if not specs.is_dir():
+        raise RunError(f"'{specs}' is not a robot's spec folder: give the folder holding its specs, codels "
+                       "and worlds, e.g. examples/atrv")
+    compiled = ensure_compiled(specs, generated)
+    if compiled.rewritten and note is not None:
+        note(f"compiled {specs} into {compiled.folder} (it was stale)")
+    return compiled.robot
 
 
 def run_in_folder(request: RunRequest, progress: Progress | None = None,
                   compiled_note: Callable[[str], None] | None = None) -> RunOutcome:
     """Compile `request.specs` if stale, run its mission and write the run folder. Bad input is a
     RunError before anything runs; a run that breaks half-way still leaves its log and a report
-    saying so, then raises RunError."""
-    from specc.run.package import ensure_compiled
-
-    specs = request.specs
-    if not specs.is_dir():
-        raise RunError(f"'{specs}' is not a robot's spec folder: give the folder holding its specs, codels "
-                       "and worlds, e.g. examples/atrv")
-    compiled = ensure_compiled(specs, request.generated)
-    if compiled.rewritten and compiled_note is not None:
-        compiled_note(f"compiled {specs} into {compiled.folder} (it was stale)")
-    outcome = run_compiled(compiled.robot, request, progress)
-    outcome.compiled = compiled.rewritten
-    return outcome
+    saying so, then raises RunCrashed."""
+    return run_compiled(compile_robot(request.specs, request.generated, compiled_note), request, progress)
 
 
 def runnable_robot(robot: str) -> str:
@@ -207,7 +207,7 @@ class _Plan:
 
 def _plan_rover(request: RunRequest) -> _Plan:
     from specc.run.measures import measure
-    from specc.run.rover import TIMINGS, prepare_mission, run_rover_mission
+    from specc.run.rover import TIMINGS, check_mission, run_rover_mission
 
     if request.mission is None or request.world is None:
         raise RunError("the rover needs --mission (M1, M2, M3, M4) and --world (W1, W2, W3, W4 or a world file)")
@@ -220,8 +220,8 @@ def _plan_rover(request: RunRequest) -> _Plan:
     configuration = request.configuration or DEFAULT_CONFIGURATION
     example = request.specs.resolve()
     # Every name checked before the run folder is made: a typo leaves nothing behind.
-    prepared = prepare_mission(configuration, request.mission, request.world, request.seed,
-                               generated=request.generated, example=example)
+    checked = check_mission(configuration, request.mission, request.world, request.seed,
+                            generated=request.generated, example=example)
 
     def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
         def tell(step: Any) -> None:
@@ -245,7 +245,7 @@ def _plan_rover(request: RunRequest) -> _Plan:
         return report, measures.summary() + ("" if measures.success else f"\n  why: {why}") + \
             f"\n  {rover_run.simulated_time:.0f} s of mission in {rover_run.wall_time:.1f} s of wall time"
 
-    return _Plan((request.mission, prepared.world.name, configuration), run)
+    return _Plan((request.mission, checked.world.name, configuration), run)
 
 
 def _plan_hunt(request: RunRequest) -> _Plan:

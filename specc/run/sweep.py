@@ -22,7 +22,7 @@ from typing import Any
 
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
-from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned, runnable_robot
+from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
 
 MISSIONS = ("M1", "M2", "M3", "M4")
 WORLDS = ("W1", "W2", "W3", "W4")
@@ -91,7 +91,6 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = MISSIONS, w
           step: Step | None = None) -> SweepResult:
     """Run `robot` (compiled into base.generated) on every combination, each run as `base` says
     otherwise (its folder under base.runs). Names are checked before the first run."""
-    runnable_robot(robot)
     if not seeds:
         raise RunError("no seed to run: give at least one")
     if robot == "atrv":

@@ -70,6 +70,22 @@ class Kernel:
     def call_later(self, delay: float, action: Callable[[], Any], priority: int = 0) -> Timer:
         return self.call_at(self.now + max(delay, 0.0), action, priority)
 
+    def call_every(self, period: float, action: Callable[[], Any], priority: int = 0) -> None:
+        """Call `action` at now + k * period (k = 1, 2, ...) for as long as the kernel runs. The
+        instants are computed from the origin, rounded to the nanosecond as the exec tasks' ticks
+        are, so no rounding drift accumulates or reorders grids of the same period; the next call
+        is scheduled after `action` has run, as a task rescheduling itself would."""
+        origin = self.now
+        calls = 0
+
+        def tick() -> None:
+            nonlocal calls
+            calls += 1
+            action()
+            self.call_at(round(origin + (calls + 1) * period, 9), tick, priority)
+
+        self.call_at(round(origin + period, 9), tick, priority)
+
     def step(self) -> bool:
         """Run the next event; False when nothing is scheduled."""
         while self._queue:

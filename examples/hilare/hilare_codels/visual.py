@@ -202,11 +202,11 @@ def nearestObject(sdi, request):
     sdi.image.seen[: len(kept)], sdi.image.nbSeen = kept, len(kept)
     hardware = sdi.hardware
     if hardware is not None:  # the simulator's object where VISUAL believes this one is, if any
-        left = [n for n in range(len(hardware.objects)) if n not in hardware.trace.taken]
-        distance = {n: math.hypot(hardware.objects[n][0] - sdi.nearest.x, hardware.objects[n][1] - sdi.nearest.y)
-                    for n in left}
-        if left and min(distance.values()) < SAME_OBJECT:
-            hardware.trace.taken.add(min(left, key=distance.__getitem__))
+        distance = {n: math.hypot(obj[0] - sdi.nearest.x, obj[1] - sdi.nearest.y)
+                    for n, obj in enumerate(hardware.objects) if n not in hardware.trace.taken}
+        nearest = min(distance, key=distance.__getitem__, default=None)
+        if nearest is not None and distance[nearest] < SAME_OBJECT:
+            hardware.trace.taken.add(nearest)
     request.object = sdi.nearest
     return "end"
 

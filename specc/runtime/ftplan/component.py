@@ -43,11 +43,11 @@ from specc.runtime.ftplan.analyzer import Violation, analyse
 from specc.runtime.ftplan.config import FtPlanConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
 from specc.runtime.ftplan.planners import Answer, Watchdog
-from specc.runtime.ftplan.state import SystemState
+from specc.runtime.ftplan.state import SystemState, fact_list
 from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Plan, format_value
-from specc.runtime.planner.replan import Fact, replanning_problem
+from specc.runtime.planner.replan import replanning_problem
 
 MISSION_FAILED_IN_TIME = "mission failure: no valid plan found in time"  # Fig 3.1 line 24, Fig 3.2 line 24
 MISSION_FAILED = "mission failure: no valid plan found"  # Fig 3.2 line 20
@@ -113,14 +113,15 @@ class MissionResult:
     failure: str  # the mission exception's message, "" when none was raised
     now: float  # mission time at the end
     plannings: int  # planning requests sent
+    rounds: int  # planning rounds: a request (Fig 3.1 line 9), or one to every planner at once (Fig 3.2 line 5)
     planner_failures: int  # watchdog expiries, crashes, plan-less answers, invalid plans
     events: list[Event]
     trace: list[tuple[int, str]]  # (line of Fig 3.1 / 3.2, what happened)
 
     @property
     def replannings(self) -> int:
-        """Requests after the first."""
-        return max(0, self.plannings - 1)
+        """Planning rounds after the first (seed 004 §4.1.4's R; model switches count too)."""
+        return max(0, self.rounds - 1)
 
     @property
     def success(self) -> bool:
@@ -166,6 +167,7 @@ class FtPlan:
         self.events: list[Event] = []
         self.trace: list[tuple[int, str]] = []
         self.plannings = 0
+        self.rounds = 0
         self.planner_failures = 0
 
     # ------------------------------------------------------------ entry point
@@ -190,7 +192,8 @@ class FtPlan:
         return MissionResult(
             met=[by_line[line] for line in sorted(self.state.met)],
             missed={by_line[line]: why for line, why in sorted(self.state.missed.items())},
-            failure=failure, now=self.now, plannings=self.plannings, planner_failures=self.planner_failures,
+            failure=failure, now=self.now, plannings=self.plannings, rounds=self.rounds,
+            planner_failures=self.planner_failures,
             events=self.events, trace=self.trace)
 
     # ------------------------------------------------------------ Fig 3.1
@@ -213,6 +216,7 @@ class FtPlan:
                 self.step(7, f"candidates <- {', '.join(candidates) or '{}'}")
                 self.step(8, f"arm the watchdog ({self.config.watchdog:g} s)")
                 self.request(k)
+                self.rounds += 1
                 self.step(9, f"request a plan from {k}")
                 self.step(10, "wait for the plan or the watchdog")
                 arrivals = self.arrivals([k])
@@ -261,6 +265,7 @@ class FtPlan:
             first = self.plannings == 0
             for k in candidates:
                 self.request(k, self.planning_problem(k, first))
+            self.rounds += 1
             self.step(5, f"request a plan from {', '.join(candidates)}")
             started = self.now
             arrivals = self.arrivals(candidates)
@@ -366,12 +371,10 @@ class FtPlan:
             return own
         view = self.views.get(k)
         if view is None:
-            return replanning_problem(own, self.state.facts_list(), [g.line for g in self.state.open_goals()],
+            return replanning_problem(own, fact_list(self.state.facts), [g.line for g in self.state.open_goals()],
                                       self.now, self.state.dates)
-        facts = [Fact(attribute, args, value) for (attribute, args), value in sorted(
-            view.read(self.state.facts).items(), key=repr)]
-        return replanning_problem(own, facts, self.open_planner_goals(k, view), self.now,
-                                  self.planner_ledgers[k].dates)
+        return replanning_problem(own, fact_list(view.read(self.state.facts)), self.open_planner_goals(k, view),
+                                  self.now, self.planner_ledgers[k].dates)
 
     def open_planner_goals(self, k: str, view: View) -> list[int]:
         """The lines of k's goals standing for a goal FTplan still has open; a goal no

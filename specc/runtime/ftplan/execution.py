@@ -83,6 +83,8 @@ class Precedences:
         if not all(p in ended_at for p, _ in self.after[action.id]):
             return None
         return max(now, action.dispatch, *(ended_at[p] + d for p, d in self.after[action.id]))
+
+
 OVERRUN_TOLERANCE = 1e-6  # seconds
 
 

@@ -34,7 +34,6 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
     ("M1"), with the problems and domains of the generated `planner` package `planning`."""
     if configuration not in configurations:
         raise UnknownName(f"no robot configuration '{configuration}' (known: {', '.join(configurations)})")
-    whole = next(iter(configurations.values()))
     base = configurations[configuration]
     try:
         config = base.for_mission(mission)
@@ -45,7 +44,7 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
     domains: dict[str, pm.PlanningDomain] = {}
     wanted = [(p.planner, p.problem) for p in statement.problems]
     if not statement.state_problem:
-        raise UnknownName(f"mission '{mission}' of ftplan '{whole.name}' names no problem in FTplan's own "
+        raise UnknownName(f"mission '{mission}' of ftplan '{base.name}' names no problem in FTplan's own "
                           "vocabulary (a planner without a view)")
     for name in dict.fromkeys([statement.state_problem] + [problem for _, problem in wanted]):
         module = planning.PROBLEMS.get(name)

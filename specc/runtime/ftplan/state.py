@@ -170,8 +170,10 @@ class SystemState:
     def open_goals(self) -> list[Goal]:
         return [g for g in self.goals if g.line not in self.met and g.line not in self.missed]
 
-    def facts_list(self) -> list[Fact]:
-        return [Fact(attribute, args, value) for (attribute, args), value in sorted(self.facts.items(), key=repr)]
+
+def fact_list(facts: Mapping[FactKey, Value]) -> list[Fact]:
+    """Facts as a replanning problem takes them, in a fixed order."""
+    return [Fact(attribute, args, value) for (attribute, args), value in sorted(facts.items(), key=repr)]
 
 
 def constant(e: pm.Expr) -> Value | None:

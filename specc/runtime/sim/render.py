@@ -256,9 +256,7 @@ def draw_background(ax: Any, scene: Scene) -> None:
             xs, ys = zip(*planned, strict=True)
             ax.plot(xs, ys, color="#9ca3af", lw=0.8, ls="--", alpha=0.6,
                     label="planned trajectories" if k == 0 else None, zorder=3)
-    if scene.planned and len(scene.planned[-1]) > 1:
-        xs, ys = zip(*scene.planned[-1], strict=True)
-        ax.plot(xs, ys, color=PLANNED_COLOUR, lw=1.4, ls="--", label="last planned trajectory", zorder=4)
+    draw_last_planned(ax, scene, zorder=4)
     draw_objects(ax, scene.objects, scene.object_states)
     for number, index in enumerate(scene.taken_order, 1):
         ax.annotate(str(number), scene.objects[index], textcoords="offset points", xytext=(5, 5), fontsize=8,
@@ -325,6 +323,13 @@ def draw_objects(ax: Any, objects: Sequence[tuple[float, float]], states: Sequen
             xs, ys = zip(*chosen, strict=True)
             ax.plot(xs, ys, marker="o", ls="", ms=7, mfc=colour if state != "undetected" else "none", mec=colour,
                     label=f"object {(labels or {}).get(state, state)}", zorder=7)
+
+
+def draw_last_planned(ax: Any, scene: Scene, zorder: float) -> None:
+    """The last trajectory planned, when there is one."""
+    if scene.planned and len(scene.planned[-1]) > 1:
+        xs, ys = zip(*scene.planned[-1], strict=True)
+        ax.plot(xs, ys, color=PLANNED_COLOUR, lw=1.4, ls="--", label="last planned trajectory", zorder=zorder)
 
 
 def draw_path(ax: Any, scene: Scene) -> None:

@@ -80,9 +80,8 @@ class Simulation:
         self.trace = Trace()
         self._trace_every = max(1, round(trace_period / physics_period))
         self._steps = 0
-        self._origin = self.kernel.now
         self._record()
-        self._schedule_tick()
+        self.kernel.call_every(physics_period, self._tick, PHYSICS_PRIORITY)
 
     # ------------------------------------------------------------ set-up
     def attach(self, registry: Any) -> Simulation:
@@ -122,13 +121,6 @@ class Simulation:
             self.trace.blocked_at = self.now
         if self._steps % self._trace_every == 0:
             self._record()
-        self._schedule_tick()
-
-    def _schedule_tick(self) -> None:
-        # On the grid origin + k * period, rounded to the nanosecond as the exec tasks' ticks are,
-        # so that no rounding drift reorders physics with the tasks of the same instant.
-        self.kernel.call_at(round(self._origin + (self._steps + 1) * self.physics_period, 9), self._tick,
-                            PHYSICS_PRIORITY)
 
     def _record(self) -> None:
         self.trace.times.append(self.kernel.now)

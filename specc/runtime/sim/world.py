@@ -245,7 +245,7 @@ def world_data(world: World) -> dict[str, Any]:
     """The world as `parse_world` reads it (TOML's tables as dicts), so a run's log can carry
     its world and be redrawn without the file: parse_world(world_data(w)) == w."""
     xmin, xmax, ymin, ymax = world.bounds
-    data: dict[str, Any] = {
+    return {
         "world": {"name": world.name, "description": world.description},
         "bounds": {"xmin": xmin, "xmax": xmax, "ymin": ymin, "ymax": ymax},
         "start": dict(zip(("x", "y", "theta"), world.start, strict=True)),
@@ -255,7 +255,6 @@ def world_data(world: World) -> dict[str, Any]:
         "targets": [{"name": t.name, "x": t.x, "y": t.y} for t in world.targets],
         "windows": [{"name": w.name, "start": w.start, "end": w.end} for w in world.windows],
     }
-    return data
 
 
 class _Where:
