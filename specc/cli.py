@@ -7,6 +7,7 @@ import os
 import sys
 import time
 from collections.abc import Callable
+from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Optional
 
@@ -409,6 +410,11 @@ def print_trace(trace: list[str], where: list[str], steps: int) -> None:
             out.print(f"    {line}", markup=False)
 
 
+class Controllability(StrEnum):
+    strong = "strong"
+    pseudo = "pseudo"
+
+
 @app.command()
 def plan(paths: PathsArg,
          problem: Annotated[str, typer.Option(help="The problem (mission) to plan: its name, or a prefix such "
@@ -426,7 +432,10 @@ def plan(paths: PathsArg,
          nodes: Annotated[int, typer.Option(min=1, help="Partial plans each search may expand (one for every "
                                                         "goal at once, then one per goal added).")] = 300,
          exact: Annotated[bool, typer.Option(help="Durations and schedule by CasADi (else the interval "
-                                                  "enclosures and the temporal network alone).")] = True) -> None:
+                                                  "enclosures and the temporal network alone).")] = True,
+         controllability: Annotated[Controllability, typer.Option(
+             help="strong: the plan holds whatever nature does; pseudo (IxTeT's): the problem's contingent "
+                  "instants one at a time, each anywhere in its bounds.")] = Controllability.strong) -> None:
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
     checked by the independent validator."""
     from specc.plan_report import print_result, solve
@@ -436,7 +445,8 @@ def plan(paths: PathsArg,
         raise typer.Exit(1)
     assert loaded.program is not None
     try:
-        outcome = solve(loaded.program, problem, domain, horizon, now, fact or [], goal, nodes, exact)
+        outcome = solve(loaded.program, problem, domain, horizon, now, fact or [], goal, nodes, exact,
+                        controllability.value)
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None
@@ -743,6 +753,105 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
         out.print(f"failed: {failure.name}: {failure.why}", markup=False)
     for path in written:
         out.print(f"wrote {path}", markup=False)
+
+
+@app.command(name="mutants")
+def mutants_command(
+        specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder (or files), e.g. "
+                                                                   "examples/atrv.", show_default=False)],
+        domain: Annotated[str, typer.Option(help="The planning domain to mutate.")] = "model1",
+        kinds: Annotated[Optional[list[str]], typer.Option(
+            "--class", help="Keep this mutation class: numeric, variable, value, operator, deletion (repeatable; "
+                            "default: all).")] = None,
+        sample: Annotated[Optional[int], typer.Option(min=1, help="List (and write) only N kept mutants, drawn "
+                                                                 "with --seed, stratified by class.")] = None,
+        seed: Annotated[int, typer.Option(help="Draws the --sample.")] = 0,
+        show: Annotated[Optional[str], typer.Option(help="Print this mutant's description, verdict and diff "
+                                                         "(e.g. model1-0042).")] = None,
+        output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write each kept (or sampled) "
+                                                       "mutant's spec file and diff into this folder.")] = None,
+        workers: Annotated[Optional[int], typer.Option(min=1, help="Processes checking mutants (default: one "
+                                                                   "per CPU, at most 8).")] = None,
+        quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
+    """Mutate a planning domain on its model (seed 004 §4.1.3), print each mutant back as spec text and
+    keep those that pass specc check: a table of counts per class, then the kept mutants.
+
+    Example: specc mutants examples/atrv --domain model1 --sample 28 --seed 1 -o mutants/
+    """
+    from rich.table import Table
+
+    from specc.mutation import (
+        ClassCounts,
+        MutationError,
+        default_workers,
+        enumerate_mutants,
+        keep_valid,
+        mutation_target,
+    )
+    from specc.mutation.mutants import verdict
+
+    if not specs.exists():
+        raise _run_error(ValueError(f"no such file or folder: '{specs}'"), 2)
+    started = time.perf_counter()
+    try:
+        target = mutation_target(specs, domain)
+        # --show finds a mutant by id whatever --class says: ids are given over every class.
+        wanted = enumerate_mutants(target, classes=None if show else kinds)
+    except MutationError as exc:
+        raise _run_error(exc, 2) from None
+    enumerated = time.perf_counter() - started
+    if show is not None:
+        chosen = next((x for x in wanted if x.id == show), None)
+        if chosen is None:
+            span = f"{wanted[0].id} .. {wanted[-1].id}" if wanted else "none"
+            raise _run_error(ValueError(f"no mutant '{show}' of {domain} (its mutants: {span})"), 2)
+        found = verdict(target, chosen.text) if chosen.text != target.original_text else (
+            "identical", "prints as the original")
+        out.print(f"{chosen.id} [{chosen.kind}] {chosen.description}", markup=False)
+        out.print("passes the checks and changes the planning domain" if found is None
+                  else f"rejected ({found[0]}): {found[1]}", markup=False)
+        sys.stdout.write(chosen.diff)
+        return
+    count = workers or default_workers()
+    with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} checked") as progress:
+        def step(done: int, total: int) -> None:
+            if progress is not None:
+                progress(done, total, f"checking {domain}'s mutants")
+
+        result = keep_valid(wanted, workers=count, progress=step)
+    table = Table(title=f"mutants of {domain} ({target.source.path})")
+    for k, column in enumerate(("class", "generated", "identical", "duplicate", "failed check", "equivalent",
+                                "kept")):
+        table.add_column(column, justify="left" if k == 0 else "right")
+
+    def cells(c: ClassCounts) -> list[str]:
+        return [str(n) for n in (c.generated, c.identical, c.duplicate, c.invalid, c.equivalent, c.kept)]
+
+    for kind, counts in result.counts().items():
+        table.add_row(kind, *cells(counts))
+    table.add_row("total", *cells(result.total()), style="bold")
+    # A file or pipe gets the whole table, not one squeezed into 80 columns.
+    (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(table)
+    out.print(f"enumerated in {enumerated:.1f} s, re-parsed and checked in {result.seconds:.1f} s "
+              f"({count} process(es))", markup=False)
+    listed = result.sample(sample, seed) if sample is not None else result.kept
+    if sample is not None:
+        out.print(f"sample of {len(listed)} kept mutant(s), seed {seed}, stratified by class:", markup=False)
+    for x in listed:
+        out.print(f"{x.id}  {x.kind:9} {x.description}", markup=False)
+    if output is not None:
+        try:
+            output.mkdir(parents=True, exist_ok=True)
+            suffix = Path(target.source.path).suffix or ".spec"
+            for x in listed:
+                (output / f"{x.id}{suffix}").write_text(x.text, encoding="utf-8")
+                (output / f"{x.id}.diff").write_text(x.diff, encoding="utf-8")
+            (output / "index.tsv").write_text("".join(f"{x.id}\t{x.kind}\t{x.description}\n" for x in listed),
+                                              encoding="utf-8")
+        except OSError as exc:
+            raise _run_error(ValueError(f"cannot write into '{output}': {exc.strerror}"), 1) from None
+        out.print(f"wrote {len(listed)} mutant(s) (spec file and diff each) and index.tsv to {output}",
+                  markup=False)
 
 
 def main() -> None:

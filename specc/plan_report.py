@@ -48,7 +48,8 @@ def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Probl
 
 
 def solve(program: m.Program, name: str, domain_name: str | None, horizon: float | None, now: float,
-          facts: list[str], goals: list[int] | None, nodes: int, exact: bool) -> Outcome:
+          facts: list[str], goals: list[int] | None, nodes: int, exact: bool,
+          controllability: str = "strong") -> Outcome:
     chosen = choose_problem(program, name, domain_name)
     model = domain_model(program, domain_block(program, chosen))
     problem = problem_model(program, chosen)
@@ -63,7 +64,8 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
             raise ValueError(f"no goal on line(s) {', '.join(map(str, unknown))} of {problem.source} "
                              f"(goal lines: {', '.join(map(str, sorted(lines)))})")
         problem = replanning_problem(problem, [Fact.parse(f) for f in facts], lines if goals is None else goals, now)
-    result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact).plan(problem, now=now)
+    result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability).plan(
+        problem, now=now)
     violations = []
     if result.plan is not None:
         violations = validate(model, problem, result.plan, dropped_lines={g.line for g in result.dropped})
@@ -86,8 +88,11 @@ def print_result(outcome: Outcome, out: Console) -> None:
         return
     assert result.plan is not None
     plan = result.plan
+    holds = ("whatever nature picks" if plan.controllability == "strong" else
+             "whatever durations nature picks, with its instants at " +
+             ", ".join(f"{name}={date:.2f}" for name, date in sorted(plan.assumed.items(), key=lambda kv: kv[1])))
     table = Table(title=f"plan ({len(plan.actions)} actions, {plan.controllability}ly controllable: the dates hold "
-                        "whatever durations nature picks)", title_justify="left", show_edge=False)
+                        f"{holds})", title_justify="left", show_edge=False)
     for column in ("start", "action", "duration", "ends by", "may start", ""):
         table.add_column(column, justify="right" if column in ("start", "ends by") else "left", no_wrap=True)
     for a in plan.ordered():

@@ -337,6 +337,18 @@ def test_plan_with_a_short_horizon_lists_the_dropped_goals_and_why() -> None:
     assert any("COMMUNICATION(W4)" in line and "impossible even alone" in line for line in dropped)
 
 
+@pytest.mark.parametrize(("controllability", "w2_dropped"), [("strong", True), ("pseudo", False)])
+def test_plan_asks_the_controllability_the_user_chooses(controllability: str, w2_dropped: bool) -> None:
+    result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M4_model1", "--no-exact",
+                   "--controllability", controllability)
+    assert result.returncode == 0, result.stderr
+    dropped = [line for line in result.stdout.splitlines() if "DROPPED" in line]
+    assert any("COMMUNICATION(W2)" in line for line in dropped) == w2_dropped
+    assert f"{controllability}ly controllable" in result.stdout
+    if controllability == "pseudo":
+        assert "t_svisi2=152.00" in result.stdout  # the opening it waits for
+
+
 def test_plan_replans_from_facts_given_on_the_command_line() -> None:
     result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M1_model1", "--no-exact", "--now", "170",
                    "--fact", "AT_ROBOT_X() = 4", "--fact", "AT_ROBOT_Y() = 0", "--fact", "PICTURE(OBJ1, 0, 0) = DONE",

@@ -16,6 +16,7 @@ import pytest
 from specc.runtime.ftplan import FtPlan, LocalPool, MissionResult, Outcome, ProcessPool, ScriptedExecutor
 from specc.runtime.ftplan.analyzer import analyse
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
+from specc.runtime.ftplan.planners import standard_planner
 from specc.runtime.ftplan.state import SystemState, consequences
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner import Planner
@@ -145,6 +146,20 @@ def test_robot2_plans_and_meets_the_mission_in_modele2_with_ftplans_state(missio
     # The goals are FTplan's own (Modele1's vocabulary), met by Modele2's reports through the view.
     assert any(goal.startswith("PICTURE(OBJ1") for goal in result.met)
     assert any(goal.startswith("AT_ROBOT_X() = 0") for goal in result.met)
+
+
+def test_robot1_plans_m4s_second_window_as_its_spec_asks_pseudo_controllability() -> None:
+    """`controllability: pseudo;` in ftplan.spec reaches p1's planner: M4's W2 (open 24 s at
+    worst) is planned, and the whole mission is met; Modele2's p2 keeps the default (strong)."""
+    config = on_mission("Robot1", "M4")
+    (p1,) = config.planners
+    assert p1.controllability == "pseudo"
+    assert [p.controllability for p in on_mission("Robot2", "M4").planners] == ["strong"]
+    problems = mission_problems("M4")
+    pool = LocalPool({"p1": standard_planner(p1, domains("M4"))})  # type: ignore[arg-type]
+    result = FtPlan(config, problems["p1"], pool, ScriptedExecutor(), problems=problems).run()  # type: ignore[arg-type]
+    assert result.success, result.missed
+    assert "COMMUNICATION(W2) = DONE (line 44, priority 3)" in result.met
 
 
 def run_in_processes(config: FtPlanConfig, mission: str) -> MissionResult:

@@ -281,3 +281,106 @@ def test_two_uses_of_a_unary_resource_never_overlap(tmp_path: Path) -> None:
     assert result.plan is not None
     first, second = sorted(result.plan.actions, key=lambda a: a.dispatch)
     assert second.dispatch >= first.dispatch + 5 - 1e-6
+
+
+# ---------------------------------------------------------------- controllability
+
+RADIO_SPEC = """
+domain radio {
+  attribute WINDOW() { ?value in {OUT, IN}; }
+  attribute SENT() { ?value in {NO, YES}; }
+  task SEND() (t_start, t_end) {
+    hold(WINDOW(): IN, (t_start, t_end));
+    event(SENT(): (NO, YES), t_end);
+    contingent (t_end - t_start) in [18, 25];
+  } nonPreemptive
+}
+problem short_window for radio {
+  timepoint t_open, t_close, t_sent;
+  explained event(SENT(): (YES, NO), t_start);
+  explained event(WINDOW(): (IN, OUT), t_start);
+  contingent event(WINDOW(): (OUT, IN), t_open);
+  contingent event(WINDOW(): (IN, OUT), t_close);
+  (t_open - t_start) in [150, 152];
+  (t_close - t_start) in [176, 178];
+  t_open < t_close;
+  hold(SENT(): YES, (t_sent, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 300];
+}
+"""
+
+
+@cache
+def radio() -> tuple[pm.PlanningDomain, pm.Problem]:
+    """M4's W2 in miniature: a window that may stay open 24 s, a message that may take 25 s."""
+    return from_text(RADIO_SPEC)
+
+
+def from_text(text: str) -> tuple[pm.PlanningDomain, pm.Problem]:
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        spec = Path(folder) / "spec.spec"
+        spec.write_text(textwrap.dedent(text))
+        loaded = load([spec])
+    assert not loaded.errors, loaded.errors
+    assert loaded.program is not None
+    domain = domain_model(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Domain)))
+    problem = problem_model(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Problem)))
+    return domain, problem
+
+
+def test_strong_controllability_drops_a_message_the_shortest_window_cannot_hold() -> None:
+    domain, problem = radio()
+    result = Planner(domain, exact=False).plan(problem)
+    assert result.plan is not None and result.plan.controllability == "strong"
+    assert [g.kept for g in result.goals] == [False]
+    assert "impossible even alone" in result.goals[0].reason
+
+
+def test_a_pseudo_controllable_plan_waits_for_the_latest_opening_and_counts_on_a_late_closing() -> None:
+    domain, problem = radio()
+    result = Planner(domain, exact=False, controllability="pseudo").plan(problem)
+    checked(domain, problem, result)
+    plan = result.plan
+    assert plan is not None and plan.controllability == "pseudo" and result.notes == ()
+    assert [g.kept for g in result.goals] == [True]
+    (send,) = plan.actions
+    # The executive cannot see the window open: it waits until the window surely is.
+    assert plan.assumed == {"t_open": 152.0, "t_close": 178.0}
+    assert send.dispatch == pytest.approx(152.0)
+    assert plan.uncontrolled["t_close"] == (176.0, 178.0)
+    # The risk pseudo-controllability takes: judged for every choice of nature, the plan fails
+    # when the window closes at 176 and the message takes its 25 s.
+    strong = replace(plan, controllability="strong", assumed={})
+    (risk,) = validate(domain, problem, strong)
+    assert "hold(WINDOW(): IN)" in risk and "t_close at its minimum" in risk
+
+
+@pytest.mark.parametrize(("deadline", "planned"), [(176.0, False), (177.0, True)])
+def test_a_pseudo_controllable_plan_never_narrows_natures_instants(deadline: float, planned: bool) -> None:
+    """Sent by `deadline`: by 177 the message may start at the latest opening (152); by 176 it
+    must start by 151, which would leave the window no right to open at 152."""
+    domain, problem = radio()
+    timed = replace(problem, constraints=problem.constraints + (
+        pm.Member(pm.Op("-", (pm.Time("t_sent"), pm.Time("t_start"))), pm.Interval(0, deadline), line=999),))
+    result = Planner(domain, exact=False, controllability="pseudo").plan(timed)
+    assert [g.kept for g in result.goals] == [planned]
+    if not planned:
+        assert "nature's choice, which the plan would narrow" in result.goals[0].reason
+
+
+def test_pseudo_controllability_keeps_m4s_second_window_and_the_validator_agrees() -> None:
+    domain, problem = models("M4_model1")
+    result = Planner(domain, exact=False, controllability="pseudo").plan(problem)
+    checked(domain, problem, result)
+    assert result.dropped == ()
+    assert result.plan is not None and result.plan.assumed["t_svisi2"] == pytest.approx(152.0)
+    second = next(a for a in result.plan.actions if a.task == "COMMUNICATE" and a.args == ("W2",))
+    assert second.dispatch >= 152.0 - 1e-6
+
+
+def test_an_unknown_controllability_is_refused() -> None:
+    domain, _ = radio()
+    with pytest.raises(ValueError, match="choose strong or pseudo"):
+        Planner(domain, controllability="weak")

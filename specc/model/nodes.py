@@ -834,6 +834,8 @@ class Planner(Node):
     name: str
     domain: Ref | None = prop("domain", "ref", doc="planning domain the planner uses")
     heuristic: Ref | None = prop("heuristic", "ref", doc="flaw/resolver ordering heuristic")
+    controllability: str | None = prop("controllability", "symbol", choices=("strong", "pseudo"),
+                                       doc="what plans must hold against nature (specc.runtime.planner.search)")
     doc: String | None = prop("doc", "string")
     view: tuple[Correspondence, ...] = ()
 

@@ -18,7 +18,7 @@ from specc.runtime.ftplan.config import (  # noqa: F401
 CONFIG = FtPlanConfig(
     name='rover',
     planners=(
-        PlannerConfig(name='p1', domain='model1'),
+        PlannerConfig(name='p1', domain='model1', controllability='pseudo'),
         PlannerConfig(
             name='p2',
             domain='model2_M1',
@@ -29,7 +29,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='PTU_TILT', args=(), value=-30.0),
                     ),
                     state_facts=(FactPattern(attribute='PTU_POSITION', args=(), value='STRAIGHT'),),
-                    line=27,
+                    line=33,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -37,7 +37,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='PTU_TILT', args=(), value=-45.0),
                     ),
                     state_facts=(FactPattern(attribute='PTU_POSITION', args=(), value='AT_MY_FEET'),),
-                    line=28,
+                    line=34,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -45,7 +45,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='PTU_TILT', args=(), value=0.0),
                     ),
                     state_facts=(FactPattern(attribute='PTU_POSITION', args=(), value='STRAIGHT'),),
-                    line=29,
+                    line=35,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -53,7 +53,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='PTU_TILT', args=(), value=50.0),
                     ),
                     state_facts=(FactPattern(attribute='PTU_POSITION', args=(), value='OTHER_POSITION'),),
-                    line=30,
+                    line=36,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -61,17 +61,17 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='PTU_TILT', args=(), value=Var('?tilt')),
                     ),
                     state_facts=(FactPattern(attribute='PTU_POSITION', args=(), value='OTHER_POSITION'),),
-                    line=31,
+                    line=37,
                 ),
                 Correspondence(
                     planner_facts=(FactPattern(attribute='PTU_STATE', args=(), value='INITED'),),
                     state_facts=(FactPattern(attribute='PTU_DRIVER_INITIALIZED', args=(), value='TRUE'),),
-                    line=32,
+                    line=38,
                 ),
                 Correspondence(
                     planner_facts=(FactPattern(attribute='PTU_STATE', args=(), value='IDLE'),),
                     state_facts=(FactPattern(attribute='PTU_DRIVER_INITIALIZED', args=(), value='FALSE'),),
-                    line=33,
+                    line=39,
                 ),
                 Correspondence(
                     planner_facts=(FactPattern(attribute='FRAME_STATE', args=(), value='INITED'),),
@@ -79,7 +79,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='MVT_GENERATION_INITIALIZED', args=(), value='TRUE'),
                         FactPattern(attribute='ROBOT_STATUS', args=(), value='STILL'),
                     ),
-                    line=34,
+                    line=40,
                 ),
                 Correspondence(
                     planner_facts=(FactPattern(attribute='FRAME_STATE', args=(), value='IDLE'),),
@@ -87,17 +87,17 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='MVT_GENERATION_INITIALIZED', args=(), value='FALSE'),
                         FactPattern(attribute='ROBOT_STATUS', args=(), value='STILL'),
                     ),
-                    line=35,
+                    line=41,
                 ),
                 Correspondence(
                     planner_facts=(FactPattern(attribute='COMMUNICATION', args=(Var('?w'),), value='TRUE'),),
                     state_facts=(FactPattern(attribute='COMMUNICATION', args=(Var('?w'),), value='DONE'),),
-                    line=36,
+                    line=42,
                 ),
                 Correspondence(
                     planner_facts=(FactPattern(attribute='COMMUNICATION', args=(Var('?w'),), value='FALSE'),),
                     state_facts=(FactPattern(attribute='COMMUNICATION', args=(Var('?w'),), value='NONE'),),
-                    line=37,
+                    line=43,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -108,7 +108,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(4.5, INF)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(4.5, INF)),
                     ),
-                    line=41,
+                    line=47,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -119,7 +119,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(4.5, INF)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(0.0, 4.5)),
                     ),
-                    line=42,
+                    line=48,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -130,7 +130,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(4.5, INF)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-4.5, 0.0)),
                     ),
-                    line=43,
+                    line=49,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -141,7 +141,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(4.5, INF)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-INF, -4.5)),
                     ),
-                    line=44,
+                    line=50,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -152,7 +152,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(0.0, 4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(4.5, INF)),
                     ),
-                    line=45,
+                    line=51,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -163,7 +163,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(0.0, 4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(0.0, 4.5)),
                     ),
-                    line=46,
+                    line=52,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -174,7 +174,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(0.0, 4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-4.5, 0.0)),
                     ),
-                    line=47,
+                    line=53,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -185,7 +185,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(0.0, 4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-INF, -4.5)),
                     ),
-                    line=48,
+                    line=54,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -196,7 +196,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-4.5, 0.0)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(4.5, INF)),
                     ),
-                    line=49,
+                    line=55,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -207,7 +207,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-4.5, 0.0)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(0.0, 4.5)),
                     ),
-                    line=50,
+                    line=56,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -218,7 +218,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-4.5, 0.0)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-4.5, 0.0)),
                     ),
-                    line=51,
+                    line=57,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -229,7 +229,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-4.5, 0.0)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-INF, -4.5)),
                     ),
-                    line=52,
+                    line=58,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -240,7 +240,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-INF, -4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(4.5, INF)),
                     ),
-                    line=53,
+                    line=59,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -251,7 +251,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-INF, -4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(0.0, 4.5)),
                     ),
-                    line=54,
+                    line=60,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -262,7 +262,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-INF, -4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-4.5, 0.0)),
                     ),
-                    line=55,
+                    line=61,
                 ),
                 Correspondence(
                     planner_facts=(
@@ -273,7 +273,7 @@ CONFIG = FtPlanConfig(
                         FactPattern(attribute='AT_ROBOT_X', args=(), value=Interval(-INF, -4.5)),
                         FactPattern(attribute='AT_ROBOT_Y', args=(), value=Interval(-INF, -4.5)),
                     ),
-                    line=56,
+                    line=62,
                 ),
             ),
         ),
@@ -286,7 +286,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_POSITION',
             attribute_args=(),
             value='AT_MY_FEET',
-            line=73,
+            line=79,
         ),
         Requirement(
             kind='during',
@@ -295,7 +295,7 @@ CONFIG = FtPlanConfig(
             attribute='AT_ROBOT_X',
             attribute_args=(),
             value=Var('?x'),
-            line=76,
+            line=82,
         ),
         Requirement(
             kind='during',
@@ -304,7 +304,7 @@ CONFIG = FtPlanConfig(
             attribute='AT_ROBOT_Y',
             attribute_args=(),
             value=Var('?y'),
-            line=77,
+            line=83,
         ),
         Requirement(
             kind='at_start',
@@ -313,7 +313,7 @@ CONFIG = FtPlanConfig(
             attribute='AT_ROBOT_X',
             attribute_args=(),
             value=Var('?x1'),
-            line=80,
+            line=86,
         ),
         Requirement(
             kind='at_start',
@@ -322,7 +322,7 @@ CONFIG = FtPlanConfig(
             attribute='AT_ROBOT_Y',
             attribute_args=(),
             value=Var('?y1'),
-            line=81,
+            line=87,
         ),
         Requirement(
             kind='during',
@@ -331,7 +331,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_POSITION',
             attribute_args=(),
             value='STRAIGHT',
-            line=82,
+            line=88,
         ),
         Requirement(
             kind='during',
@@ -340,7 +340,7 @@ CONFIG = FtPlanConfig(
             attribute='MVT_GENERATION_INITIALIZED',
             attribute_args=(),
             value='TRUE',
-            line=83,
+            line=89,
         ),
         Requirement(
             kind='at_start',
@@ -349,7 +349,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_POSITION',
             attribute_args=(),
             value=Var('?from'),
-            line=85,
+            line=91,
         ),
         Requirement(
             kind='during',
@@ -358,7 +358,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_DRIVER_INITIALIZED',
             attribute_args=(),
             value='TRUE',
-            line=86,
+            line=92,
         ),
         Requirement(
             kind='at_start',
@@ -367,7 +367,7 @@ CONFIG = FtPlanConfig(
             attribute='COMMUNICATION',
             attribute_args=(Var('?w'),),
             value='NONE',
-            line=88,
+            line=94,
         ),
         Requirement(
             kind='during',
@@ -376,25 +376,25 @@ CONFIG = FtPlanConfig(
             attribute='VISIBILITY_WINDOW',
             attribute_args=(Var('?w'),),
             value='IN',
-            line=89,
+            line=95,
         ),
-        NoOverlap(first='MOVE', second='MOVE', line=94),
-        NoOverlap(first='MOVE', second='TAKE_PICTURE', line=95),
-        NoOverlap(first='MOVE', second='COMMUNICATE', line=96),
-        NoOverlap(first='MOVE', second='MOVE_PAN_TILT_UNIT', line=97),
-        NoOverlap(first='MOVE', second='INIT_PTU_DRIVER', line=98),
-        NoOverlap(first='MOVE', second='INIT_MVT_GENERATION', line=99),
-        NoOverlap(first='MOVE_PAN_TILT_UNIT', second='MOVE_PAN_TILT_UNIT', line=100),
-        NoOverlap(first='MOVE_PAN_TILT_UNIT', second='TAKE_PICTURE', line=101),
-        NoOverlap(first='MOVE_PAN_TILT_UNIT', second='INIT_PTU_DRIVER', line=102),
-        NoOverlap(first='TAKE_PICTURE', second='INIT_PTU_DRIVER', line=103),
-        NoOverlap(first='COMMUNICATE', second='COMMUNICATE', line=104),
-        MaxDuration(task='MOVE', seconds=190.0, line=110),
-        MaxDuration(task='MOVE_PAN_TILT_UNIT', seconds=10.0, line=111),
-        MaxDuration(task='TAKE_PICTURE', seconds=6.0, line=112),
-        MaxDuration(task='COMMUNICATE', seconds=25.0, line=113),
-        MaxDuration(task='INIT_PTU_DRIVER', seconds=40.0, line=114),
-        MaxDuration(task='INIT_MVT_GENERATION', seconds=35.0, line=115),
+        NoOverlap(first='MOVE', second='MOVE', line=100),
+        NoOverlap(first='MOVE', second='TAKE_PICTURE', line=101),
+        NoOverlap(first='MOVE', second='COMMUNICATE', line=102),
+        NoOverlap(first='MOVE', second='MOVE_PAN_TILT_UNIT', line=103),
+        NoOverlap(first='MOVE', second='INIT_PTU_DRIVER', line=104),
+        NoOverlap(first='MOVE', second='INIT_MVT_GENERATION', line=105),
+        NoOverlap(first='MOVE_PAN_TILT_UNIT', second='MOVE_PAN_TILT_UNIT', line=106),
+        NoOverlap(first='MOVE_PAN_TILT_UNIT', second='TAKE_PICTURE', line=107),
+        NoOverlap(first='MOVE_PAN_TILT_UNIT', second='INIT_PTU_DRIVER', line=108),
+        NoOverlap(first='TAKE_PICTURE', second='INIT_PTU_DRIVER', line=109),
+        NoOverlap(first='COMMUNICATE', second='COMMUNICATE', line=110),
+        MaxDuration(task='MOVE', seconds=190.0, line=116),
+        MaxDuration(task='MOVE_PAN_TILT_UNIT', seconds=10.0, line=117),
+        MaxDuration(task='TAKE_PICTURE', seconds=6.0, line=118),
+        MaxDuration(task='COMMUNICATE', seconds=25.0, line=119),
+        MaxDuration(task='INIT_PTU_DRIVER', seconds=40.0, line=120),
+        MaxDuration(task='INIT_MVT_GENERATION', seconds=35.0, line=121),
         Requirement(
             kind='during',
             task='TAKE_SHOT',
@@ -402,7 +402,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_POSITION',
             attribute_args=(),
             value='AT_MY_FEET',
-            line=119,
+            line=125,
         ),
         Requirement(
             kind='during',
@@ -411,7 +411,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_POSITION',
             attribute_args=(),
             value='STRAIGHT',
-            line=120,
+            line=126,
         ),
         Requirement(
             kind='during',
@@ -420,7 +420,7 @@ CONFIG = FtPlanConfig(
             attribute='MVT_GENERATION_INITIALIZED',
             attribute_args=(),
             value='TRUE',
-            line=121,
+            line=127,
         ),
         Requirement(
             kind='during',
@@ -429,7 +429,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_POSITION',
             attribute_args=(),
             value='STRAIGHT',
-            line=122,
+            line=128,
         ),
         Requirement(
             kind='during',
@@ -438,7 +438,7 @@ CONFIG = FtPlanConfig(
             attribute='MVT_GENERATION_INITIALIZED',
             attribute_args=(),
             value='TRUE',
-            line=123,
+            line=129,
         ),
         Requirement(
             kind='during',
@@ -447,7 +447,7 @@ CONFIG = FtPlanConfig(
             attribute='PTU_DRIVER_INITIALIZED',
             attribute_args=(),
             value='TRUE',
-            line=124,
+            line=130,
         ),
         Requirement(
             kind='at_start',
@@ -456,7 +456,7 @@ CONFIG = FtPlanConfig(
             attribute='COMMUNICATION',
             attribute_args=(Var('?w'),),
             value='NONE',
-            line=125,
+            line=131,
         ),
         Requirement(
             kind='during',
@@ -465,33 +465,33 @@ CONFIG = FtPlanConfig(
             attribute='VISIBILITY_WINDOW',
             attribute_args=(Var('?w'),),
             value='IN',
-            line=126,
+            line=132,
         ),
-        NoOverlap(first='MOVE_NOMINAL', second='MOVE_NOMINAL', line=127),
-        NoOverlap(first='MOVE_NOMINAL', second='MOVE_RECOV', line=128),
-        NoOverlap(first='MOVE_RECOV', second='MOVE_RECOV', line=129),
-        NoOverlap(first='MOVE_NOMINAL', second='TAKE_SHOT', line=130),
-        NoOverlap(first='MOVE_RECOV', second='TAKE_SHOT', line=131),
-        NoOverlap(first='MOVE_NOMINAL', second='COMMUNICATE_ANTENNA', line=132),
-        NoOverlap(first='MOVE_RECOV', second='COMMUNICATE_ANTENNA', line=133),
-        NoOverlap(first='MOVE_NOMINAL', second='MOVE_PTU', line=134),
-        NoOverlap(first='MOVE_RECOV', second='MOVE_PTU', line=135),
-        NoOverlap(first='MOVE_NOMINAL', second='INIT_PTU', line=136),
-        NoOverlap(first='MOVE_RECOV', second='INIT_PTU', line=137),
-        NoOverlap(first='MOVE_NOMINAL', second='INIT_FRAME', line=138),
-        NoOverlap(first='MOVE_RECOV', second='INIT_FRAME', line=139),
-        NoOverlap(first='MOVE_PTU', second='MOVE_PTU', line=140),
-        NoOverlap(first='MOVE_PTU', second='TAKE_SHOT', line=141),
-        NoOverlap(first='MOVE_PTU', second='INIT_PTU', line=142),
-        NoOverlap(first='TAKE_SHOT', second='INIT_PTU', line=143),
-        NoOverlap(first='COMMUNICATE_ANTENNA', second='COMMUNICATE_ANTENNA', line=144),
-        MaxDuration(task='MOVE_NOMINAL', seconds=190.0, line=145),
-        MaxDuration(task='MOVE_RECOV', seconds=190.0, line=146),
-        MaxDuration(task='MOVE_PTU', seconds=10.0, line=147),
-        MaxDuration(task='TAKE_SHOT', seconds=6.0, line=148),
-        MaxDuration(task='COMMUNICATE_ANTENNA', seconds=25.0, line=149),
-        MaxDuration(task='INIT_PTU', seconds=40.0, line=150),
-        MaxDuration(task='INIT_FRAME', seconds=35.0, line=151),
+        NoOverlap(first='MOVE_NOMINAL', second='MOVE_NOMINAL', line=133),
+        NoOverlap(first='MOVE_NOMINAL', second='MOVE_RECOV', line=134),
+        NoOverlap(first='MOVE_RECOV', second='MOVE_RECOV', line=135),
+        NoOverlap(first='MOVE_NOMINAL', second='TAKE_SHOT', line=136),
+        NoOverlap(first='MOVE_RECOV', second='TAKE_SHOT', line=137),
+        NoOverlap(first='MOVE_NOMINAL', second='COMMUNICATE_ANTENNA', line=138),
+        NoOverlap(first='MOVE_RECOV', second='COMMUNICATE_ANTENNA', line=139),
+        NoOverlap(first='MOVE_NOMINAL', second='MOVE_PTU', line=140),
+        NoOverlap(first='MOVE_RECOV', second='MOVE_PTU', line=141),
+        NoOverlap(first='MOVE_NOMINAL', second='INIT_PTU', line=142),
+        NoOverlap(first='MOVE_RECOV', second='INIT_PTU', line=143),
+        NoOverlap(first='MOVE_NOMINAL', second='INIT_FRAME', line=144),
+        NoOverlap(first='MOVE_RECOV', second='INIT_FRAME', line=145),
+        NoOverlap(first='MOVE_PTU', second='MOVE_PTU', line=146),
+        NoOverlap(first='MOVE_PTU', second='TAKE_SHOT', line=147),
+        NoOverlap(first='MOVE_PTU', second='INIT_PTU', line=148),
+        NoOverlap(first='TAKE_SHOT', second='INIT_PTU', line=149),
+        NoOverlap(first='COMMUNICATE_ANTENNA', second='COMMUNICATE_ANTENNA', line=150),
+        MaxDuration(task='MOVE_NOMINAL', seconds=190.0, line=151),
+        MaxDuration(task='MOVE_RECOV', seconds=190.0, line=152),
+        MaxDuration(task='MOVE_PTU', seconds=10.0, line=153),
+        MaxDuration(task='TAKE_SHOT', seconds=6.0, line=154),
+        MaxDuration(task='COMMUNICATE_ANTENNA', seconds=25.0, line=155),
+        MaxDuration(task='INIT_PTU', seconds=40.0, line=156),
+        MaxDuration(task='INIT_FRAME', seconds=35.0, line=157),
     ),
     state_rules=(
         StateRule(
@@ -503,7 +503,7 @@ CONFIG = FtPlanConfig(
                 FactUpdate(attribute='AT_ROBOT_Y', args=(), value=Var('?y2')),
                 FactUpdate(attribute='ROBOT_STATUS', args=(), value='STILL'),
             ),
-            line=159,
+            line=165,
         ),
         StateRule(
             report='failed',
@@ -513,7 +513,7 @@ CONFIG = FtPlanConfig(
                 FactUpdate(attribute='ROBOT_STATUS', args=(), value='STILL'),
                 FactUpdate(attribute='MVT_GENERATION_INITIALIZED', args=(), value='FALSE'),
             ),
-            line=162,
+            line=168,
         ),
         StateRule(
             report='report',
@@ -523,14 +523,14 @@ CONFIG = FtPlanConfig(
                 FactUpdate(attribute='AT_ROBOT_X', args=(), value=Var('?x')),
                 FactUpdate(attribute='AT_ROBOT_Y', args=(), value=Var('?y')),
             ),
-            line=164,
+            line=170,
         ),
         StateRule(
             report='ended',
             name='MOVE_PAN_TILT_UNIT',
             args=(Var('?from'), Var('?to')),
             updates=(FactUpdate(attribute='PTU_POSITION', args=(), value=Var('?to')),),
-            line=166,
+            line=172,
         ),
         StateRule(
             report='failed',
@@ -540,71 +540,71 @@ CONFIG = FtPlanConfig(
                 FactUpdate(attribute='PTU_POSITION', args=(), value='OTHER_POSITION'),
                 FactUpdate(attribute='PTU_DRIVER_INITIALIZED', args=(), value='FALSE'),
             ),
-            line=167,
+            line=173,
         ),
         StateRule(
             report='ended',
             name='TAKE_PICTURE',
             args=(Var('?o'), Var('?x'), Var('?y')),
             updates=(FactUpdate(attribute='PICTURE', args=(Var('?o'), Var('?x'), Var('?y')), value='DONE'),),
-            line=169,
+            line=175,
         ),
         StateRule(
             report='ended',
             name='COMMUNICATE',
             args=(Var('?w'),),
             updates=(FactUpdate(attribute='COMMUNICATION', args=(Var('?w'),), value='DONE'),),
-            line=171,
+            line=177,
         ),
         StateRule(
             report='ended',
             name='INIT_PTU_DRIVER',
             args=(),
             updates=(FactUpdate(attribute='PTU_DRIVER_INITIALIZED', args=(), value='TRUE'),),
-            line=173,
+            line=179,
         ),
         StateRule(
             report='ended',
             name='INIT_MVT_GENERATION',
             args=(),
             updates=(FactUpdate(attribute='MVT_GENERATION_INITIALIZED', args=(), value='TRUE'),),
-            line=175,
-        ),
-        StateRule(
-            report='ended',
-            name='MOVE_NOMINAL',
-            args=(Var('?p1'), Var('?p2')),
-            updates=(
-                FactUpdate(attribute='FRAME_POS', args=(), value=Var('?p2')),
-                FactUpdate(attribute='FRAME_MODE', args=(), value='NOMINAL'),
-                FactUpdate(attribute='FRAME_STATE', args=(), value='INITED'),
-            ),
-            line=178,
-        ),
-        StateRule(
-            report='failed',
-            name='MOVE_NOMINAL',
-            args=(Var('?p1'), Var('?p2')),
-            updates=(FactUpdate(attribute='FRAME_STATE', args=(), value='IDLE'),),
-            line=179,
-        ),
-        StateRule(
-            report='ended',
-            name='MOVE_RECOV',
-            args=(Var('?p1'), Var('?p2')),
-            updates=(
-                FactUpdate(attribute='FRAME_POS', args=(), value=Var('?p2')),
-                FactUpdate(attribute='FRAME_MODE', args=(), value='NOMINAL'),
-                FactUpdate(attribute='FRAME_STATE', args=(), value='INITED'),
-            ),
-            line=180,
-        ),
-        StateRule(
-            report='failed',
-            name='MOVE_RECOV',
-            args=(Var('?p1'), Var('?p2')),
-            updates=(FactUpdate(attribute='FRAME_STATE', args=(), value='IDLE'),),
             line=181,
+        ),
+        StateRule(
+            report='ended',
+            name='MOVE_NOMINAL',
+            args=(Var('?p1'), Var('?p2')),
+            updates=(
+                FactUpdate(attribute='FRAME_POS', args=(), value=Var('?p2')),
+                FactUpdate(attribute='FRAME_MODE', args=(), value='NOMINAL'),
+                FactUpdate(attribute='FRAME_STATE', args=(), value='INITED'),
+            ),
+            line=184,
+        ),
+        StateRule(
+            report='failed',
+            name='MOVE_NOMINAL',
+            args=(Var('?p1'), Var('?p2')),
+            updates=(FactUpdate(attribute='FRAME_STATE', args=(), value='IDLE'),),
+            line=185,
+        ),
+        StateRule(
+            report='ended',
+            name='MOVE_RECOV',
+            args=(Var('?p1'), Var('?p2')),
+            updates=(
+                FactUpdate(attribute='FRAME_POS', args=(), value=Var('?p2')),
+                FactUpdate(attribute='FRAME_MODE', args=(), value='NOMINAL'),
+                FactUpdate(attribute='FRAME_STATE', args=(), value='INITED'),
+            ),
+            line=186,
+        ),
+        StateRule(
+            report='failed',
+            name='MOVE_RECOV',
+            args=(Var('?p1'), Var('?p2')),
+            updates=(FactUpdate(attribute='FRAME_STATE', args=(), value='IDLE'),),
+            line=187,
         ),
         StateRule(
             report='ended',
@@ -614,7 +614,7 @@ CONFIG = FtPlanConfig(
                 FactUpdate(attribute='PTU_PAN', args=(), value=Var('?pan2')),
                 FactUpdate(attribute='PTU_TILT', args=(), value=Var('?tilt2')),
             ),
-            line=182,
+            line=188,
         ),
         StateRule(
             report='failed',
@@ -625,35 +625,35 @@ CONFIG = FtPlanConfig(
                 FactUpdate(attribute='PTU_TILT', args=(), value=50.0),
                 FactUpdate(attribute='PTU_STATE', args=(), value='IDLE'),
             ),
-            line=183,
+            line=189,
         ),
         StateRule(
             report='ended',
             name='TAKE_SHOT',
             args=(Var('?o'),),
             updates=(FactUpdate(attribute='SHOT', args=(Var('?o'),), value='TRUE'),),
-            line=184,
+            line=190,
         ),
         StateRule(
             report='ended',
             name='COMMUNICATE_ANTENNA',
             args=(Var('?w'),),
             updates=(FactUpdate(attribute='COMMUNICATION', args=(Var('?w'),), value='TRUE'),),
-            line=185,
+            line=191,
         ),
         StateRule(
             report='ended',
             name='INIT_PTU',
             args=(),
             updates=(FactUpdate(attribute='PTU_STATE', args=(), value='INITED'),),
-            line=186,
+            line=192,
         ),
         StateRule(
             report='ended',
             name='INIT_FRAME',
             args=(),
             updates=(FactUpdate(attribute='FRAME_STATE', args=(), value='INITED'),),
-            line=187,
+            line=193,
         ),
     ),
     missions=(
@@ -677,7 +677,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=0.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=0.0),
                             ),
-                            line=196,
+                            line=202,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -688,7 +688,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=4.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=0.0),
                             ),
-                            line=197,
+                            line=203,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -699,28 +699,28 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=3.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-3.0),
                             ),
-                            line=198,
+                            line=204,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O1',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ1', 0.0, 0.0), value='DONE'),
                             ),
-                            line=199,
+                            line=205,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O2',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ2', 4.0, 0.0), value='DONE'),
                             ),
-                            line=200,
+                            line=206,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O3',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ3', 3.0, -3.0), value='DONE'),
                             ),
-                            line=201,
+                            line=207,
                         ),
                     ),
                 ),
@@ -746,7 +746,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=0.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=0.0),
                             ),
-                            line=208,
+                            line=214,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -757,7 +757,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=-5.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=3.0),
                             ),
-                            line=209,
+                            line=215,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -768,7 +768,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=5.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=5.0),
                             ),
-                            line=210,
+                            line=216,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -779,28 +779,28 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=4.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-5.0),
                             ),
-                            line=211,
+                            line=217,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O2',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ1', -5.0, 3.0), value='DONE'),
                             ),
-                            line=212,
+                            line=218,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O3',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ2', 5.0, 5.0), value='DONE'),
                             ),
-                            line=213,
+                            line=219,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O4',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ3', 4.0, -5.0), value='DONE'),
                             ),
-                            line=214,
+                            line=220,
                         ),
                     ),
                 ),
@@ -826,7 +826,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=0.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=0.0),
                             ),
-                            line=221,
+                            line=227,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -837,7 +837,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=2.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=1.0),
                             ),
-                            line=222,
+                            line=228,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -848,7 +848,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=-1.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=2.0),
                             ),
-                            line=223,
+                            line=229,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -859,7 +859,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=-2.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-2.0),
                             ),
-                            line=224,
+                            line=230,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -870,35 +870,35 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=1.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-3.0),
                             ),
-                            line=225,
+                            line=231,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O2',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ1', 2.0, 1.0), value='DONE'),
                             ),
-                            line=226,
+                            line=232,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O3',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ2', -1.0, 2.0), value='DONE'),
                             ),
-                            line=227,
+                            line=233,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O4',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ3', -2.0, -2.0), value='DONE'),
                             ),
-                            line=228,
+                            line=234,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O5',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ4', 1.0, -3.0), value='DONE'),
                             ),
-                            line=229,
+                            line=235,
                         ),
                     ),
                 ),
@@ -924,7 +924,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=0.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=0.0),
                             ),
-                            line=236,
+                            line=242,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -935,7 +935,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=-5.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=5.0),
                             ),
-                            line=237,
+                            line=243,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -946,7 +946,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=5.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=6.0),
                             ),
-                            line=238,
+                            line=244,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -957,7 +957,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=6.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-2.0),
                             ),
-                            line=239,
+                            line=245,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -968,7 +968,7 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=2.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-6.0),
                             ),
-                            line=240,
+                            line=246,
                         ),
                         Correspondence(
                             planner_facts=(
@@ -979,42 +979,42 @@ CONFIG = FtPlanConfig(
                                 FactPattern(attribute='AT_ROBOT_X', args=(), value=-6.0),
                                 FactPattern(attribute='AT_ROBOT_Y', args=(), value=-4.0),
                             ),
-                            line=241,
+                            line=247,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O2',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ1', -5.0, 5.0), value='DONE'),
                             ),
-                            line=242,
+                            line=248,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O3',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ2', 5.0, 6.0), value='DONE'),
                             ),
-                            line=243,
+                            line=249,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O4',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ3', 6.0, -2.0), value='DONE'),
                             ),
-                            line=244,
+                            line=250,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O5',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ4', 2.0, -6.0), value='DONE'),
                             ),
-                            line=245,
+                            line=251,
                         ),
                         Correspondence(
                             planner_facts=(FactPattern(attribute='SHOT', args=('O6',), value='TRUE'),),
                             state_facts=(
                                 FactPattern(attribute='PICTURE', args=('OBJ5', -6.0, -4.0), value='DONE'),
                             ),
-                            line=246,
+                            line=252,
                         ),
                     ),
                 ),

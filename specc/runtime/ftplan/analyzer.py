@@ -4,7 +4,8 @@ fault in a model is not repeated in the check meant to catch it (the `analyzer` 
 `ftplan`).
 
 Every check takes the worst case over what nature chooses: the contingent durations of the
-actions and the dates of the problem's contingent events (the visibility windows).
+actions and the dates of the problem's contingent events (the visibility windows), which a
+pseudo-controllable plan fixes at the dates it assumes (`Plan.assumed`).
 
 - An attribute's value along the plan is FTplan's own state (its `state` rules, not the
   planner's model) projected along the plan: the `ended` consequences of each action take
@@ -146,9 +147,11 @@ def _contingent_events(problem: pm.Problem, dates: Mapping[str, Dates]) -> dict[
 
 
 def _timepoint_dates(plan: Plan, state: SystemState) -> dict[str, Dates]:
-    """The dates of the problem's timepoints: the plan's (its schedule, and the dates nature may
-    choose for the others), else the bounds the problem's own constraints give."""
-    return state.dates | {name: (date, date) for name, date in plan.schedule.items()} | dict(plan.uncontrolled)
+    """The dates of the problem's timepoints: the plan's (its schedule, the dates nature may choose
+    for the others, or those a pseudo-controllable plan assumes), else the bounds the problem's own
+    constraints give."""
+    return (state.dates | {name: (date, date) for name, date in plan.schedule.items()} | dict(plan.uncontrolled)
+            | {name: (date, date) for name, date in plan.assumed.items()})
 
 
 # ---------------------------------------------------------------- requirements

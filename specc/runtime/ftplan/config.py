@@ -52,6 +52,9 @@ class PlannerConfig:
     name: str
     domain: str  # the planning domain's name (a module of the generated `planner` package)
     heuristic: str | None = None
+    # What its plans must hold against: "strong" (every choice of nature) or "pseudo" (the
+    # problem's contingent instants one at a time, as IxTeT: specc.runtime.planner.search).
+    controllability: str = "strong"
     # "module:callable" building, inside the planner's own process, the object whose
     # `plan(problem, now)` answers a planning request; the default is specc's planner on `domain`.
     factory: str = "specc.runtime.ftplan.planners:standard_planner"

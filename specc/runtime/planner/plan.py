@@ -60,8 +60,11 @@ class Plan:
     schedule: dict[str, float]
     uncontrolled: dict[str, tuple[float, float]]
     bindings: dict[str, Value]  # the problem's ?variables
-    controllability: str = "strong"  # the schedule holds for every contingent duration
+    # "strong": the schedule holds for every choice of nature; "pseudo": for each choice alone
+    # (the planner's search.py), and the dispatch assumes nature's timepoints at `assumed`.
+    controllability: str = "strong"
     now: float = 0.0  # mission time the plan was made for (a replanning starts later)
+    assumed: dict[str, float] = field(default_factory=dict)
 
     def ends_by(self, action: Action) -> float:
         """The latest date the action may end, whatever nature does."""

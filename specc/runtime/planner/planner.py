@@ -21,7 +21,10 @@ from specc.runtime.planner import model as pm
 from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult
 from specc.runtime.planner.search import (
+    CONTROLLABILITIES,
     EPS,
+    PSEUDO,
+    STRONG,
     Assertion,
     Bindings,
     Context,
@@ -70,8 +73,11 @@ class Attempt:
 
 class Planner:
     def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
-                 exact: bool = True, limits: Limits | None = None) -> None:
+                 exact: bool = True, limits: Limits | None = None, controllability: str = STRONG) -> None:
+        if controllability not in CONTROLLABILITIES:
+            raise ValueError(f"controllability '{controllability}': choose {' or '.join(CONTROLLABILITIES)}")
         self.domain = domain
+        self.controllability = controllability  # what the plans must hold against (search.py's doc)
         self.nodes = nodes  # budget of the search for every goal at once
         self.goal_nodes = goal_nodes  # budget of each smaller search
         self.exact = exact  # CasADi durations and schedule (else the interval enclosures and the STN)
@@ -81,7 +87,7 @@ class Planner:
     def plan(self, problem: pm.Problem, now: float = 0.0) -> PlanResult:
         started = time.perf_counter()
         try:
-            setup = Setup(self.domain, problem, now, self.limits)
+            setup = Setup(self.domain, problem, now, self.limits, self.controllability)
         except PlanningInputError as error:
             return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
         goals = setup.goals
@@ -161,7 +167,8 @@ def _generic(message: str) -> str:
 class Setup:
     """A problem made ready to plan: its goals, the contingent instants and the constraints."""
 
-    def __init__(self, domain: pm.PlanningDomain, problem: pm.Problem, now: float, limits: Limits) -> None:
+    def __init__(self, domain: pm.PlanningDomain, problem: pm.Problem, now: float, limits: Limits,
+                 controllability: str = STRONG) -> None:
         if problem.domain != domain.name:
             raise PlanningInputError(f"problem '{problem.name}' is written for domain '{problem.domain}', "
                                      f"not '{domain.name}'")
@@ -238,7 +245,7 @@ class Setup:
         self.owned = {point: owners for point, owners in used_by.items()
                       if owners <= goal_indexes and point not in (self.origin, problem.end)}
         self.context = Context(problem.end, self.origin, now, limits, {r.name: r.capacity for r in domain.resources},
-                               producers_of(domain), self.nature_before)
+                               producers_of(domain), self.nature_before, controllability)
 
     def root(self, active: list[Goal]) -> Node:
         node = Node(self.context)
@@ -248,7 +255,7 @@ class Setup:
         node.require("origin", self.origin, 0.0, 0.0)
         node.require(self.origin, problem.end, max(0.0, self.now))
         for point, (low, high) in self.bounds.items():
-            node.anchor[point] = (self.origin, low, high)
+            node.make_contingent(point, self.origin, low, high, instant=True)
         for point in problem.timepoints:
             if point not in self.bounds and point not in dropped_points:
                 node.require(self.origin, point, 0.0)
@@ -336,26 +343,20 @@ class Setup:
                     # A duration only nature decides may be a little wider than the solver's optimum.
                     durations[instance_id] = replace(spec, low=max(spec.low, tight[0] - 1e-6),
                                                      high=min(spec.high, tight[1] + 1e-6))
-        anchors = dict(node.anchor)
+        # Nature's timepoints: the problem's contingent instants and the contingent actions' ends.
+        instants = {point: (self.origin, low, high) for point, (low, high) in self.bounds.items()}
+        ends = {}
         for instance_id, spec in durations.items():
             instance = node.instances[instance_id]
             if spec.contingent:
-                anchors[instance.end] = (instance.start, spec.low, spec.high)
-        network = STN()
-        for name in node.stn.names:
-            if name not in anchors:
-                network.point(name)
-        reduced = []
-        for a, b, low, high in node.original:
-            pa, pb, new_low, new_high = translate(anchors, a, b, low, high)
-            if pa == pb:
-                continue
-            reduced.append((pa, pb, new_low, new_high))
-            try:
-                network.add(pa, pb, new_low, new_high)
-            except Inconsistent:  # rounding only: the search's network, with its tolerance, took it
-                network.add(pa, pb, new_low - 1e-6 if new_low > -INF else -INF,
-                            new_high + 1e-6 if new_high < INF else INF)
+                ends[instance.end] = (instance.start, spec.low, spec.high)
+        if self.context.controllability == PSEUDO:
+            network, reduced, note = pseudo_network(node, ends, instants)
+        else:
+            network, reduced, note = strong_network(node, ends | instants)
+        if note:
+            notes.append(note)
+        links = ends | instants
         # (The controllable durations are among node.original: the search required them.)
         schedule = network.earliest_schedule()
         if exact:
@@ -366,9 +367,11 @@ class Setup:
                 schedule = optimised
         schedule.pop("origin", None)
         schedule = {name: max(0.0, date) if abs(date) < 1e-6 else date for name, date in schedule.items()}
-        uncontrolled = {}
-        for point, (anchor, low, high) in anchors.items():
+        uncontrolled, assumed = {}, {}
+        for point, (anchor, low, high) in links.items():
             uncontrolled[point] = (schedule[anchor] + low, schedule[anchor] + high)
+            if point in network.index:  # a pseudo-controllable plan's instant, at the date it assumes
+                assumed[point] = schedule[point]
             schedule.pop(point, None)
         actions = []
         for instance in sorted(node.instances.values(), key=lambda i: int(i.id.split("#")[1])):
@@ -383,13 +386,13 @@ class Setup:
         names = {i.start: i.id for i in node.instances.values()} | {i.end: i.id for i in node.instances.values()}
         orderings = sorted({(a, b, low) for a, b, low, _ in node.original
                             if low > -INF and a in names and b in names and names[a] != names[b]})
-        links = tuple(Link(_where(node.assertions[k.producer], node), _where(node.assertions[k.consumer], node),
+        causal = tuple(Link(_where(node.assertions[k.producer], node), _where(node.assertions[k.consumer], node),
                            node.assertions[k.consumer].attribute,
                            _chosen(node.bindings.value(node.assertions[k.producer].value)))
                       for k in node.links if node.assertions[k.producer].owner != node.assertions[k.consumer].owner)
         bindings = {v: _some_value(node.bindings, v) for v in self.problem.variables}
-        plan = Plan(self.domain.name, self.problem.name, tuple(actions), tuple(orderings), links, schedule,
-                    uncontrolled, bindings, "strong", self.now)
+        plan = Plan(self.domain.name, self.problem.name, tuple(actions), tuple(orderings), causal, schedule,
+                    uncontrolled, bindings, self.context.controllability, self.now, assumed)
         return plan, tuple(notes)
 
 
@@ -415,6 +418,59 @@ def _some_value(bindings: Bindings, var: str) -> float | str:
 
 def _where(a: Assertion, node: Node) -> str:
     return f"{a.owner}: {a.text(node.bindings)}"
+
+
+Links = dict[str, tuple[str, float, float]]  # nature's timepoint -> (the point it hangs from, low, high)
+Requirements = list[tuple[str, str, float, float]]
+
+
+def _add(network: STN, reduced: Requirements, a: str, b: str, low: float, high: float) -> None:
+    try:
+        network.add(a, b, low, high)
+    except Inconsistent:  # rounding only: the search's network, with its tolerance, took it
+        low, high = low - 1e-6 if low > -INF else -INF, high + 1e-6 if high < INF else INF
+        network.add(a, b, low, high)
+    reduced.append((a, b, low, high))
+
+
+def strong_network(node: Node, links: Links) -> tuple[STN, Requirements, str]:
+    """The plan's own timepoints, every requirement rewritten for nature's worst case."""
+    network = STN()
+    for name in node.stn.names:
+        if name not in links:
+            network.point(name)
+    reduced: Requirements = []
+    for a, b, low, high in node.original:
+        pa, pb, new_low, new_high = translate(links, a, b, low, high)
+        if pa != pb:
+            _add(network, reduced, pa, pb, new_low, new_high)
+    return network, reduced, ""
+
+
+def pseudo_network(node: Node, ends: Links, instants: Links) -> tuple[STN, Requirements, str]:
+    """The plan's own timepoints and the problem's contingent instants, every requirement
+    rewritten for the contingent durations' worst case, and each instant at its latest date: the
+    executive cannot see a window open, so it waits until the window surely is. The plan carries
+    these dates (`assumed`)."""
+    network = STN()
+    for name in node.stn.names:
+        if name not in ends:
+            network.point(name)
+    reduced: Requirements = []
+    for a, b, low, high in node.original:
+        pa, pb, new_low, new_high = translate(ends, a, b, low, high)
+        if pa != pb:
+            _add(network, reduced, pa, pb, new_low, new_high)
+    latest, pinned = network.copy(), list(reduced)
+    try:
+        for point, (anchor, _, high) in sorted(instants.items()):
+            _add(latest, pinned, anchor, point, high, high)
+        return latest, pinned, ""
+    except Inconsistent:
+        for point, (anchor, low, high) in sorted(instants.items()):
+            _add(network, reduced, anchor, point, low, high)
+        return network, reduced, ("nature's instants at their latest do not fit the plan together: the dispatch "
+                                  "assumes the earliest dates of them that fit")
 
 
 def optimise_schedule(network: STN, reduced: list[tuple[str, str, float, float]],

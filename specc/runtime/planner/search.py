@@ -7,11 +7,22 @@ and resource conflicts. Resolvers link an existing event, insert a task, order t
 or keep two arguments apart; the flaw with the fewest resolvers is solved first, and a flaw
 with a single resolver is solved at once.
 
-The temporal network is kept in its strongly controllable form: a timepoint nature decides (a
-contingent task end, a visibility window's instant) is never scheduled itself; every constraint
-on it is rewritten on the timepoint it hangs from, for its worst offset (Vidal & Fargier). So
-the network is consistent exactly when one schedule of the plan's own timepoints works for every
-duration nature may pick, and each resolver is checked against that at once.
+How a timepoint nature decides (a contingent task end, a visibility window's instant) enters the
+temporal network depends on the controllability the planner asks of its plans:
+
+- strong (the default): the network is kept in its strongly controllable form. Such a point is
+  never scheduled itself; every constraint on it is rewritten on the timepoint it hangs from, for
+  its worst offset (Vidal & Fargier). So the network is consistent exactly when one schedule of the
+  plan's own timepoints works for every duration nature may pick.
+- pseudo: the problem's contingent instants (nature's events: a window opens, closes) are
+  timepoints of the network like any other, each bound to the origin by a contingent link that
+  the network must not narrow (pseudo-controllability, as IxTeT checks it: seed 004 §4.1.3, a
+  contingent interval "must not be reduced" by the plan). Each instant alone may then fall anywhere
+  in its bounds, but not every combination of them: a plan may need a window to close late when it
+  opens late. Contingent durations stay strong: the executive dispatches what follows an action
+  for its longest duration, as it must when it judges an action late from its plan alone.
+
+Either way each resolver is checked against it at once.
 """
 
 from __future__ import annotations
@@ -27,6 +38,8 @@ from specc.runtime.planner.numeric import DurationSpec, Empty, domain_of, durati
 from specc.runtime.stn import STN, Inconsistent, for_every_offset
 
 INF = math.inf
+STRONG, PSEUDO = "strong", "pseudo"  # the controllability a plan is searched for (see above)
+CONTROLLABILITIES = (STRONG, PSEUDO)
 EPS = 0.01  # seconds between two events that must not be simultaneous (IxTeT's strict precedence)
 TOLERANCE = 1e-6
 SURELY = 10 * TOLERANCE  # a bound this close counts as met: the network loosens each constraint by TOLERANCE
@@ -340,6 +353,7 @@ class Context:
     producers: Mapping[str, list[tuple[pm.Task, int]]]  # attribute -> (task, event index), see producers_of
     # Orders nature promises between its own instants (`t_evisi1 < t_svisi2`): (earlier, later).
     nature_before: set[tuple[str, str]] = field(default_factory=set)
+    controllability: str = STRONG
 
 
 def producers_of(domain: pm.PlanningDomain) -> dict[str, list[tuple[pm.Task, int]]]:
@@ -413,6 +427,8 @@ class Node:
         try:
             self.stn.add(pa, pb, new_low - TOLERANCE if new_low > -INF else new_low,
                          new_high + TOLERANCE if new_high < INF else new_high)
+            if self.stn.contingent:
+                self._keep_contingent_links()
         except Inconsistent:
             # Said without the tolerance the network adds, which would show as 29.999999 or -1e-06.
             if new_low > new_high + 2 * TOLERANCE:
@@ -420,6 +436,17 @@ class Node:
             back, ahead = self._span(self.stn.index[pa], self.stn.index[pb])
             raise DeadEnd(f"{pb} - {pa} in [{_seconds(new_low)}, {_seconds(new_high)}] contradicts "
                           f"[{_seconds(-back)}, {_seconds(ahead)}], which the plan already implies") from None
+
+    def _keep_contingent_links(self) -> None:
+        """Pseudo-controllability: the network may not narrow what nature chooses."""
+        d = self.stn.distances
+        for link in self.stn.contingent:
+            ahead, back = d.item(link.start, link.end), d.item(link.end, link.start)
+            if ahead < link.high - SURELY or -back > link.low + SURELY:
+                names = self.stn.names
+                raise DeadEnd(f"{names[link.end]} - {names[link.start]} in [{link.low:g}, {link.high:g}] is "
+                              f"nature's choice, which the plan would narrow to [{_seconds(-back)}, "
+                              f"{_seconds(ahead)}]")
 
     def allows(self, a: str, b: str, low: float = -INF, high: float = INF) -> bool:
         """Could `require(a, b, low, high)` succeed? (The network's distances between the points a
@@ -476,9 +503,22 @@ class Node:
         surely = (a, b) in self.ctx.nature_before or low >= gap - SURELY
         return surely, -(gap - (lb - ha) - TOLERANCE) + ahead >= 0
 
-    def make_contingent(self, point: str, start: str, low: float, high: float) -> None:
+    def make_contingent(self, point: str, start: str, low: float, high: float, instant: bool = False) -> None:
         """Nature now places `point` within [low, high] after `start`: every requirement already
-        written on it is rewritten for its worst case."""
+        written on it is rewritten for its worst case, unless the point is one of the problem's
+        `instant`s and the plan pseudo-controllable: the link then joins the network, which may
+        not narrow it."""
+        if instant and self.ctx.controllability == PSEUDO:
+            try:
+                self.stn.add_contingent(start, point, low, high)
+            except Inconsistent:
+                back, ahead = self.bounds(start, point)
+                raise DeadEnd(f"{point} - {start} in [{low:g}, {high:g}] is nature's choice, but the plan "
+                              f"already implies [{_seconds(back)}, {_seconds(ahead)}]") from None
+            except ValueError as error:  # a link the network cannot take as nature's (negative bounds)
+                raise DeadEnd(str(error)) from None
+            self._keep_contingent_links()
+            return
         self.anchor[point] = (start, low, high)
         self.places.pop(point, None)
         for a, b, lo, hi in self.original:

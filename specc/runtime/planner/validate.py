@@ -21,7 +21,9 @@ Written from the semantics alone, sharing no code with the planner's search (onl
    (`"<action id>.<name>"`) come from `Plan.schedule`. Nature chooses the rest: each action's end is
    its start plus a duration in [dmin, dmax], and each problem timepoint carrying a `contingent`
    event (a visibility window instant) lies in the bounds the problem's constraints give it relative
-   to `t_start`. The plan must be valid whatever nature does (strong controllability); the checks
+   to `t_start`; a pseudo-controllable plan (`Plan.controllability`) fixes these instants at the
+   dates it assumes (`Plan.assumed`, which must lie in those bounds) and leaves nature the
+   durations. The plan must be valid whatever nature does (strong controllability); the checks
    below run on several realisations of nature: all at the minimum, all at the maximum, all at the
    middle, each one at its maximum with the others at their minimum and the converse, and `samples`
    seeded random draws. Realisations breaking the constraints nature itself obeys (constraints among
@@ -649,6 +651,9 @@ class Validator:
             if all(decide(c, {}, dates.__getitem__) is not False for c in self.nature_rules):
                 checked.append(kind)
                 self.realisation(kind, dates)
+        if realisations and not checked:
+            self.report("nature", "plan: nature cannot keep the problem's constraints on its instants with the "
+                                  f"dates the plan assumes ({', '.join(sorted(self.plan.assumed)) or 'none'})")
         out = []
         for key, message in self.findings.messages.items():
             seen = self.findings.seen_in[key]
@@ -688,7 +693,14 @@ class Validator:
             if not (math.isfinite(low) and math.isfinite(high)):
                 self.report(("window", w), f"problem: cannot tell when nature puts {w} (no bounds from {p.start})")
                 low = high = low if math.isfinite(low) else high if math.isfinite(high) else 0.0
-            self.nature.append(Nature(w, low, high, w))
+            assumed = self.plan.assumed.get(w)
+            if assumed is None:
+                self.nature.append(Nature(w, low, high, w))
+                continue
+            self.fixed[w] = float(assumed)
+            if not (low - TOLERANCE <= assumed <= high + TOLERANCE):
+                self.report(("assumed", w), f"plan: assumes {w} at {date_text(assumed)}, outside its bounds "
+                                            f"[{date_text(low)}, {date_text(high)}]")
         for c in p.constraints:
             times = constraint_names(c, Time)
             if times and times <= set(windows) | {p.start} and times & set(windows):
