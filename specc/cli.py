@@ -9,7 +9,7 @@ import time
 from collections.abc import Callable
 from enum import StrEnum
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 from rich.console import Console
@@ -852,6 +852,139 @@ def mutants_command(
             raise _run_error(ValueError(f"cannot write into '{output}': {exc.strerror}"), 1) from None
         out.print(f"wrote {len(listed)} mutant(s) (spec file and diff each) and index.tsv to {output}",
                   markup=False)
+
+
+def _names(text: str) -> tuple[str, ...]:
+    return tuple(name.strip() for name in text.split(",") if name.strip())
+
+
+@app.command()
+def campaign(
+        specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder, e.g. examples/atrv.",
+                                              show_default=False)],
+        mutants: Annotated[str, typer.Option(help="How many mutants to draw among those that pass specc check "
+                                                  "(stratified by class), or 'all'.")] = "40",
+        missions: Annotated[str, typer.Option(help="Comma-separated missions.")] = "M1,M2,M3,M4",
+        worlds: Annotated[str, typer.Option(help="Comma-separated worlds.")] = "W1,W2,W3,W4",
+        runs: Annotated[int, typer.Option(min=1, help="Runs (seeds 0..N-1) of every activity.")] = 3,
+        configs: Annotated[str, typer.Option(help="Comma-separated configurations; the first one judges the "
+                                                  "mutants (add -noanalyzer to one for it without the plan "
+                                                  "analyzer).")] = "Robot1,Robot1/2",
+        domain: Annotated[str, typer.Option(help="The planning model faults are injected into.")] = "model1",
+        seed: Annotated[int, typer.Option(help="Draws the mutants.")] = 0,
+        workers: Annotated[Optional[int], typer.Option(min=1, help="Experiments at once (default: one per "
+                                                                   "CPU).")] = None,
+        scheduler: Annotated[Optional[str], typer.Option(help="Run on Dask distributed: a scheduler's address "
+                                                              "(tcp://host:8786), or 'local' for a local "
+                                                              "cluster.")] = None,
+        timeout: Annotated[float, typer.Option(min=1.0, help="Hard timeout of one experiment (s): past it, its "
+                                                             "process is killed.")] = 120.0,
+        store: Annotated[Optional[Path], typer.Option(help="The results store (SQLite); an interrupted campaign "
+                                                           "resumes from it. Default: campaigns/<robot>-<domain>"
+                                                           "-<mutants>.sqlite")] = None,
+        output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Where the report goes (default: "
+                                                       "beside the store).")] = None,
+        generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
+        = Path("generated"),
+        quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
+    """Inject faults into a planning model by mutation and run every configuration x mutant x mission x
+    world x run (seed 004 ch. 4); then the report: the measures over sets of activities with and without
+    W4, per mutant, the mutants set aside, the bar charts of Fig 4.14 and the headline.
+
+    Example: specc campaign examples/atrv --mutants 40 --runs 3 --configs Robot1,Robot1/2
+    """
+    from specc.campaign.campaign import Campaign, CampaignPlan, check_names, select_mutants
+    from specc.campaign.engines import DaskEngine, LocalEngine
+    from specc.campaign.experiments import Setting
+    from specc.campaign.report import build_report, write_report
+    from specc.campaign.store import ResultStore
+    from specc.mutation import default_workers
+    from specc.run import RunError
+    from specc.run.session import compile_robot
+
+    try:
+        if mutants != "all" and not (mutants.isdigit() and int(mutants) > 0):
+            raise RunError(f"--mutants {mutants}: give a number of mutants, or 'all'")
+        robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
+        if robot != "atrv":
+            raise RunError(f"robot '{robot}' has no planning campaign: campaigns run the rover's missions (atrv)")
+        setting = Setting(generated.resolve(), specs.resolve())
+        plan = CampaignPlan(specs, setting, domain, None if mutants == "all" else int(mutants), seed,
+                            _names(missions), _names(worlds), runs, _names(configs))
+        check_names(plan, setting.generated, setting.example)
+        count = workers or default_workers()
+        engine = (LocalEngine(setting, count, timeout) if scheduler is None
+                  else DaskEngine(setting, scheduler, count, timeout))
+        with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} checked") as progress:
+            def checking(done: int, total: int) -> None:
+                if progress is not None:
+                    progress(done, total, f"checking {domain}'s mutants")
+
+            selection = select_mutants(plan, count, checking)
+        err.print(f"{selection.generated} mutants of {domain}; {len(selection.domains)} passing specc check "
+                  f"{'in all' if mutants == 'all' else f'drawn (seed {seed})'}", markup=False)
+        path = store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite"
+        with ResultStore(path) as results:
+            job = Campaign(plan, results, engine, selection.domains, selection.records)
+            job.start()
+            err.print(f"results in {path} ({results.count()} already there); on {engine.describe()}", markup=False)
+            try:
+                with CampaignProgress(quiet) as step:
+                    verdicts = job.run(step)
+            except KeyboardInterrupt:
+                err.print(f"interrupted: {results.count()} results kept in {path}; the same command resumes the "
+                          "campaign", markup=False)
+                raise typer.Exit(130) from None
+            report = build_report(results)
+        written = write_report(report, output or path.parent, path.stem)
+    except RunError as error:
+        raise _run_error(error, 2) from None
+    kept = sum(1 for v in verdicts.values() if v.verdict == "kept")
+    out.print(f"{len(report.outcomes)} experiments; {kept} of {len(verdicts)} mutants kept", markup=False)
+    for headline in report.headlines:
+        out.print(headline.text(), markup=False)
+    for written_path in written:
+        out.print(f"wrote {written_path}", markup=False)
+
+
+class CampaignProgress:
+    """done / total, experiments per hour and the time left, on stderr when it is a terminal;
+    a line every 5 % otherwise (a campaign may run for an hour in a log file)."""
+
+    def __init__(self, quiet: bool) -> None:
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+        self.quiet, self.live = quiet, not quiet and err.is_terminal
+        self.started = time.perf_counter()
+        self.first: int | None = None  # done when this session started (a resumed campaign)
+        self.said = -1
+        self.progress = Progress(TextColumn("experiments"), BarColumn(), MofNCompleteColumn(),
+                                 TextColumn("{task.fields[rate]}"), TimeRemainingColumn(),
+                                 TextColumn("{task.description}"), console=err, transient=True)
+        self.task = self.progress.add_task("", total=None, rate="")
+
+    def __enter__(self) -> Callable[[int, int, Any], None]:
+        if self.live:
+            self.progress.start()
+        return self.update
+
+    def __exit__(self, *exc: object) -> None:
+        if self.live:
+            self.progress.stop()
+
+    def update(self, done: int, total: int, outcome: Any) -> None:
+        if self.first is None:
+            self.first = done
+            self.progress.update(self.task, completed=done, total=total)
+            self.progress.reset(self.task, completed=done, total=total)  # the rate counts this session only
+        elapsed = time.perf_counter() - self.started
+        rate = (done - self.first) / elapsed * 3600 if elapsed > 0 and done > self.first else 0.0
+        what = "" if outcome is None else f"{outcome.experiment.key}: {outcome.status}"
+        if self.live:
+            self.progress.update(self.task, completed=done, total=total, rate=f"{rate:,.0f}/h", description=what)
+        elif not self.quiet and total and (done * 20 // total) != self.said:
+            self.said = done * 20 // total
+            err.print(f"{done}/{total} experiments, {rate:,.0f}/h", markup=False)
 
 
 def main() -> None:

@@ -23,6 +23,7 @@ from specc.runtime.ftplan.planners import (
     PlannerStartError,
     Watchdog,
     first_answer,
+    planner_processes_kept,
     standard_planner,
 )
 from specc.runtime.planner import Planner
@@ -301,6 +302,52 @@ def test_first_answer_is_the_fastest_planners(domains: dict[str, pm.PlanningDoma
         assert hangs.busy
         pids = [p.pid for p in (slow, fast, hangs)]
     assert all(pid is not None and gone(pid) for pid in pids)
+
+
+# ---------------------------------------------------------------- processes kept from one mission to the next
+
+def test_kept_processes_serve_the_next_planners_each_built_anew(
+        mission: tuple[pm.PlanningDomain, pm.Problem], domains: dict[str, pm.PlanningDomain]) -> None:
+    domain, problem = mission
+    expected = Planner(domain).plan(problem, now=0.0)
+    with planner_processes_kept():
+        with PlannerProcess(PlannerConfig("ixtet1", "model1"), domains) as first:
+            first.wait_ready(ANSWER_TIMEOUT)
+            pid = first.pid
+        assert pid is not None and not gone(pid) and first.pid is None  # kept, idle
+        # The next planner takes it with its own configuration, a bad one included ...
+        with PlannerProcess(PlannerConfig("other", "model1", heuristic="astar"), domains) as second:
+            assert second.pid == pid
+            with pytest.raises(PlannerStartError, match="planner 'other': .* no heuristic 'astar'"):
+                second.wait_ready(ANSWER_TIMEOUT)
+        # ... and the one after it plans as a planner in a process of its own does.
+        with PlannerProcess(PlannerConfig("third", "model1"), domains) as third:
+            assert third.pid == pid
+            third.request(problem, 0.0)
+            answer = third.poll(ANSWER_TIMEOUT)
+            assert answer is not None and answer.status == "answered" and answer.planner == "third"
+            assert answer.result is not None and answer.result.plan == expected.plan
+        assert [p.pid for p in multiprocessing.active_children()] == [pid]
+    assert wait_gone(pid) and multiprocessing.active_children() == []
+
+
+def test_kept_processes_never_keep_a_planner_ftplan_gave_up_on(
+        domains: dict[str, pm.PlanningDomain], problem: pm.Problem) -> None:
+    with planner_processes_kept():
+        with PlannerProcess(faulty("hangs", "hanging_planner"), domains) as planner:
+            planner.wait_ready(ANSWER_TIMEOUT)
+            hung = planner.pid
+            planner.request(problem)
+            planner.abandon()  # killed, and a process started for it again
+            assert hung is not None and wait_gone(hung) and planner.pid != hung
+            busy = planner.pid
+            planner.request(problem)
+        assert busy is not None and wait_gone(busy)  # busy when closed: killed, not kept
+        with PlannerProcess(faulty("crashes", "crashing_planner"), domains) as crashing:
+            crashing.request(problem)
+            answer = crashing.poll(ANSWER_TIMEOUT)
+            assert answer is not None and answer.status == "crashed"
+        assert multiprocessing.active_children() == []
 
 
 # ---------------------------------------------------------------- no process left behind

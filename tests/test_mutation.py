@@ -23,18 +23,18 @@ from specc.mutation import (
     CLASSES,
     Mutant,
     MutantSet,
-    MutationClass,
     MutationError,
     MutationTarget,
     enumerate_mutants,
     keep_valid,
     mutant_domain,
-    mutated_setup,
     mutation_target,
 )
 from specc.mutation.edits import DomainTables, domain_edits, value_pool
-from specc.mutation.mutants import even_shares, verdict
+from specc.mutation.mutants import draw_kept, verdict
 from specc.mutation.tree import replace_at
+from specc.run import RunError
+from specc.run.rover import check_mission
 from specc.runtime.planner import Planner
 from specc.syntax.parser import parse_text
 from tests.atrv import ATRV, atrv_models, mutation_1_592, program
@@ -314,13 +314,23 @@ def test_a_program_given_as_a_model_gives_the_same_mutants() -> None:
     assert [(x.id, x.text) for x in from_model] == [(x.id, x.text) for x in of_kind(model1_mutants(), "value")]
 
 
-def test_even_shares_split_a_sample_between_the_classes() -> None:
-    available: dict[MutationClass, int] = {"numeric": 642, "variable": 390, "value": 68, "operator": 100,
-                                           "deletion": 27}
-    assert even_shares(28, available) == {"numeric": 6, "variable": 6, "value": 6, "operator": 5, "deletion": 5}
-    assert even_shares(28, available | {"deletion": 2}) == {
-        "numeric": 7, "variable": 7, "value": 6, "operator": 6, "deletion": 2}
-    assert sum(even_shares(10**4, available).values()) == sum(available.values())
+def test_a_sample_drawn_lazily_is_the_sample_of_the_judged_set(tiny_set: MutantSet) -> None:
+    """draw_kept checks only what it draws (and passes over), and draws what MutantSet.sample
+    draws from the whole set judged beforehand."""
+    judged: list[str] = []
+    kept = {x.id for x in tiny_set.kept}
+
+    def is_kept(x: Mutant) -> bool:
+        judged.append(x.id)
+        return x.id in kept
+
+    for n, seed in ((5, 0), (10, 3)):
+        judged.clear()
+        lazily = draw_kept(tiny_set.mutants, n, seed, is_kept)
+        assert lazily == tiny_set.sample(n, seed) and len(lazily) == n
+        assert n <= len(judged) < len(tiny_set.mutants)
+    by_default = draw_kept(tiny_set.mutants, 5, 0)  # judging with the checks themselves
+    assert by_default == tiny_set.sample(5, 0)
 
 
 def test_sampling_is_stratified_and_deterministic(tiny_set: MutantSet) -> None:
@@ -372,11 +382,14 @@ def test_a_mutant_domain_takes_the_place_of_the_generated_one_in_a_mission() -> 
     assert replace(domain_model(target.program, target.domain), source="") == replace(
         setup.domains["model1"], source="")
     mutant = of_kind(model1_mutants(), "deletion")[0]
-    changed = mutated_setup(setup, mutant_domain(mutant))
+    # A rover mission runs with the mutant in place of the domain of the same name.
+    changed = check_mission("Robot1/2", "M1", "W1", 0, generated=ROOT / "generated", example=ATRV,
+                            domains={"model1": mutant_domain(mutant)}).setup
     assert changed.domains["model1"] == mutant_domain(mutant) != setup.domains["model1"]
-    assert changed.domains["model2_M1"] is setup.domains["model2_M1"] and changed.problem is setup.problem
-    with pytest.raises(MutationError):
-        mutated_setup(setup, replace(mutant_domain(mutant), name="model9"))
+    assert changed.domains["model2_M1"] == setup.domains["model2_M1"] and changed.problem == setup.problem
+    with pytest.raises(RunError, match="plans in model1, model2_M1, not in model9"):
+        check_mission("Robot1/2", "M1", "W1", 0, generated=ROOT / "generated", example=ATRV,
+                      domains={"model9": replace(mutant_domain(mutant), name="model9")})
 
 
 def test_bad_input_is_one_clear_error(tiny: Path, tmp_path: Path) -> None:

@@ -268,14 +268,8 @@ problem two_shots for cameras {
 """
 
 
-def test_two_uses_of_a_unary_resource_never_overlap(tmp_path: Path) -> None:
-    spec = tmp_path / "cameras.spec"
-    spec.write_text(textwrap.dedent(RESOURCE_SPEC))
-    loaded = load([spec])
-    assert not loaded.errors, loaded.errors
-    assert loaded.program is not None
-    domain = domain_model(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Domain)))
-    problem = problem_model(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Problem)))
+def test_two_uses_of_a_unary_resource_never_overlap() -> None:
+    domain, problem = from_text(RESOURCE_SPEC)
     result = Planner(domain, exact=False).plan(problem)
     checked(domain, problem, result)
     assert result.plan is not None

@@ -158,7 +158,7 @@ def test_robot2_photographs_with_modele2s_own_angles() -> None:
 
 
 @pytest.mark.parametrize("configuration, mission, world, message", [
-    ("Robot3", "M1", "W1", "no robot configuration 'Robot3' (known: Robot1, Robot2, Robot1/2, Robot1/2c)"),
+    ("Robot3", "M1", "W1", "no robot configuration 'Robot3' (known: Robot1, Robot2, Robot1/2, Robot1/2c; add"),
     ("Robot1", "M9", "W1", "has no mission 'M9' (it has: M1, M2, M3, M4)"),
     ("Robot1", "M1", "W9", "unknown world 'W9': give W1, W2, W3, W4"),
     ("Robot1", "M1", "nowhere.toml", "nowhere.toml: cannot read the world file"),

@@ -23,15 +23,15 @@ from specc.mutation.mutants import (
     MutationTarget,
     Rejection,
     default_workers,
+    draw_kept,
     enumerate_mutants,
     keep_valid,
     mutant_domain,
-    mutated_setup,
     mutation_target,
 )
 
 __all__ = [
     "CLASSES", "ClassCounts", "Edit", "Mutant", "MutantSet", "MutationClass", "MutationError", "MutationTarget",
-    "Rejection", "default_workers", "enumerate_mutants", "keep_valid", "mutant_domain", "mutated_setup",
+    "Rejection", "default_workers", "draw_kept", "enumerate_mutants", "keep_valid", "mutant_domain",
     "mutation_target",
 ]

@@ -13,7 +13,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, fields, is_dataclass, replace
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal, Union
+from typing import Any, Literal, Union
 
 from lark import Token
 
@@ -28,9 +28,6 @@ from specc.pipeline import Loaded, load
 from specc.runtime.planner import model as pm
 from specc.syntax.parser import parse_text
 from specc.syntax.printer import format_source, print_source
-
-if TYPE_CHECKING:
-    from specc.runtime.ftplan.missions import MissionSetup
 
 Robot = Union[Path, Sequence[Path], Loaded, m.Program]
 Reason = Literal["identical", "duplicate", "invalid", "equivalent"]
@@ -157,27 +154,53 @@ class MutantSet:
         is drawn uniformly within it. Not stratified: a uniform draw among all kept mutants."""
         if n >= len(self.kept):
             return self.kept
-        draw = random.Random(seed)
-        if not stratified:
-            chosen = draw.sample(self.kept, n)
-        else:
-            by_class = {kind: [x for x in self.kept if x.kind == kind] for kind in CLASSES}
-            shares = even_shares(n, {kind: len(group) for kind, group in by_class.items()})
-            chosen = [x for kind in CLASSES for x in draw.sample(by_class[kind], shares[kind])]
+        if stratified:
+            kept = {x.id for x in self.kept}
+            return draw_kept(self.mutants, n, seed, lambda x: x.id in kept)
+        chosen = random.Random(seed).sample(self.kept, n)
         order = {x.id: i for i, x in enumerate(self.kept)}
         return tuple(sorted(chosen, key=lambda x: order[x.id]))
 
 
-def even_shares(n: int, available: dict[MutationClass, int]) -> dict[MutationClass, int]:
-    """`n` split as evenly as possible between the classes, none beyond what it has: one at a time
-    to the class with the smallest share so far (the first in CLASSES' order on a tie)."""
-    shares = dict.fromkeys(available, 0)
-    for _ in range(n):
-        open_classes = [kind for kind in CLASSES if kind in available and shares[kind] < available[kind]]
-        if not open_classes:
-            break
-        shares[min(open_classes, key=lambda kind: shares[kind])] += 1
-    return shares
+def draw_kept(mutants: Sequence[Mutant], n: int, seed: int = 0,
+              is_kept: Callable[[Mutant], bool] | None = None) -> tuple[Mutant, ...]:
+    """`n` mutants that keep_valid would keep, drawn with `seed` and stratified by class, in id order.
+
+    Each class's mutants are shuffled with the seed; the draw goes one mutant at a time to the
+    class with the fewest drawn so far (the first in CLASSES' order on a tie), which gives its next
+    kept mutant; a class with no kept mutant left drops out. `is_kept` judges a mutant (by default,
+    keep_valid's filters on that mutant alone), so only the mutants drawn and those passed over on
+    the way are checked: a sample of a few dozen costs seconds, not the minute of the whole set.
+    MutantSet.sample draws the same mutants from a set already judged."""
+    if is_kept is None:
+        first_with_text: dict[str, str] = {}
+        for x in mutants:
+            first_with_text.setdefault(x.text, x.id)
+
+        def is_kept(x: Mutant) -> bool:
+            return (x.text != x.target.original_text and first_with_text[x.text] == x.id
+                    and verdict(x.target, x.text) is None)
+
+    draw = random.Random(seed)
+    queues: dict[MutationClass, list[Mutant]] = {}
+    for kind in CLASSES:
+        group = [x for x in mutants if x.kind == kind]
+        draw.shuffle(group)
+        if group:
+            queues[kind] = group[::-1]  # popped from the end
+    drawn: dict[MutationClass, list[Mutant]] = {kind: [] for kind in queues}
+    while sum(len(group) for group in drawn.values()) < n and queues:
+        kind = min(queues, key=lambda k: (len(drawn[k]), CLASSES.index(k)))
+        queue = queues[kind]
+        while queue:
+            candidate = queue.pop()
+            if is_kept(candidate):
+                drawn[kind].append(candidate)
+                break
+        if not queue:
+            del queues[kind]
+    order = {x.id: i for i, x in enumerate(mutants)}
+    return tuple(sorted((x for group in drawn.values() for x in group), key=lambda x: order[x.id]))
 
 
 # ---------------------------------------------------------------- enumeration
@@ -402,16 +425,6 @@ def mutant_domain(mutant: Mutant) -> pm.PlanningDomain:
         return domain_model(program, _domain_of(program, mutant.target))
     except PlanningError as exc:
         raise MutationError(f"mutant {mutant.id}: the planner's domain cannot be built: {exc}") from None
-
-
-def mutated_setup(setup: MissionSetup, domain: pm.PlanningDomain) -> MissionSetup:
-    """A mission's setup (`specc.runtime.ftplan.missions.mission_setup`) with `domain` in place of
-    the domain of the same name: every planner of the configuration planning in that domain gets
-    the mutant (in the seed's campaigns, the first planner of Robot1/2 plans with Modele1)."""
-    if domain.name not in setup.domains:
-        raise MutationError(f"the mission's planners plan in {', '.join(sorted(setup.domains))}, "
-                            f"not in '{domain.name}'")
-    return replace(setup, domains={**setup.domains, domain.name: domain})
 
 
 def default_workers() -> int:

@@ -518,6 +518,9 @@ class SimExecutor:
         self.planned: list[PlannedTask] = []
         self._live: list[_Running] = []  # actions under way, also after a failure ended the execution
         self._stopping: list[tuple[Any, int]] = []  # (client, request) interrupted, not yet ended
+        self._replied_since = False  # a module answered a request of ours since the actions last advanced
+        for client in rover.clients:
+            client.final_listeners.append(self._final_reply)
 
     # ------------------------------------------------------------ Executor
     def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
@@ -553,9 +556,11 @@ class SimExecutor:
                 stuck = ", ".join(a.text() for a in waiting)
                 return Execution(False, now, waiting[0].id, f"{stuck} wait for actions that never end")
             wake = min(upcoming + [r.deadline for r in self._live])
-            # Every action advanced after each kernel event (no short cut: each sends its next
-            # request at the instant the one before ended).
-            self.kernel.run_while(lambda: not any([self._advance(r) for r in self._live]), wake)
+            # Every action advanced after each kernel event in which a module answered (each
+            # sends its next request at the instant the one before ended), and once now for what
+            # was answered while the actions before concluded.
+            self._replied_since = True
+            self.kernel.run_while(lambda: not self._advance_answered(), wake)
             for run in self._live:
                 if run.finished is None and self.kernel.now >= run.deadline - OVERRUN_TOLERANCE:
                     self._overrun(run)
@@ -589,9 +594,21 @@ class SimExecutor:
         self._live.append(run)
         self._advance(run)
 
+    def _final_reply(self, reply: rt.Reply) -> None:
+        self._replied_since = True
+
+    def _advance_answered(self) -> bool:
+        """`_advance` every action if a module answered since the last call (an action waiting
+        for a reply has nothing to do before); True when one is over."""
+        if not self._replied_since:
+            return False
+        self._replied_since = False
+        return any([self._advance(r) for r in self._live])
+
     def _advance(self, run: _Running) -> bool:
         """Send the action's next request when the one before has ended well; True when the
-        action is over (ended or failed). Called after every kernel event while it runs."""
+        action is over (ended or failed). Called after each kernel event that brought a reply
+        while it runs."""
         if run.finished is not None:
             return True
         while True:
@@ -780,9 +797,11 @@ class PreparedMission:
 
 
 def check_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
-                  generated: Path = GENERATED, example: Path = EXAMPLE) -> CheckedMission:
+                  generated: Path = GENERATED, example: Path = EXAMPLE,
+                  domains: Mapping[str, pm.PlanningDomain] | None = None) -> CheckedMission:
     """Check the names and read what the mission needs, nothing built yet; RunError when a name
-    is unknown or the package is not compiled."""
+    is unknown or the package is not compiled. `domains` replace the generated planning domains
+    of the same names (a mutant of Modele1, seed 004 §4.1.3)."""
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise RunError(f"seed {seed!r}: give a whole number >= 0")
     package = load_package(generated, example)
@@ -790,6 +809,12 @@ def check_mission(configuration: str, mission: str, world: str | Path | World, s
         setup = mission_setup(package.ftplan.CONFIGURATIONS, configuration, mission, package.planner)
     except UnknownName as error:
         raise RunError(str(error)) from None
+    if domains:
+        unused = sorted(set(domains) - setup.planned_in)
+        if unused:
+            raise RunError(f"configuration {configuration} plans in {', '.join(sorted(setup.planned_in))}, "
+                           f"not in {', '.join(unused)}")
+        setup = dataclasses.replace(setup, domains={**setup.domains, **domains})
     ground = resolve_world(world, example / "worlds")
     tasks = RoverTasks.of(setup.config, setup.problem, mission, ground)
     # The antenna's windows, and those the picture's time strip shows.
@@ -805,28 +830,33 @@ class CheckedMission(NamedTuple):
 
 
 def prepare_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
-                    generated: Path = GENERATED, example: Path = EXAMPLE) -> PreparedMission:
+                    generated: Path = GENERATED, example: Path = EXAMPLE,
+                    domains: Mapping[str, pm.PlanningDomain] | None = None) -> PreparedMission:
     """`check_mission`, then the modules on the simulated rover: what `run_rover_mission` runs."""
-    checked = check_mission(configuration, mission, world, seed, generated=generated, example=example)
+    checked = check_mission(configuration, mission, world, seed, generated=generated, example=example,
+                            domains=domains)
     return PreparedMission(configuration, mission, seed, checked.setup, checked.world,
                            build_rover(checked.modules, checked.world, seed), checked.tasks)
 
 
 def run_rover_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
                       log: EventLog | None = None, progress: Callable[[RoverProgress], None] | None = None,
-                      generated: Path = GENERATED, example: Path = EXAMPLE, timing: str = "model") -> RoverRun:
+                      generated: Path = GENERATED, example: Path = EXAMPLE, timing: str = "model",
+                      domains: Mapping[str, pm.PlanningDomain] | None = None) -> RoverRun:
     """Run `mission` (M1..M4) with the robot `configuration` of seed 004 §4.2.1.1 (Robot1,
     Robot2, Robot1/2, Robot1/2c) in `world` (W1..W4, a world file or a World), the simulation and the
     visibility windows drawn from `seed`.
 
     `generated` holds the compiled atrv package (`specc compile examples/atrv -o generated`),
     `example` the codels (atrv_codels) and the worlds;
-    `timing` is FTplan's planning charge ("model": deterministic, "wall": measured). Events go to
+    `timing` is FTplan's planning charge ("model": deterministic, "wall": measured); `domains`
+    replace the generated planning domains of the same names (check_mission). Events go to
     `log` (one in memory when none is given) and to the result. Anything the caller can get wrong
     raises RunError, whose message is one line."""
     if timing not in TIMINGS:
         raise RunError(f"timing '{timing}': give {' or '.join(TIMINGS)}")
-    prepared = prepare_mission(configuration, mission, world, seed, generated=generated, example=example)
+    prepared = prepare_mission(configuration, mission, world, seed, generated=generated, example=example,
+                               domains=domains)
     setup, rover, windows = prepared.setup, prepared.rover, prepared.world.windows
     log = log if log is not None else EventLog()
     journal = _Journal(log, progress, len(SystemState.from_problem(setup.problem).goals))

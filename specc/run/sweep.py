@@ -23,6 +23,7 @@ from typing import Any
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
 from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
+from specc.runtime.ftplan import planner_processes_kept
 
 MISSIONS = ("M1", "M2", "M3", "M4")
 WORLDS = ("W1", "W2", "W3", "W4")
@@ -102,13 +103,14 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = MISSIONS, w
         raise RunError("nothing to run: give at least one mission, world and configuration")
     planned = [plan_run(robot, request) for request in requests]  # a typo stops the table before any run
     result = SweepResult(robot)
-    for done, run in enumerate(planned):
-        if step is not None:
-            step(done, len(requests), _label(robot, run.request))
-        try:
-            result.outcomes.append(run_planned(run))
-        except RunCrashed as crash:  # one broken run is a failure of the table, not the end of it
-            result.outcomes.append(crash.outcome)
+    with planner_processes_kept():  # the runs' planners start warm, one after another
+        for done, run in enumerate(planned):
+            if step is not None:
+                step(done, len(requests), _label(robot, run.request))
+            try:
+                result.outcomes.append(run_planned(run))
+            except RunCrashed as crash:  # one broken run is a failure of the table, not the end of it
+                result.outcomes.append(crash.outcome)
     if step is not None:
         step(len(requests), len(requests), "")
     if robot == "atrv":

@@ -183,21 +183,22 @@ class Poster(Generic[T]):
 
     def __init__(self, spec: PosterSpec):
         self.spec = spec
-        self._snapshot: Snapshot[T] | None = None
+        self._content: tuple[T, float] | None = None  # the data and its date; each reader gets a Snapshot
 
     def write(self, data: T, date: float) -> None:
-        self._snapshot = Snapshot(clone(data), date)
+        self._content = clone(data), date
 
     def publish(self, sdi: Any, date: float) -> None:
         """Write the poster's fields copied from the module's SDI (each copied once: the record
         is built from the copies, not copied again whole as `write` would)."""
         spec = self.spec
-        self._snapshot = Snapshot(spec.type(**{f: clone(getattr(sdi, f)) for f in spec.fields}), date)
+        self._content = spec.type(**{f: clone(getattr(sdi, f)) for f in spec.fields}), date
 
     def read(self) -> Snapshot[T] | None:
-        if self._snapshot is None:
+        if self._content is None:
             return None
-        return Snapshot(clone(self._snapshot.data), self._snapshot.date)
+        data, date = self._content
+        return Snapshot(clone(data), date)
 
 
 _IMMUTABLE = (int, float, str, bool, type(None), enum.Enum, tuple, frozenset)
@@ -419,26 +420,32 @@ class TaskRunner:
         """Next tick on the grid delay + k * period: now at the earliest, never twice an instant."""
         if self.timer is not None:
             return
-        kernel = self.module.kernel
-        period, delay = self.spec.period, self.spec.delay
         # Never twice a slot: a tick rescheduling itself is in its own.
-        k = max(math.ceil((kernel.now - delay) / period - 1e-9), self.slot + 1)
+        spec = self.spec
+        self._schedule_slot(max(math.ceil((self.module.kernel.now - spec.delay) / spec.period - 1e-9), self.slot + 1))
+
+    def _schedule_slot(self, k: int) -> None:
         self.slot = k
+        spec = self.spec
         # Rounded to the nanosecond: 3 x 0.1 s and 1 x 0.3 s are one instant, so priority orders them.
-        self.timer = kernel.call_at(round(delay + k * period, 9), self.tick, self.spec.priority)
+        self.timer = self.module.kernel.call_at(round(spec.delay + k * spec.period, 9), self.tick, spec.priority)
 
     def tick(self) -> None:
         self.timer = None
         module = self.module
         self.cycles += 1
-        self.initialise()
-        if self.spec.permanent is not None:
-            module.call_permanent(self.spec.permanent)
-            module.cycle_done(self.spec.permanent)
-        for activity in list(self.activities):
-            module.step(activity)
-        if self.permanent or self.activities:
-            self.schedule()
+        if not self.initialised:
+            self.initialise()
+        permanent = self.spec.permanent
+        if permanent is not None:
+            module.call_permanent(permanent)
+            module.cycle_done(permanent)
+        if self.activities:
+            for activity in list(self.activities):
+                module.step(activity)
+        if (permanent is not None or self.activities) and self.timer is None:
+            # The next slot: this tick is on slot `self.slot`, so `schedule` would find no earlier one.
+            self._schedule_slot(self.slot + 1)
 
 
 # ---------------------------------------------------------------- the module and its controller
@@ -463,10 +470,10 @@ class Module:
         self.reply_listeners: list[ReplySink] = []  # see every reply the module sends (reflexes, logs)
         self._functions: dict[str, Callable[..., Any]] = {}
         # A poster's activity is a request, or a codel (of a request or an exec task) whose cycles update it.
-        self._auto_posters: dict[str, list[str]] = {}
+        self._auto_posters: dict[str, list[Poster[Any]]] = {}
         for poster_spec in spec.posters:
             if poster_spec.update == "auto" and poster_spec.activity is not None:
-                self._auto_posters.setdefault(poster_spec.activity, []).append(poster_spec.name)
+                self._auto_posters.setdefault(poster_spec.activity, []).append(self.posters[poster_spec.name])
 
     @property
     def zombie(self) -> Activity | None:
@@ -796,10 +803,10 @@ class Module:
     # -- posters
     def cycle_done(self, activity_name: str) -> None:
         """A cycle of a request or of a codel ended: update the auto posters named after it."""
-        names = self._auto_posters.get(activity_name)
-        if names:
-            for name in names:
-                self.update_poster(name)
+        posters = self._auto_posters.get(activity_name)
+        if posters:
+            for poster in posters:
+                poster.publish(self.sdi, self.kernel.now)
 
     def update_poster(self, name: str) -> None:
         self.posters[name].publish(self.sdi, self.kernel.now)
@@ -1009,6 +1016,9 @@ class ModuleClient:
         self.module = module
         self.kernel = module.kernel
         self._exchanges: dict[int, _Exchange] = {}
+        # Told of each request's final reply as it comes (a TIMEOUT the client gives itself too):
+        # what a caller waiting on several requests at once needs instead of polling `reply`.
+        self.final_listeners: list[ReplySink] = []
 
     def send(self, request: str, input_: Any = None, *, interm_timeout: float | None = None,
              final_timeout: float | None = None) -> int:
@@ -1022,15 +1032,14 @@ class ModuleClient:
                 exchange.timers.append(self.kernel.call_later(timeout, functools.partial(self._expire, rqst_id, which)))
         return rqst_id
 
-    @staticmethod
-    def _receiver(exchange: _Exchange) -> ReplySink:
+    def _receiver(self, exchange: _Exchange) -> ReplySink:
         def receive(reply: Reply) -> None:
             if exchange.final is not None:
                 return  # the client already gave up (TIMEOUT)
             if reply.final:
-                exchange.final = reply
                 for timer in exchange.timers:
                     timer.cancel()
+                self._finished(exchange, reply)
             else:
                 exchange.interm = reply
         return receive
@@ -1039,9 +1048,13 @@ class ModuleClient:
         exchange = self._exchanges[rqst_id]
         if exchange.final is not None or (which == "interm" and exchange.interm is not None):
             return
-        exchange.final = Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT,
-                               Report(which, f"no {'intermediate' if which == 'interm' else 'final'} reply in time"),
-                               time=self.kernel.now)
+        self._finished(exchange, Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT, Report(
+            which, f"no {'intermediate' if which == 'interm' else 'final'} reply in time"), time=self.kernel.now))
+
+    def _finished(self, exchange: _Exchange, reply: Reply) -> None:
+        exchange.final = reply
+        for listener in self.final_listeners:
+            listener(reply)
 
     def reply(self, rqst_id: int) -> Reply:
         """modFuncReplyRcv without waiting: the final reply, or WAITING (report: which one)."""

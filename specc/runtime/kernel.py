@@ -88,20 +88,22 @@ class Kernel:
 
     def step(self) -> bool:
         """Run the next event; False when nothing is scheduled."""
-        while self._queue:
-            timer = heapq.heappop(self._queue)[3]
-            if timer.cancelled:
-                continue
-            self.clock.wait_until(timer.when, self.now)
-            self.now = timer.when
-            timer.action()
-            return True
-        return False
+        if self.next_time() is None:
+            return False
+        self._fire(heapq.heappop(self._queue)[3])
+        return True
+
+    def _fire(self, timer: Timer) -> None:
+        self.clock.wait_until(timer.when, self.now)
+        self.now = timer.when
+        timer.action()
 
     def next_time(self) -> float | None:
-        while self._queue and self._queue[0][3].cancelled:
-            heapq.heappop(self._queue)
-        return self._queue[0][0] if self._queue else None
+        """When the next event is due (cancelled ones are dropped); None when nothing is scheduled."""
+        queue = self._queue
+        while queue and queue[0][3].cancelled:
+            heapq.heappop(queue)
+        return queue[0][0] if queue else None
 
     def run_until(self, instant: float) -> None:
         """Run every event due at or before `instant`, then set the clock to `instant`."""
@@ -109,7 +111,7 @@ class Kernel:
             upcoming = self.next_time()
             if upcoming is None or upcoming > instant:
                 break
-            self.step()
+            self._fire(heapq.heappop(self._queue)[3])  # the one next_time found
         if instant > self.now:
             self.clock.wait_until(instant, self.now)
             self.now = instant
@@ -121,11 +123,12 @@ class Kernel:
         """Run events while `condition()` holds and time stays within `deadline`.
 
         Returns True when the condition became false (what was awaited happened)."""
+        queue = self._queue
         while condition():
             upcoming = self.next_time()
             if upcoming is None or upcoming > deadline:
                 if deadline != float("inf") and deadline > self.now:
                     self.run_until(deadline)
                 return not condition()
-            self.step()
+            self._fire(heapq.heappop(queue)[3])  # the one next_time found
         return True

@@ -14,9 +14,10 @@ The ratio of the wall times is what the whole stack costs over the physics.
   end at 280 and 377-392 s), so the summary line extrapolates an 800 s mission from the longest
   one's factor. Each mission's wall time includes the start of its planner processes, printed
   apart (measured by starting and closing the same pool alone, before the mission: it also warms
-  the imports up). Under pytest a planner process starts in a few hundredths of a second; from a
-  script with heavy top-level imports it takes a few tenths, multiprocessing's forkserver running
-  the script's imports again in every child.
+  the imports up). A planner process starts in a few hundredths of a second once multiprocessing's
+  forkserver is up (the first start, a few tenths, starts it): the forkserver has imported the
+  modules of specc the program has, so a child running the program's main module again imports
+  none of them anew.
 - The Hilare hunt (`specc.run.hunt.run_hunt`): the eight modules, the executive and the PRS
   supervisor collecting five objects; seed 1 is the longest hunt of seeds 0-29. A one-second hunt
   before it imports the compiled package (its 1.4 MB resource controller takes most of a second to

@@ -176,6 +176,20 @@ def test_waiting_for_the_intermediate_reply_can_time_out(robot: Robot) -> None:
     assert client.reply(waiting).status is Status.WAITING  # only this wait gave up
 
 
+def test_final_listeners_hear_each_final_reply_once_a_client_timeout_included(robot: Robot) -> None:
+    client = robot.client()
+    heard: list[rt.Reply] = []
+    client.final_listeners.append(heard.append)
+    ended = client.send("C", robot.package.alpha.CInput(script="exec"))
+    late = client.send("A", robot.package.alpha.AInput(script="exec," * 50), final_timeout=0.05)
+    robot.kernel.run_for(0.02)
+    assert [(r.rqst_id, r.status) for r in heard] == [(ended, Status.END)]  # no intermediate reply
+    robot.kernel.run_for(1.0)
+    assert [(r.rqst_id, r.status) for r in heard] == [(ended, Status.END), (late, Status.TIMEOUT)]
+    assert late not in robot.alpha.activities  # A ended meanwhile: its own final reply is not heard
+    assert heard[-1] is client.reply(late)
+
+
 @dataclass
 class _Data(rt.InternalData):
     pass

@@ -105,11 +105,20 @@ def update_map(memory, fresh, x, y, theta, first_angle, last_angle):
     points = np.vstack((near, memory)) if len(memory) else near
     if not len(points):
         return points
-    _, first = np.unique(np.floor(points / MAP_CELL).astype(np.int64), axis=0, return_index=True)
-    points = points[np.sort(first)]
+    points = points[first_in_cells(points)]
     if len(points) > MAP_SIZE:
         points = points[np.argsort(np.hypot(points[:, 0] - x, points[:, 1] - y), kind="stable")[:MAP_SIZE]]
     return points
+
+
+def first_in_cells(points):
+    """The indices, in order, of the first point in each MAP_CELL square that holds one."""
+    cells = np.floor(points / MAP_CELL).astype(np.int64)
+    cells -= cells.min(axis=0)
+    # One number per cell (np.unique on rows costs several times more than on numbers); its
+    # first index, as the stable sort np.unique makes for return_index finds it.
+    _, first = np.unique(cells[:, 0] * (cells[:, 1].max() + 1) + cells[:, 1], return_index=True)
+    return np.sort(first)
 
 
 # ---------------------------------------------------------------- NDD: the method
@@ -136,12 +145,21 @@ def free_lengths(points, directions, clearance, horizon):
     if len(points) == 0:
         return np.full(len(directions), float(horizon))
     ux, uy = np.cos(directions), np.sin(directions)
-    forward = np.multiply.outer(ux, points[:, 0]) + np.multiply.outer(uy, points[:, 1])  # (D, P)
-    lateral = np.multiply.outer(ux, points[:, 1]) - np.multiply.outer(uy, points[:, 0])
-    inside = (np.abs(lateral) < clearance) & (forward > 0.0)  # points the disc moves towards
-    reach = forward - np.sqrt(np.maximum(clearance * clearance - lateral * lateral, 0.0))
-    reach = np.where(inside, np.maximum(reach, 0.0), horizon)
-    return np.minimum(reach.min(axis=1), horizon)
+    px, py = points[:, 0:1], points[:, 1:2]  # (P, 1): a row of the (P, D) arrays per point
+    # (P, D) rather than (D, P): the minimum over the points is then elementwise minima of whole
+    # rows, and the arrays are worked in place; each element is computed as before, to the bit.
+    forward = px * ux
+    forward += py * uy
+    lateral = py * ux
+    lateral -= px * uy
+    inside = np.abs(lateral) < clearance
+    inside &= forward > 0.0  # the points the disc moves towards
+    # reach = forward - sqrt(max(clearance² - lateral², 0)), at least 0
+    lateral *= lateral
+    np.subtract(clearance * clearance, lateral, out=lateral)
+    np.sqrt(np.maximum(lateral, 0.0, out=lateral), out=lateral)
+    reach = np.maximum(np.subtract(forward, lateral, out=forward), 0.0, out=forward)
+    return np.minimum.reduce(reach, axis=0, where=inside, initial=horizon)
 
 
 def body_distance(points):

@@ -6,6 +6,9 @@ verification, successive (Fig 3.1) and concurrent (Fig 3.2) recovery.
     setup = mission_setup(rover.CONFIGURATIONS, "Robot1/2", "M1", atrv.planner)
     with ProcessPool(setup.config.planners, setup.domains) as pool:
         result = FtPlan(setup.config, setup.problem, pool, ScriptedExecutor(), problems=setup.problems).run()
+
+A program running many missions one after another keeps the planners' processes from one to the
+next inside `with planner_processes_kept():` (see `planners`).
 """
 
 from __future__ import annotations
@@ -14,8 +17,9 @@ from specc.runtime.ftplan.component import CostModel, FtPlan, MissionFailure, Mi
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig, configurations
 from specc.runtime.ftplan.execution import Executor, Outcome, Report, ScriptedExecutor
 from specc.runtime.ftplan.missions import MissionSetup, UnknownName, mission_setup
+from specc.runtime.ftplan.planners import planner_processes_kept
 from specc.runtime.ftplan.pools import LocalPool, ProcessPool
 
 __all__ = ["CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure", "MissionResult",
            "MissionSetup", "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor", "UnknownName",
-           "configurations", "mission_setup"]
+           "configurations", "mission_setup", "planner_processes_kept"]

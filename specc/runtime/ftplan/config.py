@@ -5,6 +5,7 @@ as data in the generated package; the runtime reads nothing else."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from specc.runtime.planner.model import Interval as Interval  # re-exported: the generated modules name it here
@@ -163,6 +164,20 @@ class FtPlanConfig:
             planners.append(replace(planner, domain=problem.domain,
                                     view=views.get(planner.name, ()) + planner.view))
         return replace(self, planners=tuple(planners))
+
+
+WITHOUT_ANALYZER = "-noanalyzer"  # a configuration's name with this suffix: the same, plan analyzer off
+
+
+def configuration_named(configurations: Mapping[str, FtPlanConfig], name: str) -> FtPlanConfig:
+    """The configuration `name` of `configurations`; `<name>-noanalyzer` is it without the plan
+    analyzer (the thesis' own FTplan, which never had one). KeyError when unknown."""
+    if name in configurations:
+        return configurations[name]
+    base = name.removesuffix(WITHOUT_ANALYZER)
+    if base != name and base in configurations:
+        return replace(configurations[base], analyzer=())
+    raise KeyError(name)
 
 
 def configurations(config: FtPlanConfig) -> dict[str, FtPlanConfig]:

@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import ModuleType
 
-from specc.runtime.ftplan.config import FtPlanConfig
+from specc.runtime.ftplan.config import WITHOUT_ANALYZER, FtPlanConfig, configuration_named
 from specc.runtime.planner import model as pm
 
 
@@ -25,16 +25,23 @@ class MissionSetup:
     config: FtPlanConfig  # the configuration on the mission
     problem: pm.Problem  # FTplan's own statement of the mission: its facts and goals
     problems: dict[str, pm.Problem]  # each planner's
-    domains: dict[str, pm.PlanningDomain]  # by name: those the planners plan in
+    domains: dict[str, pm.PlanningDomain]  # by name: those of the mission's problems
+
+    @property
+    def planned_in(self) -> set[str]:
+        """The domains the configuration's planners plan in (fewer than `domains` for Robot2)."""
+        return {planner.domain for planner in self.config.planners}
 
 
 def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str, mission: str,
                   planning: ModuleType) -> MissionSetup:
     """`configuration` ("Robot1/2") of a generated ftplan module's CONFIGURATIONS on `mission`
     ("M1"), with the problems and domains of the generated `planner` package `planning`."""
-    if configuration not in configurations:
-        raise UnknownName(f"no robot configuration '{configuration}' (known: {', '.join(configurations)})")
-    base = configurations[configuration]
+    try:
+        base = configuration_named(configurations, configuration)
+    except KeyError:
+        raise UnknownName(f"no robot configuration '{configuration}' (known: {', '.join(configurations)}; "
+                          f"add {WITHOUT_ANALYZER} to one for it without the plan analyzer)") from None
     try:
         config = base.for_mission(mission)
         statement = base.mission(mission)

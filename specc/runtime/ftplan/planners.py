@@ -15,7 +15,8 @@ and restarts when the watchdog fires (as the prototype kills and relaunches the 
 
 What crosses to the child is plain data: the planner's `PlannerConfig` and the planning
 domains (`pm.PlanningDomain`, frozen dataclasses; about 10 kB pickled for the rover's Modele1),
-then one `pm.Problem` per request; a `PlanResult` comes back. Passing the domain objects rather
+sent on its pipe before anything else, then one `pm.Problem` per request; a `PlanResult` comes
+back. Passing the domain objects rather
 than the name of the generated package to import spares the child any sys.path set-up, and lets
 tests and tools plan domains that were never generated. `planning_domains(DOMAINS)` turns a
 generated `planner` package's `DOMAINS` into that mapping.
@@ -38,7 +39,16 @@ costs one interpreter start (about 0.4 s) on the first planner of the program. T
 is one per program, shared by every user of that start method; if it is already running, our
 preload is not applied and children import the planner themselves (slower, still correct). As
 with "spawn", the program's main module is imported again in each child: scripts that start
-planners keep their top level under `if __name__ == "__main__":`.
+planners keep their top level under `if __name__ == "__main__":`. What that main module imports
+is mostly specc (`specc` itself: its command line imports the whole compiler), so the server
+also imports the modules of specc the program has imported by the time it starts: a child's
+main module then imports nothing anew, where it took 0.3-0.5 s in each planner's start (each
+restart of a planner FTplan gives up on included).
+
+Many missions in one program (a campaign's worker): within `planner_processes_kept()`, a
+planner process closed idle is kept for the next PlannerProcess, which builds its own planner
+there; the planner's warming up (what it works out once per task, CasADi's solves among it)
+then serves the next missions too.
 
 No zombies, no orphans: `kill()` joins what it killed; the processes are daemonic, so
 multiprocessing terminates them at interpreter exit; and each child watches its parent (a
@@ -47,15 +57,17 @@ thread waiting on the parent's sentinel) and exits at once when FTplan dies, eve
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import itertools
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 import traceback
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from types import ModuleType, TracebackType
@@ -67,7 +79,8 @@ from specc.runtime.planner import model as pm
 
 START_METHOD: Final = "forkserver"
 # Imported once by the forkserver, so that a planner's process starts without importing them
-# (casadi, which the planner imports at its first plan, is 0.2 s of it).
+# (casadi, which the planner imports at its first plan, is 0.2 s of it); then the modules of
+# specc the program has imported (`forkserver_preload`).
 PRELOAD = ["specc.runtime.planner", "specc.runtime.ftplan.planners", "casadi"]
 KILL_GRACE = 1.0  # seconds a planner has to exit on SIGTERM before it gets SIGKILL
 
@@ -194,6 +207,15 @@ class _Request:
 
 
 @dataclass(frozen=True)
+class _Build:
+    """Build the planner to serve the requests that follow (the process's first message, and the
+    first for each PlannerProcess that takes a kept process)."""
+
+    config: PlannerConfig
+    domains: Mapping[str, pm.PlanningDomain]
+
+
+@dataclass(frozen=True)
 class _Started:
     error: str  # "": the planner is built; else why it could not be (every request gets it back)
 
@@ -271,19 +293,16 @@ def _exit_with_parent() -> None:
     threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
-def _serve(config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain], connection: Connection) -> None:
-    """The planner's process: build the planner, then answer requests until told to stop.
-    Whatever the planner raises is sent back rather than ending the process silently."""
+def _serve(connection: Connection) -> None:
+    """The planner's process: build the planner, then answer requests until told to stop; build
+    another when told to (a kept process serving its next PlannerProcess). Whatever the planner
+    raises is sent back rather than ending the process silently."""
     _exit_with_parent()
     # Ctrl-C reaches the whole process group: FTplan, not the terminal, decides when planners stop.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     planner: SupportsPlan | None = None
     startup_error = ""
-    try:
-        planner = load_factory(config.factory)(config, domains)
-    except Exception as error:
-        startup_error = f"building planner '{config.name}' with {config.factory} failed: {_describe(error)}"
-    connection.send(_Started(startup_error))
+    domains: Mapping[str, pm.PlanningDomain] = {}
     while True:
         try:
             request = connection.recv()
@@ -291,6 +310,15 @@ def _serve(config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain], conn
             return
         if request is None:
             return
+        if isinstance(request, _Build):
+            config, domains = request.config, _same_objects(request.domains, domains)
+            planner, startup_error = None, ""
+            try:
+                planner = load_factory(config.factory)(config, domains)
+            except Exception as error:
+                startup_error = f"building planner '{config.name}' with {config.factory} failed: {_describe(error)}"
+            connection.send(_Started(startup_error))
+            continue
         started = time.perf_counter()
         try:
             if planner is None:
@@ -306,6 +334,15 @@ def _serve(config: PlannerConfig, domains: Mapping[str, pm.PlanningDomain], conn
         except Exception as error:  # the result does not pickle: say so rather than die
             connection.send(_Reply(request.id, None, f"the answer could not be sent: {_describe(error)}",
                                    traceback.format_exc(), reply.seconds))
+
+
+def _same_objects(domains: Mapping[str, pm.PlanningDomain],
+                  before: Mapping[str, pm.PlanningDomain]) -> dict[str, pm.PlanningDomain]:
+    """`domains`, each one equal to the domain of its name `before` replaced by that one: the
+    planner caches what it works out per task by the task's identity, so a kept process planning
+    the same domain again (every mission of a campaign but the mutant's) finds it worked out."""
+    return {name: before[name] if name in before and before[name] == domain else domain
+            for name, domain in domains.items()}
 
 
 # ---------------------------------------------------------------- the parent's handle
@@ -362,23 +399,19 @@ class PlannerProcess:
 
     # ------------------------------------------------------------ life cycle
     def start(self) -> None:
-        """Start the process; does not wait for the planner to be built (see `wait_ready`)."""
+        """Start the process (or take a kept one, see `planner_processes_kept`); does not wait
+        for the planner to be built (see `wait_ready`)."""
         if self._process is not None:
             raise RuntimeError(f"planner '{self.name}' is already started (restart() it)")
-        context = multiprocessing.get_context(START_METHOD)
-        context.set_forkserver_preload(PRELOAD)
-        ours, theirs = context.Pipe(duplex=True)
-        process = context.Process(target=_serve, args=(self.config, self.domains, theirs),
-                                  name=f"ftplan-planner-{self.name}", daemon=True)
         self.started_at = time.perf_counter()
+        kept = _kept.take() if _kept is not None else None
+        process, connection = kept if kept is not None else _launch()
+        process.name = f"ftplan-planner-{self.name}"
         try:
-            process.start()
-        except BaseException:
-            ours.close()
-            raise
-        finally:
-            theirs.close()  # the child has its own copy: ours closed, its death reads as EOF here
-        self._process, self._connection = process, ours
+            connection.send(_Build(self.config, self.domains))
+        except OSError:
+            pass  # the process is dead: wait_ready() or poll() report it
+        self._process, self._connection = process, connection
         self._started, self._startup_error, self.startup_seconds = False, "", None
 
     def wait_ready(self, timeout: float | None = None) -> None:
@@ -402,17 +435,8 @@ class PlannerProcess:
         under way is dropped. Does nothing if the process is not started."""
         process, connection = self._process, self._connection
         self._process, self._connection, self._pending, self._started = None, None, None, False
-        if connection is not None:
-            connection.close()
-        if process is None:
-            return
-        if process.is_alive():
-            process.terminate()
-            process.join(self.kill_grace)
-            if process.is_alive():
-                process.kill()
-        process.join()
-        process.close()
+        if process is not None and connection is not None:
+            _stop(process, connection, self.kill_grace, ask=False)
 
     def restart(self) -> None:
         self.kill()
@@ -424,15 +448,20 @@ class PlannerProcess:
             self.restart()
 
     def close(self) -> None:
-        """Ask the planner to stop, give it `kill_grace` to do so, then kill it."""
+        """Ask the planner to stop, give it `kill_grace` to do so, then kill it; while processes
+        are kept (`planner_processes_kept`), keep it instead if it is built and idle."""
         process, connection = self._process, self._connection
-        if process is not None and connection is not None and self._pending is None and process.is_alive():
-            try:
-                connection.send(None)
-            except OSError:
-                pass  # already gone: kill() reaps it
-            process.join(self.kill_grace)
-        self.kill()
+        if process is None or connection is None or self._pending is not None or not process.is_alive():
+            self.kill()
+            return
+        # Built, even if nobody waited for it to be (a planner restarted and not asked since).
+        kept = _kept is not None and (self._started or self._take_started(self._read(connection)))
+        self._process, self._connection, self._started = None, None, False
+        if kept:
+            assert _kept is not None
+            _kept.keep(process, connection)
+        else:
+            _stop(process, connection, self.kill_grace, ask=True)
 
     def __enter__(self) -> PlannerProcess:
         if self._process is None:
@@ -531,6 +560,97 @@ class PlannerProcess:
         if process.is_alive():
             process.kill()
             process.join()
+
+
+def forkserver_preload() -> list[str]:
+    """What the forkserver imports before it forks a planner: PRELOAD, then the modules of specc
+    this program has imported, in the order they were (that of sys.modules), so that the child's
+    import of the program's main module finds them imported (see the module's docstring)."""
+    return PRELOAD + [name for name in list(sys.modules) if name == "specc" or name.startswith("specc.")]
+
+
+def _launch() -> tuple[multiprocessing.process.BaseProcess, Connection]:
+    """A new planner process, waiting for its first `_Build`."""
+    context = multiprocessing.get_context(START_METHOD)
+    context.set_forkserver_preload(forkserver_preload())
+    ours, theirs = context.Pipe(duplex=True)
+    process = context.Process(target=_serve, args=(theirs,), name="ftplan-planner", daemon=True)
+    try:
+        process.start()
+    except BaseException:
+        ours.close()
+        raise
+    finally:
+        theirs.close()  # the child has its own copy: ours closed, its death reads as EOF here
+    return process, ours
+
+
+def _stop(process: multiprocessing.process.BaseProcess, connection: Connection, grace: float, *, ask: bool) -> None:
+    """End a planner's process and reap it: asked to exit first when `ask` (it must be idle), then
+    SIGTERM, then SIGKILL, `grace` seconds apart."""
+    if ask:
+        try:
+            connection.send(None)
+        except OSError:
+            pass  # already gone
+        process.join(grace)
+    connection.close()
+    if process.is_alive():
+        process.terminate()
+        process.join(grace)
+        if process.is_alive():
+            process.kill()
+    process.join()
+    process.close()
+
+
+class _KeptProcesses:
+    """Planner processes idle between two PlannerProcesses (`planner_processes_kept`)."""
+
+    def __init__(self) -> None:
+        self._idle: list[tuple[multiprocessing.process.BaseProcess, Connection]] = []
+
+    def keep(self, process: multiprocessing.process.BaseProcess, connection: Connection) -> None:
+        self._idle.append((process, connection))
+
+    def take(self) -> tuple[multiprocessing.process.BaseProcess, Connection] | None:
+        """A kept process still alive with nothing unread on its pipe (else it is of no use)."""
+        while self._idle:
+            process, connection = self._idle.pop()
+            if process.is_alive() and not connection.poll():
+                return process, connection
+            _stop(process, connection, KILL_GRACE, ask=False)
+        return None
+
+    def close(self) -> None:
+        while self._idle:
+            _stop(*self._idle.pop(), KILL_GRACE, ask=True)
+
+
+_kept: _KeptProcesses | None = None  # processes are kept while planner_processes_kept() runs
+
+
+@contextlib.contextmanager
+def planner_processes_kept() -> Iterator[None]:
+    """Within it, a planner process that `PlannerProcess.close` finds built and idle is kept,
+    and the next PlannerProcess to start takes it (with its own configuration and domains)
+    rather than starting a process: a program running missions one after another (a campaign's
+    worker) pays a process start and the planner's warming up (what it works out once per
+    task and keeps: about 0.3 s of a mission's first planning) once rather than per mission.
+    Isolation holds where FTplan needs it: a planner it gives up on (`kill`, `restart`,
+    `abandon`) or that is busy or dead at `close` is still killed, and each PlannerProcess
+    builds its planner anew. The processes kept are stopped on leaving; nested, the outermost
+    one keeps them. One thread."""
+    global _kept
+    if _kept is not None:
+        yield
+        return
+    _kept = _KeptProcesses()
+    try:
+        yield
+    finally:
+        kept, _kept = _kept, None
+        kept.close()
 
 
 def _left(deadline: float | None) -> float | None:

@@ -331,6 +331,8 @@ def duration_of(task: pm.Task, args: Mapping[str, Value]) -> DurationSpec:
             outcome: DurationSpec | Empty = _duration_cached(task, key)
         except Empty as error:
             outcome = error
+        if len(_DURATIONS) >= IDENTITY_CACHE_LIMIT:
+            _DURATIONS.clear()
         found = _DURATIONS[(id(task), key)] = (task, outcome)  # the task is kept so that its id stays its own
     if isinstance(found[1], Empty):
         raise found[1]
@@ -338,6 +340,9 @@ def duration_of(task: pm.Task, args: Mapping[str, Value]) -> DurationSpec:
 
 
 _DURATIONS: dict[tuple[int, tuple[tuple[str, Value], ...]], tuple[pm.Task, DurationSpec | Empty]] = {}
+# Entries a cache keyed by a task's identity holds before it starts afresh: it keeps its tasks (and
+# their domains) alive, and one process may plan many domains (a campaign's mutants, one after another).
+IDENTITY_CACHE_LIMIT = 4096
 
 
 def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> DurationSpec:

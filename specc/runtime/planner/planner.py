@@ -37,6 +37,7 @@ from specc.runtime.planner.search import (
     is_temporal,
     is_var,
     producers_of,
+    task_constraints,
     translate,
 )
 from specc.runtime.stn import STN, Inconsistent
@@ -199,6 +200,14 @@ class Setup:
                     raise PlanningInputError(
                         f"{_source(a)}: '{value.name}' is not a value of {declared.name} "
                         f"({', '.join(declared.values.values)}), in problem '{problem.name}'")
+        for task in domain.tasks:  # a task the search could not insert is refused here, once
+            for temporal in task_constraints(task).temporal:
+                try:
+                    differences(temporal, str, self.origin)
+                except ValueError as error:
+                    raise PlanningInputError(
+                        f"task {task.name}, line {temporal.line}: {error}: the planner takes temporal constraints that "
+                        "bound the difference of two timepoints (or a timepoint's date)") from None
         # Nature's instants: the times of contingent events, bounded from the origin.
         self.contingent = sorted({a.time for a in problem.assertions
                                   if isinstance(a, pm.Event) and a.kind == "contingent" and a.time != self.origin})
@@ -433,17 +442,24 @@ def _add(network: STN, reduced: Requirements, a: str, b: str, low: float, high: 
     reduced.append((a, b, low, high))
 
 
-def strong_network(node: Node, links: Links) -> tuple[STN, Requirements, str]:
-    """The plan's own timepoints, every requirement rewritten for nature's worst case."""
+def translated_network(node: Node, anchors: Links) -> tuple[STN, Requirements]:
+    """The plan's timepoints but those hanging from another (`anchors`), every requirement
+    rewritten on the points they hang from, for nature's worst offsets."""
     network = STN()
     for name in node.stn.names:
-        if name not in links:
+        if name not in anchors:
             network.point(name)
     reduced: Requirements = []
     for a, b, low, high in node.original:
-        pa, pb, new_low, new_high = translate(links, a, b, low, high)
+        pa, pb, new_low, new_high = translate(anchors, a, b, low, high)
         if pa != pb:
             _add(network, reduced, pa, pb, new_low, new_high)
+    return network, reduced
+
+
+def strong_network(node: Node, links: Links) -> tuple[STN, Requirements, str]:
+    """The plan's own timepoints, every requirement rewritten for nature's worst case."""
+    network, reduced = translated_network(node, links)
     return network, reduced, ""
 
 
@@ -452,15 +468,7 @@ def pseudo_network(node: Node, ends: Links, instants: Links) -> tuple[STN, Requi
     rewritten for the contingent durations' worst case, and each instant at its latest date: the
     executive cannot see a window open, so it waits until the window surely is. The plan carries
     these dates (`assumed`)."""
-    network = STN()
-    for name in node.stn.names:
-        if name not in ends:
-            network.point(name)
-    reduced: Requirements = []
-    for a, b, low, high in node.original:
-        pa, pb, new_low, new_high = translate(ends, a, b, low, high)
-        if pa != pb:
-            _add(network, reduced, pa, pb, new_low, new_high)
+    network, reduced = translated_network(node, ends)
     latest, pinned = network.copy(), list(reduced)
     try:
         for point, (anchor, _, high) in sorted(instants.items()):

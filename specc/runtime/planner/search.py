@@ -34,7 +34,15 @@ from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.numeric import DurationSpec, Empty, domain_of, duration_of, is_duration, is_number
+from specc.runtime.planner.numeric import (
+    IDENTITY_CACHE_LIMIT,
+    DurationSpec,
+    Empty,
+    domain_of,
+    duration_of,
+    is_duration,
+    is_number,
+)
 from specc.runtime.stn import STN, Inconsistent, for_every_offset
 
 INF = math.inf
@@ -766,6 +774,8 @@ def task_constraints(task: pm.Task) -> TaskConstraints:
                 apart.append((c.left, c.right))
             elif isinstance(c, (pm.Member, pm.Relation)) and is_temporal(c) and not is_duration(c, task):
                 temporal.append(c)
+        if len(_TASK_CONSTRAINTS) >= IDENTITY_CACHE_LIMIT:
+            _TASK_CONSTRAINTS.clear()
         found = _TASK_CONSTRAINTS[id(task)] = (task, TaskConstraints(tuple(domains), tuple(apart), tuple(temporal)))
     return found[1]
 

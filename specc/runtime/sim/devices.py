@@ -84,6 +84,9 @@ class RangeSensor:
         self.noise = noise
         self._rng = rng
         self.offset = offset
+        # The ranges without noise from the last pose cast from: a robot stands still for most of
+        # a mission (planning, photos, waiting for a window), and the world's obstacles never move.
+        self._last_cast: tuple[tuple[float, float, float], np.ndarray] | None = None
 
     @property
     def angles(self) -> np.ndarray:
@@ -91,9 +94,11 @@ class RangeSensor:
         return self._angles
 
     def read(self) -> np.ndarray:
-        x, y, theta = self._rover.pose
-        distances = self._caster.fan(x, y, theta, self._units, self.max_range + self.offset)
-        distances -= self.offset
+        pose = self._rover.pose
+        if self._last_cast is None or self._last_cast[0] != pose:
+            x, y, theta = pose
+            self._last_cast = pose, self._caster.fan(x, y, theta, self._units, self.max_range + self.offset)
+        distances = self._last_cast[1] - self.offset
         if self.noise > 0.0:
             distances += self.noise * self._rng.standard_normal(len(distances))
         # np.clip costs twice as much on a few dozen values

@@ -107,6 +107,9 @@ class Rover:
         gear.max_bias = 2.0 * config.max_wheel_speed / config.wheel_base
         gear.max_force = traction * config.wheel_base / 2.0
         self.space.add(self.body, self.shape, self.control, pivot, gear)
+        # The body's pose as the last step left it: only a step moves the body, and reading it
+        # back from pymunk costs more than the rest of a step's own arithmetic.
+        (self._x, self._y), self._angle = self.body.position, self.body.angle
 
         self.left = self.right = 0.0  # commanded wheel rim speeds, m/s
         self.left_speed = self.right_speed = 0.0  # what the motors give, ramping towards them
@@ -142,8 +145,7 @@ class Rover:
         v = (self.left_speed + self.right_speed) / 2.0
         w = (self.right_speed - self.left_speed) / self.config.wheel_base
         body = self.body
-        x0, y0 = body.position
-        a0 = body.angle
+        x0, y0, a0 = self._x, self._y, self._angle
         # pymunk moves a body with the velocity the previous step solved, while it turns: the
         # velocity asked now carries the body during the next step, whose mid-heading is this
         # one, so that a rover that does not slip moves exactly as its odometry assumes.
@@ -151,8 +153,8 @@ class Rover:
         self.control.velocity = (v * math.cos(course), v * math.sin(course))
         self.control.angular_velocity = w
         self.space.step(dt)
-        x1, y1 = body.position
-        a1 = body.angle
+        (x1, y1), a1 = body.position, body.angle
+        self._x, self._y, self._angle = x1, y1, a1
         # The encoders see the motion along the mid-step heading (sideways slip escapes them).
         middle = (a0 + a1) / 2.0
         forward = (x1 - x0) * math.cos(middle) + (y1 - y0) * math.sin(middle)
@@ -188,8 +190,7 @@ class Rover:
     @property
     def pose(self) -> tuple[float, float, float]:
         """x, y and the heading in (-π, π] (pymunk's angle keeps counting turns)."""
-        x, y = self.body.position
-        return float(x), float(y), math.remainder(float(self.body.angle), math.tau)
+        return float(self._x), float(self._y), math.remainder(float(self._angle), math.tau)
 
     @property
     def blocked(self) -> bool:

@@ -1,0 +1,198 @@
+"""A fault-injection campaign as one command (seed 004 ch. 4): mutants of a planning model,
+every configuration x mutant x mission x world x run, the filters of §4.2.2.1, the report.
+
+It runs in two phases. The first configuration given (Robot1: the mutated model alone) runs the
+original model and every mutant; then each mutant is judged on those results (`judge`): one
+that never finds a plan in any mission, or whose every result equals the original's, is set
+aside and reported apart, as the seed did. The other configurations (Robot1/2, ...) then run
+the original and the mutants kept. Every result goes to the store as it comes, so a campaign
+stopped anywhere resumes where it stopped (the verdicts are computed again from the store)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from specc.campaign.engines import Engine
+from specc.campaign.experiments import ORIGINAL, Experiment, Outcome, Setting
+from specc.campaign.store import MutantRecord, ResultStore
+from specc.run import RunError
+from specc.runtime.planner import model as pm
+
+KEPT, NEVER_PLANS, EQUIVALENT, UNJUDGED = "kept", "never-plans", "equivalent", ""
+MISSIONS = ("M1", "M2", "M3", "M4")
+WORLDS = ("W1", "W2", "W3", "W4")
+CONFIGURATIONS = ("Robot1", "Robot1/2")
+
+Progress = Callable[[int, int, Outcome | None], None]  # (done, total, the outcome just recorded)
+
+
+@dataclass(frozen=True)
+class CampaignPlan:
+    robot: Path  # the robot's spec folder
+    setting: Setting
+    domain: str = "model1"  # the planning model faults are injected into
+    mutants: int | None = None  # how many mutants to draw (None: every kept one)
+    sample_seed: int = 0
+    missions: tuple[str, ...] = MISSIONS
+    worlds: tuple[str, ...] = WORLDS
+    runs: int = 3  # seeds 0 .. runs-1 of each activity
+    configurations: tuple[str, ...] = CONFIGURATIONS
+
+    def description(self, mutant_ids: Sequence[str]) -> dict[str, Any]:
+        """What makes two campaigns the same (the store refuses to mix two different ones)."""
+        return {"robot": self.robot.name, "domain": self.domain, "mutants": list(mutant_ids),
+                "missions": list(self.missions), "worlds": list(self.worlds), "runs": self.runs,
+                "configurations": list(self.configurations), "timing": self.setting.timing}
+
+    def experiments(self, configuration: str, mutants: Iterable[str]) -> list[Experiment]:
+        return [Experiment(configuration, mutant, mission, world, seed) for mutant in mutants
+                for mission in self.missions for world in self.worlds for seed in range(self.runs)]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    mutant: str
+    verdict: str  # KEPT, NEVER_PLANS, EQUIVALENT, or UNJUDGED while its results are incomplete
+    detail: str = ""
+
+
+def judge(outcomes: Iterable[Outcome], configuration: str, mutants: Sequence[str], expected: int
+          ) -> dict[str, Verdict]:
+    """The filters of seed 004 §4.2.2.1 on the results of `configuration` (the mutated model
+    alone): a mutant that finds no plan in any mission (every experiment a planner failure, κ = 1)
+    never plans; one whose every experiment gives the original's measures exactly is equivalent
+    (no influence on the system in these activities); the others are kept. A mutant with fewer
+    than `expected` results is not judged yet."""
+    mine: dict[str, list[Outcome]] = {}
+    for outcome in outcomes:
+        if outcome.experiment.configuration == configuration:
+            mine.setdefault(outcome.experiment.mutant, []).append(outcome)
+    original = {_activity(o.experiment): o.measures for o in mine.get(ORIGINAL, []) if o.status == "done"}
+    verdicts = {}
+    for mutant in mutants:
+        results = mine.get(mutant, [])
+        if len(results) < expected or len(original) < expected:
+            verdicts[mutant] = Verdict(mutant, UNJUDGED, f"{len(results)} of {expected} results")
+            continue
+        done = [o for o in results if o.status == "done" and o.measures is not None]
+        if len(done) == len(results) and all(o.measures is not None and o.measures["kappa"] == 1 for o in done):
+            verdicts[mutant] = Verdict(mutant, NEVER_PLANS, "no plan in any mission (κ = 1 in every experiment)")
+        elif len(done) == len(results) and all(original.get(_activity(o.experiment)) == o.measures for o in done):
+            verdicts[mutant] = Verdict(mutant, EQUIVALENT, "every measure equals the original model's")
+        else:
+            differing = sum(1 for o in results if o.status != "done" or original.get(_activity(o.experiment))
+                            != o.measures)
+            verdicts[mutant] = Verdict(mutant, KEPT, f"{differing} of {len(results)} experiments differ")
+    return verdicts
+
+
+def _activity(e: Experiment) -> tuple[str, str, int]:
+    return e.mission, e.world, e.seed
+
+
+@dataclass
+class Campaign:
+    plan: CampaignPlan
+    store: ResultStore
+    engine: Engine
+    domains: dict[str, pm.PlanningDomain]  # mutant id -> its planning domain
+    records: list[MutantRecord] = field(default_factory=list)
+
+    def start(self) -> None:
+        """Record what the campaign is, or check the store holds this very campaign."""
+        self.store.describe(self.plan.description(list(self.domains)))
+        self.store.add_mutants(self.records)
+
+    def run(self, progress: Progress | None = None) -> dict[str, Verdict]:
+        first, others = self.plan.configurations[0], self.plan.configurations[1:]
+        mutants = list(self.domains)
+        per_mutant = len(self.plan.experiments(first, [ORIGINAL]))
+        done = self.store.done()
+        # The total as far as it is known: the later phases count every mutant until judged.
+        judged = self.verdicts()
+        kept_guess = [m for m in mutants if judged[m].verdict in (KEPT, UNJUDGED)]
+        total = per_mutant * (1 + len(mutants)) + len(others) * per_mutant * (1 + len(kept_guess))
+        counter = [len(done & {e.key for e in self.plan.experiments(first, [ORIGINAL, *mutants])})]
+        counter[0] += len(done & {e.key for c in others for e in self.plan.experiments(c, [ORIGINAL, *kept_guess])})
+
+        def go(experiments: list[Experiment]) -> None:
+            nonlocal total
+            todo = [e for e in experiments if e.key not in done]
+            tasks = ((e, self.domains.get(e.mutant)) for e in todo)
+            if progress is not None:
+                progress(counter[0], total, None)
+            for outcome in self.engine.run(tasks):
+                self.store.record(outcome)
+                done.add(outcome.experiment.key)
+                counter[0] += 1
+                if progress is not None:
+                    progress(counter[0], total, outcome)
+
+        go(self.plan.experiments(first, [ORIGINAL, *mutants]))
+        judged = self.verdicts()
+        kept = [m for m in mutants if judged[m].verdict == KEPT]
+        total = per_mutant * (1 + len(mutants)) + len(others) * per_mutant * (1 + len(kept))
+        for configuration in others:
+            go(self.plan.experiments(configuration, [ORIGINAL, *kept]))
+        return judged
+
+    def verdicts(self) -> dict[str, Verdict]:
+        first = self.plan.configurations[0]
+        expected = len(self.plan.experiments(first, [ORIGINAL]))
+        verdicts = judge(self.store.outcomes(), first, list(self.domains), expected)
+        for verdict in verdicts.values():
+            self.store.judge(verdict.mutant, verdict.verdict, verdict.detail)
+        return verdicts
+
+
+def check_names(plan: CampaignPlan, generated: Path, example: Path) -> None:
+    """Every configuration, mission and world named, checked before anything runs (RunError)."""
+    from specc.run.rover import check_mission
+
+    if plan.runs < 1:
+        raise RunError(f"--runs {plan.runs}: give at least 1")
+    for name, values in (("--configs", plan.configurations), ("--missions", plan.missions),
+                         ("--worlds", plan.worlds)):
+        if not values:
+            raise RunError(f"{name}: give at least one")
+    for configuration in plan.configurations:
+        for mission in plan.missions:
+            for world in plan.worlds:
+                checked = check_mission(configuration, mission, world, 0, generated=generated, example=example)
+        if plan.domain not in checked.setup.planned_in:
+            raise RunError(f"configuration {configuration} does not plan in '{plan.domain}' (it plans in "
+                           f"{', '.join(sorted(checked.setup.planned_in))}): a campaign injects faults into the "
+                           "model its configurations use")
+
+
+@dataclass(frozen=True)
+class Selection:
+    """The mutants a campaign injects: drawn among those that pass the checks."""
+
+    records: list[MutantRecord]
+    domains: dict[str, pm.PlanningDomain]
+    generated: int  # mutants enumerated
+
+
+def select_mutants(plan: CampaignPlan, workers: int = 1,
+                   progress: Callable[[int, int], None] | None = None) -> Selection:
+    """Enumerate the domain's mutants, keep those that pass specc check, draw `plan.mutants` of
+    them (stratified by class, with `plan.sample_seed`; all when None) and lower each to the
+    planner's domain. RunError when the robot or the domain cannot be mutated."""
+    from specc.mutation import MutationError, draw_kept, enumerate_mutants, keep_valid, mutant_domain, mutation_target
+
+    try:
+        target = mutation_target(plan.robot, plan.domain)
+        enumerated = enumerate_mutants(target)
+        if plan.mutants is None:
+            chosen = keep_valid(enumerated, workers=workers, progress=progress).kept
+        else:  # only what is drawn gets checked (specc mutants --sample draws the same ones)
+            chosen = draw_kept(enumerated, plan.mutants, plan.sample_seed)
+        domains = {x.id: mutant_domain(x) for x in chosen}
+    except MutationError as error:
+        raise RunError(str(error)) from None
+    records = [MutantRecord(x.id, x.kind, x.description, x.diff) for x in chosen]
+    return Selection(records, domains, len(enumerated))

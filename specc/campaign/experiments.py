@@ -1,0 +1,79 @@
+"""One experiment of a campaign (seed 004 §4.1.1): a robot configuration runs a mission in a world
+with a planning model that may hold an injected fault, for one seed. It is a pure function of
+those five values: the same experiment gives the same measures wherever it runs."""
+
+from __future__ import annotations
+
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from specc.run import RunError
+from specc.runtime.planner import model as pm
+
+ORIGINAL = "original"  # the mutant name of the model without an injected fault (the seed's ∅)
+STATUSES = ("done", "crashed", "timeout")
+
+
+@dataclass(frozen=True, order=True)
+class Experiment:
+    configuration: str  # Robot1, Robot1/2, ...
+    mutant: str  # a mutant id (model1-0042), or ORIGINAL
+    mission: str
+    world: str
+    seed: int
+
+    @property
+    def key(self) -> str:
+        """The experiment's name in the results store: one row per key, ever."""
+        return f"{self.configuration}|{self.mutant}|{self.mission}|{self.world}|{self.seed}"
+
+    @property
+    def activity(self) -> str:
+        return f"{self.mission}{self.world}"
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What an experiment gave: its measures when it ran to its end (whatever the mission's
+    outcome), else why not (the experiment crashed, or overran its hard timeout)."""
+
+    experiment: Experiment
+    status: str  # one of STATUSES
+    measures: dict[str, Any] | None  # specc.run.measures.Measures.to_json() when done
+    seconds: float  # wall time
+    why: str = ""
+
+
+@dataclass(frozen=True)
+class Setting:
+    """Where every experiment of a campaign finds the robot: the compiled package's parent folder
+    and the robot's spec folder (codels, worlds), plus FTplan's planning charge."""
+
+    generated: Path
+    example: Path
+    timing: str = "model"
+
+
+def run_experiment(experiment: Experiment, domain: pm.PlanningDomain | None, setting: Setting) -> Outcome:
+    """Run the experiment with `domain` (the mutant's planning domain; None: the original model)
+    in place of the generated domain of the same name. Never raises: a failure is the outcome."""
+    from specc.run.measures import measure
+    from specc.run.rover import run_rover_mission
+
+    started = time.perf_counter()
+    try:
+        run = run_rover_mission(experiment.configuration, experiment.mission, experiment.world, experiment.seed,
+                                generated=setting.generated, example=setting.example, timing=setting.timing,
+                                domains={domain.name: domain} if domain is not None else None)
+        measures = measure(run).to_json()
+    except RunError as error:
+        return Outcome(experiment, "crashed", None, time.perf_counter() - started, str(error))
+    except Exception as error:  # an experiment must never take the campaign with it
+        last = traceback.extract_tb(error.__traceback__)[-1]
+        where = f" ({Path(last.filename).name}:{last.lineno})"
+        return Outcome(experiment, "crashed", None, time.perf_counter() - started,
+                       f"{type(error).__name__}: {error}{where}")
+    return Outcome(experiment, "done", measures, time.perf_counter() - started)

@@ -1,0 +1,231 @@
+"""The report of a campaign, from its results store alone (seed 004 §4.2.2.3, Fig 4.14).
+
+The measures of §4.1.4 are averaged over sets of activities in the seed's notation: σ̄_p({W*, M*},
+F*) is the mean photo quotient over every world and mission and over F*, the kept mutants (∅: the
+original model). Each mean is given with W4 and without it (the seed set W4 apart for its
+adversity), for each configuration; the headline is the change of mission success ν̄ from the
+first configuration to the second under injected faults, absolute (points) and relative, beside
+the fault-free figures."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS
+from specc.campaign.experiments import ORIGINAL, Outcome
+from specc.campaign.store import MutantRecord, ResultStore
+from specc.run.measures import MeanMeasures, Measures, aggregate
+
+FAULTY, FAULT_FREE = "F*", "∅"
+QUOTIENTS = (("sigma_p", "σ̄_p"), ("sigma_c", "σ̄_c"), ("sigma_h", "σ̄_h"), ("nu", "ν̄"))
+# The seed's headline (§4.2.2.3, without W4): FTplan raised ν̄ by 19 points, 41 % relative.
+SEED_HEADLINE = (0.19, 0.41)
+
+
+@dataclass(frozen=True)
+class Mean:
+    configuration: str
+    faults: str  # FAULTY or FAULT_FREE
+    worlds: str  # "W*" or "W* \\ W4"
+    experiments: int
+    means: MeanMeasures | None  # None when no experiment is in the set
+
+
+@dataclass(frozen=True)
+class Headline:
+    worlds: str
+    first: str
+    second: str
+    faulty: tuple[float, float]  # ν̄(F*) of the first and of the second configuration
+    fault_free: tuple[float, float]  # ν̄(∅)
+
+    @property
+    def absolute(self) -> float:
+        return self.faulty[1] - self.faulty[0]
+
+    @property
+    def relative(self) -> float | None:
+        """The change relative to the first configuration's ν̄ (None when that is 0)."""
+        return self.absolute / self.faulty[0] if self.faulty[0] else None
+
+    def text(self) -> str:
+        below = "still below" if self.faulty[1] < self.fault_free[1] else "not below"
+        relative = f"{self.relative:+.0%} relative" if self.relative is not None else "no relative change from 0"
+        return (f"{self.worlds}: under injected faults, {self.second} succeeds in {self.faulty[1]:.0%} of missions "
+                f"against {self.first}'s {self.faulty[0]:.0%}: {self.absolute * 100:+.0f} points "
+                f"({relative}); {below} the fault-free {self.fault_free[1]:.0%} "
+                f"({self.first} fault-free: {self.fault_free[0]:.0%})")
+
+
+@dataclass(frozen=True)
+class CampaignReport:
+    description: dict[str, Any]
+    mutants: tuple[MutantRecord, ...]
+    outcomes: tuple[Outcome, ...]
+    means: tuple[Mean, ...]
+    per_mutant: tuple[tuple[MutantRecord, dict[str, MeanMeasures | None]], ...]  # kept ones, per configuration
+    headlines: tuple[Headline, ...]
+
+    def with_verdict(self, verdict: str) -> list[MutantRecord]:
+        return [m for m in self.mutants if m.verdict == verdict]
+
+    @property
+    def failed(self) -> list[Outcome]:
+        return [o for o in self.outcomes if o.status != "done"]
+
+
+def build_report(store: ResultStore) -> CampaignReport:
+    description = store.description()
+    mutants = tuple(store.mutants())
+    outcomes = tuple(store.outcomes())
+    configurations: list[str] = list(description.get("configurations", []))
+    kept = {m.id for m in mutants if m.verdict == KEPT}
+    measures = [(o, Measures.from_json(o.measures)) for o in outcomes if o.status == "done" and o.measures]
+    world_sets = (("W*", None), ("W* \\ W4", "W4"))
+    means = []
+    for configuration in configurations:
+        for faults, wanted in ((FAULTY, kept), (FAULT_FREE, {ORIGINAL})):
+            for label, left_out in world_sets:
+                chosen = [m for o, m in measures if o.experiment.configuration == configuration
+                          and o.experiment.mutant in wanted and o.experiment.world != left_out]
+                means.append(Mean(configuration, faults, label, len(chosen), aggregate(chosen) if chosen else None))
+    per_mutant = []
+    for mutant in (m for m in mutants if m.id in kept):
+        row: dict[str, MeanMeasures | None] = {}
+        for configuration in configurations:
+            chosen = [m for o, m in measures if o.experiment.configuration == configuration
+                      and o.experiment.mutant == mutant.id]
+            row[configuration] = aggregate(chosen) if chosen else None
+        per_mutant.append((mutant, row))
+    headlines = []
+    if len(configurations) >= 2:
+        first, second = configurations[:2]
+        for label, _ in world_sets:
+            faulty = tuple(_nu(means, c, FAULTY, label) for c in (first, second))
+            free = tuple(_nu(means, c, FAULT_FREE, label) for c in (first, second))
+            if all(v is not None for v in faulty + free):
+                headlines.append(Headline(label, first, second, faulty, free))  # type: ignore[arg-type]
+    return CampaignReport(description, mutants, outcomes, tuple(means), tuple(per_mutant), tuple(headlines))
+
+
+def _nu(means: Iterable[Mean], configuration: str, faults: str, worlds: str) -> float | None:
+    for mean in means:
+        if (mean.configuration, mean.faults, mean.worlds) == (configuration, faults, worlds) and mean.means:
+            return mean.means.nu
+    return None
+
+
+# ---------------------------------------------------------------- writing
+
+
+def markdown(report: CampaignReport) -> str:
+    d = report.description
+    lines = [f"# Campaign: faults injected into {d.get('domain')} of {d.get('robot')}", ""]
+    counts = {v: len(report.with_verdict(v)) for v in (KEPT, NEVER_PLANS, EQUIVALENT)}
+    lines += [f"- missions {', '.join(d.get('missions', []))} x worlds {', '.join(d.get('worlds', []))} x "
+              f"{d.get('runs')} run(s); configurations {', '.join(d.get('configurations', []))}",
+              f"- mutants drawn: {len(report.mutants)}; kept (F*): {counts[KEPT]}; never plan: "
+              f"{counts[NEVER_PLANS]}; equivalent to the original: {counts[EQUIVALENT]}",
+              f"- experiments: {len(report.outcomes)} ({len(report.failed)} crashed or timed out)", ""]
+    if report.headlines:
+        lines += ["## Headline", ""]
+        lines += [f"- {h.text()}" for h in report.headlines]
+        seed_abs, seed_rel = SEED_HEADLINE
+        lines += [f"- seed 004 (W* \\ W4): +{seed_abs * 100:.0f} points ({seed_rel:+.0%} relative), still below "
+                  "fault-free", ""]
+    lines += ["## Means over sets of activities", "",
+              "| configuration | faults | worlds | experiments | σ̄_p | σ̄_c | σ̄_h | ν̄ | κ̄ | R̄ | T̄ (s) | D̄ (m) |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for mean in report.means:
+        m = mean.means
+        cells = ["-"] * 8 if m is None else [_pct(m.sigma_p), _pct(m.sigma_c), _pct(m.sigma_h), _pct(m.nu),
+                                              _pct(m.kappa), f"{m.replannings:.2f}", f"{m.activity_time:.0f}",
+                                              f"{m.distance:.1f}"]
+        lines.append(f"| {mean.configuration} | {mean.faults} | {mean.worlds} | {mean.experiments} | "
+                     + " | ".join(cells) + " |")
+    configurations = list(d.get("configurations", []))
+    lines += ["", "## Kept mutants (F*): mission success ν̄ over every activity", "",
+              "| mutant | class | mutation | " + " | ".join(configurations) + " |",
+              "| --- | --- | --- | " + " | ".join("---" for _ in configurations) + " |"]
+    for mutant, row in report.per_mutant:
+        cells = [_pct(row[c].nu) if row.get(c) is not None else "-" for c in configurations]  # type: ignore[union-attr]
+        lines.append(f"| {mutant.id} | {mutant.kind} | {_cell(mutant.description)} | " + " | ".join(cells) + " |")
+    for verdict, title in ((NEVER_PLANS, "Set aside: never find a plan"),
+                           (EQUIVALENT, "Set aside: results equal the original's")):
+        listed = report.with_verdict(verdict)
+        if listed:
+            lines += ["", f"## {title} ({len(listed)})", ""]
+            lines += [f"- {m.id} ({m.kind}): {_cell(m.description)}" for m in listed]
+    if report.failed:
+        lines += ["", f"## Experiments that crashed or timed out ({len(report.failed)})", ""]
+        lines += [f"- {o.experiment.key}: {o.status}: {o.why}" for o in report.failed[:50]]
+    return "\n".join(lines) + "\n"
+
+
+def _pct(value: float) -> str:
+    return f"{value:.0%}"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def to_json(report: CampaignReport) -> dict[str, Any]:
+    return {
+        "description": report.description,
+        "mutants": [{"id": m.id, "kind": m.kind, "description": m.description, "verdict": m.verdict,
+                     "detail": m.detail} for m in report.mutants],
+        "means": [{"configuration": m.configuration, "faults": m.faults, "worlds": m.worlds,
+                   "experiments": m.experiments, **(m.means.to_json() if m.means else {})} for m in report.means],
+        "headlines": [{"worlds": h.worlds, "first": h.first, "second": h.second, "nu_faulty": list(h.faulty),
+                       "nu_fault_free": list(h.fault_free), "absolute": h.absolute, "relative": h.relative}
+                      for h in report.headlines],
+        "experiments": len(report.outcomes), "failed": len(report.failed),
+    }
+
+
+def draw(report: CampaignReport, path: Path) -> Path:
+    """Fig 4.14: the mean quotients of each configuration, without and with injected faults,
+    over every world and without W4."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    panels = ("W*", "W* \\ W4")
+    series = [(c, f) for c in dict.fromkeys(m.configuration for m in report.means) for f in (FAULT_FREE, FAULTY)]
+    figure, axes = plt.subplots(1, len(panels), figsize=(12, 4.2), sharey=True)
+    width = 0.8 / max(1, len(series))
+    for axis, worlds in zip(axes, panels, strict=True):
+        for k, (configuration, faults) in enumerate(series):
+            mean = next((m.means for m in report.means if (m.configuration, m.faults, m.worlds)
+                         == (configuration, faults, worlds)), None)
+            values = [getattr(mean, name) if mean is not None else 0.0 for name, _ in QUOTIENTS]
+            xs = [i + (k - (len(series) - 1) / 2) * width for i in range(len(QUOTIENTS))]
+            bars = axis.bar(xs, values, width, label=f"{configuration}, {faults}",
+                            hatch="//" if faults == FAULTY else None, edgecolor="black", linewidth=0.5)
+            axis.bar_label(bars, labels=[f"{v:.0%}" for v in values], fontsize=6, padding=1)
+        axis.set_xticks(range(len(QUOTIENTS)), [label for _, label in QUOTIENTS])
+        axis.set_ylim(0, 1.1)
+        axis.set_title(f"{{{worlds}, M*}}")
+        axis.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
+    axes[0].legend(fontsize=7, loc="lower left")
+    figure.suptitle("Goals met and missions succeeded, without faults (∅) and with injected faults (F*)")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+    return path
+
+
+def write_report(report: CampaignReport, folder: Path, stem: str = "campaign") -> list[Path]:
+    folder.mkdir(parents=True, exist_ok=True)
+    written = [folder / f"{stem}.md", folder / f"{stem}.json"]
+    written[0].write_text(markdown(report), encoding="utf-8")
+    written[1].write_text(json.dumps(to_json(report), indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    if any(m.means is not None for m in report.means):
+        written.append(draw(report, folder / f"{stem}.png"))
+    return written

@@ -1,0 +1,133 @@
+"""The results store of a campaign: one SQLite file, one row per experiment, written as each
+experiment finishes and committed at once. An interrupted campaign resumes from what the file
+holds: an experiment already there is never run again, and the primary key refuses a second row
+for it, so no result is lost or duplicated.
+
+The file also records what the campaign is (robot, mutants and their diffs, missions, worlds,
+runs, configurations, and the filters' verdicts), so that a report can be made from it alone and
+a resumed campaign is refused when it would mix two different campaigns' results."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+import time
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from specc.campaign.experiments import Experiment, Outcome
+from specc.run import RunError
+
+GROWING = ("configurations",)  # a resumed campaign may add to these (see ResultStore.describe)
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS campaign (name TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS mutants (
+    id TEXT PRIMARY KEY, kind TEXT NOT NULL, description TEXT NOT NULL, diff TEXT NOT NULL,
+    verdict TEXT NOT NULL DEFAULT '', detail TEXT NOT NULL DEFAULT '');
+CREATE TABLE IF NOT EXISTS results (
+    key TEXT PRIMARY KEY, configuration TEXT NOT NULL, mutant TEXT NOT NULL, mission TEXT NOT NULL,
+    world TEXT NOT NULL, seed INTEGER NOT NULL, status TEXT NOT NULL, measures TEXT,
+    seconds REAL NOT NULL, why TEXT NOT NULL, finished REAL NOT NULL);
+"""
+
+
+@dataclass(frozen=True)
+class MutantRecord:
+    id: str
+    kind: str
+    description: str
+    diff: str
+    verdict: str = ""  # "" (not judged yet), kept, never-plans, equivalent
+    detail: str = ""
+
+
+class ResultStore:
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self.db = sqlite3.connect(path)
+            # WAL: a commit per result stays cheap, and a reader (a report) never blocks the writer.
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.executescript(SCHEMA)
+        except (OSError, sqlite3.Error) as error:
+            raise RunError(f"cannot open the results store '{path}': {error}") from None
+
+    def __enter__(self) -> ResultStore:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
+                 trace: TracebackType | None) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self.db.close()
+
+    # ------------------------------------------------------------ what the campaign is
+    def describe(self, description: dict[str, Any]) -> None:
+        """Record the campaign's description, or check that the store already holds this one (a
+        resumed campaign): RunError naming what differs otherwise. A list under one of GROWING
+        may be longer than the stored one if it starts with it (more configurations compared on
+        the same mutants and activities): the stored description grows."""
+        stored = self.description()
+        if stored:
+            differs = sorted(k for k in set(stored) | set(description) if stored.get(k) != description.get(k))
+            grows = [k for k in differs if k in GROWING and isinstance(stored.get(k), list)
+                     and description.get(k, [])[:len(stored[k])] == stored[k]]
+            if set(differs) - set(grows):
+                raise RunError(f"'{self.path}' holds another campaign (it differs in {', '.join(differs)}): "
+                               "give another --store, or the same options to resume it")
+            with self.db:
+                self.db.executemany("UPDATE campaign SET value = ? WHERE name = ?",
+                                    [(json.dumps(description[k]), k) for k in grows])
+            return
+        with self.db:
+            self.db.executemany("INSERT INTO campaign VALUES (?, ?)",
+                                [(name, json.dumps(value)) for name, value in description.items()])
+
+    def description(self) -> dict[str, Any]:
+        return {name: json.loads(value) for name, value in self.db.execute("SELECT name, value FROM campaign")}
+
+    def add_mutants(self, mutants: Iterable[MutantRecord]) -> None:
+        with self.db:
+            self.db.executemany("INSERT OR IGNORE INTO mutants (id, kind, description, diff) VALUES (?, ?, ?, ?)",
+                                [(m.id, m.kind, m.description, m.diff) for m in mutants])
+
+    def judge(self, mutant: str, verdict: str, detail: str = "") -> None:
+        with self.db:
+            self.db.execute("UPDATE mutants SET verdict = ?, detail = ? WHERE id = ?", (verdict, detail, mutant))
+
+    def mutants(self) -> list[MutantRecord]:
+        return [MutantRecord(*row) for row in
+                self.db.execute("SELECT id, kind, description, diff, verdict, detail FROM mutants ORDER BY id")]
+
+    # ------------------------------------------------------------ results
+    def record(self, outcome: Outcome) -> None:
+        """Store one experiment's outcome, committed at once; a second outcome for the same
+        experiment is an error (a campaign runs each experiment once)."""
+        e = outcome.experiment
+        measures = json.dumps(outcome.measures, sort_keys=True) if outcome.measures is not None else None
+        try:
+            with self.db:
+                self.db.execute("INSERT INTO results VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                                (e.key, e.configuration, e.mutant, e.mission, e.world, e.seed, outcome.status,
+                                 measures, outcome.seconds, outcome.why, time.time()))
+        except sqlite3.IntegrityError:
+            raise RunError(f"experiment {e.key} is already in '{self.path}'") from None
+
+    def done(self) -> set[str]:
+        return {key for (key,) in self.db.execute("SELECT key FROM results")}
+
+    def outcomes(self) -> Iterator[Outcome]:
+        rows = self.db.execute("SELECT configuration, mutant, mission, world, seed, status, measures, seconds, why "
+                               "FROM results ORDER BY key")
+        for configuration, mutant, mission, world, seed, status, measures, seconds, why in rows:
+            yield Outcome(Experiment(configuration, mutant, mission, world, seed), status,
+                          json.loads(measures) if measures is not None else None, seconds, why)
+
+    def count(self) -> int:
+        (n,) = self.db.execute("SELECT COUNT(*) FROM results").fetchone()
+        return int(n)

@@ -1,0 +1,221 @@
+"""Fault-injection campaigns (seed 004 ch. 4): real experiments on the simulated rover, a real
+kill and resume, the seed's filters, the report."""
+
+from __future__ import annotations
+
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED, judge
+from specc.campaign.engines import DaskEngine, ExperimentProcess, LocalEngine
+from specc.campaign.experiments import ORIGINAL, Experiment, Outcome, Setting
+from specc.campaign.report import build_report, markdown, write_report
+from specc.campaign.store import MutantRecord, ResultStore
+from specc.run import RunError
+from tests.conftest import is_png
+
+ROOT = Path(__file__).resolve().parents[1]
+ATRV = ROOT / "examples" / "atrv"
+SETTING = Setting(ROOT / "generated", ATRV)
+ONE = Experiment("Robot1", ORIGINAL, "M1", "W1", 0)
+# A small real campaign: three mutants drawn, one activity, one run, Robot1 then Robot1/2.
+SMALL = ["--mutants", "3", "--missions", "M1", "--worlds", "W1", "--runs", "1", "--configs", "Robot1,Robot1/2",
+         "--workers", "2", "--seed", "0"]
+
+
+def specc(*args: str | Path, **kwargs: object) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "specc.cli", *map(str, args)], capture_output=True, text=True,
+                          cwd=ROOT, timeout=600, **kwargs)  # type: ignore[call-overload]
+
+
+def rows(store: Path) -> list[tuple[str, float]]:
+    """The store's results as (key, when recorded); none while the campaign is creating it."""
+    db = sqlite3.connect(store)
+    try:
+        return list(db.execute("SELECT key, finished FROM results ORDER BY key"))
+    except sqlite3.OperationalError:
+        return []
+    finally:
+        db.close()
+
+
+def start_and_stop_after(store: Path, results: int, stop: signal.Signals) -> subprocess.Popen[str]:
+    """The small campaign, sent `stop` once the store holds `results` results."""
+    command = [sys.executable, "-m", "specc.cli", "campaign", str(ATRV), *SMALL, "--store", str(store), "-q"]
+    started = subprocess.Popen(command, cwd=ROOT, start_new_session=True, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and started.poll() is None and len(rows(store)) < results:
+        time.sleep(0.2)
+    assert started.poll() is None, started.communicate()
+    if stop == signal.SIGKILL:
+        os.killpg(started.pid, stop)  # the campaign and its experiment processes, mid-campaign
+    else:
+        started.send_signal(stop)  # Ctrl-C
+    return started
+
+
+def test_a_killed_campaign_resumes_without_losing_or_repeating_a_result(tmp_path: Path) -> None:
+    store = tmp_path / "small.sqlite"
+    interrupted = start_and_stop_after(store, 1, signal.SIGINT)
+    _, stderr = interrupted.communicate(timeout=30)  # at once, not after the experiments in flight
+    assert interrupted.returncode == 130 and "Traceback" not in stderr
+    assert f"interrupted: {len(rows(store))} results kept in {store}; the same command resumes" in stderr
+    killed = start_and_stop_after(store, len(rows(store)) + 1, signal.SIGKILL)
+    killed.wait(30)
+    before = rows(store)
+    assert 2 <= len(before)
+    resumed = specc("campaign", ATRV, *SMALL, "--store", store, "-q")
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"results in {store} ({len(before)} already there)" in resumed.stderr
+    after = rows(store)
+    keys = [key for key, _ in after]
+    assert len(keys) == len(set(keys))
+    assert set(before) <= set(after)  # each result from before the kill kept, never run again
+    with ResultStore(store) as results:
+        verdicts = {m.id: m.verdict for m in results.mutants()}
+        kept = [m for m, v in verdicts.items() if v == KEPT]
+        assert len(verdicts) == 3 and UNJUDGED not in verdicts.values()
+        expected = {f"Robot1|{m}|M1|W1|0" for m in [ORIGINAL, *verdicts]}
+        expected |= {f"Robot1/2|{m}|M1|W1|0" for m in [ORIGINAL, *kept]}
+        assert set(keys) == expected
+        assert all(o.status == "done" for o in results.outcomes())
+    report = (tmp_path / "small.md").read_text()
+    assert "kept (F*)" in report and "## Means over sets of activities" in report
+    assert is_png(tmp_path / "small.png")
+    # Once complete, the same command runs nothing again and rewrites the same report.
+    again = specc("campaign", ATRV, *SMALL, "--store", store, "-q")
+    assert again.returncode == 0 and rows(store) == after
+    assert (tmp_path / "small.md").read_text() == report
+
+
+def test_a_store_refuses_to_mix_two_campaigns(tmp_path: Path) -> None:
+    with ResultStore(tmp_path / "c.sqlite") as store:
+        first = {"robot": "atrv", "mutants": ["model1-0001"], "runs": 3, "configurations": ["Robot1"]}
+        store.describe(first)
+        store.describe(first)  # the same: a resume
+        with pytest.raises(RunError, match="holds another campaign .*differs in mutants, runs"):
+            store.describe(first | {"mutants": ["model1-0002"], "runs": 1})
+        # More configurations after those it has: the same campaign, compared further.
+        store.describe(first | {"configurations": ["Robot1", "Robot1/2"]})
+        assert store.description()["configurations"] == ["Robot1", "Robot1/2"]
+        with pytest.raises(RunError, match="differs in configurations"):
+            store.describe(first | {"configurations": ["Robot1/2"]})
+        outcome = Outcome(ONE, "done", {"kappa": 0}, 1.0)
+        store.record(outcome)
+        with pytest.raises(RunError, match="already in"):
+            store.record(outcome)
+        assert store.count() == 1 and list(store.outcomes()) == [outcome]
+
+
+def measures(kappa: int = 0, distance: float = 10.0) -> dict[str, object]:
+    return {"kappa": kappa, "distance": distance}
+
+
+def outcomes_of(mutant: str, values: list[dict[str, object]], status: str = "done") -> list[Outcome]:
+    return [Outcome(Experiment("Robot1", mutant, "M1", world, 0), status, value if status == "done" else None, 1.0)
+            for world, value in zip(("W1", "W2"), values, strict=True)]
+
+
+def test_the_seeds_filters_set_aside_mutants_that_never_plan_or_change_nothing() -> None:
+    original = [measures(), measures(distance=12.0)]
+    outcomes = (outcomes_of(ORIGINAL, original) + outcomes_of("same", original)
+                + outcomes_of("blind", [measures(kappa=1), measures(kappa=1)])
+                + outcomes_of("changed", [measures(), measures(distance=3.0)])
+                + outcomes_of("hung", original, status="timeout")
+                + outcomes_of("half", original)[:1]
+                + [Outcome(Experiment("Robot1/2", "same", "M1", "W1", 0), "done", measures(distance=1.0), 1.0)])
+    verdicts = judge(outcomes, "Robot1", ["same", "blind", "changed", "hung", "half"], expected=2)
+    assert {m: v.verdict for m, v in verdicts.items()} == {
+        "same": EQUIVALENT, "blind": NEVER_PLANS, "changed": KEPT, "hung": KEPT, "half": UNJUDGED}
+    assert verdicts["changed"].detail == "1 of 2 experiments differ"
+
+
+def test_an_experiment_past_its_hard_timeout_is_killed_and_the_next_one_runs() -> None:
+    process = ExperimentProcess(SETTING, timeout=0.3)
+    try:
+        late = process.run(ONE, None)
+        assert late.status == "timeout" and "killed" in late.why and process.process is None
+        process.timeout = 120.0
+        done = process.run(ONE, None)
+        assert done.status == "done" and done.measures is not None and done.measures["nu"] == 1
+    finally:
+        process.close()
+
+
+def test_an_experiment_is_a_pure_function_wherever_it_runs(tmp_path: Path) -> None:
+    """The same experiment on the local pool and on a local Dask cluster gives the same measures;
+    an unknown world is a crashed experiment that says why, not a crashed campaign."""
+    odd = Experiment("Robot1", ORIGINAL, "M1", "W9", 0)
+    local = {o.experiment: o for o in LocalEngine(SETTING, 2, 120.0).run([(ONE, None), (odd, None)])}
+    assert local[odd].status == "crashed" and "W9" in local[odd].why
+    (dask,) = DaskEngine(SETTING, "local", 1, 120.0).run([(ONE, None)])
+    assert dask.status == local[ONE].status == "done"
+    assert dask.measures == local[ONE].measures
+
+
+def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path: Path) -> None:
+    with ResultStore(tmp_path / "r.sqlite") as store:
+        store.describe({"robot": "atrv", "domain": "model1", "configurations": ["Robot1", "Robot1/2"],
+                        "missions": ["M1"], "worlds": ["W1", "W4"], "runs": 1})
+        store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
+        store.judge("model1-0001", KEPT)
+
+        def one(configuration: str, mutant: str, world: str, success: bool) -> None:
+            goals = {"asked": 1, "met": 1 if success else 0}
+            store.record(Outcome(Experiment(configuration, mutant, "M1", world, 0), "done", {
+                "configuration": configuration, "mission": "M1", "world": world, "seed": 0, "photos": goals,
+                "communications": goals, "home": goals, "kappa": 0, "replannings": 0, "activity_time": 10.0,
+                "distance": 5.0, "mission_time": 100.0, "planner_failures": 0, "believed": goals}, 1.0))
+
+        for configuration in ("Robot1", "Robot1/2"):
+            for world in ("W1", "W4"):
+                one(configuration, ORIGINAL, world, True)
+        one("Robot1", "model1-0001", "W1", False)
+        one("Robot1", "model1-0001", "W4", False)
+        one("Robot1/2", "model1-0001", "W1", True)
+        one("Robot1/2", "model1-0001", "W4", False)
+        report = build_report(store)
+    without_w4 = next(h for h in report.headlines if h.worlds == "W* \\ W4")
+    assert (without_w4.faulty, without_w4.fault_free) == ((0.0, 1.0), (1.0, 1.0))
+    every = next(h for h in report.headlines if h.worlds == "W*")
+    assert every.faulty == (0.0, 0.5) and every.absolute == 0.5 and every.relative is None
+    text = markdown(report)
+    assert "Robot1/2 succeeds in 50% of missions against Robot1's 0%: +50 points" in text
+    assert "| model1-0001 | numeric |" in text and "| 0% | 50% |" in text
+    written = write_report(report, tmp_path / "out")
+    assert [p.name for p in written] == ["campaign.md", "campaign.json", "campaign.png"] and is_png(written[2])
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--mutants", "many"], "error: --mutants many: give a number of mutants, or 'all'"),
+    (["--missions", "M9"], "no mission 'M9'"),
+    (["--configs", "Robot7"], "no robot configuration 'Robot7'"),
+    (["--configs", "Robot2"], "configuration Robot2 does not plan in 'model1'"),
+    (["--domain", "model9", "--mutants", "2"], "model9"),
+])
+def test_bad_campaign_input_is_one_line_and_exit_2(tmp_path: Path, args: list[str], message: str) -> None:
+    result = specc("campaign", ATRV, "--missions", "M1", "--worlds", "W1", "--runs", "1", *args,
+                   "--store", tmp_path / "bad.sqlite", "-q")
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert not (tmp_path / "bad.sqlite").exists()
+
+
+def test_a_configuration_without_its_plan_analyzer_is_named_by_a_suffix() -> None:
+    from specc.run.rover import check_mission
+
+    kwargs = {"generated": SETTING.generated, "example": SETTING.example}
+    with_analyzer = check_mission("Robot1/2", "M1", "W1", **kwargs).setup.config  # type: ignore[arg-type]
+    without = check_mission("Robot1/2-noanalyzer", "M1", "W1", **kwargs).setup.config  # type: ignore[arg-type]
+    assert with_analyzer.analyzer and without.analyzer == ()
+    assert without.planners == with_analyzer.planners and without.policy == with_analyzer.policy
+    with pytest.raises(RunError, match="add -noanalyzer to one"):
+        check_mission("Robot3-noanalyzer", "M1", "W1", **kwargs)  # type: ignore[arg-type]
