@@ -21,6 +21,7 @@ from typing import Any, Protocol
 
 from specc.campaign.experiments import Experiment, Outcome, Setting, run_experiment
 from specc.run import RunError
+from specc.runtime.ftplan.planners import stop_process
 from specc.runtime.planner import model as pm
 
 # forkserver: the parent may run threads (the progress display, the local engine's own), which
@@ -93,30 +94,15 @@ class ExperimentProcess:
         return Outcome(experiment, "timeout", None, self.timeout,
                        f"overran its hard timeout of {self.timeout:g} s and was killed")
 
-    def _stop(self) -> int | None:
-        process, self.process = self.process, None
-        if self.connection is not None:
-            self.connection.close()
-            self.connection = None
-        if process is None:
+    def _stop(self, ask: bool = False) -> int | None:
+        process, connection = self.process, self.connection
+        self.process, self.connection = None, None
+        if process is None or connection is None:
             return None
-        if process.is_alive():
-            process.terminate()
-            process.join(KILL_GRACE)
-            if process.is_alive():
-                process.kill()
-        process.join()
-        code: int | None = process.exitcode
-        return code
+        return stop_process(process, connection, KILL_GRACE, ask=ask)
 
     def close(self) -> None:
-        if self.process is not None and self.process.is_alive() and self.connection is not None:
-            try:
-                self.connection.send(None)
-                self.process.join(KILL_GRACE)
-            except OSError:
-                pass
-        self._stop()
+        self._stop(ask=self.process is not None and self.process.is_alive())
 
     def abort(self) -> None:
         """Kill the process now, from another thread than the one running an experiment in it:

@@ -3,9 +3,9 @@
 The measures of §4.1.4 are averaged over sets of activities in the seed's notation: σ̄_p({W*, M*},
 F*) is the mean photo quotient over every world and mission and over F*, the kept mutants (∅: the
 original model). Each mean is given with W4 and without it (the seed set W4 apart for its
-adversity), for each configuration; the headline is the change of mission success ν̄ from the
-first configuration to the second under injected faults, absolute (points) and relative, beside
-the fault-free figures."""
+adversity), for each configuration; the headlines are the change of mission success ν̄ from the
+first configuration to each other one under injected faults, absolute (points) and relative,
+beside the fault-free figures."""
 
 from __future__ import annotations
 
@@ -102,8 +102,8 @@ def build_report(store: ResultStore) -> CampaignReport:
             row[configuration] = aggregate(chosen) if chosen else None
         per_mutant.append((mutant, row))
     headlines = []
-    if len(configurations) >= 2:
-        first, second = configurations[:2]
+    first = configurations[0] if configurations else ""
+    for second in configurations[1:]:  # each other configuration against the first (the model alone)
         for label, _ in world_sets:
             faulty = tuple(_nu(means, c, FAULTY, label) for c in (first, second))
             free = tuple(_nu(means, c, FAULT_FREE, label) for c in (first, second))

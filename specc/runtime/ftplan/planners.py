@@ -436,7 +436,7 @@ class PlannerProcess:
         process, connection = self._process, self._connection
         self._process, self._connection, self._pending, self._started = None, None, None, False
         if process is not None and connection is not None:
-            _stop(process, connection, self.kill_grace, ask=False)
+            stop_process(process, connection, self.kill_grace, ask=False)
 
     def restart(self) -> None:
         self.kill()
@@ -461,7 +461,7 @@ class PlannerProcess:
             assert _kept is not None
             _kept.keep(process, connection)
         else:
-            _stop(process, connection, self.kill_grace, ask=True)
+            stop_process(process, connection, self.kill_grace, ask=True)
 
     def __enter__(self) -> PlannerProcess:
         if self._process is None:
@@ -585,9 +585,11 @@ def _launch() -> tuple[multiprocessing.process.BaseProcess, Connection]:
     return process, ours
 
 
-def _stop(process: multiprocessing.process.BaseProcess, connection: Connection, grace: float, *, ask: bool) -> None:
-    """End a planner's process and reap it: asked to exit first when `ask` (it must be idle), then
-    SIGTERM, then SIGKILL, `grace` seconds apart."""
+def stop_process(process: multiprocessing.process.BaseProcess, connection: Connection, grace: float, *,
+                 ask: bool) -> int | None:
+    """End a child serving requests on `connection` (a planner's, a campaign's experiment process)
+    and reap it: asked to exit first when `ask` (it must be idle: None is its signal to stop),
+    then SIGTERM, then SIGKILL, `grace` seconds apart. Its exit code."""
     if ask:
         try:
             connection.send(None)
@@ -601,7 +603,9 @@ def _stop(process: multiprocessing.process.BaseProcess, connection: Connection, 
         if process.is_alive():
             process.kill()
     process.join()
+    code = process.exitcode
     process.close()
+    return code
 
 
 class _KeptProcesses:
@@ -619,12 +623,12 @@ class _KeptProcesses:
             process, connection = self._idle.pop()
             if process.is_alive() and not connection.poll():
                 return process, connection
-            _stop(process, connection, KILL_GRACE, ask=False)
+            stop_process(process, connection, KILL_GRACE, ask=False)
         return None
 
     def close(self) -> None:
         while self._idle:
-            _stop(*self._idle.pop(), KILL_GRACE, ask=True)
+            stop_process(*self._idle.pop(), KILL_GRACE, ask=True)
 
 
 _kept: _KeptProcesses | None = None  # processes are kept while planner_processes_kept() runs
