@@ -108,6 +108,10 @@ def test_a_store_refuses_to_mix_two_campaigns(tmp_path: Path) -> None:
         assert store.description()["configurations"] == ["Robot1", "Robot1/2"]
         with pytest.raises(RunError, match="differs in configurations"):
             store.describe(first | {"configurations": ["Robot1/2"]})
+        # More mutants drawn (a larger sample holds the smaller one), never fewer.
+        store.describe(first | {"configurations": ["Robot1", "Robot1/2"], "mutants": ["model1-0000", "model1-0001"]})
+        with pytest.raises(RunError, match="differs in mutants"):
+            store.describe(first | {"configurations": ["Robot1", "Robot1/2"], "mutants": ["model1-0009"]})
         outcome = Outcome(ONE, "done", {"kappa": 0}, 1.0)
         store.record(outcome)
         with pytest.raises(RunError, match="already in"):

@@ -331,6 +331,8 @@ def test_a_sample_drawn_lazily_is_the_sample_of_the_judged_set(tiny_set: MutantS
         assert n <= len(judged) < len(tiny_set.mutants)
     by_default = draw_kept(tiny_set.mutants, 5, 0)  # judging with the checks themselves
     assert by_default == tiny_set.sample(5, 0)
+    # A larger draw holds the smaller one: a campaign can grow by mutants (specc.campaign.store).
+    assert set(by_default) <= set(draw_kept(tiny_set.mutants, 9, 0))
 
 
 def test_sampling_is_stratified_and_deterministic(tiny_set: MutantSet) -> None:

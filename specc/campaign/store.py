@@ -21,7 +21,13 @@ from typing import Any
 from specc.campaign.experiments import Experiment, Outcome
 from specc.run import RunError
 
-GROWING = ("configurations",)  # a resumed campaign may add to these (see ResultStore.describe)
+# What a resumed campaign may add to (see ResultStore.describe), and whether the first must stay.
+GROWING = {"configurations": True, "mutants": False}
+
+
+def _grows(key: str, stored: Any, given: Any) -> bool:
+    return (isinstance(stored, list) and isinstance(given, list) and set(stored) <= set(given)
+            and (not GROWING[key] or given[:1] == stored[:1]))
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS campaign (name TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS mutants (
@@ -70,13 +76,13 @@ class ResultStore:
     def describe(self, description: dict[str, Any]) -> None:
         """Record the campaign's description, or check that the store already holds this one (a
         resumed campaign): RunError naming what differs otherwise. A list under one of GROWING
-        may be longer than the stored one if it starts with it (more configurations compared on
-        the same mutants and activities): the stored description grows."""
+        may hold more than the stored one if it holds all of it (more configurations compared after
+        the same first one, which judges the mutants; more mutants drawn, as a larger draw_kept
+        sample holds the smaller one): the stored description grows."""
         stored = self.description()
         if stored:
             differs = sorted(k for k in set(stored) | set(description) if stored.get(k) != description.get(k))
-            grows = [k for k in differs if k in GROWING and isinstance(stored.get(k), list)
-                     and description.get(k, [])[:len(stored[k])] == stored[k]]
+            grows = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))]
             if set(differs) - set(grows):
                 raise RunError(f"'{self.path}' holds another campaign (it differs in {', '.join(differs)}): "
                                "give another --store, or the same options to resume it")
