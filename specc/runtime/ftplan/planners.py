@@ -306,7 +306,7 @@ def _serve(connection: Connection) -> None:
     while True:
         try:
             request = connection.recv()
-        except EOFError:  # FTplan closed its end: nothing more to plan
+        except (EOFError, OSError):  # FTplan closed its end, or is gone: nothing more to plan
             return
         if request is None:
             return
@@ -317,7 +317,10 @@ def _serve(connection: Connection) -> None:
                 planner = load_factory(config.factory)(config, domains)
             except Exception as error:
                 startup_error = f"building planner '{config.name}' with {config.factory} failed: {_describe(error)}"
-            connection.send(_Started(startup_error))
+            try:
+                connection.send(_Started(startup_error))
+            except OSError:  # FTplan is gone (killed mid-mission): nobody to tell
+                return
             continue
         started = time.perf_counter()
         try:
@@ -331,6 +334,8 @@ def _serve(connection: Connection) -> None:
             reply = _Reply(request.id, None, _describe(error), traceback.format_exc(), time.perf_counter() - started)
         try:
             connection.send(reply)
+        except OSError:  # FTplan is gone (killed mid-mission): nobody to answer
+            return
         except Exception as error:  # the result does not pickle: say so rather than die
             connection.send(_Reply(request.id, None, f"the answer could not be sent: {_describe(error)}",
                                    traceback.format_exc(), reply.seconds))
