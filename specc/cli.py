@@ -975,7 +975,6 @@ class CampaignProgress:
     def update(self, done: int, total: int, outcome: Any) -> None:
         if self.first is None:
             self.first = done
-            self.progress.update(self.task, completed=done, total=total)
             self.progress.reset(self.task, completed=done, total=total)  # the rate counts this session only
         elapsed = time.perf_counter() - self.started
         rate = (done - self.first) / elapsed * 3600 if elapsed > 0 and done > self.first else 0.0

@@ -170,7 +170,7 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
         store.describe({"robot": "atrv", "domain": "model1", "configurations": ["Robot1", "Robot1/2"],
                         "missions": ["M1"], "worlds": ["W1", "W4"], "runs": 1})
         store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
-        store.judge("model1-0001", KEPT)
+        store.judge([("model1-0001", KEPT, "")])
 
         def one(configuration: str, mutant: str, world: str, success: bool) -> None:
             goals = {"asked": 1, "met": 1 if success else 0}

@@ -106,35 +106,39 @@ class Campaign:
         self.store.describe(self.plan.description(list(self.domains)))
         self.store.add_mutants(self.records)
 
+    def experiments(self, kept: Sequence[str]) -> list[Experiment]:
+        """The whole campaign when the later configurations run the mutants `kept`: the first
+        configuration runs the original and every mutant, to judge them."""
+        first, others = self.plan.configurations[0], self.plan.configurations[1:]
+        judging = self.plan.experiments(first, [ORIGINAL, *self.domains])
+        return judging + [e for c in others for e in self.plan.experiments(c, [ORIGINAL, *kept])]
+
     def run(self, progress: Progress | None = None) -> dict[str, Verdict]:
         first, others = self.plan.configurations[0], self.plan.configurations[1:]
         mutants = list(self.domains)
-        per_mutant = len(self.plan.experiments(first, [ORIGINAL]))
         done = self.store.done()
-        # The total as far as it is known: the later phases count every mutant until judged.
+        # The total as far as it is known: until judged, a mutant counts in the later configurations.
         judged = self.verdicts()
-        kept_guess = [m for m in mutants if judged[m].verdict in (KEPT, UNJUDGED)]
-        total = per_mutant * (1 + len(mutants)) + len(others) * per_mutant * (1 + len(kept_guess))
-        counter = [len(done & {e.key for e in self.plan.experiments(first, [ORIGINAL, *mutants])})]
-        counter[0] += len(done & {e.key for c in others for e in self.plan.experiments(c, [ORIGINAL, *kept_guess])})
+        everything = self.experiments([m for m in mutants if judged[m].verdict in (KEPT, UNJUDGED)])
+        total, counted = len(everything), len(done & {e.key for e in everything})
 
         def go(experiments: list[Experiment]) -> None:
-            nonlocal total
+            nonlocal counted
             todo = [e for e in experiments if e.key not in done]
             tasks = ((e, self.domains.get(e.mutant)) for e in todo)
             if progress is not None:
-                progress(counter[0], total, None)
+                progress(counted, total, None)
             for outcome in self.engine.run(tasks):
                 self.store.record(outcome)
                 done.add(outcome.experiment.key)
-                counter[0] += 1
+                counted += 1
                 if progress is not None:
-                    progress(counter[0], total, outcome)
+                    progress(counted, total, outcome)
 
         go(self.plan.experiments(first, [ORIGINAL, *mutants]))
         judged = self.verdicts()
         kept = [m for m in mutants if judged[m].verdict == KEPT]
-        total = per_mutant * (1 + len(mutants)) + len(others) * per_mutant * (1 + len(kept))
+        total = len(self.experiments(kept))
         for configuration in others:
             go(self.plan.experiments(configuration, [ORIGINAL, *kept]))
         return judged
@@ -143,8 +147,7 @@ class Campaign:
         first = self.plan.configurations[0]
         expected = len(self.plan.experiments(first, [ORIGINAL]))
         verdicts = judge(self.store.outcomes(), first, list(self.domains), expected)
-        for verdict in verdicts.values():
-            self.store.judge(verdict.mutant, verdict.verdict, verdict.detail)
+        self.store.judge((v.mutant, v.verdict, v.detail) for v in verdicts.values())
         return verdicts
 
 
@@ -161,11 +164,12 @@ def check_names(plan: CampaignPlan, generated: Path, example: Path) -> None:
     for configuration in plan.configurations:
         for mission in plan.missions:
             for world in plan.worlds:
-                checked = check_mission(configuration, mission, world, 0, generated=generated, example=example)
-        if plan.domain not in checked.setup.planned_in:
-            raise RunError(f"configuration {configuration} does not plan in '{plan.domain}' (it plans in "
-                           f"{', '.join(sorted(checked.setup.planned_in))}): a campaign injects faults into the "
-                           "model its configurations use")
+                planned_in = check_mission(configuration, mission, world, 0, generated=generated,
+                                           example=example).setup.planned_in
+                if plan.domain not in planned_in:
+                    raise RunError(f"configuration {configuration} does not plan in '{plan.domain}' (it plans in "
+                                   f"{', '.join(sorted(planned_in))}): a campaign injects faults into the model "
+                                   "its configurations use")
 
 
 @dataclass(frozen=True)

@@ -11,17 +11,16 @@ finishes, in whatever order they finish."""
 from __future__ import annotations
 
 import multiprocessing
-import os
 import threading
 from collections.abc import Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from multiprocessing.connection import Connection
-from multiprocessing.connection import wait as wait_any
 from typing import Any, Protocol
 
 from specc.campaign.experiments import Experiment, Outcome, Setting, run_experiment
 from specc.run import RunError
-from specc.runtime.ftplan.planners import stop_process
+from specc.runtime.ftplan import planner_processes_kept
+from specc.runtime.ftplan.planners import exit_with_parent, stop_process
 from specc.runtime.planner import model as pm
 
 # forkserver: the parent may run threads (the progress display, the local engine's own), which
@@ -34,15 +33,7 @@ Task = tuple[Experiment, pm.PlanningDomain | None]
 
 def _serve(connection: Connection, setting: Setting) -> None:
     """The experiment process: run what the parent sends until it sends None or goes away."""
-    parent = multiprocessing.parent_process()
-    if parent is not None:
-        # A parent that dies (killed campaign) takes its experiment process along at once.
-        def watch() -> None:
-            wait_any([parent.sentinel])
-            os._exit(1)
-
-        threading.Thread(target=watch, daemon=True).start()
-    from specc.runtime.ftplan import planner_processes_kept
+    exit_with_parent()  # a killed campaign takes its experiment processes (and their planners) along
 
     # Planner processes go from one experiment to the next (each builds its planner anew from
     # its own domains): a mission's planners then start warm instead of paying a process start.

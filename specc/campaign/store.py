@@ -102,9 +102,11 @@ class ResultStore:
             self.db.executemany("INSERT OR IGNORE INTO mutants (id, kind, description, diff) VALUES (?, ?, ?, ?)",
                                 [(m.id, m.kind, m.description, m.diff) for m in mutants])
 
-    def judge(self, mutant: str, verdict: str, detail: str = "") -> None:
+    def judge(self, verdicts: Iterable[tuple[str, str, str]]) -> None:
+        """Record (mutant, verdict, detail) for each judged mutant, in one transaction."""
         with self.db:
-            self.db.execute("UPDATE mutants SET verdict = ?, detail = ? WHERE id = ?", (verdict, detail, mutant))
+            self.db.executemany("UPDATE mutants SET verdict = ?, detail = ? WHERE id = ?",
+                                [(verdict, detail, mutant) for mutant, verdict, detail in verdicts])
 
     def mutants(self) -> list[MutantRecord]:
         return [MutantRecord(*row) for row in

@@ -9,18 +9,25 @@ from typing import Any
 from specc.model.nodes import Node
 
 
-def children(node: Node) -> Iterator[Node]:
-    """The direct child nodes of `node`, in field order."""
+def child_steps(node: Node) -> Iterator[tuple[str, int | None, Node]]:
+    """The direct child nodes of `node`, in field order, with where each sits: the field's name
+    and, in a field holding a tuple, its index there (None otherwise)."""
     for f in fields(node):
         if f.name == "span":
             continue
         value = getattr(node, f.name)
         if isinstance(value, Node):
-            yield value
+            yield f.name, None, value
         elif isinstance(value, tuple):
-            for element in value:
+            for index, element in enumerate(value):
                 if isinstance(element, Node):
-                    yield element
+                    yield f.name, index, element
+
+
+def children(node: Node) -> Iterator[Node]:
+    """The direct child nodes of `node`, in field order."""
+    for _, _, child in child_steps(node):
+        yield child
 
 
 def walk(node: Node) -> Iterator[Node]:

@@ -34,6 +34,7 @@ from typing import Any, Literal
 from specc.analysis.planning import VALUE_VAR, members
 from specc.model import nodes as m
 from specc.model.span import Span
+from specc.model.visitor import walk
 from specc.mutation.tree import Path, nodes_with_paths
 from specc.syntax.printer import ixexpr, tstmt
 
@@ -181,7 +182,7 @@ def value_pool(expanded: Iterable[Any], random_values: int, seed: int) -> tuple[
     drawn with `seed` (one decimal). The first spelling of a value is kept (10.0 stays 10.0)."""
     written: dict[float, float] = {}
     for member in expanded:
-        for _, node in nodes_with_paths(member):
+        for node in walk(member):
             value = literal_value(node)
             if value is not None:
                 written.setdefault(value, value)

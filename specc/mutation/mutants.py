@@ -4,6 +4,7 @@ the checks `specc check` runs, sampled, and lowered to the planner's domain for 
 from __future__ import annotations
 
 import difflib
+import functools
 import multiprocessing
 import os
 import random
@@ -369,17 +370,27 @@ def _verdict_here(text: str) -> tuple[Reason, str] | None:
 
 def verdict(target: MutationTarget, text: str) -> tuple[Reason, str] | None:
     """Why the mutated file `text` is rejected (invalid or equivalent), or None to keep it."""
-    program, errors = mutated_program(target, text)
-    if errors:
-        return "invalid", _first_error(errors)
-    assert program is not None
     try:
-        lowered = domain_model(program, _domain_of(program, target))
-    except PlanningError as exc:  # checked specs the planner cannot take: a bug the mutant found
-        return "invalid", f"checked, but the planner's domain cannot be built: {exc}"
+        lowered = lowered_domain(target, text)
+    except MutationError as error:
+        return "invalid", str(error)
     if without_lines(lowered) == target.original_planning:
         return "equivalent", "lowers to the original planning domain"
     return None
+
+
+@functools.lru_cache(maxsize=1024)
+def lowered_domain(target: MutationTarget, text: str) -> pm.PlanningDomain:
+    """The planner's domain of the robot with `text` in place of the domain's file, lowered as
+    `specc compile` lowers it; MutationError (the first error `specc check` finds, or why the
+    planner cannot take it) otherwise. Cached: a campaign lowers the mutants its draw judged."""
+    program, errors = mutated_program(target, text)
+    if errors or program is None:
+        raise MutationError(_first_error(errors))
+    try:
+        return domain_model(program, _domain_of(program, target))
+    except PlanningError as exc:  # checked specs the planner cannot take: a bug the mutant found
+        raise MutationError(f"checked, but the planner's domain cannot be built: {exc}") from None
 
 
 def mutated_program(target: MutationTarget, text: str) -> tuple[m.Program | None, list[Diagnostic]]:
@@ -418,13 +429,10 @@ def without_lines(value: Any) -> Any:
 def mutant_domain(mutant: Mutant) -> pm.PlanningDomain:
     """The planner's domain (what `specc compile` generates as `<robot>.planner.<domain>.DOMAIN`)
     of a mutant: plan with `Planner(mutant_domain(x)).plan(problem)`, the problems unchanged."""
-    program, errors = mutated_program(mutant.target, mutant.text)
-    if errors or program is None:
-        raise MutationError(f"mutant {mutant.id} does not check: {_first_error(errors)}")
     try:
-        return domain_model(program, _domain_of(program, mutant.target))
-    except PlanningError as exc:
-        raise MutationError(f"mutant {mutant.id}: the planner's domain cannot be built: {exc}") from None
+        return lowered_domain(mutant.target, mutant.text)
+    except MutationError as error:
+        raise MutationError(f"mutant {mutant.id}: {error}") from None
 
 
 def default_workers() -> int:

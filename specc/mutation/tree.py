@@ -8,10 +8,11 @@ is rebuilt along that path with `dataclasses.replace` (the rest is shared, untou
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import fields, replace
+from dataclasses import replace
 from typing import Any, TypeVar
 
 from specc.model import nodes as m
+from specc.model.visitor import child_steps
 
 # One step down: the field's name and, when the field holds a tuple, the element's index.
 Step = tuple[str, int | None]
@@ -22,23 +23,8 @@ N = TypeVar("N", bound=m.Node)
 def nodes_with_paths(node: m.Node, path: Path = ()) -> Iterator[tuple[Path, m.Node]]:
     """`node` and every node below it with their paths, depth first, in field (= source) order."""
     yield path, node
-    for f in fields(node):
-        if f.name == "span":
-            continue
-        value = getattr(node, f.name)
-        if isinstance(value, m.Node):
-            yield from nodes_with_paths(value, path + ((f.name, None),))
-        elif isinstance(value, tuple):
-            for index, element in enumerate(value):
-                if isinstance(element, m.Node):
-                    yield from nodes_with_paths(element, path + ((f.name, index),))
-
-
-def node_at(root: m.Node, path: Path) -> m.Node:
-    node: Any = root
-    for name, index in path:
-        node = getattr(node, name) if index is None else getattr(node, name)[index]
-    return node  # type: ignore[no-any-return]
+    for name, index, child in child_steps(node):
+        yield from nodes_with_paths(child, path + ((name, index),))
 
 
 def replace_at(root: N, path: Path, new: m.Node | None) -> N:

@@ -278,9 +278,10 @@ def _describe(error: BaseException) -> str:
 
 # ---------------------------------------------------------------- the child
 
-def _exit_with_parent() -> None:
-    """End this process as soon as its parent is gone, even in the middle of a planning: a
-    planner must not outlive FTplan (nobody would ever kill it)."""
+def exit_with_parent() -> None:
+    """End this process as soon as its parent is gone, even in the middle of its work: a planner
+    must not outlive FTplan, nor a campaign's experiment process its campaign (nobody would ever
+    kill them)."""
     parent = multiprocessing.parent_process()
     if parent is None or parent.sentinel is None:
         return
@@ -297,7 +298,7 @@ def _serve(connection: Connection) -> None:
     """The planner's process: build the planner, then answer requests until told to stop; build
     another when told to (a kept process serving its next PlannerProcess). Whatever the planner
     raises is sent back rather than ending the process silently."""
-    _exit_with_parent()
+    exit_with_parent()
     # Ctrl-C reaches the whole process group: FTplan, not the terminal, decides when planners stop.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     planner: SupportsPlan | None = None
