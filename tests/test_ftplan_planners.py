@@ -11,11 +11,12 @@ import sys
 import textwrap
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
-from specc.runtime.ftplan import CostModel, FtPlan, LocalPool, ScriptedExecutor
+from specc.runtime.ftplan import CostModel, FtPlan, LocalPool, ScriptedExecutor, planners_as_run
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.planners import (
     Answer,
@@ -162,6 +163,41 @@ def test_standard_planner_in_its_process_plans_as_in_process(
         assert charged(answer, problem, cost=CostModel(base=0.0, per_node=0.01)) == pytest.approx(0.01 * expected.nodes)
         assert planner.poll(0.0) is None  # nothing under way any more
     assert not planner.running and planner.pid is None
+
+
+def test_a_node_limit_stops_the_planning_once_passed_and_changes_nothing_below_it(
+        mission: tuple[pm.PlanningDomain, pm.Problem]) -> None:
+    domain, problem = mission
+    free = Planner(domain).plan(problem, now=0.0)
+    assert free.plan is not None and free.nodes > 2
+    enough = Planner(domain, node_limit=free.nodes).plan(problem, now=0.0)
+    assert enough.plan == free.plan and enough.goals == free.goals and enough.nodes == free.nodes
+    # One partial plan short: it stops on the one that passes the limit, the last one it needed.
+    short = Planner(domain, node_limit=free.nodes - 1).plan(problem, now=0.0)
+    assert short.plan is None and short.nodes == free.nodes
+    assert f"limit of {free.nodes - 1} partial plans" in short.reason
+
+
+def test_under_the_cost_model_planners_stop_where_the_watchdog_would_find_them_late(
+        mission: tuple[pm.PlanningDomain, pm.Problem], domains: dict[str, pm.PlanningDomain]) -> None:
+    cost = CostModel()
+    assert cost.nodes_within(10.0) == 800 and cost.charge(800) <= 10.0 < cost.charge(801)
+    assert CostModel(base=2.0, per_node=0.3).nodes_within(10.0) == 26  # 9.8 s; 27 would be 10.1 s
+    assert cost.nodes_within(1.0) == 0
+    config = FtPlanConfig("ftplan", (PlannerConfig("ixtet1", "model1"), PlannerConfig("ixtet2", "model1")),
+                          watchdog=3.0)
+    assert [p.node_limit for p in planners_as_run(config, "model")] == [100, 100]
+    assert planners_as_run(config, "wall") == config.planners  # the wall-clock watchdog stops them
+    # The limit reaches the planner in its own process: a late answer, whatever the machine's speed.
+    domain, problem = mission
+    needed = Planner(domain).plan(problem, now=0.0).nodes
+    limited = replace(PlannerConfig("ixtet1", "model1"), node_limit=needed - 1)
+    with PlannerProcess(limited, domains) as planner:
+        planner.request(problem, 0.0)
+        answer = planner.poll(ANSWER_TIMEOUT)
+    assert answer is not None and answer.result is not None
+    assert answer.result.plan is None and answer.nodes == needed
+    assert charged(answer, problem, cost=CostModel(base=0.0, per_node=1.0)) > needed - 1
 
 
 def test_a_bad_configuration_is_reported_at_start_and_on_every_request(

@@ -68,6 +68,7 @@ from specc.run.package import import_generated
 from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
 from specc.runtime import functional as rt
 from specc.runtime.ftplan import (
+    HUNG_PLANNER_SECONDS,
     FtPlan,
     MissionResult,
     MissionSetup,
@@ -75,6 +76,7 @@ from specc.runtime.ftplan import (
     Report,
     UnknownName,
     mission_setup,
+    planners_as_run,
 )
 from specc.runtime.ftplan.config import FtPlanConfig
 from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precedences
@@ -868,8 +870,9 @@ def run_rover_mission(configuration: str, mission: str, world: str | Path | Worl
              windows=[[w.name, w.start, w.end] for w in windows],
              targets=[[t.name, t.x, t.y] for t in prepared.tasks.targets.values()])
     PoseRecorder(journal.emit, rover.sim).start()
-    with ProcessPool(setup.config.planners, setup.domains) as pool:
-        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems)
+    with ProcessPool(planners_as_run(setup.config, timing), setup.domains) as pool:
+        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems,
+                        wall_limit=HUNG_PLANNER_SECONDS if timing == "model" else None)
         journal.ftplan = ftplan
         result = ftplan.run()
     journal.catch_up()

@@ -4,8 +4,9 @@ verification, successive (Fig 3.1) and concurrent (Fig 3.2) recovery.
 
     from specc.runtime.ftplan import FtPlan, ProcessPool, ScriptedExecutor, mission_setup
     setup = mission_setup(rover.CONFIGURATIONS, "Robot1/2", "M1", atrv.planner)
-    with ProcessPool(setup.config.planners, setup.domains) as pool:
-        result = FtPlan(setup.config, setup.problem, pool, ScriptedExecutor(), problems=setup.problems).run()
+    with ProcessPool(planners_as_run(setup.config, "model"), setup.domains) as pool:
+        result = FtPlan(setup.config, setup.problem, pool, ScriptedExecutor(), problems=setup.problems,
+                        wall_limit=HUNG_PLANNER_SECONDS).run()
 
 A program running many missions one after another keeps the planners' processes from one to the
 next inside `with planner_processes_kept():` (see `planners`).
@@ -13,13 +14,20 @@ next inside `with planner_processes_kept():` (see `planners`).
 
 from __future__ import annotations
 
-from specc.runtime.ftplan.component import CostModel, FtPlan, MissionFailure, MissionResult
+from specc.runtime.ftplan.component import (
+    HUNG_PLANNER_SECONDS,
+    CostModel,
+    FtPlan,
+    MissionFailure,
+    MissionResult,
+    planners_as_run,
+)
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig, configurations
 from specc.runtime.ftplan.execution import Executor, Outcome, Report, ScriptedExecutor
 from specc.runtime.ftplan.missions import MissionSetup, UnknownName, mission_setup
 from specc.runtime.ftplan.planners import planner_processes_kept
 from specc.runtime.ftplan.pools import LocalPool, ProcessPool
 
-__all__ = ["CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure", "MissionResult",
-           "MissionSetup", "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor", "UnknownName",
-           "configurations", "mission_setup", "planner_processes_kept"]
+__all__ = ["HUNG_PLANNER_SECONDS", "CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure",
+           "MissionResult", "MissionSetup", "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor",
+           "UnknownName", "configurations", "mission_setup", "planner_processes_kept", "planners_as_run"]

@@ -35,12 +35,13 @@ Two departures from the figures, both where they are silent:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Collection, Generator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 from specc.runtime.ftplan.analyzer import Violation, analyse
-from specc.runtime.ftplan.config import FtPlanConfig
+from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
 from specc.runtime.ftplan.planners import Answer, Watchdog
 from specc.runtime.ftplan.state import SystemState, fact_list
@@ -89,7 +90,35 @@ class CostModel:
     per_node: float = 0.01  # seconds per partial plan expanded
 
     def seconds(self, answer: Answer) -> float:
-        return self.base + self.per_node * answer.nodes
+        return self.charge(answer.nodes)
+
+    def charge(self, nodes: int) -> float:
+        return self.base + self.per_node * nodes
+
+    def nodes_within(self, seconds: float) -> int:
+        """The most partial plans a planning may expand and still be charged at most `seconds`."""
+        nodes = max(0, math.floor((seconds - self.base) / self.per_node))
+        while self.charge(nodes + 1) <= seconds:  # the division's rounding, either way
+            nodes += 1
+        while nodes > 0 and self.charge(nodes) > seconds:
+            nodes -= 1
+        return nodes
+
+
+# Under the cost model a planner stops by itself once its answer would be late (`planners_as_run`):
+# the wall-clock kill is then for a planner that hangs, and must not catch a slow machine.
+HUNG_PLANNER_SECONDS = 60.0
+
+
+def planners_as_run(config: FtPlanConfig, timing: str, cost: CostModel | None = None) -> tuple[PlannerConfig, ...]:
+    """`config`'s planners as FTplan runs them. Under the cost model (`timing="model"`) each stops
+    once it has expanded more partial plans than the watchdog pays for: its answer would be late
+    whatever it found, and where it stops does not depend on the machine's speed, so a run
+    depends on its seed only. With the wall clock, the watchdog stops them."""
+    if timing != "model":
+        return config.planners
+    limit = (cost or CostModel()).nodes_within(config.watchdog)
+    return tuple(replace(planner, node_limit=limit) for planner in config.planners)
 
 
 # ---------------------------------------------------------------- results

@@ -61,6 +61,9 @@ class PlannerConfig:
     factory: str = "specc.runtime.ftplan.planners:standard_planner"
     # How this planner's vocabulary reads FTplan's state; empty: it speaks the state's vocabulary.
     view: tuple[Correspondence, ...] = ()
+    # Partial plans a planning may expand before it gives up (None: no limit); FTplan sets it
+    # (component.planners_as_run), the spec does not.
+    node_limit: int | None = None
 
 
 @dataclass(frozen=True)

@@ -110,7 +110,7 @@ def standard_planner(config: PlannerConfig, domains: Mapping[str, pm.PlanningDom
     if config.domain not in domains:
         raise ValueError(f"planner '{config.name}': no planning domain '{config.domain}' "
                          f"(given: {', '.join(sorted(domains)) or 'none'})")
-    return Planner(domains[config.domain], controllability=config.controllability)
+    return Planner(domains[config.domain], controllability=config.controllability, node_limit=config.node_limit)
 
 
 def planning_domains(generated: Mapping[str, ModuleType]) -> dict[str, pm.PlanningDomain]:

@@ -45,6 +45,10 @@ from specc.runtime.stn import STN, Inconsistent
 INF = math.inf
 
 
+class NodeLimitReached(Exception):
+    """The planning expanded more partial plans than its node limit allows."""
+
+
 class PlanningInputError(ValueError):
     """The problem cannot be planned as written (a contingent instant without bounds, a
     constraint the planner does not handle): one clear message, no plan."""
@@ -74,7 +78,8 @@ class Attempt:
 
 class Planner:
     def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
-                 exact: bool = True, limits: Limits | None = None, controllability: str = STRONG) -> None:
+                 exact: bool = True, limits: Limits | None = None, controllability: str = STRONG,
+                 node_limit: int | None = None) -> None:
         if controllability not in CONTROLLABILITIES:
             raise ValueError(f"controllability '{controllability}': choose {' or '.join(CONTROLLABILITIES)}")
         self.domain = domain
@@ -83,6 +88,10 @@ class Planner:
         self.goal_nodes = goal_nodes  # budget of each smaller search
         self.exact = exact  # CasADi durations and schedule (else the interval enclosures and the STN)
         self.limits = limits or Limits()
+        # Partial plans one planning may expand in all before it gives up: FTplan sets it to what
+        # its watchdog pays for, so that a planning stops where its answer would be late anyway,
+        # at the same count on any machine. Below it, the search is the same as without.
+        self.node_limit = node_limit
 
     # ------------------------------------------------------------ entry point
     def plan(self, problem: pm.Problem, now: float = 0.0) -> PlanResult:
@@ -91,21 +100,36 @@ class Planner:
             setup = Setup(self.domain, problem, now, self.limits, self.controllability)
         except PlanningInputError as error:
             return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
+        expanded = [0]
+        try:
+            return self._plan(setup, started, expanded)
+        except NodeLimitReached:
+            return PlanResult(None, reason=f"no plan within the limit of {self.node_limit} partial plans",
+                              nodes=expanded[0], seconds=time.perf_counter() - started)
+
+    def _plan(self, setup: Setup, started: float, expanded: list[int]) -> PlanResult:
+        """`plan` once the problem is set up; `expanded` counts the partial plans as they go."""
         goals = setup.goals
-        total = 0
         outcomes: dict[int, GoalOutcome] = {}
 
         def attempt(active: Iterable[Goal], budget: int, discrepancies: bool = True) -> Attempt:
-            nonlocal total
-            result = setup.search(list(active), budget, discrepancies)
-            total += result.nodes
+            allowance = None if self.node_limit is None else self.node_limit - expanded[0]
+            try:
+                result = setup.search(list(active), budget, discrepancies, allowance)
+            except NodeLimitReached as reached:
+                expanded[0] += reached.args[0]
+                raise
+            expanded[0] += result.nodes
+            if self.node_limit is not None and expanded[0] > self.node_limit:
+                raise NodeLimitReached(0)
             return result
 
         base = attempt([], self.goal_nodes)
         if base.node is None:
             why = "no plan satisfies the problem's required assertions and constraints"
             return PlanResult(None, tuple(GoalOutcome(g.text, g.priority, g.hold.line, False, why) for g in goals),
-                              reason=f"{why}: {explain(base)}", nodes=total, seconds=time.perf_counter() - started)
+                              reason=f"{why}: {explain(base)}", nodes=expanded[0],
+                              seconds=time.perf_counter() - started)
         candidates = []
         for goal in goals:
             alone = attempt([goal], self.goal_nodes)
@@ -136,7 +160,7 @@ class Planner:
         assert best.node is not None
         plan, notes = setup.extract(best.node, self.exact)
         ordered = tuple(outcomes[g.index] for g in goals)
-        return PlanResult(plan, ordered, nodes=total, seconds=time.perf_counter() - started, notes=notes)
+        return PlanResult(plan, ordered, nodes=expanded[0], seconds=time.perf_counter() - started, notes=notes)
 
 
 def explain(attempt: Attempt) -> str:
@@ -288,7 +312,10 @@ class Setup:
         return node
 
     # ------------------------------------------------------------ search
-    def search(self, active: list[Goal], budget: int, discrepancies: bool = True) -> Attempt:
+    def search(self, active: list[Goal], budget: int, discrepancies: bool = True,
+               allowance: int | None = None) -> Attempt:
+        """A plan for the `active` goals within `budget` partial plans; NodeLimitReached (with the
+        count) once more than `allowance` are expanded."""
         failures: Counter[str] = Counter()
         try:
             root = self.root(active)
@@ -316,6 +343,8 @@ class Setup:
                         cut = True
                         break
                     return Attempt(None, nodes - 1, False, failures)
+                if allowance is not None and nodes > allowance:
+                    raise NodeLimitReached(nodes)
                 try:
                     if resolver is not None:
                         resolver.apply(node)
