@@ -213,9 +213,12 @@ def draw(report: CampaignReport, path: Path) -> Path:
         axis.set_ylim(0, 1.1)
         axis.set_title(f"{{{worlds}, M*}}")
         axis.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
-    axes[0].legend(fontsize=7, loc="lower left")
+    # Below the panels: inside one, the legend would hide its bars.
+    columns = min(4, len(series))
+    handles, labels = axes[0].get_legend_handles_labels()
+    figure.legend(handles, labels, loc="lower center", ncol=columns, fontsize=8, frameon=False)
     figure.suptitle("Goals met and missions succeeded, without faults (∅) and with injected faults (F*)")
-    figure.tight_layout()
+    figure.tight_layout(rect=(0, 0.02 + 0.06 * -(-len(series) // columns), 1, 1))
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
