@@ -9,6 +9,7 @@ import sqlite3
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -16,7 +17,7 @@ import pytest
 from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED, judge
 from specc.campaign.engines import DaskEngine, ExperimentProcess, LocalEngine
 from specc.campaign.experiments import ORIGINAL, Experiment, Outcome, Setting
-from specc.campaign.report import build_report, markdown, write_report
+from specc.campaign.report import Coverage, build_report, coverage, markdown, write_report
 from specc.campaign.store import MutantRecord, ResultStore
 from specc.run import RunError
 from tests.conftest import is_png
@@ -192,6 +193,12 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     every = next(h for h in report.headlines if h.worlds == "W*")
     assert every.faulty == (0.0, 0.5) and every.absolute == 0.5 and every.relative is None
     text = markdown(report)
+    assert [(c.configuration, c.done, c.expected) for c in report.coverage] == [("Robot1", 4, 4), ("Robot1/2", 4, 4)]
+    assert "Robot1 4 of 4; Robot1/2 4 of 4" in text and "not finished" not in text
+    grown = {**report.description, "configurations": ["Robot1", "Robot1/2", "Robot1/2c"]}
+    partial = replace(report, coverage=coverage(grown, report.mutants, report.outcomes))
+    assert partial.coverage[-1] == Coverage("Robot1/2c", 0, 4)
+    assert "**not finished: Robot1/2c.**" in markdown(partial)
     assert "Robot1/2 succeeds in 50% of missions against Robot1's 0%: +50 points" in text
     assert "| model1-0001 | numeric |" in text and "| 0% | 50% |" in text
     written = write_report(report, tmp_path / "out")

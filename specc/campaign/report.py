@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS
+from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED
 from specc.campaign.experiments import ORIGINAL, Outcome
 from specc.campaign.store import MutantRecord, ResultStore
 from specc.run.measures import MeanMeasures, Measures, aggregate
@@ -62,6 +62,19 @@ class Headline:
 
 
 @dataclass(frozen=True)
+class Coverage:
+    """How much of a configuration's share of the campaign has run: the means cover that only."""
+
+    configuration: str
+    done: int
+    expected: int  # the original and the mutants it runs (all for the first, else the kept or unjudged)
+
+    @property
+    def complete(self) -> bool:
+        return self.done >= self.expected
+
+
+@dataclass(frozen=True)
 class CampaignReport:
     description: dict[str, Any]
     mutants: tuple[MutantRecord, ...]
@@ -69,6 +82,7 @@ class CampaignReport:
     means: tuple[Mean, ...]
     per_mutant: tuple[tuple[MutantRecord, dict[str, MeanMeasures | None]], ...]  # kept ones, per configuration
     headlines: tuple[Headline, ...]
+    coverage: tuple[Coverage, ...]
 
     def with_verdict(self, verdict: str) -> list[MutantRecord]:
         return [m for m in self.mutants if m.verdict == verdict]
@@ -109,7 +123,23 @@ def build_report(store: ResultStore) -> CampaignReport:
             free = tuple(_nu(means, c, FAULT_FREE, label) for c in (first, second))
             if all(v is not None for v in faulty + free):
                 headlines.append(Headline(label, first, second, faulty, free))  # type: ignore[arg-type]
-    return CampaignReport(description, mutants, outcomes, tuple(means), tuple(per_mutant), tuple(headlines))
+    return CampaignReport(description, mutants, outcomes, tuple(means), tuple(per_mutant), tuple(headlines),
+                          coverage(description, mutants, outcomes))
+
+
+def coverage(description: dict[str, Any], mutants: Iterable[MutantRecord],
+             outcomes: Iterable[Outcome]) -> tuple[Coverage, ...]:
+    """Each configuration's experiments run against those it has to run: the first runs the
+    original and every mutant, the others the original and the mutants kept (or not judged yet)."""
+    configurations: list[str] = list(description.get("configurations", []))
+    activities = len(description.get("missions", [])) * len(description.get("worlds", [])) * description.get("runs", 0)
+    mutants = list(mutants)
+    runs_later = {m.id for m in mutants if m.verdict in (KEPT, UNJUDGED)}
+    done: dict[str, int] = {}
+    for outcome in outcomes:
+        done[outcome.experiment.configuration] = done.get(outcome.experiment.configuration, 0) + 1
+    return tuple(Coverage(c, done.get(c, 0), activities * (1 + (len(mutants) if k == 0 else len(runs_later))))
+                 for k, c in enumerate(configurations))
 
 
 def _nu(means: Iterable[Mean], configuration: str, faults: str, worlds: str) -> float | None:
@@ -130,7 +160,13 @@ def markdown(report: CampaignReport) -> str:
               f"{d.get('runs')} run(s); configurations {', '.join(d.get('configurations', []))}",
               f"- mutants drawn: {len(report.mutants)}; kept (F*): {counts[KEPT]}; never plan: "
               f"{counts[NEVER_PLANS]}; equivalent to the original: {counts[EQUIVALENT]}",
-              f"- experiments: {len(report.outcomes)} ({len(report.failed)} crashed or timed out)", ""]
+              f"- experiments: {len(report.outcomes)} ({len(report.failed)} crashed or timed out): "
+              + "; ".join(f"{c.configuration} {c.done:,} of {c.expected:,}" for c in report.coverage)]
+    unfinished = [c.configuration for c in report.coverage if not c.complete]
+    if unfinished:
+        lines.append(f"- **not finished: {', '.join(unfinished)}.** The means cover the experiments run so far; "
+                     "the same command resumes the campaign")
+    lines.append("")
     if report.headlines:
         lines += ["## Headline", ""]
         lines += [f"- {h.text()}" for h in report.headlines]
@@ -185,6 +221,8 @@ def to_json(report: CampaignReport) -> dict[str, Any]:
                        "nu_fault_free": list(h.fault_free), "absolute": h.absolute, "relative": h.relative}
                       for h in report.headlines],
         "experiments": len(report.outcomes), "failed": len(report.failed),
+        "coverage": [{"configuration": c.configuration, "done": c.done, "expected": c.expected}
+                     for c in report.coverage],
     }
 
 
