@@ -50,8 +50,11 @@ def rows(store: Path) -> list[tuple[str, float]]:
 def start_and_stop_after(store: Path, results: int, stop: signal.Signals) -> subprocess.Popen[str]:
     """The small campaign, sent `stop` once the store holds `results` results."""
     command = [sys.executable, "-m", "specc.cli", "campaign", str(ATRV), *SMALL, "--store", str(store), "-q"]
+    # Ctrl-C's default disposition, whatever this process inherited: a job started in the
+    # background (`make test &`) ignores SIGINT, and so would the campaign.
     started = subprocess.Popen(command, cwd=ROOT, start_new_session=True, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
+                               stderr=subprocess.PIPE, text=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 300
     while time.monotonic() < deadline and started.poll() is None and len(rows(store)) < results:
         time.sleep(0.2)
@@ -67,7 +70,7 @@ def test_a_killed_campaign_resumes_without_losing_or_repeating_a_result(tmp_path
     store = tmp_path / "small.sqlite"
     interrupted = start_and_stop_after(store, 1, signal.SIGINT)
     _, stderr = interrupted.communicate(timeout=30)  # at once, not after the experiments in flight
-    assert interrupted.returncode == 130 and "Traceback" not in stderr
+    assert interrupted.returncode == 130 and "Traceback" not in stderr, stderr
     assert f"interrupted: {len(rows(store))} results kept in {store}; the same command resumes" in stderr
     killed = start_and_stop_after(store, len(rows(store)) + 1, signal.SIGKILL)
     killed.wait(30)
