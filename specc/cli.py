@@ -22,6 +22,7 @@ from specc.syntax.printer import format_source
 
 if TYPE_CHECKING:
     from specc.analysis.prs_net import Translation
+    from specc.campaign.report import CampaignReport
 
 app = typer.Typer(
     name="specc",
@@ -886,6 +887,9 @@ def campaign(
                                                        "beside the store).")] = None,
         generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
         = Path("generated"),
+        report_only: Annotated[bool, typer.Option("--report-only", help="Run nothing: write the report of the "
+                                                                        "store as it is (a campaign stopped "
+                                                                        "half-way says so).")] = False,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
     """Inject faults into a planning model by mutation and run every configuration x mutant x mission x
     world x run (seed 004 ch. 4); then the report: the measures over sets of activities with and without
@@ -896,7 +900,7 @@ def campaign(
     from specc.campaign.campaign import Campaign, CampaignPlan, check_names, select_mutants
     from specc.campaign.engines import DaskEngine, LocalEngine
     from specc.campaign.experiments import Setting
-    from specc.campaign.report import build_report, write_report
+    from specc.campaign.report import build_report
     from specc.campaign.store import ResultStore
     from specc.mutation import default_workers
     from specc.run import RunError
@@ -906,6 +910,9 @@ def campaign(
         if mutants != "all" and not (mutants.isdigit() and int(mutants) > 0):
             raise RunError(f"--mutants {mutants}: give a number of mutants, or 'all'")
         robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
+        if report_only:
+            _campaign_report(store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite", output)
+            return
         if robot != "atrv":
             raise RunError(f"robot '{robot}' has no planning campaign: campaigns run the rover's missions (atrv)")
         setting = Setting(generated.resolve(), specs.resolve())
@@ -936,14 +943,40 @@ def campaign(
                           "campaign", markup=False)
                 raise typer.Exit(130) from None
             report = build_report(results)
-        written = write_report(report, output or path.parent, path.stem)
+        kept = sum(1 for v in verdicts.values() if v.verdict == "kept")
+        out.print(f"{len(report.outcomes)} experiments; {kept} of {len(verdicts)} mutants kept", markup=False)
+        _print_report(report, output or path.parent, path.stem)
     except RunError as error:
         raise _run_error(error, 2) from None
-    kept = sum(1 for v in verdicts.values() if v.verdict == "kept")
-    out.print(f"{len(report.outcomes)} experiments; {kept} of {len(verdicts)} mutants kept", markup=False)
+
+
+def _campaign_report(path: Path, output: Path | None) -> None:
+    """`specc campaign --report-only`: the report of the store at `path`, nothing run."""
+    from specc.campaign.report import build_report
+    from specc.campaign.store import ResultStore
+    from specc.run import RunError
+
+    if not path.is_file():
+        raise RunError(f"no results store '{path}': give the campaign's --store, or its --mutants")
+    with ResultStore(path) as results:
+        if not results.description():
+            raise RunError(f"'{path}' holds no campaign: give the campaign's --store")
+        report = build_report(results)
+    out.print(f"{len(report.outcomes)} experiments in {path}", markup=False)
+    _print_report(report, output or path.parent, path.stem)
+
+
+def _print_report(report: CampaignReport, folder: Path, stem: str) -> None:
+    """Write the campaign's report and say what it found: what is not finished, the headlines."""
+    from specc.campaign.report import write_report
+
+    for covered in report.coverage:
+        if not covered.complete:
+            out.print(f"{covered.configuration}: {covered.done:,} of {covered.expected:,} experiments: not finished",
+                      markup=False)
     for headline in report.headlines:
         out.print(headline.text(), markup=False)
-    for written_path in written:
+    for written_path in write_report(report, folder, stem):
         out.print(f"wrote {written_path}", markup=False)
 
 

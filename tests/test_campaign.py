@@ -76,6 +76,12 @@ def test_a_killed_campaign_resumes_without_losing_or_repeating_a_result(tmp_path
     killed.wait(30)
     before = rows(store)
     assert 2 <= len(before)
+    # The report of a campaign stopped half-way: nothing run, and it says what is not finished.
+    partial = specc("campaign", ATRV, *SMALL, "--store", store, "--report-only", "-o", tmp_path / "partial")
+    assert partial.returncode == 0, partial.stderr
+    assert f"{len(before)} experiments in {store}" in partial.stdout and "not finished" in partial.stdout
+    assert rows(store) == before
+    assert "**not finished: Robot1" in (tmp_path / "partial" / "small.md").read_text()
     resumed = specc("campaign", ATRV, *SMALL, "--store", store, "-q")
     assert resumed.returncode == 0, resumed.stderr
     assert f"results in {store} ({len(before)} already there)" in resumed.stderr
@@ -206,6 +212,14 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     assert "| model1-0001 | numeric |" in text and "| 0% | 50% |" in text
     written = write_report(report, tmp_path / "out")
     assert [p.name for p in written] == ["campaign.md", "campaign.json", "campaign.png"] and is_png(written[2])
+
+
+def test_a_report_needs_a_store_that_holds_a_campaign(tmp_path: Path) -> None:
+    missing = specc("campaign", ATRV, *SMALL, "--store", tmp_path / "none.sqlite", "--report-only")
+    assert missing.returncode == 2 and "no results store" in missing.stderr and "Traceback" not in missing.stderr
+    ResultStore(tmp_path / "empty.sqlite").close()
+    empty = specc("campaign", ATRV, *SMALL, "--store", tmp_path / "empty.sqlite", "--report-only")
+    assert empty.returncode == 2 and "holds no campaign" in empty.stderr
 
 
 @pytest.mark.parametrize(("args", "message"), [
