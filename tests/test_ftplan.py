@@ -147,9 +147,12 @@ def test_a_crashed_or_planless_planner_counts_as_a_late_one() -> None:
     assert "scripted fault" in watchdog[0] and "no plan" in watchdog[1]
 
 
-def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner() -> None:
+@pytest.mark.parametrize("policy", ["successive", "concurrent"])
+def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner(policy: str) -> None:
     # p1's plan meets every goal but COMMUNICATION(W2) (a planner that silently drops it); the
-    # goal check at the plan's end finds it open and line 5 gives it to p2.
+    # goal check at the plan's end finds it open. Successive planning gives it to p2 (line 5).
+    # Concurrent planning asks both again, and p1, the fastest, wins with a plan that meets
+    # nothing; p1 is then left out of the next round, so p2's plan runs.
     _, problem = mission()
     w2 = next(g for g in problem.assertions if g.goal is not None and getattr(g, "args", ()) == (pm.Sym("W2"),))
 
@@ -167,13 +170,18 @@ def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner() -> Non
             requests.append(problem)
             return Planner(mission()[0]).plan(problem, now)
 
-    result = FtPlan(config(("p1", "p2")), problem, LocalPool({"p1": DropsW2(), "p2": Recording()}),
+    result = FtPlan(config(("p1", "p2"), policy), problem, LocalPool({"p1": DropsW2(), "p2": Recording()}),
                     ScriptedExecutor()).run()
     assert result.success, result.missed
-    assert chosen(result) == ["p1", "p2"]
     assert any(e.kind == "goals-open" and "COMMUNICATION(W2)" in e.text for e in result.events)
-    goals = {a.line for a in requests[0].assertions if a.goal is not None}
-    assert w2.line in goals and len(goals) == 3  # W2, and the return home (X and Y) still to hold
+    if policy == "successive":
+        assert chosen(result) == ["p1", "p2"]
+        goals = {a.line for a in requests[0].assertions if a.goal is not None}
+        assert w2.line in goals and len(goals) == 3  # W2, and the return home (X and Y) still to hold
+    else:
+        executed = [e.planner for e in result.events if e.kind == "execute"]
+        assert executed[0] == "p1" and executed[-1] == "p2" and "p2" not in executed[:-1]
+        assert any("(not p1: its last plan met no goal)" in text for line, text in result.trace if line == 3)
 
 
 # ---------------------------------------------------------------- Fig 3.2

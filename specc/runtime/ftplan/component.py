@@ -28,7 +28,9 @@ Two departures from the figures, both where they are silent:
   plan (lines 16-20);
 - the loops of Fig 3.1/3.2 end when goals remain after a round in which every planner gave a
   valid plan, carried out to its end, that met no goal (they all leave those goals aside): the
-  remaining goals are reported missed instead of replanning until their deadlines pass. A
+  remaining goals are reported missed instead of replanning until their deadlines pass.
+  Concurrent planning runs one plan per round: a planner whose last plan met no goal sits out
+  the next rounds until a plan meets one. A
   round with a failure goes on as the figures say; its failures cost mission time, so the goals'
   deadlines end it.
 """
@@ -286,10 +288,14 @@ class FtPlan:
     # ------------------------------------------------------------ Fig 3.2
     def concurrent(self) -> None:
         planners = [p.name for p in self.config.planners]
+        # Planners whose last valid plan ran to its end and met no goal: asking them again would
+        # give the same plan, which the fastest of them would win every time.
+        idle: list[str] = []
         while self.objectives():
             self.step(2, "goals remain")
-            candidates = list(planners)
-            self.step(3, f"candidates <- {', '.join(candidates)}")
+            candidates = [k for k in planners if k not in idle]
+            self.step(3, f"candidates <- {', '.join(candidates)}"
+                      + (f" (not {', '.join(idle)}: its last plan met no goal)" if idle else ""))
             self.step(4, f"arm the watchdog ({self.config.watchdog:g} s)")
             first = self.plannings == 0
             for k in candidates:
@@ -335,8 +341,12 @@ class FtPlan:
                         self.step(19, "no candidate left")
                         self.step(20, MISSION_FAILED)
                         raise MissionFailure(MISSION_FAILED)
-            if outcome == "idle" and self.objectives():
-                self.give_up("the first valid plan left them aside")
+            if outcome == "idle":
+                idle.append(k)
+            elif outcome == "met":
+                idle.clear()
+            if len(idle) == len(planners) and self.objectives():
+                self.give_up("every planner's plan left them aside")
                 return
 
     def arrivals(self, candidates: list[str]) -> Generator[Answer, None, None]:
