@@ -909,10 +909,13 @@ def campaign(
     try:
         if mutants != "all" and not (mutants.isdigit() and int(mutants) > 0):
             raise RunError(f"--mutants {mutants}: give a number of mutants, or 'all'")
-        robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
-        if report_only:
-            _campaign_report(store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite", output)
+        def robot_name() -> str:
+            return compile_robot(specs, generated, lambda text: err.print(text, markup=False))
+
+        if report_only:  # the store is all a report needs: the robot compiles only to name the default one
+            _campaign_report(store or Path("campaigns") / f"{robot_name()}-{domain}-{mutants}.sqlite", output)
             return
+        robot = robot_name()
         if robot != "atrv":
             raise RunError(f"robot '{robot}' has no planning campaign: campaigns run the rover's missions (atrv)")
         setting = Setting(generated.resolve(), specs.resolve())

@@ -30,9 +30,8 @@ Two departures from the figures, both where they are silent:
   valid plan, carried out to its end, that met no goal (they all leave those goals aside): the
   remaining goals are reported missed instead of replanning until their deadlines pass.
   Concurrent planning runs one plan per round: a planner whose last plan met no goal sits out
-  the next rounds until a plan meets one. A
-  round with a failure goes on as the figures say; its failures cost mission time, so the goals'
-  deadlines end it.
+  the next rounds until a plan meets one. A round with a failure goes on as the figures say;
+  its failures cost mission time, so the goals' deadlines end it.
 """
 
 from __future__ import annotations

@@ -46,7 +46,11 @@ INF = math.inf
 
 
 class NodeLimitReached(Exception):
-    """The planning expanded more partial plans than its node limit allows."""
+    """The planning expanded more partial plans than its node limit allows: `nodes` of them."""
+
+    def __init__(self, nodes: int) -> None:
+        super().__init__(nodes)
+        self.nodes = nodes
 
 
 class PlanningInputError(ValueError):
@@ -100,35 +104,32 @@ class Planner:
             setup = Setup(self.domain, problem, now, self.limits, self.controllability)
         except PlanningInputError as error:
             return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
-        expanded = [0]
         try:
-            return self._plan(setup, started, expanded)
-        except NodeLimitReached:
+            return self._plan(setup, started)
+        except NodeLimitReached as reached:
             return PlanResult(None, reason=f"no plan within the limit of {self.node_limit} partial plans",
-                              nodes=expanded[0], seconds=time.perf_counter() - started)
+                              nodes=reached.nodes, seconds=time.perf_counter() - started)
 
-    def _plan(self, setup: Setup, started: float, expanded: list[int]) -> PlanResult:
-        """`plan` once the problem is set up; `expanded` counts the partial plans as they go."""
+    def _plan(self, setup: Setup, started: float) -> PlanResult:
+        """`plan` once the problem is set up; NodeLimitReached past the node limit."""
         goals = setup.goals
+        total = 0
         outcomes: dict[int, GoalOutcome] = {}
 
         def attempt(active: Iterable[Goal], budget: int, discrepancies: bool = True) -> Attempt:
-            allowance = None if self.node_limit is None else self.node_limit - expanded[0]
-            try:
-                result = setup.search(list(active), budget, discrepancies, allowance)
-            except NodeLimitReached as reached:
-                expanded[0] += reached.args[0]
-                raise
-            expanded[0] += result.nodes
-            if self.node_limit is not None and expanded[0] > self.node_limit:
-                raise NodeLimitReached(0)
+            nonlocal total
+            allowance = None if self.node_limit is None else self.node_limit - total
+            result = setup.search(list(active), budget, discrepancies, allowance)
+            total += result.nodes
+            if self.node_limit is not None and total > self.node_limit:
+                raise NodeLimitReached(total)
             return result
 
         base = attempt([], self.goal_nodes)
         if base.node is None:
             why = "no plan satisfies the problem's required assertions and constraints"
             return PlanResult(None, tuple(GoalOutcome(g.text, g.priority, g.hold.line, False, why) for g in goals),
-                              reason=f"{why}: {explain(base)}", nodes=expanded[0],
+                              reason=f"{why}: {explain(base)}", nodes=total,
                               seconds=time.perf_counter() - started)
         candidates = []
         for goal in goals:
@@ -160,7 +161,7 @@ class Planner:
         assert best.node is not None
         plan, notes = setup.extract(best.node, self.exact)
         ordered = tuple(outcomes[g.index] for g in goals)
-        return PlanResult(plan, ordered, nodes=expanded[0], seconds=time.perf_counter() - started, notes=notes)
+        return PlanResult(plan, ordered, nodes=total, seconds=time.perf_counter() - started, notes=notes)
 
 
 def explain(attempt: Attempt) -> str:
@@ -314,8 +315,8 @@ class Setup:
     # ------------------------------------------------------------ search
     def search(self, active: list[Goal], budget: int, discrepancies: bool = True,
                allowance: int | None = None) -> Attempt:
-        """A plan for the `active` goals within `budget` partial plans; NodeLimitReached (with the
-        count) once more than `allowance` are expanded."""
+        """A plan for the `active` goals within `budget` partial plans, or none; the search stops
+        as soon as it has expanded more than `allowance` (the planning's node limit)."""
         failures: Counter[str] = Counter()
         try:
             root = self.root(active)
@@ -344,7 +345,7 @@ class Setup:
                         break
                     return Attempt(None, nodes - 1, False, failures)
                 if allowance is not None and nodes > allowance:
-                    raise NodeLimitReached(nodes)
+                    return Attempt(None, nodes, False, failures)
                 try:
                     if resolver is not None:
                         resolver.apply(node)
