@@ -1,9 +1,10 @@
 """Running a compiled robot end to end, on the simulated kernel (issue #9, `specc run`).
 
 - `specc.run.events`: the JSONL event log every run writes, stamped with simulated time.
-- `specc.run.hunt`: Hilare's object hunt of seed 000 ch. 5 (`run_hunt`) and the §5.5 checks
-  read from its log.
-- `specc.run.rover`: the rover missions of seed 004 on the simulated ATRV (`run_rover_mission`).
+- `specc.run.hunt`: Hilare's object hunt of seed 000 ch. 5 (`run_hunt`); `specc.run.hunt_log`:
+  the §5.5 checks read from its log.
+- `specc.run.rover`: the rover missions of seed 004 on the simulated ATRV (`run_rover_mission`);
+  `specc.run.rover_tasks`: their planning models' tasks by kind.
 - `specc.run.measures`: the measures of seed 004 §4.1.4 and their tables.
 - `specc.run.render`: every picture of a run, drawn from its event log alone (`render_run`);
   `specc.run.pictures`: the state of Fig 5.11.

@@ -6,18 +6,21 @@ log: a `Scene` that `specc.run.render.hunt_scene` reads from the events alone.
   retrieved, and retrieved, the cell of the best observation position, the last planned
   trajectory, and the model's cells by certainty (below 1/3, between 1/3 and 2/3, above 2/3);
 - `write_state(scene, path, title)`: that state alone (a run folder's state.png);
-- `draw_hunt(result, path)`: side by side, the hunt's map (the room, the certainty cells, the
-  planned trajectories, the robot's true path from start to end, the objects by what became of
-  them, numbered in the order taken, and where the detection of an object interrupted an
-  exploration move, §5.5) and the state of Fig 5.11; drawn from `result.events`, as
-  `specc replay` draws them.
+- `write_hunt(scene, path, title)`: side by side, the hunt's map (the room, the certainty cells,
+  the planned trajectories, the robot's true path from start to end, the objects by what became
+  of them, numbered in the order taken, and where the detection of an object interrupted an
+  exploration move, §5.5) and the state of Fig 5.11 (`specc.run.hunt.draw_hunt` draws it from a
+  result's events, as `specc replay` draws them).
+
+It draws scenes and reads no log itself: `specc.run.render` and `specc.run.hunt` import it, never
+the other way round.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from specc.run import RunError
 from specc.runtime.sim.render import (
@@ -31,22 +34,10 @@ from specc.runtime.sim.render import (
     pyplot,
 )
 
-if TYPE_CHECKING:
-    from specc.run.hunt import HuntResult
-
 # Fig 5.11 tells apart the objects not detected, detected and retrieved: one taken was retrieved.
 STATE_OF_FIG_5_11 = {"taken": "retrieved", "retrieved": "retrieved", "detected": "detected",
                      "undetected": "undetected"}
 STATE_LABELS = {"detected": "detected, not retrieved"}
-
-
-def draw_hunt(result: HuntResult, path: str | Path, *, title: str = "") -> Path:
-    """Write a PNG of the hunt and of its final state (Fig 5.11), from the result's events;
-    returns its path. `title` replaces the run's description in the headline."""
-    from specc.run import render  # render draws the run folder's state.png with this module
-
-    events = result.events
-    return write_hunt(render.hunt_scene(events), path, title or render.run_info(events).title())
 
 
 def write_hunt(scene: Scene, path: str | Path, title: str) -> Path:

@@ -42,8 +42,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from specc.run import RunError, pictures
-from specc.run.hunt import HuntObject, detection_interruptions, motion_stretches
-from specc.run.rover import TASK_KINDS, task_text
+from specc.run.hunt_log import HuntObject, detection_interruptions, motion_stretches
+from specc.run.rover_tasks import TASK_KINDS, task_text
 from specc.runtime.planner.plan import Value, format_value
 from specc.runtime.sim import ROBOTS, Target, Window, World, WorldError, parse_world
 from specc.runtime.sim.render import (

@@ -54,7 +54,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -66,6 +66,8 @@ from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
 from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
+from specc.run.render import draw_map
+from specc.run.rover_tasks import LINK, MOTION_INIT, MOVE, PAN_TILT, PHOTO, PTU_INIT, TASK_KINDS, task_text
 from specc.runtime import functional as rt
 from specc.runtime.ftplan import (
     HUNG_PLANNER_SECONDS,
@@ -80,7 +82,8 @@ from specc.runtime.ftplan import (
 )
 from specc.runtime.ftplan.config import FtPlanConfig
 from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precedences
-from specc.runtime.ftplan.state import FactKey, SystemState, consequences, constant, constant_key
+from specc.runtime.ftplan.facts import FactKey
+from specc.runtime.ftplan.state import SystemState, consequences, constant, constant_key
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
@@ -112,17 +115,6 @@ ROBOT_X, ROBOT_Y = "AT_ROBOT_X", "AT_ROBOT_Y"
 PICTURE = "PICTURE"
 COMMUNICATION = "COMMUNICATION"
 
-# What each task of Modele1 and Modele2 is, for the executor.
-MOVE, PAN_TILT, PHOTO, LINK, PTU_INIT, MOTION_INIT = "move", "pan-tilt", "photo", "communication", \
-    "pan-tilt init", "motion init"
-TASK_KINDS = {
-    "MOVE": MOVE, "MOVE_NOMINAL": MOVE, "MOVE_RECOV": MOVE,
-    "MOVE_PAN_TILT_UNIT": PAN_TILT, "MOVE_PTU": PAN_TILT,
-    "TAKE_PICTURE": PHOTO, "TAKE_SHOT": PHOTO,
-    "COMMUNICATE": LINK, "COMMUNICATE_ANTENNA": LINK,
-    "INIT_PTU_DRIVER": PTU_INIT, "INIT_PTU": PTU_INIT,
-    "INIT_MVT_GENERATION": MOTION_INIT, "INIT_FRAME": MOTION_INIT,
-}
 # NDD's failures, as a person reads them (examples/atrv/modules/ndd.spec).
 NAVIGATION_FAILURES = {
     "NO_PROGRESS": "the goal came no closer for {progress:g} s: the robot is trapped",
@@ -193,11 +185,6 @@ class ExecutedAction:
         return task_text(self.task, self.args)
 
 
-def task_text(task: str, args: Sequence[Value]) -> str:
-    """An action as a plan writes it, TASK(arg, ...) (as `Action.text`)."""
-    return f"{task}({', '.join(format_value(a) for a in args)})"
-
-
 @dataclass(frozen=True)
 class PlannedTask:
     """An action of a plan FTplan executed, as planned."""
@@ -240,8 +227,6 @@ class RoverRun:
     def draw(self, path: str | Path) -> Path:
         """A PNG of the run: the world, the robot's path, the photo targets, the windows. Drawn
         from the events, as `specc replay` draws the run folder's map.png."""
-        from specc.run.render import draw_map  # here: render imports this module
-
         return draw_map(self.events, path)
 
 

@@ -25,16 +25,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from specc.runtime.ftplan.config import FtPlanConfig, MaxDuration, NoOverlap, Requirement, Term, Var
-from specc.runtime.ftplan.state import (
-    Dates,
-    FactKey,
-    SystemState,
-    consequences,
-    constant,
-    constant_key,
-    match,
-    substitute,
-)
+from specc.runtime.ftplan.facts import FactKey, match, substitute
+from specc.runtime.ftplan.state import Dates, SystemState, consequences, constant, constant_key
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Action, Plan, Value, format_value

@@ -13,7 +13,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from specc.runtime.ftplan.config import FactUpdate, StateRule, Term, Value, Var
+from specc.runtime.ftplan.config import FactUpdate, StateRule, Value
+from specc.runtime.ftplan.facts import FactKey, match, substitute
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import format_value
 from specc.runtime.planner.replan import Fact
@@ -22,35 +23,7 @@ from specc.runtime.planner.validate import normalise, same
 if TYPE_CHECKING:
     from specc.runtime.ftplan.view import View
 
-FactKey = tuple[str, tuple[Value, ...]]
-Bindings = dict[str, Value]
 Dates = tuple[float, float]  # [earliest, latest]
-
-
-def match(terms: tuple[Term, ...], values: tuple[Value, ...], bindings: Bindings | None = None) -> Bindings | None:
-    """The bindings that make `terms` read `values` (extending `bindings`), or None."""
-    if len(terms) != len(values):
-        return None
-    found: Bindings = dict(bindings or {})
-    for term, value in zip(terms, values, strict=True):
-        value = normalise(value)
-        if isinstance(term, Var):
-            bound = found.get(term.name)
-            if bound is None:
-                found[term.name] = value
-            elif not same(bound, value):
-                return None
-        elif not same(normalise(term), value):
-            return None
-    return found
-
-
-def substitute(term: Term, bindings: Mapping[str, Value]) -> Value:
-    if isinstance(term, Var):
-        if term.name not in bindings:
-            raise KeyError(f"{term.name} is not bound by the rule's task or report")
-        return bindings[term.name]
-    return normalise(term)
 
 
 def ground(updates: Iterable[FactUpdate], bindings: Mapping[str, Value]) -> list[tuple[FactKey, Value]]:

@@ -24,7 +24,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 
 from specc.runtime.ftplan.config import Correspondence, FactPattern, Interval, Term, Value, Var
-from specc.runtime.ftplan.state import Bindings, FactKey, match, substitute
+from specc.runtime.ftplan.facts import Bindings, FactKey, match, substitute
 from specc.runtime.planner.validate import normalise, same
 
 Change = tuple[FactKey, Value]
