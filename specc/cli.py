@@ -608,8 +608,10 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
                                                  "(measured).")] = "model",
         objects: Annotated[Optional[int], typer.Option(help="The hunt's objects to take (0-5; default 5).")]
         = None,
-        horizon: Annotated[Optional[float], typer.Option(help="The hunt's horizon, s of simulated time (default "
-                                                              "900).")] = None,
+        horizon: Annotated[Optional[float], typer.Option(help="Simulated seconds before the run stops (default: "
+                                                              "the mission's; 900 for the hunt).")] = None,
+        goal: Annotated[Optional[list[str]], typer.Option(help="Post this PRS goal instead of a mission's, e.g. "
+                                                               "'!(GO 3 4)' (repeatable: posted together).")] = None,
         pictures: Annotated[bool, typer.Option(help="Draw the map and timeline now (else: specc replay "
                                                     "RUN).")] = True,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
@@ -620,7 +622,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
     from specc.run.session import RunCrashed, RunRequest, run_in_folder
 
     request = RunRequest(specs, mission=mission, world=world, configuration=config, seed=seed, generated=generated,
-                         runs=runs, folder=folder, timing=timing, objects=objects, horizon=horizon, pictures=pictures)
+                         runs=runs, folder=folder, timing=timing, objects=objects, horizon=horizon,
+                         goals=tuple(goal or ()), pictures=pictures)
     try:
         with ProgressDisplay(quiet) as progress:
             outcome = run_in_folder(request, progress, compiled_note=lambda text: err.print(text, markup=False))

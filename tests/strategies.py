@@ -54,7 +54,7 @@ services = st.builds(
     m.Service, name=hyphenated, request=st.none() | dotted, input=st.none() | refs, output=st.none() | dotted,
     timeout=st.none() | st.builds(m.Timeouts, start=st.none() | durations, interm=st.none() | durations,
                                   final=st.none() | durations),
-    args=small(st.builds(m.Argument, name=lower, value=prop_values)),
+    args=small(st.builds(m.Argument, name=lower, value=prop_values)), takes=small(refs),
     conflicts=small(st.builds(m.Conflict, service=hyphenated, policy=st.sampled_from(["interrupt", "wait"]))))
 reflexes = st.builds(
     m.Reflex, name=st.none() | lower, trigger=st.sampled_from(["reply", "warning", "interm"]), source=dotted,
@@ -145,7 +145,7 @@ procedures = st.builds(
                                kinds=small(st.sampled_from(["closed", "functional", "event", "evaluable"])),
                                params=small(pparams), result=st.none() | pdomains)),
     actions=small(st.builds(m.ActionDecl, name=hyphenated, params=small(pparams), result=st.none() | pdomains,
-                            binding=strings)),
+                            binding=strings | st.builds(m.ServiceBinding, service=hyphenated))),
     kas=small(kas))
 
 # ---------------------------------------------------------------- IxTeT
@@ -220,9 +220,13 @@ ftplans = st.builds(
     state_updates=small(st.builds(
         m.StateUpdate, report=st.sampled_from(["ended", "failed", "report"]), task=upper, args=small(ixexprs),
         updates=small(st.builds(m.FactUpdate, attribute=upper, args=small(ixexprs), value=ixexprs), 1))))
-systems = st.builds(m.System, name=lower, modules=small(refs), executive=st.none() | refs,
-                    supervisor=st.none() | refs, planning=st.none() | refs, missions=small(refs),
-                    world=st.none() | strings)
+systems = st.builds(
+    m.System, name=lower, modules=small(refs), executive=st.none() | refs, supervisor=st.none() | refs,
+    planning=st.none() | refs, doc=st.none() | strings,
+    body=st.none() | small(st.builds(m.Setting, name=lower, value=numbers)),
+    worlds=small(st.builds(m.Setting, name=lower, value=strings)),
+    missions=small(st.builds(m.SystemMission, name=lower, world=st.none() | refs, horizon=st.none() | durations,
+                             doc=st.none() | strings, goals=small(goals))))
 
 items = st.one_of(modules, executives, rule_bases, procedures, planning_items, ftplans, systems)
 source_files = st.builds(m.SourceFile, path=st.just("generated.spec"), items=small(items, 1, 3))

@@ -72,6 +72,12 @@ def ka(node: m.KA) -> rp.KA:
     )
 
 
+def primitive(node: m.ActionDecl) -> rp.Primitive:
+    if isinstance(node.binding, m.ServiceBinding):
+        return rp.Primitive(node.name, len(node.params), "", node.result is not None, service=node.binding.service)
+    return rp.Primitive(node.name, len(node.params), node.binding.value, node.result is not None)
+
+
 def predicate_kind(node: m.PredicateDecl) -> str:
     for kind in ("evaluable", "event", "functional", "closed"):
         if kind in node.kinds:
@@ -84,8 +90,7 @@ def library(node: m.Procedures) -> rp.Library:
         name=node.name,
         predicates=tuple(rp.Predicate(p.name, predicate_kind(p), len(p.params), p.binding.value if p.binding else "")
                          for p in node.predicates),
-        primitives=tuple(rp.Primitive(a.name, len(a.params), a.binding.value, a.result is not None)
-                         for a in node.actions),
+        primitives=tuple(primitive(a) for a in node.actions),
         kas=tuple(ka(k) for k in node.kas),
         source=node.span.file,
     )

@@ -40,7 +40,7 @@ def executive_spec(program: m.Program, controller: Controller) -> rx.ExecutiveSp
         group = next((g.services for g in controller.groups if service.name in g.services), ())
         services[service.name] = rx.ServiceSpec(
             name=service.name, module=module, request=request, kind=kind,
-            args={a.name: value_of(a.value) for a in service.args},
+            args={a.name: value_of(a.value) for a in service.args}, takes=tuple(t.text for t in service.takes),
             input=service.input.text if service.input else None,
             output=service.output.text if service.output else None,
             start_timeout=seconds(timeout.start), interm_timeout=seconds(timeout.interm),

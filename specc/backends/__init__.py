@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from specc.backends import executive, ftplan, modules, package, planner, rules, supervisor
+from specc.backends import executive, ftplan, modules, package, planner, rules, supervisor, systems
 from specc.backends.manifest import Output
 from specc.model import nodes as m
 
 # Every back end, in the order they write into the package.
 BACKENDS = (package.generate_package, modules.generate, rules.generate, executive.generate, supervisor.generate,
-            planner.generate, ftplan.generate)
+            planner.generate, ftplan.generate, systems.generate)
 
 
 def generate_all(program: m.Program, robot: str) -> Output:

@@ -80,6 +80,15 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                 if arg.name not in inputs:
                     ctx.unknown("undefined-input", "input", arg.name, inputs, arg.span,
                                 f" of request '{service.request.text}'")
+            constants = {a.name for a in service.args}
+            for taken in service.takes if request is not None else ():
+                if taken.text not in inputs:
+                    ctx.unknown("undefined-input", "input", taken.text, inputs, taken.span,
+                                f" of request '{service.request.text}' (a service takes its request's inputs)")
+                elif taken.text in constants:
+                    ctx.report("duplicate-definition", f"input '{taken.text}' is both a constant of 'args' and "
+                               "taken from the task level; keep one", taken.span)
+            ctx.duplicates(service.takes, "taken input", key="text")
         if service.output is not None and len(service.output.parts) >= 2:
             ctx.report("bad-reference", f"'{service.output.text}': a service's output is a function of the "
                        "executive's codels (it prepares the result for the task level); only modules write posters",

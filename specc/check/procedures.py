@@ -122,7 +122,8 @@ def check(ctx: Context) -> None:
         for ka in procedures.kas:
             check_ka(ctx, ka)
         for action in procedures.actions:
-            check_binding(ctx, action.name, action.binding)
+            if isinstance(action.binding, m.String):  # a service binding is checked with the system
+                check_binding(ctx, action.name, action.binding)
         for predicate in procedures.predicates:
             evaluable = "evaluable" in predicate.kinds
             if evaluable and predicate.binding is None:

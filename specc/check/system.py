@@ -1,28 +1,265 @@
-"""A system names the blocks that make one robot; each must exist and be of the right kind."""
+"""A system says how one robot runs: the blocks it is made of (each must exist and be of the
+right kind), its simulated body, its worlds and its missions, and how its procedures reach the
+executive's services. Names are resolved across layers here, so that what `check` accepts runs:
+a mission's goal is one its supervisor can achieve, an action bound to a service gives that
+service exactly the inputs it takes, with values of their types."""
 
 from __future__ import annotations
 
+from specc.check.codels import python_functions
 from specc.check.context import Context
+from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
+from specc.model.visitor import walk
+from specc.runtime.body import BODY_KEYS, body_problem
+from specc.runtime.sim.world import WorldError, load_world
+
+# The PRS domains a request input of each type accepts (seed 000 §4.2: the task level passes
+# numbers and symbols; records are the functional level's business).
+NUMERIC_INPUTS = frozenset({"double", "float"})
+WHOLE_INPUTS = frozenset({"int", "long", "char"})
+TEXT_INPUTS = frozenset({"string"})
+NUMERIC_DOMAINS = frozenset({"int", "float", "number"})
+TEXT_DOMAINS = frozenset({"string", "symbol"})
+MISSION_GOAL_OPS = ("!", "?")  # achieve or test: what a mission can ask of the supervisor
 
 
 def check(ctx: Context) -> None:
-    for system in ctx.items(m.System):
-        for ref in system.modules:
-            ctx.lookup(m.Module, ref, ref.span, "undefined-module")
-        single: tuple[tuple[m.Ref | None, type, str], ...] = (
-            (system.executive, m.Executive, "undefined-executive"),
-            (system.supervisor, m.Procedures, "undefined-procedures"),
-            (system.planning, m.FtPlan, "undefined-ftplan"))
-        for reference, kind, code in single:
-            if reference is not None:
-                ctx.lookup(kind, reference, reference.span, code)
-        for ref in system.missions:
-            ctx.lookup(m.Problem, ref, ref.span, "undefined-problem")
-        if not system.modules:
-            ctx.report("missing-property", f"system '{system.name}' needs 'modules: ...;'", system.span)
-        if system.world is not None:
-            path = ctx.base_dir(system.world.span) / system.world.value
-            if not path.is_file():
-                ctx.warn("missing-world", f"world file '{system.world.value}' not found (looked at {path})",
-                         system.world.span)
+    systems = list(ctx.items(m.System))
+    for system in systems:
+        check_blocks(ctx, system)
+        check_body(ctx, system)
+        worlds = check_worlds(ctx, system)
+        check_missions(ctx, system, worlds)
+        executive = ctx.named(m.Executive).get(system.executive.text) if system.executive else None
+        supervisor = ctx.named(m.Procedures).get(system.supervisor.text) if system.supervisor else None
+        if supervisor is not None and (executive is not None or system.executive is None):
+            check_service_actions(ctx, supervisor, [executive] if executive is not None else [],
+                                  f"system '{system.name}' has no executive: give it 'executive: NAME;'")
+    # Procedures no system runs: their services are looked for in every executive.
+    supervised = {s.supervisor.text for s in systems if s.supervisor is not None}
+    for procedures in ctx.items(m.Procedures):
+        if procedures.name not in supervised:
+            check_service_actions(ctx, procedures, list(ctx.items(m.Executive)),
+                                  "no executive offers services: declare one")
+
+
+def check_blocks(ctx: Context, system: m.System) -> None:
+    for ref in system.modules:
+        ctx.lookup(m.Module, ref, ref.span, "undefined-module")
+    single: tuple[tuple[m.Ref | None, type, str], ...] = (
+        (system.executive, m.Executive, "undefined-executive"),
+        (system.supervisor, m.Procedures, "undefined-procedures"),
+        (system.planning, m.FtPlan, "undefined-ftplan"))
+    for reference, kind, code in single:
+        if reference is not None:
+            ctx.lookup(kind, reference, reference.span, code)
+    if system.extension is not None:
+        python_functions(ctx, system.extension)  # reports a module that is not there
+    if not system.modules:
+        ctx.report("missing-property", f"system '{system.name}' needs 'modules: ...;'", system.span)
+        return
+    executive = ctx.named(m.Executive).get(system.executive.text) if system.executive else None
+    listed = {ref.text for ref in system.modules}
+    for service in executive.services if executive is not None else ():
+        module = service.request.parts[0] if service.request is not None else None
+        if module is not None and module not in listed and module in ctx.named(m.Module):
+            ctx.report("undefined-module", f"service '{service.name}' runs a request of module '{module}', which "
+                       f"system '{system.name}' does not list: add it to 'modules:'", service.request.span)  # type: ignore[union-attr]
+
+
+def check_body(ctx: Context, system: m.System) -> None:
+    ctx.duplicates(system.body or (), "body key")
+    for entry in system.body or ():
+        if entry.name not in BODY_KEYS:
+            ctx.report("unknown-property", f"a body has no key '{entry.name}'{did_you_mean(entry.name, BODY_KEYS)}; "
+                       f"known: {', '.join(BODY_KEYS)}", entry.span)
+            continue
+        value = entry.value
+        unit = BODY_KEYS[entry.name].unit or "a count"
+        if not isinstance(value, m.Number):
+            ctx.report("bad-property-value", f"'{entry.name}' expects a number ({unit})", value.span)
+            continue
+        problem = body_problem(entry.name, float(value.value))
+        if problem is not None:
+            ctx.report("bad-property-value", problem, value.span)
+
+
+def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
+    """The system's worlds by name; each a TOML world file the simulator can load."""
+    ctx.duplicates(system.worlds, "world")
+    worlds: dict[str, m.Setting] = {}
+    for entry in system.worlds:
+        worlds.setdefault(entry.name, entry)
+        if not isinstance(entry.value, m.String):
+            ctx.report("bad-property-value", f"world '{entry.name}' is a world file: give its path in quotes, "
+                       "relative to this spec", entry.value.span)
+            continue
+        path = ctx.base_dir(entry.span) / entry.value.value
+        if not path.is_file():
+            ctx.report("missing-world", f"world file '{entry.value.value}' not found (looked at {path})",
+                       entry.value.span)
+            continue
+        try:
+            load_world(path)
+        except WorldError as problem:
+            ctx.report("bad-world", f"{problem}", entry.value.span)
+    return worlds
+
+
+def check_missions(ctx: Context, system: m.System, worlds: dict[str, m.Setting]) -> None:
+    ctx.duplicates(system.missions, "mission")
+    supervisor = ctx.named(m.Procedures).get(system.supervisor.text) if system.supervisor else None
+    goals = achievable_goals(supervisor) if supervisor is not None else {}
+    for mission in system.missions:
+        if mission.world is not None:
+            if mission.world.text not in worlds:
+                ctx.unknown("undefined-world", "world", mission.world.text, worlds, mission.world.span,
+                            f" of system '{system.name}'")
+        elif len(worlds) != 1:
+            ctx.report("missing-property", f"mission '{mission.name}' needs 'world: NAME;' (system '{system.name}' "
+                       f"has {len(worlds)} worlds{': ' + ', '.join(worlds) if worlds else ''})", mission.span)
+        if mission.horizon is not None and mission.horizon.seconds <= 0:
+            ctx.report("bad-duration", "a mission's horizon must be longer than zero", mission.horizon.span)
+        if not mission.goals:
+            ctx.report("missing-property", f"mission '{mission.name}' asks nothing: give it 'goal: !(...);'",
+                       mission.span)
+        for goal in mission.goals:
+            if system.supervisor is None:
+                ctx.report("goal-without-supervisor", f"mission '{mission.name}' posts a goal, but system "
+                           f"'{system.name}' has no supervisor to achieve it: give it 'supervisor: NAME;'", goal.span)
+            elif supervisor is not None:
+                check_mission_goal(ctx, goal, goals, supervisor.name)
+
+
+def achievable_goals(procedures: m.Procedures) -> dict[str, int]:
+    """The goals a KA of `procedures` is invoked by, with their arity."""
+    goals: dict[str, int] = {}
+    for ka in procedures.kas:
+        if isinstance(ka.invocation, m.Goal):
+            goals.setdefault(ka.invocation.body.head, len(ka.invocation.body.args))
+    return goals
+
+
+def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], procedures: str) -> None:
+    if goal.op not in MISSION_GOAL_OPS:
+        ctx.report("bad-mission-goal", f"a mission asks to achieve '!(...)' or test '?(...)', not '{goal.op}(...)'",
+                   goal.span)
+        return
+    for node in walk(goal):
+        if isinstance(node, m.LogicVar | m.ProgramVar):
+            ctx.report("unbound-variable", f"'{node.name}' has no value in a mission: give a constant", node.span)
+    body = goal.body
+    if goal.op == "!" and body.head not in goals:
+        ctx.report("undefined-goal", f"no KA of procedures '{procedures}' is invoked by '!({body.head} ...)'"
+                   f"{did_you_mean(body.head, goals)}", body.span)
+    elif goal.op == "!" and goals[body.head] != len(body.args):
+        ctx.report("arity-mismatch", f"'{body.head}' takes {goals[body.head]} argument(s), {len(body.args)} given",
+                   body.span)
+
+
+def check_service_actions(ctx: Context, procedures: m.Procedures, executives: list[m.Executive],
+                          without: str) -> None:
+    """Each action bound to a service gives it the inputs it `takes`, in number and type."""
+    for action in procedures.actions:
+        binding = action.binding
+        if not isinstance(binding, m.ServiceBinding):
+            continue
+        if not executives:
+            ctx.report("undefined-service", f"action '{action.name}' requests service '{binding.service}', but "
+                       f"{without}", binding.span)
+            continue
+        services = {s.name: s for e in executives for s in e.services}
+        service = services.get(binding.service)
+        if service is None:
+            ctx.unknown("undefined-service", "service", binding.service, services, binding.span,
+                        f" (action '{action.name}' requests it)")
+            continue
+        if len(action.params) != len(service.takes):
+            taken = ", ".join(t.text for t in service.takes) or "nothing"
+            ctx.report("arity-mismatch", f"service '{service.name}' takes {len(service.takes)} input(s) ({taken}); "
+                       f"action '{action.name}' gives {len(action.params)}", action.span)
+            continue
+        inputs = request_inputs(ctx, service)
+        for param, taken_input in zip(action.params, service.takes, strict=True):
+            typed = inputs.get(taken_input.text)
+            if typed is not None:
+                check_argument_type(ctx, procedures, param, typed, service.name)
+
+
+def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:
+    if service.request is None or len(service.request.parts) != 2:
+        return {}
+    module = ctx.named(m.Module).get(service.request.parts[0])
+    request = next((r for r in module.requests if r.name == service.request.parts[1]), None) if module else None
+    return {i.name: i for i in request.inputs} if request is not None else {}
+
+
+def check_argument_type(ctx: Context, procedures: m.Procedures, param: m.PParam, typed: m.TypedName,
+                        service: str) -> None:
+    """A PRS parameter's domain must hold only values the request's input can take."""
+    kind = domain_kind(procedures, param.domain)
+    input_type = typed.type.name
+    if typed.type.size is not None:
+        accepted = False
+    elif input_type in NUMERIC_INPUTS:
+        accepted = kind in ("int", "number")
+    elif input_type in WHOLE_INPUTS:
+        accepted = kind == "int"
+    elif input_type in TEXT_INPUTS:
+        accepted = kind in ("symbol", "int", "number")  # a symbol or a number, written as text
+    elif input_type == "bool":
+        accepted = kind == "symbol" and symbols(procedures, param.domain) <= {"true", "false", "TRUE", "FALSE"}
+    else:
+        enum = next((e for mod in ctx.items(m.Module) for e in mod.enums if e.name == input_type), None)
+        accepted = enum is not None and kind == "symbol" and bool(symbols(procedures, param.domain)) \
+            and symbols(procedures, param.domain) <= set(enum.values)
+    if not accepted:
+        ctx.report("bad-argument-type", f"'{param.name}' ({describe_domain(param.domain)}) cannot be service "
+                   f"'{service}''s input '{typed.name}' of type {input_type}"
+                   f"{'[' + str(typed.type.size) + ']' if typed.type.size is not None else ''}", param.span)
+
+
+def domain_kind(procedures: m.Procedures, domain: m.PDomain, seen: frozenset[str] = frozenset()) -> str:
+    """int (whole numbers), number, symbol, or unknown."""
+    if isinstance(domain, m.IntRange):
+        return "int"
+    if isinstance(domain, m.SymbolSet):
+        numeric = all(_is_number(v) for v in domain.values)
+        return ("int" if all(v.lstrip("-").isdigit() for v in domain.values) else "number") if numeric else \
+            "symbol" if not any(_is_number(v) for v in domain.values) else "unknown"
+    if domain.name in ("int",):
+        return "int"
+    if domain.name in ("float", "number"):
+        return "number"
+    if domain.name in TEXT_DOMAINS:
+        return "symbol"
+    declared = next((t.domain for t in procedures.types if t.name == domain.name), None)
+    if declared is None or domain.name in seen:
+        return "unknown"
+    return domain_kind(procedures, declared, seen | {domain.name})
+
+
+def symbols(procedures: m.Procedures, domain: m.PDomain, seen: frozenset[str] = frozenset()) -> set[str]:
+    if isinstance(domain, m.SymbolSet):
+        return set(domain.values)
+    if isinstance(domain, m.DomainRef) and domain.name not in seen:
+        declared = next((t.domain for t in procedures.types if t.name == domain.name), None)
+        return symbols(procedures, declared, seen | {domain.name}) if declared is not None else set()
+    return set()
+
+
+def describe_domain(domain: m.PDomain) -> str:
+    if isinstance(domain, m.SymbolSet):
+        return "{" + ", ".join(domain.values) + "}"
+    if isinstance(domain, m.IntRange):
+        return f"{domain.low}..{domain.high}"
+    return domain.name
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True

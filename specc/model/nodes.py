@@ -216,6 +216,7 @@ class Service(Node):
     request: Ref | None = prop("request", "ref", doc="module.request the service runs")
     input: Ref | None = prop("input", "ref", doc="input function or poster giving the request's input")
     output: Ref | None = prop("output", "ref", doc="output function receiving the final reply")
+    takes: tuple[Ref, ...] = prop("takes", "refs", doc="the request's inputs the task level gives, in order")
     doc: String | None = prop("doc", "string")
     timeout: Timeouts | None = None
     args: tuple[Argument, ...] = ()
@@ -482,11 +483,19 @@ class PredicateDecl(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class ServiceBinding(Node):
+    """`action GOTO(x: float, y: float) -> int = service GOTO;`: the action requests the executive's
+    service with its arguments (the service's `takes:` inputs) and its value is the request's id."""
+
+    service: str
+
+
+@dataclass(frozen=True, kw_only=True)
 class ActionDecl(Node):
     name: str
     params: tuple[PParam, ...] = ()
     result: PDomain | None = None
-    binding: String
+    binding: String | ServiceBinding
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -917,15 +926,37 @@ class FtPlan(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class Setting(Node):
+    """One `name: value;` entry of a system's `body { }` or `worlds { }`."""
+
+    name: str
+    value: PropValue
+
+
+@dataclass(frozen=True, kw_only=True)
+class SystemMission(Node):
+    """A mission of the robot: the goals its supervisor is given, in one of its worlds."""
+
+    name: str
+    world: Ref | None = prop("world", "ref", doc="one of the system's worlds (default: its only one)")
+    horizon: Duration | None = prop("horizon", "duration", doc="simulated time after which the run stops")
+    doc: String | None = prop("doc", "string")
+    goals: tuple[Goal, ...] = ()  # `goal: !(...);`, posted together at the start
+
+
+@dataclass(frozen=True, kw_only=True)
 class System(Node):
     name: str
     modules: tuple[Ref, ...] = prop("modules", "refs")
     executive: Ref | None = prop("executive", "ref")
     supervisor: Ref | None = prop("supervisor", "ref")
     planning: Ref | None = prop("planning", "ref", doc="the ftplan block")
-    missions: tuple[Ref, ...] = prop("missions", "refs", doc="problems the robot can be given")
-    world: String | None = prop("world", "string", doc="world file, relative to the spec")
+    extension: String | None = prop("extension", "string", doc="Python module beside the codels with the "
+                                    "robot's own run hooks (world draws, observers, measures)")
     doc: String | None = prop("doc", "string")
+    body: tuple[Setting, ...] | None = None  # `body { radius: 0.3; ... }` (specc.runtime.body)
+    worlds: tuple[Setting, ...] = ()  # `worlds { room: "worlds/room.toml"; }`, relative to the spec
+    missions: tuple[SystemMission, ...] = ()
 
 
 Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment, FtPlan, System]

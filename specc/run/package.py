@@ -197,6 +197,38 @@ def import_generated(generated: Path, example: Path, robot: str, codels: str,
                        f"run `specc compile examples/{robot} -o {generated}` again") from None
 
 
+def import_robot(generated: Path, folder: Path, robot: str) -> ModuleType:
+    """The compiled package `robot` imported from `generated`, whole, with the codels its
+    modules, executive and procedures name imported from the robot's folder `folder`. A
+    package or codel package of the same name imported from elsewhere is forgotten first."""
+    generated, folder = Path(generated).resolve(), Path(folder).resolve()
+    if not (generated / robot / "__init__.py").is_file():
+        raise RunError(f"{generated}: no compiled {robot} package in this folder; "
+                       f"run `specc compile {folder} -o {generated}` first")
+    for place, package in ((folder, None), (generated, robot)):
+        _put_first(place)
+        if package is not None:
+            forget_unless_from(package, place)
+    try:
+        root = importlib.import_module(robot)
+        for part in ("modules", "executive", "supervisor", "planner", "ftplan", "systems"):
+            if (generated / robot / part / "__init__.py").is_file():
+                importlib.import_module(f"{robot}.{part}")
+    except ImportError as error:
+        raise RunError(f"{generated}/{robot}: the compiled package is incomplete or stale ({error}); "
+                       f"run `specc compile {folder} -o {generated}` again") from None
+    for codels in _codel_packages(root):
+        forget_unless_from(codels, folder)
+    return root
+
+
+def _codel_packages(package: ModuleType) -> set[str]:
+    """The top-level packages of the codels the robot's modules name (imported when they start)."""
+    modules = getattr(getattr(package, "modules", None), "MODULES", {})
+    named = {generated.SPEC.codel_module or "" for generated in modules.values()}
+    return {name.partition(".")[0] for name in named if name}
+
+
 def _put_first(folder: Path) -> None:
     while str(folder) in sys.path:
         sys.path.remove(str(folder))

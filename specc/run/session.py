@@ -66,7 +66,8 @@ class RunRequest:
     folder: Path | None = None  # the run folder itself, instead of runs/<name>
     timing: str = "model"  # FTplan's planning charge (the rover): model (deterministic) or wall
     objects: int | None = None  # the hunt's objects to take (default: 5)
-    horizon: float | None = None  # the hunt's, s of simulated time (default: 900)
+    horizon: float | None = None  # s of simulated time (the hunt's default: 900; a mission's: its own)
+    goals: tuple[str, ...] = ()  # PRS goals to post instead of a mission's (`--goal '!(...)'`)
     pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
 
 
@@ -132,7 +133,13 @@ class PlannedRun:
 def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     """Check every name and option of `request` for `robot` (compiled into request.generated);
     RunError when one is wrong. Nothing is written."""
-    plan = _plan_rover(request) if runnable_robot(robot) == "atrv" else _plan_hunt(request)
+    from specc.run.mission import load_robot
+
+    loaded = load_robot(request.generated, request.specs, robot) if _has_systems(request.generated, robot) else None
+    if loaded is not None and (loaded.system.missions or request.goals or robot not in ROBOTS):
+        plan = _plan_system(loaded, request)
+    else:
+        plan = _plan_rover(request) if runnable_robot(robot) == "atrv" else _plan_hunt(request)
     if request.folder is not None:
         return PlannedRun(robot, request, plan, request.folder)
     # Options that change what a run does name its folder too: it never holds another run's files.
@@ -203,6 +210,89 @@ def _finish(outcome: RunOutcome, request: RunRequest, plan: _Plan, report: dict[
 class _Plan:
     name_parts: tuple[str, str, str | None]  # mission, world, configuration
     run: Callable[[EventLog, Progress | None], tuple[dict[str, Any], str]]
+
+
+def _has_systems(generated: Path, robot: str) -> bool:
+    return (generated / robot / "systems" / "__init__.py").is_file()
+
+
+def _plan_system(robot: Any, request: RunRequest) -> _Plan:
+    """A mission of any robot, from its system block (`specc.run.mission`)."""
+    from specc.run.mission import check_mission, run_mission
+    from specc.runtime.system import MissionSpec
+
+    unused = [name for name, value in (("--config", request.configuration), ("--objects", request.objects))
+              if value is not None]
+    if unused:
+        raise RunError(f"{' and '.join(unused)}: robot '{robot.name}' has no such option (it runs its system's "
+                       "missions; configurations are an ftplan block's)")
+    if request.timing != "model":
+        raise RunError(f"timing '{request.timing}': FTplan's planning charge; robot '{robot.name}' plans nothing")
+    if request.goals:
+        if request.mission is not None:
+            raise RunError("give --mission or --goal, not both: --goal posts its goals instead of a mission's")
+        worlds = list(robot.system.worlds)
+        if request.world is None and len(worlds) != 1:
+            raise RunError(f"--goal needs --world (robot '{robot.name}' has {len(worlds)} worlds: "
+                           f"{', '.join(worlds) or 'none'})")
+        mission = MissionSpec("goal", request.world or worlds[0], tuple(_checked_goal(robot, g) for g in request.goals))
+    elif request.mission is None:
+        missions = list(robot.system.missions)
+        if len(missions) != 1:
+            raise RunError(f"robot '{robot.name}' needs --mission ({', '.join(missions) or 'it has none'}) "
+                           "or --goal '!(...)'")
+        mission = robot.mission(missions[0])
+    else:
+        mission = robot.mission(request.mission)
+    check_mission(robot, mission, request.world, request.seed, request.horizon)
+    world = request.world or mission.world
+    world_name = Path(world).stem if world.endswith(".toml") else world
+
+    def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
+        def tell(step: Any) -> None:
+            if progress is not None:
+                progress(step.time, step.horizon, f"{step.goals_done}/{step.goals} goal(s) ended")
+
+        result = run_mission(robot, mission, request.seed, world=request.world, horizon=request.horizon, log=log,
+                             progress=tell)
+        report = {"outcome": "succeeded" if result.outcome == "succeeded" else result.outcome, "why": result.why,
+                  "simulated_time": round(result.simulated_time, 3), "goals": [list(g) for g in result.goals],
+                  "measures": result.measures(), "incidents": list(result.incidents)}
+        return report, result.summary()
+
+    return _Plan((mission.name, world_name, None), run)
+
+
+def _checked_goal(robot: Any, text: str) -> str:
+    """A goal given on the command line: PRS syntax, for a goal some KA of the supervisor is invoked by."""
+    from specc.runtime.procedures import parse_goal
+
+    if robot.system.supervisor is None:
+        raise RunError(f"--goal {text}: robot '{robot.name}' has no supervisor to post it to "
+                       "(give its system 'supervisor: NAME;')")
+    try:
+        goal = parse_goal(text)
+    except ValueError as error:
+        raise RunError(f"--goal {text}: not a PRS goal ({error}); write e.g. '!(GO 3 4)'") from None
+    library = robot.part("supervisor").LIBRARIES[robot.system.supervisor].LIBRARY
+    invoked = {ka.trigger.head: len(ka.trigger.args) for ka in library.kas if ka.goal_invoked}
+    head = goal.expr.head
+    if goal.op not in ("!", "?") or _has_variables(goal.expr):
+        raise RunError(f"--goal {text}: post an achieve '!(...)' or test '?(...)' goal of constants")
+    if head not in invoked:
+        from specc.diagnostics import did_you_mean
+
+        raise RunError(f"--goal {text}: no KA of procedures '{library.name}' is invoked by {head}"
+                       f"{did_you_mean(head, invoked)}")
+    if invoked[head] != len(goal.expr.args):
+        raise RunError(f"--goal {text}: {head} takes {invoked[head]} argument(s), {len(goal.expr.args)} given")
+    return text
+
+
+def _has_variables(term: Any) -> bool:
+    from specc.runtime.procedures import Compound, Var
+
+    return isinstance(term, Var) or isinstance(term, Compound) and any(_has_variables(a) for a in term.args)
 
 
 def _plan_rover(request: RunRequest) -> _Plan:

@@ -100,6 +100,7 @@ class ServiceSpec:
     request: str
     kind: str  # control | exec: the module request's type
     args: Mapping[str, Any] = field(default_factory=dict)  # constant inputs
+    takes: tuple[str, ...] = ()  # the inputs the task level gives with each request, in order
     input: str | None = None  # input function, or module.Poster[.field]
     output: str | None = None  # output function
     start_timeout: float | None = None  # s in WAIT before REPLY TIMEOUT
@@ -239,10 +240,11 @@ class Executive:
                 module.reply_listeners.append(self._module_reply_seen)
 
     # ------------------------------------------------------------ the task level's interface
-    def request(self, service: str, ident: int | None = None) -> int:
-        """RQST EXEC: ask for `service`; its (REPLY id result) comes later. Returns the id."""
+    def request(self, service: str, ident: int | None = None, inputs: tuple[Any, ...] = ()) -> int:
+        """RQST EXEC: ask for `service`, giving the inputs it takes; its (REPLY id result) comes
+        later. Returns the id."""
         ident = next(self._internal_ids) if ident is None else ident
-        self._post(self._on_request, service, ident)
+        self._post(self._on_request, service, ident, inputs)
         return ident
 
     def interrupt(self, ident: int) -> None:
@@ -306,7 +308,7 @@ class Executive:
                 self._try_start(activity)
 
     # ------------------------------------------------------------ the request manager
-    def _on_request(self, name: str, ident: int) -> None:
+    def _on_request(self, name: str, ident: int, inputs: tuple[Any, ...] = ()) -> None:
         service = self.spec.services.get(name)
         if service is None:
             self._tell("REPLY", name, ident, "BAD-SERVICE", f"the executive offers no service '{name}'")
@@ -317,8 +319,12 @@ class Executive:
         activity = Activity(ident, service, self.kernel.now)
         self.activities[ident] = activity
         self._move(activity, Phase.WAIT)
+        if len(inputs) != len(service.takes):
+            taken = ", ".join(service.takes) or "no input"
+            self._end(activity, "BAD-INPUT", f"{name} takes {taken} from the task level; {len(inputs)} given")
+            return
         try:
-            activity.input = self._input(service)
+            activity.input = self._input(service, inputs)
         except Exception as exc:  # the user's input function: report it, keep running
             self._end(activity, "ERROR", f"input of {name}: {type(exc).__name__}: {exc}")
             return
@@ -326,8 +332,9 @@ class Executive:
             activity.timers.append(self.kernel.call_later(
                 service.start_timeout, functools.partial(self._post, self._on_timeout, activity, "start")))
 
-    def _input(self, service: ServiceSpec) -> Any:
-        """The request's input: the constant args, completed by the input function or poster."""
+    def _input(self, service: ServiceSpec, inputs: tuple[Any, ...] = ()) -> Any:
+        """The request's input: the constant args, completed by the input function or poster,
+        then by the inputs the task level gave (`takes`)."""
         module = self.registry.modules[service.module]
         input_type = module.spec.requests[service.request].input_type
         values: dict[str, Any] = dict(service.args)
@@ -337,8 +344,11 @@ class Executive:
             else:
                 found = getattr(self.codels, service.input)(self.context)
             if input_type is not None and isinstance(found, input_type):
-                return found
+                if not inputs:
+                    return found
+                found = vars(found)  # a record the task level's inputs complete
             values.update(_input_fields(input_type, found, service.input))
+        values.update(zip(service.takes, inputs, strict=True))
         if input_type is None:
             return None
         built = build_record(input_type, values)

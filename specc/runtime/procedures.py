@@ -166,8 +166,9 @@ class Predicate:
 class Primitive:
     name: str
     arity: int
-    binding: str  # "python.module.function", called as function(ctx, *args)
+    binding: str  # "python.module.function", called as function(ctx, *args); "" for a service
     returns: bool = False
+    service: str = ""  # an executive service requested with the arguments; the value is the request's id
 
 
 @dataclass(frozen=True)
@@ -217,7 +218,8 @@ def compare(head: str, left: Any, right: Any) -> bool:
 
 def bindings(library: Library) -> list[str]:
     """Every "python.module.function" the library calls, sorted."""
-    named = {p.binding for p in library.primitives} | {p.binding for p in library.predicates if p.binding}
+    named = {p.binding for p in library.primitives if p.binding} | {p.binding for p in library.predicates
+                                                                     if p.binding}
     return sorted(named)
 
 

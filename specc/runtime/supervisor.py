@@ -386,16 +386,17 @@ class PrimitiveContext:
         self._frame = frame
         self._line = line
 
-    def send(self, message: tuple[str, int]) -> None:
-        """(service, id) requests a service of the executive; ("INT", id) interrupts one."""
+    def send(self, message: tuple[Any, ...]) -> None:
+        """(service, id, *inputs) requests a service of the executive, with the inputs it takes;
+        ("INT", id) interrupts one."""
         executive = self.supervisor.executive
         if executive is None:
             raise RuntimeError(f"no executive to send {message} to")
-        service, ident = message
+        service, ident, *inputs = message
         if service == "INT":
             executive.interrupt(ident)
         else:
-            executive.request(service, ident)
+            executive.request(service, ident, tuple(inputs))
 
     def new_id(self) -> int:
         return next(self.supervisor._ids)
@@ -1097,13 +1098,26 @@ class Supervisor:
             raise ExecutionError(f"{call}: {_unbound(args)[0]} is unbound", action.line)
         if len(args) != primitive.arity:
             raise ExecutionError(f"{call}: {call.head} takes {primitive.arity} argument(s)", action.line)
-        function = self._function(primitive.binding, call.head)
+        function = self._request_service(primitive.service) if primitive.service else \
+            self._function(primitive.binding, call.head)
         try:
             value = function(PrimitiveContext(self, frame, action.line, candidates), *args)
         except Exception as exc:
             raise ExecutionError(f"{resolve(call, env)} raised {type(exc).__name__}: {exc}", action.line) from None
         self._record(frame, action.line, f"{resolve(call, env)}" + (f" -> {value!r}" if primitive.returns else ""))
         return value
+
+    @staticmethod
+    def _request_service(service: str) -> Callable[..., Any]:
+        """An action bound to an executive service: SEND-REQUEST (Fig 4.2) with the action's
+        arguments as the service's inputs; its value is the request's id."""
+
+        def request(ctx: PrimitiveContext, *args: Any) -> int:
+            ident = ctx.new_id()
+            ctx.send((service, ident, *args))
+            return ident
+
+        return request
 
     def _function(self, binding: str, name: str) -> Callable[..., Any]:
         function = self.functions.get(binding)

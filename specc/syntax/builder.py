@@ -37,6 +37,7 @@ class Section:
 
 
 SERVICE_SECTIONS = ("args", "conflicts", "timeout")
+SYSTEM_SECTIONS = ("body", "worlds")
 
 
 def _present(children: list[Any]) -> list[Any]:
@@ -544,6 +545,9 @@ class Builder(Transformer[Token, Any]):
         return m.ActionDecl(name=str(name), params=params, result=result, binding=binding,
                             span=self.span(meta))
 
+    def service_binding(self, meta: Meta, children: list[Any]) -> m.ServiceBinding:
+        return m.ServiceBinding(service=str(children[0]), span=self.span(meta))
+
     def ka(self, meta: Meta, children: list[Any]) -> m.KA:
         name, *members = children
         fields: dict[str, Any] = {}
@@ -888,8 +892,42 @@ class Builder(Transformer[Token, Any]):
 
     # ------------------------------------------------------------ system
     def system(self, meta: Meta, children: list[Any]) -> m.System:
-        name, *props = children
-        return self.apply_props(m.System, self.span(meta), props, name=str(name))
+        name, *members = children
+        props, rest = self.split(members)
+        sections: dict[str, tuple[m.Setting, ...]] = {}
+        for section in (r for r in rest if isinstance(r, Section)):
+            if section.name not in SYSTEM_SECTIONS:
+                self.diagnostics.append(error(
+                    "unknown-property",
+                    f"a system has no section '{section.name}'{did_you_mean(section.name, SYSTEM_SECTIONS)}; "
+                    f"known: {', '.join(SYSTEM_SECTIONS)}", section.span))
+            elif section.name in sections:
+                self.diagnostics.append(error(
+                    "duplicate-property", f"section '{section.name}' is given twice; merge them", section.span))
+            else:
+                sections[section.name] = self.settings(section)
+        missions = self.of(rest, m.SystemMission)
+        return self.apply_props(m.System, self.span(meta), props, name=str(name), body=sections.get("body"),
+                                worlds=sections.get("worlds", ()), missions=missions)
+
+    def settings(self, section: Section) -> tuple[m.Setting, ...]:
+        """`name: value;` entries, one value each."""
+        entries = []
+        for p in section.props:
+            if len(p.values) != 1:
+                self.diagnostics.append(error(
+                    "bad-property-value", f"'{p.key}' takes one value", p.values[0].span))
+                continue
+            entries.append(m.Setting(name=p.key, value=p.values[0], span=p.span))
+        return tuple(entries)
+
+    def system_mission(self, meta: Meta, children: list[Any]) -> m.SystemMission:
+        name, *members = children
+        props, goals = self.split(members)
+        return self.apply_props(m.SystemMission, self.span(meta), props, name=str(name), goals=tuple(goals))
+
+    def mission_goal(self, meta: Meta, children: list[Any]) -> m.Goal:
+        return children[0]  # type: ignore[no-any-return]
 
     def __default__(self, data: str, children: list[Any], meta: Meta) -> Any:
         raise AssertionError(f"grammar rule '{data}' has no builder method")

@@ -534,7 +534,8 @@ class Printer:
                 self.line(f"predicate {kinds}{p.name}{pparams(p.params)}{result}{binding};", p.span)
             for a in node.actions:
                 result = f" -> {pdomain(a.result)}" if a.result else ""
-                self.line(f"action {a.name}{pparams(a.params)}{result} = {string(a.binding)};", a.span)
+                bound = f"service {a.binding.service}" if isinstance(a.binding, m.ServiceBinding) else string(a.binding)
+                self.line(f"action {a.name}{pparams(a.params)}{result} = {bound};", a.span)
             for ka in node.kas:
                 with self.block(f"ka {ka.name}", ka.span):
                     self.ka(ka)
@@ -692,6 +693,16 @@ class Printer:
     def p_System(self, node: m.System) -> None:
         with self.block(f"system {node.name}", node.span):
             self.props(node)
+            for section, settings in (("body", node.body), ("worlds", node.worlds or None)):
+                if settings is not None:
+                    with self.block(section, None):
+                        for entry in settings:
+                            self.line(f"{entry.name}: {prop_value(entry.value)};", entry.span)
+            for mission in node.missions:
+                with self.block(f"mission {mission.name}", mission.span):
+                    self.props(mission)
+                    for g in mission.goals:
+                        self.line(f"goal: {goal(g)};", g.span)
 
 
 def _runs(items: Iterable[Any], key: Callable[[Any], str]) -> list[tuple[str, list[Any]]]:

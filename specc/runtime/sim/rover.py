@@ -13,45 +13,14 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass
 
 import numpy as np
 import pymunk
 
+from specc.runtime.body import RobotConfig
 from specc.runtime.sim.world import Circle, World
 
 GRAVITY = 9.81
-
-
-@dataclass(frozen=True)
-class RobotConfig:
-    """The simulated robot's body, drive, and devices (lengths in m, angles in rad)."""
-
-    name: str
-    radius: float  # the body's footprint is a disc (Hilare) ...
-    length: float = 0.0  # ... or, when given, a length x width box (the ATRV)
-    width: float = 0.0
-    mass: float = 60.0  # kg
-    wheel_base: float = 0.6  # distance between the drive wheels
-    max_wheel_speed: float = 1.0  # m/s at the wheel rim
-    max_wheel_accel: float = 1.0  # m/s²: the motors' speed loops ramp towards what is asked
-    traction: float = 0.8  # friction coefficient: bounds the force the wheels can exert
-    encoder_noise: float = 0.0  # relative standard deviation of each wheel's measured travel
-    encoder_bias: float = 0.0  # relative error on the right wheel's radius (a calibration fault)
-    sonars: int = 0  # a ring of range finders, evenly spaced, the first one facing forward
-    sonar_range: float = 5.0
-    sonar_noise: float = 0.01  # m, standard deviation
-    laser_beams: int = 0  # a planar laser scanner facing forward
-    laser_fov: float = math.pi
-    laser_range: float = 30.0
-    laser_noise: float = 0.01
-    camera_r_min: float = 0.5  # detection model of seed 000 §5.2.4
-    camera_r_max: float = 4.0
-    camera_open: float = math.radians(60)  # field of view θ_open
-    pan_speed: float = math.radians(60)  # rad/s, pan-tilt unit
-    tilt_speed: float = math.radians(60)
-    arm_joints: int = 0
-    arm_speed: float = 0.5  # rad/s per joint
 
 
 # Hilare 2 (seed 000 §2.3, §5.2): two drive wheels, odometry, a belt of 32 sonars, a camera and a

@@ -1,0 +1,92 @@
+"""Back end `systems`: each `system` block becomes `systems/<name>.py`, one `SystemSpec` (its
+blocks, its body, its worlds and its missions) that `specc.run` drives the robot from."""
+
+from __future__ import annotations
+
+import posixpath
+from dataclasses import dataclass
+
+from specc.backends.env import render
+from specc.backends.manifest import HEADER, Output
+from specc.backends.records import literal
+from specc.backends.rules import python_name
+from specc.model import nodes as m
+from specc.runtime.system import MissionSpec
+from specc.syntax.printer import goal as goal_text
+from specc.syntax.printer import prop_value
+
+BACKEND = "systems"
+
+
+def robot_folder(program: m.Program) -> str:
+    """The folder of the robot's specs as the spans name it: the deepest one holding them all.
+    Paths the package records are relative to it, and `specc.run` resolves them against the
+    same folder of the specs it runs (`specc.syntax.parser.spec_root`)."""
+    return posixpath.commonpath([posixpath.dirname(f.path) or "." for f in program.files]) if program.files else "."
+
+
+@dataclass(frozen=True)
+class SystemView:
+    system: m.System
+    root: str  # robot_folder(program)
+
+    @property
+    def header(self) -> str:
+        return HEADER.format(sources=self.system.span.file)
+
+    @property
+    def name(self) -> str:
+        return self.system.name
+
+    @property
+    def name_literal(self) -> str:
+        return repr(self.system.name)
+
+    def names(self, refs: tuple[m.Ref, ...]) -> str:
+        return literal(tuple(r.text for r in refs))
+
+    def optional(self, ref: m.Ref | None) -> str:
+        return repr(ref.text if ref is not None else None)
+
+    @property
+    def extension(self) -> str:
+        return repr(self.system.extension.value if self.system.extension is not None else None)
+
+    @property
+    def body(self) -> str:
+        values = {s.name: s.value.value for s in self.system.body or () if isinstance(s.value, m.Number)}
+        return f"RobotConfig.from_spec({self.name!r}, {values!r})"
+
+    @property
+    def worlds(self) -> list[tuple[str, str]]:
+        """(name, path relative to the robot's folder), each as a Python literal."""
+        here = posixpath.dirname(self.system.span.file) or "."
+        shown = []
+        for entry in self.system.worlds:
+            written = prop_value(entry.value) if not isinstance(entry.value, m.String) else entry.value.value
+            path = posixpath.relpath(posixpath.normpath(posixpath.join(here, written)), self.root)
+            shown.append((repr(entry.name), repr(path)))
+        return shown
+
+    @property
+    def missions(self) -> list[tuple[str, str]]:
+        only_world = self.system.worlds[0].name if len(self.system.worlds) == 1 else ""
+        shown = []
+        for mission in self.system.missions:
+            spec = MissionSpec(mission.name, mission.world.text if mission.world is not None else only_world,
+                               tuple(goal_text(g) for g in mission.goals),
+                               mission.horizon.seconds if mission.horizon is not None else None)
+            shown.append((repr(mission.name), literal(spec, (), 8, len(repr(mission.name)) + 2)))
+        return shown
+
+
+def generate(program: m.Program, output: Output, robot: str = "") -> None:
+    systems = sorted((i for i in program.items if isinstance(i, m.System)), key=lambda s: s.name)
+    root = robot_folder(program)
+    for system in systems:
+        output.add(BACKEND, f"systems/{python_name(system.name)}.py",
+                   render("systems/system.py.j2", view=SystemView(system, root)))
+    if systems:
+        output.add(BACKEND, "systems/__init__.py", render(
+            "systems/__init__.py.j2", names=[python_name(s.name) for s in systems],
+            header=HEADER.format(sources="the system blocks")))

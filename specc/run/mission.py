@@ -1,0 +1,451 @@
+"""Any robot's mission, run from its `system` block alone.
+
+    robot = load_robot(Path("generated"), Path("examples/tug"), "tug")
+    run = run_mission(robot, robot.mission("deliver"), seed=0, log=EventLog("deliver.jsonl"))
+    run.outcome, run.why, run.simulated_time
+
+The compiled package says everything (`specc.runtime.system.SystemSpec`): the modules run on one
+kernel with the simulated body in the mission's world (codels reach its devices as
+`sdi.hardware`), the executive over them (its input functions see the world file as
+`ctx.world`), and the supervisor, to which the mission's goals are posted together. The run ends
+when every goal has ended or at the mission's horizon; it succeeds when every goal succeeded.
+Codels run with the robot's folder as the working directory, so the files they read are named
+relative to it, as the specs name their worlds.
+
+A robot's own Python beyond its codels, when a run needs it, is its system's `extension:` module
+(beside the codels), whose functions, each optional, the runner calls:
+
+- `prepare(world, seed) -> World`: the world as the run's own random draws make it;
+- `attach(run)`: once everything is built, with a `RunContext` (the kernel, simulation, modules,
+  executive, supervisor; `run.emit(kind, **fields)` logs an event of its own kind,
+  `run.at_end(callback)` is called when the mission ends);
+- `measure(events) -> dict`: the robot's own figures, read from the log alone;
+- `judge(events, measures, outcome, why) -> (outcome, why)`: its own success criteria.
+
+What the log holds (`specc.run.events`): `mission-start` (the robot, mission, world, body, seed,
+goals, horizon), each `goal` posted and ended, every `request`, `activity`, `reply` and
+`warning` of the executive, every `fact` the procedures conclude or retract, `robot-motion`
+and `arm-motion` from the simulator's true state, `pose` every 0.5 s, an `alarm` for every
+incident (a permanent codel or a listener that raised, the executive's ERROR state, the robot
+blocked), and `mission-end`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import functools
+import importlib
+import math
+import time
+from collections import Counter
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any, NamedTuple
+
+from specc.run import RunError
+from specc.run.events import EventLog
+from specc.run.package import import_robot
+from specc.run.recording import PoseRecorder, world_fields
+from specc.runtime import executive as rx
+from specc.runtime import functional as rt
+from specc.runtime.system import DEFAULT_HORIZON, MissionSpec, SystemSpec
+
+ROBOT_MOVING = 0.005  # m/s at the wheel rims: slower than this, the robot stands still
+SAMPLE_PRIORITY = 1000  # the motion sampler runs after the physics and codels of its instant
+PROGRESS_PERIOD = 10.0  # s of simulated time between two progress reports
+
+
+class MissionProgress(NamedTuple):
+    """What `progress` receives every PROGRESS_PERIOD simulated seconds and at the end."""
+
+    time: float
+    horizon: float
+    goals_done: int
+    goals: int
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A compiled robot, imported: its system and the generated modules it runs."""
+
+    name: str  # the package's
+    folder: Path  # the robot's folder: its codels and worlds
+    system: SystemSpec
+    package: ModuleType
+
+    def part(self, name: str) -> ModuleType:
+        module: ModuleType = getattr(self.package, name)
+        return module
+
+    def mission(self, name: str) -> MissionSpec:
+        """The system's mission `name` (case as written); RunError naming the missions there are."""
+        missions = self.system.missions
+        if name in missions:
+            return missions[name]
+        folded = {key.lower(): key for key in missions}
+        if name.lower() in folded:
+            return missions[folded[name.lower()]]
+        known = ", ".join(missions) or "none: add a 'mission NAME { ... }' to the system block"
+        raise RunError(f"robot '{self.name}' has no mission '{name}' (its missions: {known})")
+
+    @functools.cached_property
+    def extension(self) -> ModuleType | None:
+        """The robot's own run hooks (the system's `extension:` module), imported from its folder."""
+        name = self.system.extension
+        if name is None:
+            return None
+        try:
+            return importlib.import_module(name)
+        except Exception as error:  # the user's module: any error is theirs to fix, said in one line
+            raise RunError(f"robot '{self.name}': cannot import its extension {name} from {self.folder} "
+                           f"({type(error).__name__}: {error})") from None
+
+    def hook(self, name: str) -> Callable[..., Any] | None:
+        """The extension's function `name` (one of EXTENSION_HOOKS), None when it has none."""
+        function = getattr(self.extension, name, None)
+        return function if callable(function) else None
+
+    def world_file(self, name: str) -> Path:
+        """The world file of the system's world `name`, or a world file's path as it is."""
+        worlds = self.system.worlds
+        folded = {key.lower(): key for key in worlds}
+        if name.lower() in folded:
+            return self.folder / worlds[folded[name.lower()]]
+        path = Path(name)
+        if path.suffix == ".toml" and path.is_file():
+            return path
+        known = ", ".join(worlds) or "none: add 'worlds { NAME: \"file.toml\"; }' to the system block"
+        raise RunError(f"robot '{self.name}' has no world '{name}' (its worlds: {known}; or give a .toml file)")
+
+
+def load_robot(generated: Path, folder: Path, robot: str, system: str | None = None) -> Robot:
+    """The compiled package `robot` from `generated`, with the codels of `folder`; its system
+    `system` (default: its only one)."""
+    package = import_robot(generated, folder, robot)
+    systems: Mapping[str, SystemSpec] = package.systems.SYSTEMS if hasattr(package, "systems") else {}
+    if not systems:
+        raise RunError(f"robot '{robot}' has no system block: add 'system {robot} {{ modules: ...; }}' to its "
+                       "specs to say how it runs")
+    if system is None:
+        if len(systems) > 1:
+            raise RunError(f"robot '{robot}' has {len(systems)} systems ({', '.join(systems)}): name one")
+        system = next(iter(systems))
+    if system not in systems:
+        raise RunError(f"robot '{robot}' has no system '{system}' (its systems: {', '.join(systems)})")
+    return Robot(robot, folder.resolve(), systems[system], package)
+
+
+@dataclass
+class RunContext:
+    """What a robot's extension sees of a run in its `attach(run)` hook: the parts running, and
+    the log to add its own events to."""
+
+    robot: Robot
+    mission: MissionSpec
+    seed: int
+    world: Any  # specc.runtime.sim.World, with what `prepare` drew
+    sim: Any  # specc.runtime.sim.Simulation
+    registry: rt.Registry
+    executive: rx.Executive | None
+    supervisor: Any  # specc.runtime.supervisor.Supervisor, or None
+    log: EventLog
+    ending: list[Callable[[], None]] = dataclasses.field(default_factory=list)
+
+    @property
+    def kernel(self) -> Any:
+        return self.registry.kernel
+
+    def emit(self, kind: str, **fields: Any) -> None:
+        """An event of the extension's own kind, at the mission time now."""
+        self.log.emit(self.kernel.now, kind, **fields)
+
+    def at_end(self, callback: Callable[[], None]) -> None:
+        """Call `callback` once the mission has ended, before `mission-end` is logged."""
+        self.ending.append(callback)
+
+
+@dataclass(frozen=True)
+class MissionRun:
+    robot: str
+    mission: str
+    world: str
+    seed: int
+    outcome: str  # succeeded | failed | horizon
+    why: str
+    goals: tuple[tuple[str, str], ...]  # (goal, status) in the order posted
+    simulated_time: float
+    wall_time: float
+    distance: float  # m the robot really travelled
+    requests: int
+    replies: Mapping[str, int]  # "SERVICE RESULT" -> how many
+    incidents: tuple[str, ...]
+    events: tuple[dict[str, Any], ...]
+    extension_measures: Mapping[str, Any] = dataclasses.field(default_factory=dict)  # the extension's `measure`
+
+    def measures(self) -> dict[str, Any]:
+        return {"goals_succeeded": sum(1 for _, status in self.goals if status == "succeeded"),
+                "goals": len(self.goals), "distance": round(self.distance, 3), "requests": self.requests,
+                "replies": dict(self.replies), "incidents": len(self.incidents), **self.extension_measures}
+
+    def summary(self) -> str:
+        lines = [f"{self.robot}'s mission {self.mission} in {self.world} (seed {self.seed}): "
+                 f"{self.outcome}: {self.why}"]
+        lines += [f"  {goal}: {status}" for goal, status in self.goals]
+        lines.append(f"  {self.distance:.1f} m travelled, {self.requests} service request(s), "
+                     f"{len(self.incidents)} incident(s)")
+        lines += [f"  incident: {text}" for text in self.incidents[:5]]
+        lines += [f"  {name}: {value}" for name, value in self.extension_measures.items()]
+        lines.append(f"  {self.simulated_time:.0f} s of mission in {self.wall_time:.1f} s of wall time")
+        return "\n".join(lines)
+
+
+def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: int, horizon: float | None) -> Path:
+    """Check what a run is asked before anything is built: the world file (the mission's unless
+    `world` names another), the seed and the horizon; RunError when one is wrong."""
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise RunError(f"seed {seed!r}: give a whole number >= 0")
+    if horizon is not None and (not math.isfinite(horizon) or horizon <= 0):
+        raise RunError(f"horizon {horizon!r}: give a positive number of simulated seconds")
+    if mission.goals and robot.system.supervisor is None:
+        raise RunError(f"mission {mission.name} posts goals, but robot '{robot.name}' has no supervisor "
+                       "(give its system 'supervisor: NAME;')")
+    return robot.world_file(world or mission.world)
+
+
+def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str | None = None,
+                horizon: float | None = None, log: EventLog | None = None,
+                progress: Callable[[MissionProgress], None] | None = None) -> MissionRun:
+    """Run `mission` on `robot` (see the module's docstring), in `world` (a name of the system's
+    worlds or a world file) instead of the mission's when given, for `horizon` seconds of
+    simulated time instead of the mission's. Bad arguments raise RunError before anything runs."""
+    from specc.runtime.sim import Simulation, WorldError, load_world
+
+    world_path = check_mission(robot, mission, world, seed, horizon)
+    limit = horizon if horizon is not None else mission.horizon if mission.horizon is not None else DEFAULT_HORIZON
+    try:
+        ground = load_world(world_path)
+    except WorldError as error:
+        raise RunError(str(error)) from None
+    prepare = robot.hook("prepare")
+    if prepare is not None:  # the robot's own random draws (where its objects lie...)
+        ground = prepare(ground, seed)
+    log = log if log is not None else EventLog()
+    system = robot.system
+    started = time.perf_counter()
+    with contextlib.chdir(robot.folder):
+        registry = rt.Registry()
+        try:
+            sim = Simulation(ground, system.body, seed=seed, kernel=registry.kernel).attach(registry)
+        except WorldError as error:  # what the world asks cannot be built (objects without room)
+            raise RunError(str(error)) from None
+        kernel = registry.kernel
+        robot.part("modules").create_all(registry)
+        executive = robot.part("executive").EXECUTIVES[system.executive].create(
+            registry, world=str(world_path.resolve())) if system.executive else None
+        recorder = Recorder(log, sim, registry, executive, limit, len(mission.goals), progress)
+        supervisor = robot.part("supervisor").LIBRARIES[system.supervisor].create(
+            kernel=kernel, executive=executive, seed=seed, log=recorder.operator) if system.supervisor else None
+        if supervisor is not None:
+            recorder.watch_facts(supervisor.database)
+        log.emit(kernel.now, "mission-start", robot=robot.name, mission=mission.name, seed=seed,
+                 goals=list(mission.goals), horizon=limit, body=dataclasses.asdict(system.body),
+                 **world_fields(ground))
+        context = RunContext(robot, mission, seed, ground, sim, registry, executive, supervisor, log)
+        attach = robot.hook("attach")
+        if attach is not None:
+            attach(context)
+        intentions = []
+        for goal in mission.goals:
+            assert supervisor is not None  # check_mission: goals need a supervisor
+            intentions.append((goal, supervisor.post(goal)))
+            log.emit(kernel.now, "goal", goal=goal, status="posted")
+        recorder.start(lambda: sum(1 for _, i in intentions if i.status != "running"))
+        PoseRecorder(log.emit, sim).start()
+        ended: set[str] = set()
+
+        def running() -> bool:
+            recorder.poll()
+            for goal, intention in intentions:
+                if intention.status != "running" and goal not in ended:
+                    ended.add(goal)
+                    log.emit(kernel.now, "goal", goal=goal, status=intention.status)
+            return any(i.status == "running" for _, i in intentions)
+
+        kernel.run_while(running, kernel.now + limit)
+        recorder.poll()
+        for callback in context.ending:
+            callback()
+    statuses = tuple((goal, intention.status) for goal, intention in intentions)
+    outcome, why = _outcome(intentions, limit, log.events)
+    measure, judge = robot.hook("measure"), robot.hook("judge")
+    extension_measures = dict(measure(log.events)) if measure is not None else {}
+    if judge is not None:  # the robot's own success criteria, on top of its goals'
+        outcome, why = judge(log.events, extension_measures, outcome, why)
+    log.emit(kernel.now, "mission-end", outcome=outcome, why=why, goals=[list(s) for s in statuses],
+             distance=round(sim.rover.distance, 3), requests=recorder.requests, incidents=len(recorder.incidents))
+    recorder.report(kernel.now)
+    return MissionRun(robot.name, mission.name, ground.name, seed, outcome, why, statuses, kernel.now,
+                      time.perf_counter() - started, sim.rover.distance, recorder.requests,
+                      dict(sorted(recorder.replies.items())), tuple(recorder.incidents), tuple(log.events),
+                      extension_measures)
+
+
+def _outcome(intentions: list[tuple[str, Any]], horizon: float,
+             events: Iterable[Mapping[str, Any]]) -> tuple[str, str]:
+    running = [goal for goal, intention in intentions if intention.status == "running"]
+    if running:
+        return "horizon", f"{', '.join(running)} still running at the {horizon:g} s horizon"
+    failed = [(goal, intention) for goal, intention in intentions if intention.status == "failed"]
+    if failed:
+        goal, intention = failed[0]
+        return "failed", f"{goal} failed: {why_failed(intention.trace, list(events))}"
+    return "succeeded", f"every goal achieved ({len(intentions)})"
+
+
+def why_failed(trace: Iterable[Any], events: list[Mapping[str, Any]]) -> str:
+    """The first statement that failed in the goal's intention, and the last service reply that
+    was not OK before it (what the procedures most likely reacted to)."""
+    failure = next((entry for entry in trace if " failed" in entry.text), None)
+    if failure is None:
+        return "no applicable KA succeeded"
+    refused = next((e for e in reversed(events) if e["kind"] == "reply" and e["t"] <= failure.time
+                    and e.get("result") != "OK"), None)
+    answer = ""
+    if refused is not None:
+        detail = f" ({refused['detail']})" if refused.get("detail") else ""
+        answer = f"; service {refused['service']} answered {refused['result']}{detail} at {refused['t']:.1f} s"
+    return f"{failure.ka}:{failure.line}: {failure.text}{answer}"
+
+
+class Recorder:
+    """Writes what any robot's run does to the event log: the executive's requests, replies and
+    activities, the supervisor's facts, the robot's and the arm's motion, incidents."""
+
+    def __init__(self, log: EventLog, sim: Any, registry: rt.Registry, executive: rx.Executive | None,
+                 horizon: float, goals: int, progress: Callable[[MissionProgress], None] | None) -> None:
+        self.log = log
+        self.sim = sim
+        self.registry = registry
+        self.executive = executive
+        self.kernel = sim.kernel
+        self.horizon = horizon
+        self.goals = goals
+        self.progress = progress
+        self.requests = 0
+        self.replies: Counter[str] = Counter()
+        self.incidents: list[str] = []
+        self._done: Callable[[], int] = lambda: 0
+        self._pose = sim.pose
+        self._robot_moving = False
+        self._arm_moving = False
+        self._blocked = False
+        self._seen = {"registry": 0, "executive": 0}
+        self._next_progress = self.kernel.now + PROGRESS_PERIOD
+        self._database: Any = None
+        self._facts: dict[str, list[Any]] = {}
+        if executive is not None:
+            executive.observers.append(self._activity)
+            executive.listeners.append(self._message)
+
+    # ------------------------------------------------------------ the executive
+    def _activity(self, activity: rx.Activity, source: rx.Phase, target: rx.Phase) -> None:
+        self.poll_facts()  # what the procedures concluded before sending this request comes first
+        service = activity.service.name
+        if source is rx.Phase.ETHER and target is rx.Phase.WAIT:
+            self.requests += 1
+            self.log.emit(self.kernel.now, "request", service=service, id=activity.id)
+        else:
+            self.log.emit(self.kernel.now, "activity", service=service, id=activity.id, **{"from": source.value},
+                          to=target.value)
+
+    def _message(self, message: rx.Message) -> None:
+        now = self.kernel.now
+        self.poll_facts()
+        if message.kind == "WARNING":
+            self.log.emit(now, "warning", service=message.service, id=message.id, type=str(message.result),
+                          detail=message.detail)
+            if message.service == "EXECUTIVE":
+                self.log.emit(now, "alarm", what="executive-error", detail=message.detail)
+            return
+        result = message.result if isinstance(message.result, int | float | str) else str(message.result)
+        self.replies[f"{message.service} {result}"] += 1
+        self.log.emit(now, "reply", service=message.service, id=message.id, result=result, detail=message.detail)
+
+    # ------------------------------------------------------------ the supervisor
+    def operator(self, text: str) -> None:
+        self.log.emit(self.kernel.now, "operator", text=text)
+
+    def watch_facts(self, database: Any) -> None:
+        """The facts the procedures share (closed and functional predicates): the supervisor has
+        no listener for its database, so it is compared after each kernel event and before each
+        executive event is logged."""
+        self._database = database
+        self._facts = {p.name: [] for p in database.predicates.values() if p.kind in ("closed", "functional")}
+
+    def poll_facts(self) -> None:
+        if self._database is None:
+            return
+        for head, before in self._facts.items():
+            now = self._database.facts(head)
+            if now == before:
+                continue
+            for fact in before:
+                if fact not in now:
+                    self.log.emit(self.kernel.now, "fact", fact=str(fact), change="retracted")
+            for fact in now:
+                if fact not in before:
+                    self.log.emit(self.kernel.now, "fact", fact=str(fact), change="concluded")
+            self._facts[head] = now
+
+    def poll(self) -> None:
+        self.poll_facts()
+        self._check_incidents()
+
+    # ------------------------------------------------------------ the simulator
+    def start(self, done: Callable[[], int]) -> None:
+        """Sample the motion on the physics grid, after the simulator's own ticks; `done` counts
+        the goals ended, for the progress reports."""
+        self._done = done
+        self.kernel.call_every(self.sim.physics_period, self._sample, SAMPLE_PRIORITY)
+
+    def _sample(self) -> None:
+        now = self.kernel.now
+        x, y, theta = pose = self.sim.pose
+        dt = self.sim.physics_period
+        turned = abs(math.remainder(theta - self._pose[2], math.tau))
+        rims = (math.hypot(x - self._pose[0], y - self._pose[1]) + turned * self.sim.robot.wheel_base / 2.0) / dt
+        self._pose = pose
+        moving = rims > ROBOT_MOVING
+        if moving != self._robot_moving:
+            self._robot_moving = moving
+            self.log.emit(now, "robot-motion", moving=moving, x=round(x, 3), y=round(y, 3), theta=round(theta, 3))
+        arm = self.sim.arm
+        if arm is not None and arm.moving != self._arm_moving:
+            self._arm_moving = arm.moving
+            self.log.emit(now, "arm-motion", moving=arm.moving)
+        if self.sim.trace.blocked_at is not None and not self._blocked:
+            self._blocked = True
+            self.log.emit(now, "alarm", what="blocked", detail=f"the robot is blocked at ({x:.2f}, {y:.2f})")
+        self._check_incidents()
+        if now >= self._next_progress:
+            self._next_progress += PROGRESS_PERIOD
+            self.report(now)
+
+    def _check_incidents(self) -> None:
+        """A permanent codel, a listener or an observer that raised: the robot keeps going and
+        notes it; the log says so."""
+        sources: list[tuple[str, list[str]]] = [("registry", self.registry.incidents)]
+        if self.executive is not None:
+            sources.append(("executive", self.executive.incidents))
+        for key, incidents in sources:
+            for incident in incidents[self._seen[key]:]:
+                self.incidents.append(incident)
+                self.log.emit(self.kernel.now, "alarm", what="incident", detail=incident)
+            self._seen[key] = len(incidents)
+
+    def report(self, now: float) -> None:
+        if self.progress is not None:
+            self.progress(MissionProgress(now, self.horizon, self._done(), self.goals))
