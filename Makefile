@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
-EXAMPLES := examples/hilare examples/generic examples/atrv
+EXAMPLES := examples/hilare examples/generic examples/atrv examples/tug
 
 .PHONY: demo tour test test-slow goldens bench style install clean
 
@@ -20,6 +20,7 @@ demo: $(STAMP)
 	$(BIN)/specc compile examples/hilare -o generated
 	$(BIN)/specc run examples/hilare --seed 0
 	$(BIN)/specc run examples/atrv --mission M1 --world W2 --config Robot1/2
+	$(BIN)/specc run examples/tug --mission shuttle --world crowded
 
 # The rest of the tour: each level on its own, the formal checks, the planner, the simulator.
 tour: $(STAMP)
@@ -50,6 +51,7 @@ goldens: $(STAMP)
 	$(BIN)/specc compile examples/hilare -o generated
 	$(BIN)/specc compile examples/generic -o generated
 	$(BIN)/specc compile examples/atrv -o generated
+	$(BIN)/specc compile examples/tug -o generated
 
 BENCH_STAMP := $(VENV)/.bench-stamp
 

@@ -589,13 +589,12 @@ def _run_error(error: Exception, code: int = 1) -> typer.Exit:
 
 
 @app.command()
-def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder (its codels and "
-                                                   "worlds beside the specs), e.g. examples/atrv or examples/hilare.",
-                                              show_default=False)],
-        mission: Annotated[Optional[str], typer.Option(help="M1, M2, M3, M4 for the rover; hunt (the default) "
-                                                            "for Hilare.")] = None,
-        world: Annotated[Optional[str], typer.Option(help="W1..W4 (or a world file) for the rover; room (the "
-                                                          "default) for Hilare.")] = None,
+def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder (its specs, codels and "
+                                                   "worlds), e.g. examples/hilare.", show_default=False)],
+        mission: Annotated[Optional[str], typer.Option(help="One of the system block's missions (default: its only "
+                                                            "one); M1..M4 for the rover.")] = None,
+        world: Annotated[Optional[str], typer.Option(help="One of the system's worlds or a world file (default: "
+                                                          "the mission's); W1..W4 for the rover.")] = None,
         config: Annotated[Optional[str], typer.Option(help="The rover's configuration: Robot1, Robot2, Robot1/2 "
                                                            "(default), Robot1/2c.")] = None,
         seed: Annotated[int, typer.Option(min=0, help="Draws the run's randomness: one seed, one event log.")] = 0,
@@ -606,10 +605,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
                                                        "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>).")] = None,
         timing: Annotated[str, typer.Option(help="FTplan's planning time: model (deterministic) or wall "
                                                  "(measured).")] = "model",
-        objects: Annotated[Optional[int], typer.Option(help="The hunt's objects to take (0-5; default 5).")]
-        = None,
         horizon: Annotated[Optional[float], typer.Option(help="Simulated seconds before the run stops (default: "
-                                                              "the mission's; 900 for the hunt).")] = None,
+                                                              "the mission's).")] = None,
         goal: Annotated[Optional[list[str]], typer.Option(help="Post this PRS goal instead of a mission's, e.g. "
                                                                "'!(GO 3 4)' (repeatable: posted together).")] = None,
         pictures: Annotated[bool, typer.Option(help="Draw the map and timeline now (else: specc replay "
@@ -617,12 +614,15 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
     """Run a mission end to end (modules on the simulated robot, executive, supervisor, FTplan and its
     planners) and write a run folder: events.jsonl, report.json, summary.txt, map.png, timeline.png.
-    Exits 0 when the mission succeeded, 1 when it failed (the report says why), 2 on bad input."""
+    Exits 0 when the mission succeeded, 1 when it failed (the report says why), 2 on bad input.
+
+    Examples: specc run examples/hilare (its mission hunt); specc run examples/hilare --goal
+    '!(COLLECT-OBJECTS 2)' --seed 3; specc run examples/atrv --mission M1 --world W2 --config Robot1/2."""
     from specc.run import RunError
     from specc.run.session import RunCrashed, RunRequest, run_in_folder
 
     request = RunRequest(specs, mission=mission, world=world, configuration=config, seed=seed, generated=generated,
-                         runs=runs, folder=folder, timing=timing, objects=objects, horizon=horizon,
+                         runs=runs, folder=folder, timing=timing, horizon=horizon,
                          goals=tuple(goal or ()), pictures=pictures)
     try:
         with ProgressDisplay(quiet) as progress:
@@ -706,13 +706,14 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
 
 
 @app.command()
-def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder, e.g. examples/atrv.",
+def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder, e.g. examples/hilare.",
                                                 show_default=False)],
-          mission: Annotated[Optional[list[str]], typer.Option(help="A rover mission (repeatable; default: "
-                                                                    "M1-M4).")] = None,
-          world: Annotated[Optional[list[str]], typer.Option(help="A world (repeatable; default: W1-W4).")] = None,
-          config: Annotated[Optional[list[str]], typer.Option(help="A configuration (repeatable; default: all "
-                                                                   "four).")] = None,
+          mission: Annotated[Optional[list[str]], typer.Option(help="A mission (repeatable; default: every mission "
+                                                                    "of the system; M1-M4 for the rover).")] = None,
+          world: Annotated[Optional[list[str]], typer.Option(help="A world (repeatable; default: each mission's; "
+                                                                  "W1-W4 for the rover).")] = None,
+          config: Annotated[Optional[list[str]], typer.Option(help="The rover's configuration (repeatable; "
+                                                                   "default: all four).")] = None,
           seeds: Annotated[int, typer.Option(min=1, help="Seeds 0..N-1 for every combination.")] = 1,
           generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
           = Path("generated"),
@@ -721,17 +722,19 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
                                                          "beside it). Default: RUNS/<robot>-table.md")] = None,
           pictures: Annotated[bool, typer.Option(help="Draw every run's pictures.")] = False,
           quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
-    """Run every mission x world x configuration (x seed), one run folder each, and print the table of
-    the measures of seed 004 §4.1.4 (for Hilare: the hunt's success rate over the seeds)."""
+    """Run every mission x world (x configuration) x seed, one run folder each, and print the table of
+    their measures: per mission and world, the success rate and the means of the runs' figures (for
+    the rover, the measures of seed 004 §4.1.4).
+
+    Examples: specc table examples/hilare --seeds 10; specc table examples/atrv --mission M1 --world W2
+    --config Robot1."""
     from specc.run import RunError
     from specc.run.measures import rich_table
     from specc.run.session import RunRequest, compile_robot
-    from specc.run.sweep import CONFIGURATIONS, MISSIONS, WORLDS, sweep, write_table
+    from specc.run.sweep import sweep, write_table
 
     try:
         robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
-        if robot != "atrv" and (mission or world or config):
-            raise RunError(f"{robot} has one mission: --mission, --world and --config are the rover's")
         base = RunRequest(specs, generated=generated, runs=runs, pictures=pictures)
         with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} run(s) done") as progress:
             def step(done: int, total: int, label: str) -> None:
@@ -740,16 +743,18 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
                 elif not quiet and label:
                     err.print(f"[{done + 1}/{total}] {label}", markup=False)
 
-            result = sweep(robot, base, missions=mission or MISSIONS, worlds=world or WORLDS,
-                           configurations=config or CONFIGURATIONS, seeds=range(seeds), step=step)
+            result = sweep(robot, base, missions=mission or (), worlds=world or (), configurations=config or (),
+                           seeds=range(seeds), step=step)
         written = write_table(result, output or runs / f"{robot}-table.md")
     except RunError as error:
         raise _run_error(error, 2) from None
-    if result.hunt is not None:
-        h = result.hunt
-        out.print(f"hilare's hunt: {h.succeeded} of {h.seeds} seed(s) succeeded ({100 * h.success_rate:.0f} %), "
-                  f"{h.objects_taken:.2f} objects taken on average, {h.simulated_time:.0f} s per successful hunt",
-                  markup=False)
+    if result.missions:
+        for row in result.missions:
+            configuration = f" with {row.configuration}" if row.configuration else ""
+            out.print(f"{robot}'s mission {row.mission} in {row.world}{configuration}: {row.succeeded} of "
+                      f"{row.seeds} seed(s) "
+                      f"succeeded ({100 * row.success_rate:.0f} %), {row.simulated_time:.0f} s per successful run",
+                      markup=False)
     else:
         # A file or pipe gets the whole table, not one squeezed into 80 columns.
         (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(rich_table(result.rows))

@@ -9,7 +9,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
-EXAMPLE_ROBOTS = ("hilare", "generic", "atrv")
+EXAMPLE_ROBOTS = ("hilare", "generic", "atrv", "tug")
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 HUNT_SEED = 0  # five objects taken; its first exploration move is interrupted by a detection (§5.5, t2)
 
@@ -47,13 +47,21 @@ def no_planner_left_behind() -> Iterator[None]:
 
 @pytest.fixture(scope="session")
 def hunt_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Any, Path, list[Any]]:
-    """One full hunt of seed HUNT_SEED (about 4 s), its log file and its progress reports, shared
-    by the tests of the hunt and of its pictures."""
+    """One full hunt of seed HUNT_SEED (about 4 s) through the generic runner, its log file and its
+    progress reports, shared by the tests of the hunt and of its pictures."""
     from specc.run.events import EventLog
-    from specc.run.hunt import run_hunt
+    from specc.run.mission import run_mission
 
+    robot = hilare()
     path = tmp_path_factory.mktemp("hunt") / "hunt.jsonl"
     reports: list[Any] = []
     with EventLog(path) as log:
-        result = run_hunt(HUNT_SEED, log=log, progress=reports.append)
+        result = run_mission(robot, robot.mission("hunt"), HUNT_SEED, log=log, progress=reports.append)
     return result, path, reports
+
+
+def hilare() -> Any:
+    """The compiled Hilare of generated/, with its codels (and its extension) importable."""
+    from specc.run.mission import load_robot
+
+    return load_robot(ROOT / "generated", EXAMPLES / "hilare", "hilare")

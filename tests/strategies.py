@@ -223,10 +223,13 @@ ftplans = st.builds(
 systems = st.builds(
     m.System, name=lower, modules=small(refs), executive=st.none() | refs, supervisor=st.none() | refs,
     planning=st.none() | refs, doc=st.none() | strings,
-    body=st.none() | small(st.builds(m.Setting, name=lower, value=numbers)),
-    worlds=small(st.builds(m.Setting, name=lower, value=strings)),
+    body=st.none() | st.builds(m.Settings, entries=small(st.builds(m.Setting, name=lower, value=numbers))),
+    worlds=st.none() | st.builds(m.Settings, entries=small(st.builds(m.Setting, name=lower, value=strings))),
     missions=small(st.builds(m.SystemMission, name=lower, world=st.none() | refs, horizon=st.none() | durations,
-                             doc=st.none() | strings, goals=small(goals))))
+                             plan=st.none() | refs, doc=st.none() | strings, goals=small(goals))),
+    bindings=st.none() | st.builds(m.Bindings, entries=small(st.builds(
+        m.Binding, task=upper, args=small(ixexprs), kind=st.sampled_from(["goal", "service", "request"]),
+        target=refs | dotted, target_args=small(ixexprs)))))
 
 items = st.one_of(modules, executives, rule_bases, procedures, planning_items, ftplans, systems)
 source_files = st.builds(m.SourceFile, path=st.just("generated.spec"), items=small(items, 1, 3))

@@ -87,7 +87,7 @@ def start(sdi, request):
 def step(sdi, request):
     sim = sdi.hardware
     x, y, theta = sim.pose
-    dx, dy = request.input.x - x, request.input.y - y
+    dx, dy = request.x - x, request.y - y
     if math.hypot(dx, dy) < ARRIVED:
         sim.wheels.drive(0.0, 0.0)
         return "end"
@@ -105,14 +105,93 @@ def halt(sdi, request):
 '''
 
 
-def write_robot(folder: Path, spec: str = SPEC) -> Path:
+# The same cart with a planner: FTplan plans a round (go to A, drop there, come back to the dock)
+# and the bindings carry each action out, GOTO as a PRS goal whose KA requests the GOTO service,
+# DROP as the module request itself.
+PLANNING = """
+domain carting {
+  attribute AT() { ?value in {DOCK, A, B}; }
+  attribute DELIVERED(?p) { ?p in {A, B}; ?value in {NO, YES}; }
+  task GOTO(?from, ?to) (t_start, t_end) {
+    ?from in {DOCK, A, B};
+    ?to in {DOCK, A, B};
+    event(AT(): (?from, ?to), t_end);
+    contingent (t_end - t_start) in [2, 40];
+  } nonPreemptive
+  task DROP(?p) (t_start, t_end) {
+    ?p in {A, B};
+    hold(AT(): ?p, (t_start, t_end));
+    event(DELIVERED(?p): (NO, YES), t_end);
+    contingent (t_end - t_start) in [1, 3];
+  } nonPreemptive
+}
+problem round_a for carting {
+  timepoint t1, t2;
+  explained event(AT(): (A, DOCK), t_start);
+  explained event(DELIVERED(A): (YES, NO), t_start);
+  explained event(DELIVERED(B): (YES, NO), t_start);
+  hold(DELIVERED(A): YES, (t1, t_end)) goal(2, 0);
+  hold(AT(): DOCK, (t2, t_end)) goal(1, 0);
+  t1 < t2;
+  (t_end - t_start) in [0, 200];
+}
+ftplan rounds {
+  planners: p1;
+  policy: successive;
+  watchdog: 10 s;
+  planner p1 { domain: carting; }
+  state {
+    on ended GOTO(?from, ?to) => AT() := ?to;
+    on ended DROP(?p) => DELIVERED(?p) := YES;
+  }
+  mission round_a { p1: round_a; }
+}
+"""
+PLANNED_SPEC = SPEC.replace("""  mission deliver { world: shop; horizon: 120 s; goal: !(GO 3 4); }
+}""", """  mission deliver { world: shop; horizon: 120 s; goal: !(GO 3 4); }
+  planning: rounds;
+  mission round { world: shop; plan: round_a; horizon: 300 s; }
+  bindings {
+    GOTO(?from, ?to) => goal GO-PLACE(?to);
+    DROP(?p) => request drive.Drop(?p);
+  }
+}""").replace("""  exec_task Motion""", """  request Drop {
+    type: exec;
+    input: place: string;
+    task: Motion;
+    codel start: start_drop;
+    codel exec: drop;
+  }
+  exec_task Motion""").replace("""module drive {""", """module drive {
+  internal_data { dropCycles: int; }""").replace("""  ka Goto {""", """\
+  ka GoDock { invocation: !(GO-PLACE DOCK); body { !(GO 1 1); } }
+  ka GoA { invocation: !(GO-PLACE A); body { !(GO 4 4); } }
+  ka GoB { invocation: !(GO-PLACE B); body { !(GO 2 5); } }
+  ka Goto {""") + PLANNING
+DROP_CODELS = '''
+
+DROP_CYCLES = 20  # of the 50 ms task: 1 s
+
+
+def start_drop(sdi, request):
+    sdi.dropCycles = 0
+    return "exec"
+
+
+def drop(sdi, request):
+    sdi.dropCycles += 1
+    return "end" if sdi.dropCycles >= DROP_CYCLES else "exec"
+'''
+
+
+def write_robot(folder: Path, spec: str = SPEC, codels: str = CODELS) -> Path:
     robot = folder / "cart"
     (robot / "worlds").mkdir(parents=True)
     (robot / "cart_codels").mkdir()
     (robot / "cart.spec").write_text(spec)
     (robot / "worlds" / "shop.toml").write_text(WORLD)
     (robot / "cart_codels" / "__init__.py").write_text("")
-    (robot / "cart_codels" / "drive.py").write_text(CODELS)
+    (robot / "cart_codels" / "drive.py").write_text(codels)
     return robot
 
 
@@ -175,7 +254,7 @@ def test_a_goal_the_robot_cannot_reach_fails_with_the_modules_reason(cart: Path)
     (("--goal", "!(GO 1)"), "GO takes 2 argument(s), 1 given"),
     (("--goal", "!(GO $X 1)"), "goal of constants"),
     (("--goal", "!(GO 1 2)", "--mission", "deliver"), "give --mission or --goal, not both"),
-    (("--config", "Robot1"), "--config: robot 'cart' has no such option"),
+    (("--config", "Robot1"), "--config: mission deliver of robot 'cart' is not planned"),
 ])
 def test_bad_run_options_are_one_clear_message_and_leave_no_run_folder(cart: Path, args: tuple[str, ...],
                                                                         message: str) -> None:
@@ -203,6 +282,68 @@ def test_a_spec_that_cannot_run_is_refused_with_a_code_and_a_caret(tmp_path: Pat
     assert result.returncode == 2, result.stderr
     assert f"[{code}]" in result.stderr and "^" in result.stderr and "Traceback" not in result.stderr
     assert not (tmp_path / "runs").exists()
+
+
+@pytest.fixture(scope="module")
+def planned_cart(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_robot(tmp_path_factory.mktemp("planned"), PLANNED_SPEC, CODELS + DROP_CODELS)
+
+
+def test_ftplan_plans_and_the_bindings_carry_each_action_out(planned_cart: Path) -> None:
+    work = planned_cart.parent
+    result = specc(work, "run", planned_cart, "--mission", "round", "-q")
+    assert result.returncode == 0, result.stderr
+    folder = work / "runs" / "cart-round-shop-Robot1-s0"
+    report = json.loads((folder / "report.json").read_text())
+    assert report["outcome"] == "succeeded" and report["configuration"] == "Robot1"
+    assert report["measures"]["planned_goals_met"] == report["measures"]["planned_goals"] == 2
+    events = read_events(folder / "events.jsonl")
+    started = [e for e in events if e["kind"] == "action" and e["status"] == "started"]
+    # Each action of the plan, and how it was carried out: the goal, or the module request.
+    assert [(e["task"], e.get("goal"), e.get("request")) for e in started] == [
+        ("GOTO", "!(GO-PLACE A)", None), ("DROP", None, "drive.Drop(A)"), ("GOTO", "!(GO-PLACE DOCK)", None)]
+    # The goal's procedure asked the executive for its service, with the place's coordinates.
+    requests = [e for e in events if e["kind"] == "request"]
+    assert [r["service"] for r in requests] == ["GOTO", "GOTO"]
+    assert all(e["status"] == "ended" for e in events if e["kind"] == "action" and e["status"] != "started")
+    last = [e for e in events if e["kind"] == "pose"][-1]
+    assert math.hypot(last["x"] - 1, last["y"] - 1) < 0.2  # back at the dock
+    assert (folder / "timeline.png").is_file()
+
+
+def test_an_action_past_its_planned_duration_is_stopped_and_fails(tmp_path: Path) -> None:
+    """Temporal execution control: DROP may take 3 s; a drop of 5 s is stopped at 3 s, fails,
+    and FTplan replans from the state the reports left."""
+    slow = DROP_CODELS.replace("DROP_CYCLES = 20", "DROP_CYCLES = 100")
+    robot = write_robot(tmp_path, PLANNED_SPEC, CODELS + slow)
+    result = specc(tmp_path, "run", robot, "--mission", "round", "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 1, result.stderr
+    events = read_events(tmp_path / "run" / "events.jsonl")
+    failed = [e for e in events if e["kind"] == "action" and e["status"] == "failed"]
+    assert failed and failed[0]["task"] == "DROP" and "overran its planned duration" in failed[0]["why"]
+    drop = next(e for e in events if e["kind"] == "action" and e["status"] == "started" and e["task"] == "DROP")
+    assert "still running 3 s after it started" in failed[0]["why"]
+    assert failed[0]["t"] - drop["t"] == pytest.approx(3.0, abs=0.06)  # the drop ends as it is interrupted
+    assert any(e["kind"] == "ftplan" and e["event"] == "action-failed" for e in events)
+    assert sum(1 for e in events if e["kind"] == "ftplan" and e["event"] == "plan-request") >= 2  # it replanned
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "failed" and report["why"]
+
+
+@pytest.mark.parametrize(("change", "code"), [
+    (("    DROP(?p) => request drive.Drop(?p);\n", ""), "missing-binding"),
+    (("request drive.Drop(?p)", "request drive.Drop(?p, 2)"), "arity-mismatch"),
+    (("goal GO-PLACE(?to)", "goal GO-PLAZA(?to)"), "undefined-goal"),
+    (("goal GO-PLACE(?to)", "goal GO-PLACE(?where)"), "unbound-variable"),
+    (("DROP(?p) => request", "DROOP(?p) => request"), "undefined-task"),
+    (("plan: round_a;", "plan: round_b;"), "undefined-mission"),
+])
+def test_bindings_that_cannot_run_are_refused_by_check(tmp_path: Path, change: tuple[str, str], code: str) -> None:
+    old, new = change
+    assert old in PLANNED_SPEC
+    robot = write_robot(tmp_path, PLANNED_SPEC.replace(old, new), CODELS + DROP_CODELS)
+    result = specc(tmp_path, "check", robot)
+    assert result.returncode == 1 and f"[{code}]" in result.stdout + result.stderr, result.stdout + result.stderr
 
 
 def test_the_minimal_robot_formats_to_itself() -> None:

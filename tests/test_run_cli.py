@@ -103,7 +103,19 @@ def test_the_hunt_runs_from_the_command_line(tmp_path: Path) -> None:
     assert report["measures"]["arm_moves_while_robot_moves"] == 0
     assert report["measures"]["detections_interrupting_exploration"] >= 1
     assert {"map.png", "timeline.png", "state.png"} <= set(report["pictures"])
-    assert "5 of 5 objects taken" in result.stdout
+    assert "5 of 5 object(s) taken" in result.stdout
+
+
+def test_a_table_of_the_hunt_over_seeds(tmp_path: Path) -> None:
+    result = specc("table", HILARE, "--seeds", "2", "--runs", tmp_path, "--quiet")
+    assert result.returncode == 0, result.stderr
+    assert "hilare's mission hunt in room: 2 of 2 seed(s) succeeded (100 %)" in result.stdout
+    data = json.loads((tmp_path / "hilare-table.json").read_text())
+    (row,) = data["missions"]
+    assert (row["mission"], row["world"], row["seeds"], row["succeeded"]) == ("hunt", "room", 2, 2)
+    assert row["means"]["objects_taken"] == 5 and row["means"]["arm_moves_while_robot_moves"] == 0
+    table = (tmp_path / "hilare-table.md").read_text()
+    assert "| hunt | room | - | 2 | 2 | 100 % |" in table and "objects_taken" in table
 
 
 @pytest.mark.parametrize(("args", "message"), [
@@ -111,7 +123,7 @@ def test_the_hunt_runs_from_the_command_line(tmp_path: Path) -> None:
     (("--mission", "M1", "--world", "W9"), "error: unknown world 'W9': give W1, W2, W3, W4"),
     (("--mission", "M1", "--world", "W1", "--config", "Robot3"), "error: no robot configuration 'Robot3'"),
     (("--mission", "M1",), "error: the rover needs --mission (M1, M2, M3, M4) and --world"),
-    (("--mission", "M1", "--world", "W1", "--horizon", "60"), "error: --horizon: the hunt's (Hilare's)"),
+    (("--mission", "M1", "--world", "W1", "--horizon", "60"), "error: --horizon: a rover mission ends with its plan"),
 ])
 def test_unknown_names_are_one_line_and_leave_no_run_folder(args: tuple[str, ...], message: str,
                                                             tmp_path: Path) -> None:
@@ -123,13 +135,14 @@ def test_unknown_names_are_one_line_and_leave_no_run_folder(args: tuple[str, ...
 
 def test_the_hunt_refuses_the_rovers_options(tmp_path: Path) -> None:
     assert_clean_failure(specc("run", HILARE, "--config", "Robot1", "--runs", tmp_path), 2,
-                         "error: configuration 'Robot1': hilare has none")
-    assert_clean_failure(specc("run", HILARE, "--objects", "9", "--runs", tmp_path), 2,
-                         "error: 9 objects wanted: COLLECT-OBJECTS takes 0 to 5")
+                         "error: --config: mission hunt of robot 'hilare' is not planned")
+    assert_clean_failure(specc("run", HILARE, "--goal", "!(COLLECT-OBJECT 2)", "--runs", tmp_path), 2,
+                         "no KA of procedures 'hilare_tasks' is invoked by COLLECT-OBJECT (did you mean "
+                         "'COLLECT-OBJECTS'?)")
     assert_clean_failure(specc("run", HILARE, "--horizon", "nan", "--runs", tmp_path), 2, "error: horizon nan")
     assert not any(tmp_path.iterdir())  # checked before anything is written
     assert_clean_failure(specc("run", EXAMPLES / "generic", "--runs", tmp_path), 2,
-                         "error: robot 'generic' has no mission runner")
+                         "error: robot 'generic' has no system block")
     assert_clean_failure(specc("run", tmp_path / "nowhere"), 2, "is not a robot's spec folder")
 
 
@@ -235,7 +248,9 @@ def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
                    "--runs", tmp_path)
     assert_clean_failure(result, 2, "error: ftplan 'rover' has no mission 'M7'")
     assert not any(tmp_path.iterdir())  # every name is checked before the first run
-    assert_clean_failure(specc("table", HILARE, "--world", "W1"), 2, "hilare has one mission")
+    assert_clean_failure(specc("table", HILARE, "--world", "W1"), 2, "robot 'hilare' has no world 'W1'")
+    assert_clean_failure(specc("table", HILARE, "--config", "Robot1"), 2, "--config: mission hunt of robot 'hilare' "
+                         "is not planned")
 
 
 def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:

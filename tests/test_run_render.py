@@ -10,11 +10,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 
 from specc.run import RunError
-from specc.run.hunt import HuntResult, draw_hunt, motion_stretches
+from specc.run.mission import MissionRun
 from specc.run.render import (
     MAP,
     STATE,
@@ -22,15 +21,16 @@ from specc.run.render import (
     action_bars,
     draw_map,
     ftplan_marks,
-    hunt_model,
-    hunt_objects,
-    hunt_scene,
+    last_model,
+    logged_objects,
+    motion_stretches,
     path_of,
     plan_starts,
     render_run,
     reply_outcome,
     run_info,
     run_world,
+    scene_of,
     service_bars,
     trajectories,
 )
@@ -41,7 +41,7 @@ POSE_TOLERANCE = 0.03  # m between a pose event and the simulator's trace at the
 
 
 @pytest.fixture
-def hunt(hunt_run: tuple[HuntResult, Path, list]) -> HuntResult:
+def hunt(hunt_run: tuple[MissionRun, Path, list]) -> MissionRun:
     return hunt_run[0]
 
 
@@ -147,12 +147,16 @@ def test_a_rover_log_cut_inside_an_action_still_draws(rover: RoverRun, tmp_path:
 # ---------------------------------------------------------------- the hunt
 
 
-def test_the_objects_states_from_the_log_are_the_hunt_s(hunt: HuntResult) -> None:
-    assert hunt_objects(hunt.events) == hunt.objects
-    assert {o.state for o in hunt.objects} >= {"taken", "undetected"}
+def test_the_objects_states_from_the_log_are_the_hunt_s(hunt: MissionRun) -> None:
+    objects = logged_objects(hunt.events)
+    start = hunt.events[0]
+    assert [(o.x, o.y) for o in objects] == [tuple(xy) for xy in start["objects"]]
+    taken = [e["object"] for e in hunt.events if e["kind"] == "object-taken"]
+    assert sorted(o.index for o in objects if o.state == "taken") == sorted(taken)
+    assert {o.state for o in objects} >= {"taken", "undetected"}
 
 
-def test_the_service_bars_pair_each_request_with_its_reply(hunt: HuntResult) -> None:
+def test_the_service_bars_pair_each_request_with_its_reply(hunt: MissionRun) -> None:
     bars = service_bars(hunt.events)
     requests = [e for e in hunt.events if e["kind"] == "request"]
     replies = {e["id"]: e for e in hunt.events if e["kind"] == "reply"}
@@ -169,54 +173,58 @@ def test_the_service_bars_pair_each_request_with_its_reply(hunt: HuntResult) -> 
     assert reply_outcome("TIMEOUT") == reply_outcome("BLOCKED") == "failed"
 
 
-def test_motions_alternate_and_the_arm_moves_for_its_services(hunt: HuntResult) -> None:
+def test_motions_alternate_and_the_arm_moves_for_its_services(hunt: MissionRun) -> None:
     robot = motion_stretches(hunt.events, "robot-motion")
     assert robot and all(a.end <= b.start for a, b in zip(robot, robot[1:], strict=False))
     arm = motion_stretches(hunt.events, "arm-motion")
     assert {s.label for s in arm} == {"ARM-OBJ", "ARM-BACK"}
 
 
-def test_the_map_shows_the_model_and_trajectories_the_hunt_ended_with(hunt: HuntResult) -> None:
-    certainty, goal = hunt_model(hunt.events)
-    assert certainty is not None and hunt.certainty is not None
-    assert (certainty.cell, certainty.nx, certainty.ny) == (hunt.certainty.cell, hunt.certainty.nx, hunt.certainty.ny)
-    assert np.allclose(certainty.grid(), hunt.certainty.grid(), atol=1e-3)
-    assert goal == hunt.goal
-    assert trajectories(hunt.events) == tuple(p.points for p in hunt.planned)
-    scene = hunt_scene(hunt.events)
-    assert scene.object_states == tuple(o.state for o in hunt.objects)
-    assert scene.taken_order == tuple(sorted((o.index for o in hunt.objects if o.taken_at is not None),
-                                             key=lambda k: hunt.objects[k].taken_at or 0.0))
+def test_the_map_shows_the_model_and_trajectories_the_hunt_ended_with(hunt: MissionRun) -> None:
+    certainty, goal = last_model(hunt.events)
+    model = [e for e in hunt.events if e["kind"] == "model"][-1]
+    assert certainty is not None and (certainty.cell, certainty.nx, certainty.ny) == (
+        model["certainty"]["cell"], model["certainty"]["nx"], model["certainty"]["ny"])
+    assert certainty.grid().shape == (certainty.ny, certainty.nx) and 0.0 <= certainty.grid().min()
+    assert goal == tuple(model["goal"])
+    planned = [e["points"] for e in hunt.events if e["kind"] == "trajectory"]
+    assert trajectories(hunt.events) == tuple(tuple(tuple(p) for p in points) for points in planned) and planned
+    scene = scene_of(hunt.events)
+    objects = logged_objects(hunt.events)
+    assert scene.object_states == tuple(o.state for o in objects)
+    assert scene.taken_order == tuple(sorted((o.index for o in objects if o.taken_at is not None),
+                                             key=lambda k: objects[k].taken_at or 0.0))
+    assert scene.robot.radius == 0.35 and scene.robot.sonars == 32  # the body the log carries
     assert any(mark.points for mark in scene.marks if "interrupted" in mark.label)
 
 
-def test_the_hunt_run_folder_holds_map_timeline_and_state(hunt: HuntResult, tmp_path: Path) -> None:
+def test_the_hunt_run_folder_holds_map_timeline_and_state(hunt: MissionRun, tmp_path: Path) -> None:
     folder = tmp_path / "hunt"
     written = render_run(hunt.events, folder)
     assert written == [folder / MAP, folder / TIMELINE, folder / STATE]
     assert sorted(folder.iterdir()) == sorted(written) and all(is_png(p) for p in written)
-    assert is_png(draw_hunt(hunt, tmp_path / "hunt.png"))  # the same drawing, from the result's events
 
 
-def test_a_hunt_log_cut_in_the_middle_still_draws(hunt: HuntResult, tmp_path: Path) -> None:
+def test_a_hunt_log_cut_in_the_middle_still_draws(hunt: MissionRun, tmp_path: Path) -> None:
     events = list(hunt.events[: len(hunt.events) // 2])
     assert not any(e["kind"] in ("mission-end", "model") for e in events)
-    assert hunt_model(events) == (None, None)
+    assert last_model(events) == (None, None)
     open_bars = [b for b in service_bars(events) if b.outcome == "running"]
     assert open_bars and all(b.ended == events[-1]["t"] for b in open_bars)
-    states = [o.state for o in hunt_objects(events)]
+    states = [o.state for o in logged_objects(events)]
     assert states.count("taken") < 5
+    # No model yet, so no state of Fig 5.11 to draw.
     written = render_run(events, tmp_path / "cut")
-    assert [p.name for p in written] == [MAP, TIMELINE, STATE] and all(is_png(p) for p in written)
+    assert [p.name for p in written] == [MAP, TIMELINE] and all(is_png(p) for p in written)
     # Cut right after its first line: the room, the objects where they lie, empty rows.
     written = render_run(hunt.events[:1], tmp_path / "start")
-    assert [p.name for p in written] == [MAP, TIMELINE, STATE] and all(is_png(p) for p in written)
+    assert [p.name for p in written] == [MAP, TIMELINE] and all(is_png(p) for p in written)
 
 
 # ---------------------------------------------------------------- logs that cannot be drawn
 
 
-def test_a_log_without_mission_start_cannot_be_drawn(hunt: HuntResult, tmp_path: Path) -> None:
+def test_a_log_without_mission_start_cannot_be_drawn(hunt: MissionRun, tmp_path: Path) -> None:
     headless = [e for e in hunt.events if e["kind"] != "mission-start"]
     with pytest.raises(RunError, match="no mission-start") as error:
         render_run(headless, tmp_path / "none")
@@ -224,13 +232,13 @@ def test_a_log_without_mission_start_cannot_be_drawn(hunt: HuntResult, tmp_path:
     assert not (tmp_path / "none").exists()
 
 
-def test_a_log_without_the_world_or_of_an_unknown_robot_cannot_be_drawn(hunt: HuntResult, tmp_path: Path) -> None:
+def test_a_log_without_the_world_or_the_body_cannot_be_drawn(hunt: MissionRun, tmp_path: Path) -> None:
     start = {k: v for k, v in hunt.events[0].items() if k != "world_data"}
     with pytest.raises(RunError, match="no world_data"):
         render_run([start, *hunt.events[1:]], tmp_path / "old")
-    stranger = {**hunt.events[0], "robot": "r2d2", "mission": "rescue"}
-    with pytest.raises(RunError, match="r2d2"):
-        render_run([stranger, *hunt.events[1:]], tmp_path / "r2d2")
+    bodiless = {k: v for k, v in hunt.events[0].items() if k != "body"}
+    with pytest.raises(RunError, match="no body"):
+        render_run([bodiless, *hunt.events[1:]], tmp_path / "bodiless")
     broken = {**hunt.events[0], "world_data": {"room": {"width": -1, "height": 2}}}
     with pytest.raises(RunError, match="positive"):
         render_run([broken, *hunt.events[1:]], tmp_path / "broken")

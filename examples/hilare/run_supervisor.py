@@ -1,6 +1,7 @@
 """Run Hilare's task level (seed 000 ch. 4, §5.4): the PRS procedures of procedures.spec drive the
 executive and the modules on the simulated robot and room until the robot has collected its
-objects - the object hunt of ch. 5, through `specc.run.hunt.run_hunt`.
+objects - the object hunt of ch. 5, through specc's generic runner (`specc.run.mission`) and this
+robot's extension (hilare_codels/hunt.py).
 
 Run from the repository root after `specc compile examples/hilare -o generated`:
     python examples/hilare/run_supervisor.py [N] [--seed S] [--log hunt.jsonl] [-o hunt.png]
@@ -18,6 +19,7 @@ Exit status: 0 when the goal succeeded, 1 when it failed or was still running at
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -26,13 +28,9 @@ sys.path.insert(0, str(HERE.parent.parent))  # specc itself, when it is not inst
 
 from specc.run import RunError  # noqa: E402
 from specc.run.events import EventLog  # noqa: E402
-from specc.run.hunt import (  # noqa: E402
-    HORIZON,
-    arm_motion_overlaps,
-    detection_interruptions,
-    draw_hunt,
-    run_hunt,
-)
+from specc.run.mission import load_robot, run_mission  # noqa: E402
+from specc.run.package import ensure_compiled  # noqa: E402
+from specc.run.render import draw_map  # noqa: E402
 
 WANTED = 2
 SEED = 7  # the seed places the objects and draws every random event: a fixed seed, a repeatable run
@@ -43,19 +41,25 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("wanted", nargs="?", type=int, default=WANTED, help="objects to collect (0 to 5)")
     parser.add_argument("--seed", type=int, default=SEED, help="places the objects, draws the random events")
-    parser.add_argument("--horizon", type=float, default=HORIZON, help="simulated seconds allowed")
+    parser.add_argument("--horizon", type=float, default=900.0, help="simulated seconds allowed")
     parser.add_argument("--log", type=Path, help="write the event log (JSON lines) here")
     parser.add_argument("-o", "--output", type=Path, help="PNG picture of the hunt and of its final state")
     args = parser.parse_args(argv)
     try:
         if args.output is not None and args.output.suffix.lower() != ".png":
             raise RunError(f"-o {args.output}: the file name must end in .png")
+        goal = f"!(COLLECT-OBJECTS {args.wanted})"
+        generated = HERE.parent.parent / "generated"
+        robot = load_robot(generated, HERE, ensure_compiled(HERE, generated).robot)
+        hunt = dataclasses.replace(robot.mission("hunt"), goals=(goal,))
         with EventLog(args.log) as log:
-            result = run_hunt(args.seed, args.wanted, args.horizon, log)
+            result = run_mission(robot, hunt, args.seed, horizon=args.horizon, log=log)
     except RunError as error:
         print(f"run_supervisor.py: error: {error}", file=sys.stderr)
         return 2
-    goal = f"!(COLLECT-OBJECTS {args.wanted})"
+    from hilare_codels.hunt import arm_motion_overlaps, detection_interruptions, objects  # on sys.path now
+
+    seen = objects(result.events)
     print(f"posted {goal} (seed {args.seed}); the executive's replies and warnings "
           "(routine modelling replies only counted):")
     retrieved = taken = 0
@@ -88,8 +92,8 @@ def main(argv: list[str] | None = None) -> int:
           f"travelled; {requests} executive requests, {sum(result.replies.values())} replies, {warnings} warnings")
     print("replies: " + ", ".join(f"{name} x{count}" for name, count in result.replies.items()))
     print(f"database: {facts.get('OBJ-FOUND', '(OBJ-FOUND -)')} {facts.get('EXECUTION', '(EXECUTION -)')}")
-    print(f"objects taken: {result.objects_taken} of {args.wanted} wanted ({retrieved} retrieved, "
-          f"{sum(1 for o in result.objects if o.detected_at is not None)} of {len(result.objects)} seen)")
+    print(f"objects taken: {taken} of {args.wanted} wanted ({retrieved} retrieved, "
+          f"{sum(1 for o in seen if o.detected_at is not None)} of {len(seen)} seen)")
     report = detection_interruptions(result.events)
     overlaps = arm_motion_overlaps(result.events)
     print(f"§5.5: {len(report.interruptions)} exploration move(s) interrupted by the take-object cycle, "
@@ -97,11 +101,11 @@ def main(argv: list[str] | None = None) -> int:
           f"{len(overlaps)} time(s)")
     if args.output is not None:
         try:
-            print(f"wrote {draw_hunt(result, args.output)}")
+            print(f"wrote {draw_map(result.events, args.output)}")
         except RunError as error:
             print(f"run_supervisor.py: error: {error}", file=sys.stderr)
             return 1
-    return 0 if result.success else 1
+    return 0 if result.outcome == "succeeded" else 1
 
 
 if __name__ == "__main__":

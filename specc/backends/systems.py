@@ -6,12 +6,14 @@ from __future__ import annotations
 import posixpath
 from dataclasses import dataclass
 
+from specc.analysis.ftplan import terms
 from specc.backends.env import render
 from specc.backends.manifest import HEADER, Output
 from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
-from specc.runtime.system import MissionSpec
+from specc.runtime.ftplan.config import Var
+from specc.runtime.system import BindingSpec, MissionSpec
 from specc.syntax.printer import goal as goal_text
 from specc.syntax.printer import prop_value
 
@@ -54,15 +56,20 @@ class SystemView:
 
     @property
     def body(self) -> str:
-        values = {s.name: s.value.value for s in self.system.body or () if isinstance(s.value, m.Number)}
+        entries = self.system.body.entries if self.system.body is not None else ()
+        values = {s.name: s.value.value for s in entries if isinstance(s.value, m.Number)}
         return f"RobotConfig.from_spec({self.name!r}, {values!r})"
+
+    @property
+    def worlds_declared(self) -> tuple[m.Setting, ...]:
+        return self.system.worlds.entries if self.system.worlds is not None else ()
 
     @property
     def worlds(self) -> list[tuple[str, str]]:
         """(name, path relative to the robot's folder), each as a Python literal."""
         here = posixpath.dirname(self.system.span.file) or "."
         shown = []
-        for entry in self.system.worlds:
+        for entry in self.worlds_declared:
             written = prop_value(entry.value) if not isinstance(entry.value, m.String) else entry.value.value
             path = posixpath.relpath(posixpath.normpath(posixpath.join(here, written)), self.root)
             shown.append((repr(entry.name), repr(path)))
@@ -70,14 +77,25 @@ class SystemView:
 
     @property
     def missions(self) -> list[tuple[str, str]]:
-        only_world = self.system.worlds[0].name if len(self.system.worlds) == 1 else ""
+        worlds = self.worlds_declared
+        only_world = worlds[0].name if len(worlds) == 1 else ""
         shown = []
         for mission in self.system.missions:
             spec = MissionSpec(mission.name, mission.world.text if mission.world is not None else only_world,
                                tuple(goal_text(g) for g in mission.goals),
-                               mission.horizon.seconds if mission.horizon is not None else None)
+                               mission.horizon.seconds if mission.horizon is not None else None,
+                               mission.plan.text if mission.plan is not None else None)
             shown.append((repr(mission.name), literal(spec, (), 8, len(repr(mission.name)) + 2)))
         return shown
+
+
+    @property
+    def bindings(self) -> list[tuple[str, str]]:
+        """(task, BindingSpec), each as a Python literal."""
+        entries = self.system.bindings.entries if self.system.bindings is not None else ()
+        return [(repr(b.task), literal(BindingSpec(b.task, terms(b.args), b.kind, b.target.text,
+                                                   terms(b.target_args)), (Var,), 8, len(repr(b.task)) + 2))
+                for b in entries]
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> None:

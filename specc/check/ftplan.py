@@ -178,6 +178,16 @@ def check_bound(ctx: Context, binding: tuple[m.IxExpr, ...], used: tuple[m.IxExp
                        f"arguments, or write a constant", expr.span)
 
 
+def planned_tasks(ctx: Context, ftplan: m.FtPlan) -> DomainTables:
+    """Every task the planners of `ftplan` may put in a plan (their domains', includes expanded)."""
+    found = DomainTables()
+    for planner in ftplan.planners:
+        domain = ctx.named(m.Domain).get(planner.domain.text) if planner.domain is not None else None
+        if domain is not None:
+            found.tasks.update(tables(_quiet(ctx), domain.members).tasks)
+    return found
+
+
 def _quiet(ctx: Context) -> Context:
     """A context whose reports go nowhere: the domains are checked on their own already."""
     return Context(ctx.program, ctx.base_dirs)

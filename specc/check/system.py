@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from specc.check.codels import python_functions
 from specc.check.context import Context
+from specc.check.executive import resolve_request
+from specc.check.ftplan import check_bound, check_task, check_terms, planned_tasks
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
@@ -33,6 +35,7 @@ def check(ctx: Context) -> None:
         check_missions(ctx, system, worlds)
         executive = ctx.named(m.Executive).get(system.executive.text) if system.executive else None
         supervisor = ctx.named(m.Procedures).get(system.supervisor.text) if system.supervisor else None
+        check_planning(ctx, system, supervisor, executive)
         if supervisor is not None and (executive is not None or system.executive is None):
             check_service_actions(ctx, supervisor, [executive] if executive is not None else [],
                                   f"system '{system.name}' has no executive: give it 'executive: NAME;'")
@@ -69,8 +72,9 @@ def check_blocks(ctx: Context, system: m.System) -> None:
 
 
 def check_body(ctx: Context, system: m.System) -> None:
-    ctx.duplicates(system.body or (), "body key")
-    for entry in system.body or ():
+    body = system.body.entries if system.body is not None else ()
+    ctx.duplicates(body, "body key")
+    for entry in body:
         if entry.name not in BODY_KEYS:
             ctx.report("unknown-property", f"a body has no key '{entry.name}'{did_you_mean(entry.name, BODY_KEYS)}; "
                        f"known: {', '.join(BODY_KEYS)}", entry.span)
@@ -87,9 +91,10 @@ def check_body(ctx: Context, system: m.System) -> None:
 
 def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
     """The system's worlds by name; each a TOML world file the simulator can load."""
-    ctx.duplicates(system.worlds, "world")
+    entries = system.worlds.entries if system.worlds is not None else ()
+    ctx.duplicates(entries, "world")
     worlds: dict[str, m.Setting] = {}
-    for entry in system.worlds:
+    for entry in entries:
         worlds.setdefault(entry.name, entry)
         if not isinstance(entry.value, m.String):
             ctx.report("bad-property-value", f"world '{entry.name}' is a world file: give its path in quotes, "
@@ -121,15 +126,83 @@ def check_missions(ctx: Context, system: m.System, worlds: dict[str, m.Setting])
                        f"has {len(worlds)} worlds{': ' + ', '.join(worlds) if worlds else ''})", mission.span)
         if mission.horizon is not None and mission.horizon.seconds <= 0:
             ctx.report("bad-duration", "a mission's horizon must be longer than zero", mission.horizon.span)
-        if not mission.goals:
-            ctx.report("missing-property", f"mission '{mission.name}' asks nothing: give it 'goal: !(...);'",
-                       mission.span)
+        if not mission.goals and mission.plan is None:
+            ctx.report("missing-property", f"mission '{mission.name}' asks nothing: give it 'goal: !(...);' or "
+                       "'plan: <mission of the ftplan block>;'", mission.span)
         for goal in mission.goals:
             if system.supervisor is None:
                 ctx.report("goal-without-supervisor", f"mission '{mission.name}' posts a goal, but system "
                            f"'{system.name}' has no supervisor to achieve it: give it 'supervisor: NAME;'", goal.span)
             elif supervisor is not None:
                 check_mission_goal(ctx, goal, goals, supervisor.name)
+
+
+def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | None,
+                   executive: m.Executive | None) -> None:
+    """Missions FTplan plans name the ftplan block's missions; every task its planners may put in a
+    plan is bound to a goal, a service or a request that takes its arguments."""
+    ftplan = ctx.named(m.FtPlan).get(system.planning.text) if system.planning is not None else None
+    bindings = system.bindings.entries if system.bindings is not None else ()
+    for mission in system.missions:
+        if mission.plan is None:
+            continue
+        if system.planning is None:
+            ctx.report("missing-property", f"mission '{mission.name}' is planned, but system '{system.name}' has "
+                       "no planning: give it 'planning: <ftplan block>;'", mission.plan.span)
+        elif ftplan is not None and mission.plan.text not in {m_.name for m_ in ftplan.missions}:
+            ctx.unknown("undefined-mission", "mission", mission.plan.text, {m_.name for m_ in ftplan.missions},
+                        mission.plan.span, f" of ftplan '{ftplan.name}'")
+    if system.planning is None:
+        for binding in bindings[:1]:
+            ctx.report("missing-property", f"system '{system.name}' binds tasks but plans nothing: give it "
+                       "'planning: <ftplan block>;'", binding.span)
+        return
+    if ftplan is None:
+        return
+    ctx.duplicates(bindings, "binding of task", key="task")
+    tasks = planned_tasks(ctx, ftplan)
+    bound = {b.task for b in bindings}
+    for task in tasks.tasks.values():
+        if task.name not in bound:
+            ctx.report("missing-binding", f"task '{task.name}' of the planners' domains has no binding: say how it "
+                       f"is carried out in system '{system.name}''s 'bindings {{ {task.name}(...) => goal "
+                       "G(...); }'", (system.bindings or system).span)
+    goals = achievable_goals(supervisor) if supervisor is not None else {}
+    services = {s.name: s for s in executive.services} if executive is not None else {}
+    for binding in bindings:
+        check_task(ctx, tasks, binding.task, binding.span, binding.args)
+        check_terms(ctx, (*binding.args, *binding.target_args))
+        check_bound(ctx, binding.args, binding.target_args, f"task '{binding.task}'")
+        check_binding_target(ctx, system, binding, goals, services)
+
+
+def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goals: dict[str, int],
+                         services: dict[str, m.Service]) -> None:
+    target, given = binding.target, len(binding.target_args)
+    if binding.kind == "goal":
+        if system.supervisor is None:
+            ctx.report("goal-without-supervisor", f"task '{binding.task}' is carried out as a goal, but system "
+                       f"'{system.name}' has no supervisor: give it 'supervisor: NAME;'", target.span)
+        elif target.text not in goals:
+            ctx.unknown("undefined-goal", "goal", target.text, goals, target.span, " (no KA is invoked by it)")
+        elif goals[target.text] != given:
+            ctx.report("arity-mismatch", f"'{target.text}' takes {goals[target.text]} argument(s), {given} given",
+                       target.span)
+    elif binding.kind == "service":
+        service = services.get(target.text)
+        if system.executive is None:
+            ctx.report("undefined-service", f"task '{binding.task}' is carried out by a service, but system "
+                       f"'{system.name}' has no executive: give it 'executive: NAME;'", target.span)
+        elif service is None:
+            ctx.unknown("undefined-service", "service", target.text, services, target.span)
+        elif len(service.takes) != given:
+            ctx.report("arity-mismatch", f"service '{service.name}' takes {len(service.takes)} input(s) "
+                       f"({', '.join(t.text for t in service.takes) or 'none'}), {given} given", target.span)
+    else:
+        request = resolve_request(ctx, target)
+        if request is not None and len(request.inputs) != given:
+            ctx.report("arity-mismatch", f"request '{target.text}' takes {len(request.inputs)} input(s) "
+                       f"({', '.join(i.name for i in request.inputs) or 'none'}), {given} given", target.span)
 
 
 def achievable_goals(procedures: m.Procedures) -> dict[str, int]:

@@ -934,12 +934,37 @@ class Setting(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class Settings(Node):
+    """A system's `body { }` or `worlds { }` section."""
+
+    entries: tuple[Setting, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Binding(Node):
+    """`TASK(?a, ?b) => goal G(?a);`: how a planning task is carried out (kind: goal, service or
+    request), with the target's arguments made from the task's."""
+
+    task: str
+    args: tuple[IxExpr, ...] = ()
+    kind: str  # goal | service | request
+    target: Ref
+    target_args: tuple[IxExpr, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class Bindings(Node):
+    entries: tuple[Binding, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
 class SystemMission(Node):
     """A mission of the robot: the goals its supervisor is given, in one of its worlds."""
 
     name: str
     world: Ref | None = prop("world", "ref", doc="one of the system's worlds (default: its only one)")
     horizon: Duration | None = prop("horizon", "duration", doc="simulated time after which the run stops")
+    plan: Ref | None = prop("plan", "ref", doc="the mission of the system's ftplan block that FTplan plans")
     doc: String | None = prop("doc", "string")
     goals: tuple[Goal, ...] = ()  # `goal: !(...);`, posted together at the start
 
@@ -954,9 +979,10 @@ class System(Node):
     extension: String | None = prop("extension", "string", doc="Python module beside the codels with the "
                                     "robot's own run hooks (world draws, observers, measures)")
     doc: String | None = prop("doc", "string")
-    body: tuple[Setting, ...] | None = None  # `body { radius: 0.3; ... }` (specc.runtime.body)
-    worlds: tuple[Setting, ...] = ()  # `worlds { room: "worlds/room.toml"; }`, relative to the spec
+    body: Settings | None = None  # `body { radius: 0.3; ... }` (specc.runtime.body)
+    worlds: Settings | None = None  # `worlds { room: "worlds/room.toml"; }`, relative to the spec
     missions: tuple[SystemMission, ...] = ()
+    bindings: Bindings | None = None  # how the planners' tasks are carried out
 
 
 Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment, FtPlan, System]

@@ -1,8 +1,8 @@
 """Running a compiled robot end to end, on the simulated kernel (issue #9, `specc run`).
 
 - `specc.run.events`: the JSONL event log every run writes, stamped with simulated time.
-- `specc.run.hunt`: Hilare's object hunt of seed 000 ch. 5 (`run_hunt`); `specc.run.hunt_log`:
-  the §5.5 checks read from its log.
+- `specc.run.mission`: any robot's mission, from its system block (`load_robot`, `run_mission`),
+  with the robot's own extension hooks.
 - `specc.run.rover`: the rover missions of seed 004 on the simulated ATRV (`run_rover_mission`);
   `specc.run.rover_tasks`: their planning models' tasks by kind.
 - `specc.run.measures`: the measures of seed 004 §4.1.4 and their tables.

@@ -14,24 +14,30 @@ know):
 
 | kind | when | fields |
 | --- | --- | --- |
-| `mission-start` | the run begins | what the run was asked (`seed`, `goal`, ...), `world`, `world_data` (*) |
+| `mission-start` | the run begins | what was asked (`seed`, `goals`, ...), `body`, `objects`, `world_data` (*) |
 | `goal` | a goal is posted to the supervisor, and when it ends | `goal`, `status` (posted, succeeded, failed) |
-| `request` | the task level asks the executive for a service (RQST EXEC, §3.9) | `service`, `id` |
+| `request` | the task level asks the executive for a service (RQST EXEC, §3.9) | `service`, `id`, `request` |
 | `activity` | an executive activity changes phase (Fig 3.3; WAIT→INIT is its start) | `service`, `id`, `from`, `to` |
 | `reply` | the executive answers `(REPLY id result)` | `service`, `id`, `result`, `detail` |
 | `warning` | the executive sends `(WARNING service id type)` | `service`, `id`, `type`, `detail` |
 | `fact` | a fact of the supervisor's database is concluded or retracted | `fact`, `change` |
 | `operator` | a procedure tells the operator something (WARN-OPERATOR) | `text` |
 | `robot-motion` | the robot starts or stops moving (true motion, from the simulator) | `moving`, `x`, `y`, `theta` |
-| `arm-motion` | the arm starts or stops moving | `moving`, `service` (the arm service driving it) |
-| `object-detected` | the camera sees an object for the first time | `object`, `x`, `y` |
-| `object-retrieved` | GET-NEAR-OBJ hands an object over | `object`, `x`, `y` (null: none there), `seen_x`, `seen_y` |
-| `object-taken` | a take cycle ends with the object on the robot | `object`, `x`, `y`, `taken` |
+| `arm-motion` | the arm starts or stops moving | `moving`, `service` (the service whose codel moved it) |
 | `pose` | every 0.5 s of simulated time | `x`, `y`, `theta`: the robot's true pose |
-| `trajectory` | a trajectory is planned (CALC-TRAJ-GOAL, CALC-TRAJ-OBJ) | `service`, `points` ([x, y] ...) |
-| `model` | the hunt ends: EXPLOR's model (Fig 5.11) | `goal` ([x, y] or null), `certainty` (**) |
-| `alarm` | trouble the procedures miss (robot blocked, executive ERROR, empty take, ...) | `what`, `detail` |
+| `alarm` | trouble the procedures miss (robot blocked, executive ERROR, a codel that raised...) | `what`, `detail` |
 | `mission-end` | the run ends | `outcome` (succeeded, failed, horizon), `why`, and the run's figures |
+
+A robot's extension (`specc.run.mission`) may log kinds of its own; these are drawn on the map:
+
+| kind | what | fields |
+| --- | --- | --- |
+| `object-detected` | a sensor sees one of mission-start's `objects` for the first time | `object`, `x`, `y` |
+| `object-retrieved` | the robot goes for an object | `object`, `x`, `y` (null: none there), ... |
+| `object-taken` | the object is on the robot | `object`, `x`, `y`, `taken` |
+| `trajectory` | a trajectory is planned | `service`, `points` ([x, y] ...) |
+| `model` | a model with certainty cells (Hilare's EXPLOR, Fig 5.11) | `goal` ([x, y] or null), `certainty` (**) |
+| `mark` | something worth a marker on the path | `label`, `at` (a time of the run) |
 
 (*) the world whole, as `specc.runtime.sim.parse_world` reads it, so a log can be redrawn alone.
 (**) `cell`, `nx`, `ny` and `values`, the certainty per cell row by row from (0, 0).

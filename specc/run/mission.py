@@ -48,6 +48,7 @@ from typing import Any, NamedTuple
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_robot
+from specc.run.plans import BoundExecutor, FtplanJournal
 from specc.run.recording import PoseRecorder, world_fields
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
@@ -151,7 +152,7 @@ class RunContext:
     registry: rt.Registry
     executive: rx.Executive | None
     supervisor: Any  # specc.runtime.supervisor.Supervisor, or None
-    log: EventLog
+    log: FtplanJournal  # `log.events`: what the run logged so far
     ending: list[Callable[[], None]] = dataclasses.field(default_factory=list)
 
     @property
@@ -202,9 +203,22 @@ class MissionRun:
         return "\n".join(lines)
 
 
-def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: int, horizon: float | None) -> Path:
+@dataclass(frozen=True)
+class CheckedMission:
+    world: Path  # the world file
+    planning: Any = None  # specc.runtime.ftplan.MissionSetup when FTplan plans the mission
+
+
+TIMINGS = ("model", "wall")  # FtPlan's: a deterministic planning charge, or the measured wall time
+
+
+def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: int, horizon: float | None,
+                  configuration: str | None = None, timing: str = "model") -> CheckedMission:
     """Check what a run is asked before anything is built: the world file (the mission's unless
-    `world` names another), the seed and the horizon; RunError when one is wrong."""
+    `world` names another), the seed, the horizon, and for a planned mission FTplan's
+    configuration (default: every planner, in the block's policy); RunError when one is wrong."""
+    from specc.runtime.ftplan import UnknownName, mission_setup
+
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise RunError(f"seed {seed!r}: give a whole number >= 0")
     if horizon is not None and (not math.isfinite(horizon) or horizon <= 0):
@@ -212,18 +226,45 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
     if mission.goals and robot.system.supervisor is None:
         raise RunError(f"mission {mission.name} posts goals, but robot '{robot.name}' has no supervisor "
                        "(give its system 'supervisor: NAME;')")
-    return robot.world_file(world or mission.world)
+    if timing not in TIMINGS:
+        raise RunError(f"timing '{timing}': give {' or '.join(TIMINGS)}")
+    world_file = robot.world_file(world or mission.world)
+    if mission.plan is None:
+        if configuration is not None:
+            raise RunError(f"--config: mission {mission.name} of robot '{robot.name}' is not planned (a "
+                           "configuration is FTplan's)")
+        return CheckedMission(world_file)
+    block = robot.part("ftplan").FTPLANS[robot.system.planning]
+    try:
+        setup = mission_setup(block.CONFIGURATIONS, configuration or default_configuration(block), mission.plan,
+                              robot.part("planner"))
+    except UnknownName as error:
+        raise RunError(str(error)) from None
+    return CheckedMission(world_file, setup)
+
+
+def default_configuration(block: ModuleType) -> str:
+    """The configuration of a generated ftplan module that is its block as written: every planner,
+    in the block's order and policy."""
+    whole = block.CONFIG
+    return next((name for name, config in block.CONFIGURATIONS.items()
+                 if config.planners == whole.planners and config.policy == whole.policy), next(iter(
+                     block.CONFIGURATIONS)))
 
 
 def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str | None = None,
                 horizon: float | None = None, log: EventLog | None = None,
-                progress: Callable[[MissionProgress], None] | None = None) -> MissionRun:
+                progress: Callable[[MissionProgress], None] | None = None, configuration: str | None = None,
+                timing: str = "model") -> MissionRun:
     """Run `mission` on `robot` (see the module's docstring), in `world` (a name of the system's
     worlds or a world file) instead of the mission's when given, for `horizon` seconds of
-    simulated time instead of the mission's. Bad arguments raise RunError before anything runs."""
+    simulated time instead of the mission's; a planned mission with FTplan's `configuration`
+    (Robot1, Robot1/2...) and planning charge `timing`. Bad arguments raise RunError before
+    anything runs."""
     from specc.runtime.sim import Simulation, WorldError, load_world
 
-    world_path = check_mission(robot, mission, world, seed, horizon)
+    checked = check_mission(robot, mission, world, seed, horizon, configuration, timing)
+    world_path = checked.world
     limit = horizon if horizon is not None else mission.horizon if mission.horizon is not None else DEFAULT_HORIZON
     try:
         ground = load_world(world_path)
@@ -231,8 +272,13 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         raise RunError(str(error)) from None
     prepare = robot.hook("prepare")
     if prepare is not None:  # the robot's own random draws (where its objects lie...)
-        ground = prepare(ground, seed)
-    log = log if log is not None else EventLog()
+        try:
+            ground = prepare(ground, seed)
+        except WorldError as error:  # what the world asks cannot be drawn
+            raise RunError(str(error)) from None
+    events = log if log is not None else EventLog()
+    # Everything is logged through the journal, so that FTplan's own events come in time order.
+    journal = FtplanJournal(events)
     system = robot.system
     started = time.perf_counter()
     with contextlib.chdir(robot.folder):
@@ -245,15 +291,20 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         robot.part("modules").create_all(registry)
         executive = robot.part("executive").EXECUTIVES[system.executive].create(
             registry, world=str(world_path.resolve())) if system.executive else None
-        recorder = Recorder(log, sim, registry, executive, limit, len(mission.goals), progress)
+        recorder = Recorder(journal, sim, registry, executive, limit, len(mission.goals) + bool(mission.plan),
+                            progress)
         supervisor = robot.part("supervisor").LIBRARIES[system.supervisor].create(
             kernel=kernel, executive=executive, seed=seed, log=recorder.operator) if system.supervisor else None
         if supervisor is not None:
             recorder.watch_facts(supervisor.database)
-        log.emit(kernel.now, "mission-start", robot=robot.name, mission=mission.name, seed=seed,
-                 goals=list(mission.goals), horizon=limit, body=dataclasses.asdict(system.body),
-                 **world_fields(ground))
-        context = RunContext(robot, mission, seed, ground, sim, registry, executive, supervisor, log)
+        setup = checked.planning
+        planned = {"plan": mission.plan, "configuration": configuration or default_configuration(
+            robot.part("ftplan").FTPLANS[system.planning]), "timing": timing,
+                   "planners": [f"{p.name} ({p.domain})" for p in setup.config.planners]} if setup else {}
+        journal.emit(kernel.now, "mission-start", robot=robot.name, mission=mission.name, seed=seed,
+                     goals=list(mission.goals), horizon=limit, body=dataclasses.asdict(system.body),
+                     objects=[list(o) for o in sim.objects], **planned, **world_fields(ground))
+        context = RunContext(robot, mission, seed, ground, sim, registry, executive, supervisor, journal)
         attach = robot.hook("attach")
         if attach is not None:
             attach(context)
@@ -261,9 +312,10 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         for goal in mission.goals:
             assert supervisor is not None  # check_mission: goals need a supervisor
             intentions.append((goal, supervisor.post(goal)))
-            log.emit(kernel.now, "goal", goal=goal, status="posted")
-        recorder.start(lambda: sum(1 for _, i in intentions if i.status != "running"))
-        PoseRecorder(log.emit, sim).start()
+            journal.emit(kernel.now, "goal", goal=goal, status="posted")
+        planning: list[Any] = []  # FTplan's result, once it has run
+        recorder.start(lambda: sum(1 for _, i in intentions if i.status != "running") + len(planning))
+        PoseRecorder(journal.emit, sim).start()
         ended: set[str] = set()
 
         def running() -> bool:
@@ -271,26 +323,58 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
             for goal, intention in intentions:
                 if intention.status != "running" and goal not in ended:
                     ended.add(goal)
-                    log.emit(kernel.now, "goal", goal=goal, status=intention.status)
+                    journal.emit(kernel.now, "goal", goal=goal, status=intention.status)
             return any(i.status == "running" for _, i in intentions)
 
-        kernel.run_while(running, kernel.now + limit)
+        if setup is not None:
+            planning.append(_plan_and_execute(robot, setup, timing, journal, registry, executive, supervisor, sim))
+        kernel.run_while(running, max(kernel.now, limit))
         recorder.poll()
         for callback in context.ending:
             callback()
     statuses = tuple((goal, intention.status) for goal, intention in intentions)
-    outcome, why = _outcome(intentions, limit, log.events)
+    outcome, why = _outcome(intentions, limit, events.events)
+    planned_figures: dict[str, Any] = {}
+    if planning:
+        result = planning[0]
+        planned_figures = {"planned_goals_met": len(result.met), "planned_goals": len(result.met) + len(result.missed),
+                           "plannings": result.plannings, "replannings": result.replannings,
+                           "planner_failures": result.planner_failures}
+        if outcome == "succeeded" and (result.failure or result.missed):
+            outcome, why = "failed", result.failure or f"{len(result.missed)} planned goal(s) missed: " + "; ".join(
+                f"{goal}: {reason}" for goal, reason in result.missed.items())
+        elif outcome == "succeeded":
+            why = f"every goal achieved ({len(intentions)} posted, {len(result.met)} planned)"
     measure, judge = robot.hook("measure"), robot.hook("judge")
-    extension_measures = dict(measure(log.events)) if measure is not None else {}
+    extension_measures = dict(measure(events.events)) if measure is not None else {}
     if judge is not None:  # the robot's own success criteria, on top of its goals'
-        outcome, why = judge(log.events, extension_measures, outcome, why)
-    log.emit(kernel.now, "mission-end", outcome=outcome, why=why, goals=[list(s) for s in statuses],
-             distance=round(sim.rover.distance, 3), requests=recorder.requests, incidents=len(recorder.incidents))
+        outcome, why = judge(events.events, extension_measures, outcome, why)
+    journal.emit(kernel.now, "mission-end", outcome=outcome, why=why, goals=[list(s) for s in statuses],
+                 distance=round(sim.rover.distance, 3), requests=recorder.requests,
+                 incidents=len(recorder.incidents), **planned_figures)
     recorder.report(kernel.now)
     return MissionRun(robot.name, mission.name, ground.name, seed, outcome, why, statuses, kernel.now,
                       time.perf_counter() - started, sim.rover.distance, recorder.requests,
-                      dict(sorted(recorder.replies.items())), tuple(recorder.incidents), tuple(log.events),
-                      extension_measures)
+                      dict(sorted(recorder.replies.items())), tuple(recorder.incidents), tuple(events.events),
+                      {**planned_figures, **extension_measures})
+
+
+def _plan_and_execute(robot: Robot, setup: Any, timing: str, journal: FtplanJournal, registry: rt.Registry,
+                      executive: rx.Executive | None, supervisor: Any, sim: Any) -> Any:
+    """FTplan plans the mission with the configuration's planners, each in its own process, and
+    the system's bindings carry every plan out (`specc.run.plans`); FTplan's result."""
+    from specc.runtime.ftplan import HUNG_PLANNER_SECONDS, FtPlan, ProcessPool, planners_as_run
+
+    executor = BoundExecutor(registry.kernel, robot.system.bindings, registry, executive, supervisor, sim.rover,
+                             journal.emit)
+    with ProcessPool(planners_as_run(setup.config, timing), setup.domains) as pool:
+        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems,
+                        wall_limit=HUNG_PLANNER_SECONDS if timing == "model" else None)
+        journal.ftplan = ftplan
+        result = ftplan.run()
+    journal.catch_up()
+    executor.safe_state(result.now)  # nothing runs past the plan's end; the robot idles to its last instant
+    return result
 
 
 def _outcome(intentions: list[tuple[str, Any]], horizon: float,
@@ -324,7 +408,7 @@ class Recorder:
     """Writes what any robot's run does to the event log: the executive's requests, replies and
     activities, the supervisor's facts, the robot's and the arm's motion, incidents."""
 
-    def __init__(self, log: EventLog, sim: Any, registry: rt.Registry, executive: rx.Executive | None,
+    def __init__(self, log: FtplanJournal, sim: Any, registry: rt.Registry, executive: rx.Executive | None,
                  horizon: float, goals: int, progress: Callable[[MissionProgress], None] | None) -> None:
         self.log = log
         self.sim = sim
@@ -341,6 +425,7 @@ class Recorder:
         self._pose = sim.pose
         self._robot_moving = False
         self._arm_moving = False
+        self._arm_service: str | None = None
         self._blocked = False
         self._seen = {"registry": 0, "executive": 0}
         self._next_progress = self.kernel.now + PROGRESS_PERIOD
@@ -356,7 +441,8 @@ class Recorder:
         service = activity.service.name
         if source is rx.Phase.ETHER and target is rx.Phase.WAIT:
             self.requests += 1
-            self.log.emit(self.kernel.now, "request", service=service, id=activity.id)
+            self.log.emit(self.kernel.now, "request", service=service, id=activity.id,
+                          request=f"{activity.service.module}.{activity.service.request}")
         else:
             self.log.emit(self.kernel.now, "activity", service=service, id=activity.id, **{"from": source.value},
                           to=target.value)
@@ -425,7 +511,9 @@ class Recorder:
         arm = self.sim.arm
         if arm is not None and arm.moving != self._arm_moving:
             self._arm_moving = arm.moving
-            self.log.emit(now, "arm-motion", moving=arm.moving)
+            if arm.moving:
+                self._arm_service = self._service_of(arm.moved_by)
+            self.log.emit(now, "arm-motion", moving=arm.moving, service=self._arm_service)
         if self.sim.trace.blocked_at is not None and not self._blocked:
             self._blocked = True
             self.log.emit(now, "alarm", what="blocked", detail=f"the robot is blocked at ({x:.2f}, {y:.2f})")
@@ -433,6 +521,17 @@ class Recorder:
         if now >= self._next_progress:
             self._next_progress += PROGRESS_PERIOD
             self.report(now)
+
+    def _service_of(self, activity: Any) -> str | None:
+        """The executive service whose module request is `activity` (a module's activity), else
+        the request as module.request; None when nothing commanded."""
+        if activity is None:
+            return None
+        module, request = activity.module.name, activity.spec.name
+        for running in (self.executive.activities.values() if self.executive is not None else ()):
+            if running.module_id == activity.id and running.service.module == module:
+                return str(running.service.name)
+        return f"{module}.{request}"
 
     def _check_incidents(self) -> None:
         """A permanent codel, a listener or an observer that raised: the robot keeps going and

@@ -218,6 +218,9 @@ def import_robot(generated: Path, folder: Path, robot: str) -> ModuleType:
         raise RunError(f"{generated}/{robot}: the compiled package is incomplete or stale ({error}); "
                        f"run `specc compile {folder} -o {generated}` again") from None
     for codels in _codel_packages(root):
+        if not ((folder / codels / "__init__.py").is_file() or (folder / f"{codels}.py").is_file()):
+            raise RunError(f"{folder}: no {codels}/ with the codels robot '{robot}' names here: give the robot's "
+                           "folder (the one holding its specs and codels)")
         forget_unless_from(codels, folder)
     return root
 

@@ -1,19 +1,13 @@
-"""Pictures of Hilare's hunt (matplotlib's Agg backend: no display needed), drawn from its event
-log: a `Scene` that `specc.run.render.hunt_scene` reads from the events alone.
+"""Pictures of a run's state (matplotlib's Agg backend: no display needed), drawn from its event
+log: a `Scene` that `specc.run.render.scene_of` reads from the events alone.
 
 - `draw_state(ax, scene)`: the state of the system at the end, as the interface of seed 000 §5.6
   shows it (Fig 5.11): the robot, the obstacles, the objects not detected, detected and not yet
   retrieved, and retrieved, the cell of the best observation position, the last planned
   trajectory, and the model's cells by certainty (below 1/3, between 1/3 and 2/3, above 2/3);
-- `write_state(scene, path, title)`: that state alone (a run folder's state.png);
-- `write_hunt(scene, path, title)`: side by side, the hunt's map (the room, the certainty cells,
-  the planned trajectories, the robot's true path from start to end, the objects by what became
-  of them, numbered in the order taken, and where the detection of an object interrupted an
-  exploration move, §5.5) and the state of Fig 5.11 (`specc.run.hunt.draw_hunt` draws it from a
-  result's events, as `specc replay` draws them).
+- `write_state(scene, path, title)`: that state alone (a run folder's state.png).
 
-It draws scenes and reads no log itself: `specc.run.render` and `specc.run.hunt` import it, never
-the other way round.
+It draws scenes and reads no log itself: `specc.run.render` imports it, never the other way round.
 """
 
 from __future__ import annotations
@@ -29,7 +23,6 @@ from specc.runtime.sim.render import (
     draw_certainty,
     draw_last_planned,
     draw_objects,
-    draw_scene,
     draw_world,
     pyplot,
 )
@@ -38,22 +31,6 @@ from specc.runtime.sim.render import (
 STATE_OF_FIG_5_11 = {"taken": "retrieved", "retrieved": "retrieved", "detected": "detected",
                      "undetected": "undetected"}
 STATE_LABELS = {"detected": "detected, not retrieved"}
-
-
-def write_hunt(scene: Scene, path: str | Path, title: str) -> Path:
-    """The hunt's map and its final state, side by side."""
-    plt = pyplot()
-    figure, (hunt, state) = plt.subplots(1, 2, figsize=(16.0, 5.8), dpi=110)
-    try:
-        draw_scene(hunt, scene)
-        hunt.set_title("The hunt: path, objects, model, planned trajectories", fontsize=10)
-        draw_state(state, scene)
-        for ax in (hunt, state):
-            ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.12), ncol=3, fontsize=7, framealpha=0.9)
-        figure.suptitle(title, fontsize=10)
-        return save(figure, path)
-    finally:
-        plt.close(figure)
 
 
 def write_state(scene: Scene, path: str | Path, title: str) -> Path:

@@ -3,31 +3,30 @@ the run's folder, `specc replay RUN` draws them again from the run's JSONL log).
 
     render_run(read_events("runs/m1w1/events.jsonl"), Path("runs/m1w1"))   # [map.png, timeline.png]
 
-The `mission-start` event says what the run was, and so which pictures it gets:
+What the log holds decides which pictures a run gets, whatever the robot:
 
-- a rover mission of seed 004 (`robot` atrv, `specc.run.rover`):
-  - map.png: the world, the robot's path from start to end, the mission's photo targets (green
-    once a photo of them succeeded), where photos were taken, where actions failed, and the
-    visibility windows on a time strip with the communications and photos done;
-  - timeline.png: a Gantt chart, one row per kind of task, each executed action a bar from its
-    start to its end coloured by outcome inside the hollow bar of its planned bound (start to
-    `latest_end`); the visibility windows; FTplan's events (plan requests, plans, invalid plans,
-    watchdogs, failures, safe states...) as markers, and the plans' starts and planner switches
-    as vertical lines.
-- Hilare's object hunt of seed 000 ch. 5 (`robot` hilare, `mission` hunt, `specc.run.hunt`):
-  - map.png: the room, EXPLOR's certainty cells, the planned trajectories, the path, the objects
-    by what became of them (numbered in the order taken), the last observation goal, and where a
-    detection interrupted an exploration move (§5.5);
-  - timeline.png: one row per executive service, each activity a bar from its start (WAIT to
-    INIT) to its end coloured by its reply (its wait for the controller thinner before it); the
-    robot's and the arm's motion; detections, objects taken, alarms;
-  - state.png: the state at the end as the interface of §5.6 shows it (Fig 5.11,
-    `specc.run.pictures`).
+- map.png: the world, the robot's path from start to end (its footprint from mission-start's
+  `body`), the world's objects by what became of them (`object-detected`, `object-retrieved`,
+  `object-taken`, numbered in the order taken), the photo targets (green once a `photo` of them
+  succeeded), where photos were taken, the planned `trajectory`s, the last `model` (its
+  certainty cells and observation goal), `mark`s (an extension's: a label at a time on the
+  path), where actions failed and where the robot was blocked, and the visibility windows on a
+  time strip with the `communication`s and photos done;
+- timeline.png: for a run that executed plans (`action` events), a Gantt chart, one row per
+  kind of task, each executed action a bar from its start to its end coloured by outcome inside
+  the hollow bar of its planned bound (start to `latest_end`); the visibility windows; FTplan's
+  events (plan requests, plans, invalid plans, watchdogs, failures, safe states...) as markers,
+  and the plans' starts and planner switches as vertical lines. Otherwise one row per executive
+  service, each activity a bar from its start (WAIT to INIT) to its end coloured by its reply
+  (its wait for the controller thinner before it); the robot's and the arm's motion; the
+  objects' events and the alarms;
+- state.png, when the log has a `model` with certainty cells: the state at the end as seed 000's
+  interface of §5.6 shows it (Fig 5.11, `specc.run.pictures`).
 
 The world comes whole in mission-start's `world_data`. A log cut short (a run that crashed or was
 interrupted has no `mission-end`) is drawn as far as it goes. The functions that read the log
-(`action_bars`, `service_bars`, `path_of`, `hunt_objects`, ...) draw nothing: tests and other
-tools can use them alone.
+(`action_bars`, `service_bars`, `path_of`, `logged_objects`, `motion_stretches`, ...) draw
+nothing: tests and other tools can use them alone.
 """
 
 from __future__ import annotations
@@ -42,10 +41,10 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from specc.run import RunError, pictures
-from specc.run.hunt_log import HuntObject, detection_interruptions, motion_stretches
 from specc.run.rover_tasks import TASK_KINDS, task_text
+from specc.runtime.body import RobotConfig
 from specc.runtime.planner.plan import Value, format_value
-from specc.runtime.sim import ROBOTS, Target, Window, World, WorldError, parse_world
+from specc.runtime.sim import Target, Window, World, WorldError, parse_world
 from specc.runtime.sim.render import (
     OBJECT_COLOURS,
     Certainty,
@@ -61,7 +60,6 @@ from specc.runtime.sim.render import (
 Events = Sequence[Mapping[str, Any]]
 
 MAP, TIMELINE, STATE = "map.png", "timeline.png", "state.png"
-ROVER, HUNT = "rover", "hunt"
 TITLE_WIDTH = 130  # characters of a title line before it wraps
 SHORTEST_AXIS = 1.0  # s: a timeline's time axis spans at least this (a log cut at its start)
 
@@ -126,23 +124,12 @@ def run_world(events: Events) -> World:
     return world
 
 
-def run_kind(events: Events) -> str:
-    """ROVER or HUNT, from what mission-start says the robot and the mission are."""
-    start = mission_start(events)
-    if start.get("robot") == "atrv":
-        return ROVER
-    if start.get("robot") == "hilare" or start.get("mission") == HUNT:
-        return HUNT
-    raise RunError(f"cannot draw a run of robot '{start.get('robot')}', mission '{start.get('mission')}': "
-                   "known are the ATRV's missions (robot atrv) and Hilare's hunt (robot hilare)")
-
-
 @dataclass(frozen=True)
 class RunInfo:
     """What a picture's title says of the run."""
 
     robot: str
-    configuration: str  # the rover's (Robot1...); "" for the hunt
+    configuration: str  # an FTplan configuration (Robot1...); "" for none
     mission: str
     world: str
     seed: Any
@@ -179,11 +166,50 @@ def path_of(events: Events) -> np.ndarray:
     return np.asarray(rows, dtype=float).reshape(-1, 4)
 
 
-def robot_of(events: Events) -> Any:
-    name = mission_start(events).get("robot")
-    if name not in ROBOTS:
-        raise RunError(f"the log's robot '{name}' is none the simulator knows ({', '.join(sorted(ROBOTS))})")
-    return ROBOTS[name]
+def robot_of(events: Events) -> RobotConfig:
+    """The robot's body, as mission-start carries it."""
+    start = mission_start(events)
+    body = start.get("body")
+    if not isinstance(body, Mapping):
+        raise RunError("the log's mission-start carries no body: the run was made by an older specc; run it again "
+                       "to draw it")
+    known = {f.name for f in dataclasses.fields(RobotConfig)}
+    try:
+        return RobotConfig(**{k: v for k, v in body.items() if k in known})
+    except TypeError as error:
+        raise RunError(f"the log's body cannot be read ({error})") from None
+
+
+class Span(NamedTuple):
+    """A stretch of motion: the service moving it ("" when none is known), from start to end."""
+
+    label: str
+    start: float
+    end: float
+
+
+def motion_stretches(events: Events, kind: str, services: Sequence[str] | None = None) -> list[Span]:
+    """Each stretch of `kind` events (`robot-motion`, `arm-motion`) from moving to still, for
+    `services` only when given; a stretch still open at the end of the log ends with its last
+    event."""
+    stretches: list[Span] = []
+    opened: tuple[str, float] | None = None
+    last = 0.0
+    for event in events:
+        last = event["t"]
+        if event["kind"] != kind:
+            continue
+        service = str(event.get("service") or "")
+        if event["moving"] and opened is None:
+            opened = (service, event["t"])
+        elif not event["moving"] and opened is not None:
+            stretches.append(Span(opened[0], opened[1], event["t"]))
+            opened = None
+    if opened is not None:
+        stretches.append(Span(opened[0], opened[1], last))
+    if services is None:
+        return stretches
+    return [s for s in stretches if s.label in services]
 
 
 # ---------------------------------------------------------------- the rover's log
@@ -277,25 +303,33 @@ def links_of(events: Events) -> tuple[Link, ...]:
                  for e in events if e.get("kind") == "communication")
 
 
-def rover_scene(events: Events) -> Scene:
-    """The map of a rover mission, from its log."""
-    start = mission_start(events)
-    world = run_world(events)
-    path = path_of(events)
-    targets = tuple(Target(str(n), float(x), float(y)) for n, x, y in start["targets"]) \
-        if start.get("targets") is not None else world.targets
-    failed = tuple(position_at(path, world, bar.end) for bar in action_bars(events) if bar.outcome == "failed")
-    return Scene(world, robot_of(events), path, objects=world.objects,
-                 object_states=("undetected",) * len(world.objects), targets=targets, shots=shots_of(events),
-                 marks=(Mark("action failed", failed),), links=links_of(events), now=last_time(events))
+# ---------------------------------------------------------------- the executive's, the objects', the model's
 
 
-# ---------------------------------------------------------------- the hunt's log
+@dataclass(frozen=True)
+class LoggedObject:
+    """One of the world's objects and what the log says became of it (times in simulated s)."""
+
+    index: int  # in mission-start's `objects` (the world's, with what the run drew)
+    x: float  # where it really is
+    y: float
+    detected_at: float | None = None  # `object-detected`: a sensor first saw it
+    retrieved_at: float | None = None  # `object-retrieved`: the robot went for it
+    taken_at: float | None = None  # `object-taken`: it is on the robot
+
+    @property
+    def state(self) -> str:
+        """taken, retrieved (not taken yet), detected, or undetected."""
+        if self.taken_at is not None:
+            return "taken"
+        if self.retrieved_at is not None:
+            return "retrieved"
+        return "detected" if self.detected_at is not None else "undetected"
 
 
-def hunt_objects(events: Events) -> tuple[HuntObject, ...]:
-    """The room's objects (mission-start's `objects`) and when each was detected, retrieved and
-    taken; a retrieval of nothing (VISUAL saw a ghost) is no object's."""
+def logged_objects(events: Events) -> tuple[LoggedObject, ...]:
+    """The world's objects (mission-start's `objects`, else the world's) and when each was
+    detected, retrieved and taken; a retrieval of no object (`object` null) is none's."""
     start = mission_start(events)
     placed = start.get("objects")
     if placed is None:
@@ -305,8 +339,9 @@ def hunt_objects(events: Events) -> tuple[HuntObject, ...]:
         seen = when.get(str(event.get("kind")))
         if seen is not None and event.get("object") is not None:
             seen.setdefault(int(event["object"]), float(event["t"]))
-    return tuple(HuntObject(k, float(x), float(y), when["object-detected"].get(k), when["object-retrieved"].get(k),
-                            when["object-taken"].get(k)) for k, (x, y) in enumerate(placed))
+    return tuple(LoggedObject(k, float(x), float(y), when["object-detected"].get(k),
+                              when["object-retrieved"].get(k), when["object-taken"].get(k))
+                 for k, (x, y) in enumerate(placed))
 
 
 def taken_order(events: Events) -> tuple[int, ...]:
@@ -362,9 +397,9 @@ def service_bars(events: Events) -> list[ServiceBar]:
     return bars
 
 
-def hunt_model(events: Events) -> tuple[Certainty | None, tuple[float, float] | None]:
-    """EXPLOR's model at the end (the `model` event): the certainty grid and the last
-    observation goal; nothing when the log ends before it."""
+def last_model(events: Events) -> tuple[Certainty | None, tuple[float, float] | None]:
+    """The last `model` event's certainty grid and observation goal (Hilare's EXPLOR writes one
+    at the end, Fig 5.11); nothing when the log has none."""
     model = next((e for e in reversed(events) if e.get("kind") == "model"), None)
     if model is None:
         return None, None
@@ -375,25 +410,38 @@ def hunt_model(events: Events) -> tuple[Certainty | None, tuple[float, float] | 
 
 
 def trajectories(events: Events) -> tuple[tuple[tuple[float, float], ...], ...]:
-    """The trajectories PLAN computed, in the order planned."""
+    """The `trajectory` events' points (the paths a planning module computed), in order."""
     return tuple(tuple((float(x), float(y)) for x, y in e["points"]) for e in events if e.get("kind") == "trajectory")
 
 
-def hunt_scene(events: Events) -> Scene:
-    """The map of the hunt, from its log."""
+def marks_of(events: Events, path: np.ndarray, world: World) -> tuple[Mark, ...]:
+    """Where things happened on the path: actions that failed, the robot blocked, and each
+    label of the `mark` events (an extension's: {label, at})."""
+    placed: dict[str, list[tuple[float, float]]] = {}
+    for bar in action_bars(events):
+        if bar.outcome == "failed":
+            placed.setdefault("action failed", []).append(position_at(path, world, bar.end))
+    for event in events:
+        if event.get("kind") == "mark":
+            placed.setdefault(str(event["label"]), []).append(position_at(path, world, float(event["at"])))
+        elif event.get("kind") == "alarm" and event.get("what") == "blocked":
+            placed.setdefault("blocked", []).append(position_at(path, world, float(event["t"])))
+    return tuple(Mark(label, tuple(points), "P" if label == "blocked" else "X") for label, points in placed.items())
+
+
+def scene_of(events: Events) -> Scene:
+    """The map of a run, from its log: whatever of it the log holds."""
+    start = mission_start(events)
     world = run_world(events)
     path = path_of(events)
-    objects = hunt_objects(events)
-    certainty, goal = hunt_model(events)
-    interrupted = tuple(position_at(path, world, i.interrupted_at)
-                        for i in detection_interruptions(events).interruptions)
-    blocked = tuple(position_at(path, world, float(e["t"])) for e in events
-                    if e.get("kind") == "alarm" and e.get("what") == "blocked")
+    objects = logged_objects(events)
+    certainty, goal = last_model(events)
+    targets = tuple(Target(str(n), float(x), float(y)) for n, x, y in start["targets"]) \
+        if start.get("targets") is not None else world.targets
     return Scene(world, robot_of(events), path, objects=tuple((o.x, o.y) for o in objects),
                  object_states=tuple(o.state for o in objects), taken_order=taken_order(events),
-                 planned=trajectories(events), certainty=certainty, goal=goal,
-                 marks=(Mark("exploration move interrupted", interrupted), Mark("blocked", blocked, "P")),
-                 now=last_time(events))
+                 targets=targets, shots=shots_of(events), links=links_of(events), planned=trajectories(events),
+                 certainty=certainty, goal=goal, marks=marks_of(events, path, world), now=last_time(events))
 
 
 # ---------------------------------------------------------------- the pictures
@@ -402,11 +450,10 @@ def hunt_scene(events: Events) -> Scene:
 def render_run(events: Events, folder: Path) -> list[Path]:
     """Draw the run's pictures into `folder` from its events alone; returns the files written.
     RunError (one line) when the log cannot be drawn."""
-    kind = run_kind(events)
     run_world(events)  # a log that cannot be drawn fails before any file is written
-    drawers: tuple[tuple[str, Callable[[Events, Path], Path]], ...] = (
-        (MAP, draw_map), (TIMELINE, draw_rover_timeline if kind == ROVER else draw_hunt_timeline))
-    if kind == HUNT:
+    robot_of(events)
+    drawers: tuple[tuple[str, Callable[[Events, Path], Path]], ...] = ((MAP, draw_map), (TIMELINE, draw_timeline))
+    if last_model(events)[0] is not None:
         drawers += ((STATE, draw_state),)
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -423,8 +470,7 @@ def render_run(events: Events, folder: Path) -> list[Path]:
 
 def draw_map(events: Events, path: str | Path) -> Path:
     """The run's map (see the module's docstring) as a PNG at `path`."""
-    scene = rover_scene(events) if run_kind(events) == ROVER else hunt_scene(events)
-    figure = map_figure(scene, run_info(events).title())
+    figure = map_figure(scene_of(events), run_info(events).title())
     try:
         return pictures.save(figure, path)
     finally:
@@ -432,12 +478,19 @@ def draw_map(events: Events, path: str | Path) -> Path:
 
 
 def draw_state(events: Events, path: str | Path) -> Path:
-    """The hunt's state at the end (Fig 5.11) as a PNG at `path`."""
-    return pictures.write_state(hunt_scene(events), path, run_info(events).title())
+    """The state at the end (Fig 5.11) as a PNG at `path`."""
+    return pictures.write_state(scene_of(events), path, run_info(events).title())
+
+
+def draw_timeline(events: Events, path: str | Path) -> Path:
+    """The plan's actions when the run executed plans, else the executive's services."""
+    if any(e.get("kind") == "action" for e in events):
+        return draw_rover_timeline(events, path)
+    return draw_service_timeline(events, path)
 
 
 def draw_rover_timeline(events: Events, path: str | Path) -> Path:
-    """The rover mission's Gantt chart (see the module's docstring) as a PNG at `path`."""
+    """The Gantt chart of the plans' actions (see the module's docstring) as a PNG at `path`."""
     bars = action_bars(events)
     kinds = list(dict.fromkeys(bar.kind for bar in bars))
     windows = run_world(events).windows
@@ -490,8 +543,9 @@ def draw_rover_timeline(events: Events, path: str | Path) -> Path:
         plt.close(figure)
 
 
-def draw_hunt_timeline(events: Events, path: str | Path) -> Path:
-    """The hunt's chart of services and motions (see the module's docstring) as a PNG at `path`."""
+def draw_service_timeline(events: Events, path: str | Path) -> Path:
+    """The chart of the executive's services and the motions (see the module's docstring) as a
+    PNG at `path`."""
     bars = service_bars(events)
     services = list(dict.fromkeys(bar.service for bar in bars))
     motions, objects, alarms = "robot motion", "objects", "alarms"

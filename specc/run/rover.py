@@ -65,6 +65,7 @@ import numpy as np
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
+from specc.run.plans import FtplanJournal
 from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
 from specc.run.render import draw_map
 from specc.run.rover_tasks import LINK, MOTION_INIT, MOVE, PAN_TILT, PHOTO, PTU_INIT, TASK_KINDS, task_text
@@ -733,34 +734,20 @@ def _reply_text(reply: rt.Reply) -> str:
 # ---------------------------------------------------------------- the run
 
 
-class _Journal:
+class _Journal(FtplanJournal):
     """The run's event log: FTplan's own events as they come (kind `ftplan`), then the
     executor's (actions, photos, communications), each at its mission time; and the progress."""
 
     def __init__(self, log: EventLog, progress: Callable[[RoverProgress], None] | None, goals: int) -> None:
-        self.log = log
+        super().__init__(log)
         self.progress = progress
         self.goals = goals
-        self.ftplan: FtPlan | None = None
-        self._forwarded = 0
 
-    def emit(self, time_: float, kind: str, **fields: Any) -> None:
-        self.catch_up(time_)
-        self.log.emit(time_, kind, **fields)
+    def emit(self, time_: float, kind: str, **fields: Any) -> dict[str, Any]:
+        event = super().emit(time_, kind, **fields)
         if kind == "action" and self.progress is not None:
             self.report_progress(time_, f"{fields.get('status')} {task_text(fields['task'], fields['args'])}")
-
-    def catch_up(self, until: float = math.inf) -> None:
-        """Forward FTplan's events up to `until`: FTplan notes a plan's execution at the end of
-        its planning time before the kernel (and its pose samples) has caught up with it."""
-        if self.ftplan is None:
-            return
-        events = self.ftplan.events
-        while self._forwarded < len(events) and events[self._forwarded].time <= until:
-            event = events[self._forwarded]
-            self.log.emit(event.time, "ftplan", event=event.kind, text=event.text,
-                          **({"planner": event.planner} if event.planner else {}))
-            self._forwarded += 1
+        return event
 
     def report_progress(self, time_: float, what: str) -> None:
         if self.progress is not None:
@@ -849,7 +836,8 @@ def run_rover_mission(configuration: str, mission: str, world: str | Path | Worl
     journal = _Journal(log, progress, len(SystemState.from_problem(setup.problem).goals))
     executor = SimExecutor(rover, prepared.tasks, journal.emit)
     started = time.perf_counter()
-    log.emit(rover.kernel.now, "mission-start", robot=ROBOT, configuration=configuration, mission=mission,
+    log.emit(rover.kernel.now, "mission-start", robot=ROBOT, body=dataclasses.asdict(ATRV),
+             configuration=configuration, mission=mission,
              **world_fields(prepared.world), seed=seed, timing=timing, policy=setup.config.policy,
              planners=[f"{p.name} ({p.domain})" for p in setup.config.planners],
              windows=[[w.name, w.start, w.end] for w in windows],

@@ -9,12 +9,12 @@ leave a run folder behind.
 The folder holds `events.jsonl` (the event log, written as the run goes, so a run that crashes
 keeps what it logged), `report.json` (the request, the outcome, the measures), `summary.txt`
 (the same for a person) and the pictures `specc.run.render` draws from the log alone (the map,
-the timeline; the state of Fig 5.11 for the hunt).
+the timeline; the state of Fig 5.11 when the log holds a model).
 
-Two kinds of mission run today, chosen by the robot the specs compile to:
-- `atrv`: the rover missions of seed 004 (M1..M4 in W1..W4, configurations Robot1, Robot2,
-  Robot1/2, Robot1/2c; `specc.run.rover`), measured as §4.1.4 says (`specc.run.measures`);
-- `hilare`: the object hunt of seed 000 ch. 5 (`specc.run.hunt`), mission `hunt` in its room.
+A robot runs the missions of its system block (`specc.run.mission`), or goals given with
+`--goal`. The rover of seed 004 still has its own runner until its system block says how its
+plans are carried out: `atrv` runs M1..M4 in W1..W4 with the configurations Robot1, Robot2,
+Robot1/2, Robot1/2c (`specc.run.rover`), measured as §4.1.4 says (`specc.run.measures`).
 """
 
 from __future__ import annotations
@@ -37,10 +37,8 @@ RUN_FILES = (LOG, REPORT, SUMMARY, "map.png", "timeline.png", "state.png")  # wh
 RUNS = Path("runs")  # where run folders go by default, under the working directory
 GENERATED = Path("generated")  # where the specs compile to by default (`specc compile -o generated`)
 DEFAULT_CONFIGURATION = "Robot1/2"  # seed 004's fault-tolerant configuration (two models, successive)
-HUNT = "hunt"
-HUNT_WORLD = "room"
-ROBOTS = {"atrv": "the rover missions of seed 004 (examples/atrv)",
-          "hilare": "the object hunt of seed 000 ch. 5 (examples/hilare)"}
+# Robots whose runs are not yet driven by their system block: their own runner, by package name.
+LEGACY_RUNNERS = {"atrv": "the rover missions of seed 004 (examples/atrv)"}
 
 PLANNER_FAILURES = ("watchdog", "invalid-plan")  # FTplan's events for a planner that gave no usable plan
 Progress = Callable[[float, float | None, str], None]  # mission time, horizon (None: unknown), what
@@ -65,7 +63,6 @@ class RunRequest:
     runs: Path = RUNS
     folder: Path | None = None  # the run folder itself, instead of runs/<name>
     timing: str = "model"  # FTplan's planning charge (the rover): model (deterministic) or wall
-    objects: int | None = None  # the hunt's objects to take (default: 5)
     horizon: float | None = None  # s of simulated time (the hunt's default: 900; a mission's: its own)
     goals: tuple[str, ...] = ()  # PRS goals to post instead of a mission's (`--goal '!(...)'`)
     pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
@@ -112,14 +109,6 @@ def run_in_folder(request: RunRequest, progress: Progress | None = None,
     return run_compiled(compile_robot(request.specs, request.generated, compiled_note), request, progress)
 
 
-def runnable_robot(robot: str) -> str:
-    """`robot` when specc run has a mission runner for it, else a RunError naming those it has."""
-    if robot not in ROBOTS:
-        known = "; ".join(f"{name}: {what}" for name, what in ROBOTS.items())
-        raise RunError(f"robot '{robot}' has no mission runner: specc run knows {known}")
-    return robot
-
-
 @dataclass(frozen=True)
 class PlannedRun:
     """A run whose names are all checked, ready to go into its folder."""
@@ -135,16 +124,14 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     RunError when one is wrong. Nothing is written."""
     from specc.run.mission import load_robot
 
-    loaded = load_robot(request.generated, request.specs, robot) if _has_systems(request.generated, robot) else None
-    if loaded is not None and (loaded.system.missions or request.goals or robot not in ROBOTS):
-        plan = _plan_system(loaded, request)
+    if robot in LEGACY_RUNNERS and not _has_systems(request.generated, robot):
+        plan = _plan_rover(request)
     else:
-        plan = _plan_rover(request) if runnable_robot(robot) == "atrv" else _plan_hunt(request)
+        plan = _plan_system(load_robot(request.generated, request.specs, robot), request)
     if request.folder is not None:
         return PlannedRun(robot, request, plan, request.folder)
     # Options that change what a run does name its folder too: it never holds another run's files.
-    variant = "".join(f"-{label}{value:g}" for label, value in (("objects", request.objects),
-                                                                ("horizon", request.horizon)) if value is not None)
+    variant = f"-horizon{request.horizon:g}" if request.horizon is not None else ""
     variant += "-wall" if request.timing != "model" else ""
     name = folder_name(robot, *plan.name_parts, request.seed)
     return PlannedRun(robot, request, plan, request.runs / (name + variant))
@@ -218,16 +205,9 @@ def _has_systems(generated: Path, robot: str) -> bool:
 
 def _plan_system(robot: Any, request: RunRequest) -> _Plan:
     """A mission of any robot, from its system block (`specc.run.mission`)."""
-    from specc.run.mission import check_mission, run_mission
+    from specc.run.mission import check_mission, default_configuration, run_mission
     from specc.runtime.system import MissionSpec
 
-    unused = [name for name, value in (("--config", request.configuration), ("--objects", request.objects))
-              if value is not None]
-    if unused:
-        raise RunError(f"{' and '.join(unused)}: robot '{robot.name}' has no such option (it runs its system's "
-                       "missions; configurations are an ftplan block's)")
-    if request.timing != "model":
-        raise RunError(f"timing '{request.timing}': FTplan's planning charge; robot '{robot.name}' plans nothing")
     if request.goals:
         if request.mission is not None:
             raise RunError("give --mission or --goal, not both: --goal posts its goals instead of a mission's")
@@ -244,9 +224,14 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         mission = robot.mission(missions[0])
     else:
         mission = robot.mission(request.mission)
-    check_mission(robot, mission, request.world, request.seed, request.horizon)
+    checked = check_mission(robot, mission, request.world, request.seed, request.horizon, request.configuration,
+                            request.timing)
+    if checked.planning is None and request.timing != "model":
+        raise RunError(f"timing '{request.timing}': FTplan's planning charge; mission {mission.name} is not planned")
     world = request.world or mission.world
     world_name = Path(world).stem if world.endswith(".toml") else world
+    configuration = (request.configuration or default_configuration(robot.part("ftplan").FTPLANS[
+        robot.system.planning])) if checked.planning is not None else None
 
     def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
         def tell(step: Any) -> None:
@@ -254,13 +239,13 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
                 progress(step.time, step.horizon, f"{step.goals_done}/{step.goals} goal(s) ended")
 
         result = run_mission(robot, mission, request.seed, world=request.world, horizon=request.horizon, log=log,
-                             progress=tell)
+                             progress=tell, configuration=configuration, timing=request.timing)
         report = {"outcome": "succeeded" if result.outcome == "succeeded" else result.outcome, "why": result.why,
                   "simulated_time": round(result.simulated_time, 3), "goals": [list(g) for g in result.goals],
                   "measures": result.measures(), "incidents": list(result.incidents)}
         return report, result.summary()
 
-    return _Plan((mission.name, world_name, None), run)
+    return _Plan((mission.name, world_name, configuration), run)
 
 
 def _checked_goal(robot: Any, text: str) -> str:
@@ -303,10 +288,8 @@ def _plan_rover(request: RunRequest) -> _Plan:
         raise RunError("the rover needs --mission (M1, M2, M3, M4) and --world (W1, W2, W3, W4 or a world file)")
     if request.timing not in TIMINGS:
         raise RunError(f"timing '{request.timing}': give {' or '.join(TIMINGS)}")
-    hunts = [name for name, value in (("--objects", request.objects), ("--horizon", request.horizon))
-             if value is not None]
-    if hunts:
-        raise RunError(f"{' and '.join(hunts)}: the hunt's (Hilare's); a rover mission ends with its plan")
+    if request.horizon is not None:
+        raise RunError("--horizon: a rover mission ends with its plan")
     configuration = request.configuration or DEFAULT_CONFIGURATION
     example = request.specs.resolve()
     # Every name checked before the run folder is made: a typo leaves nothing behind.
@@ -336,61 +319,6 @@ def _plan_rover(request: RunRequest) -> _Plan:
             f"\n  {rover_run.simulated_time:.0f} s of mission in {rover_run.wall_time:.1f} s of wall time"
 
     return _Plan((request.mission, checked.world.name, configuration), run)
-
-
-def _plan_hunt(request: RunRequest) -> _Plan:
-    from specc.run.hunt import (
-        HORIZON,
-        MAX_OBJECTS_WANTED,
-        arm_motion_overlaps,
-        check_arguments,
-        detection_interruptions,
-        run_hunt,
-    )
-
-    mission = request.mission or HUNT
-    world = request.world or HUNT_WORLD
-    if mission.lower() != HUNT:
-        raise RunError(f"unknown mission '{mission}' for hilare: its mission is '{HUNT}' (seed 000 ch. 5)")
-    if world.lower() != HUNT_WORLD and Path(world).stem != HUNT_WORLD:
-        raise RunError(f"unknown world '{world}' for hilare: the hunt takes place in '{HUNT_WORLD}' "
-                       "(examples/hilare/worlds/room.toml)")
-    if request.configuration is not None:
-        raise RunError(f"configuration '{request.configuration}': hilare has none (configurations are the "
-                       "rover's: Robot1, Robot2, Robot1/2, Robot1/2c)")
-    if request.timing != "model":
-        raise RunError(f"timing '{request.timing}': the rover's (FTplan's planning time); the hunt has no planner")
-    wanted = MAX_OBJECTS_WANTED if request.objects is None else request.objects
-    horizon = HORIZON if request.horizon is None else request.horizon
-    check_arguments(request.seed, wanted, horizon)
-
-    def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
-        def tell(step: Any) -> None:
-            if progress is not None:
-                progress(step.time, step.horizon, f"{step.objects_taken}/{step.objects_wanted} objects taken")
-
-        result = run_hunt(request.seed, wanted, horizon, log, tell,
-                          generated=request.generated, example=request.specs.resolve())
-        detections = detection_interruptions(result.events)
-        overlaps = arm_motion_overlaps(result.events)
-        report = {"outcome": result.outcome, "why": result.why, "simulated_time": round(result.simulated_time, 3),
-                  "measures": {"objects_taken": result.objects_taken, "objects_wanted": result.objects_wanted,
-                               "distance": round(result.distance, 3),
-                               "explored_fraction": round(result.explored_fraction, 4),
-                               "detections_interrupting_exploration": len(detections.interruptions),
-                               "detections_not_interrupting": len(detections.missed),
-                               "arm_moves_while_robot_moves": len(overlaps),
-                               "replies": dict(result.replies)}}
-        summary = "\n".join([
-            f"hilare's hunt (seed {request.seed}): {result.outcome}: {result.why}",
-            f"  {result.objects_taken} of {result.objects_wanted} objects taken, {result.distance:.1f} m travelled, "
-            f"{100 * result.explored_fraction:.0f} % of the room explored",
-            f"  §5.5: {len(detections.interruptions)} detection(s) interrupted an exploration move, "
-            f"{len(detections.missed)} did not; the arm took while the robot moved {len(overlaps)} time(s)",
-            f"  {result.simulated_time:.0f} s of mission in {result.wall_time:.1f} s of wall time"])
-        return report, summary
-
-    return _Plan((HUNT, HUNT_WORLD, None), run)
 
 
 def load_report(folder: Path) -> Mapping[str, Any]:

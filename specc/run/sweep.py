@@ -5,9 +5,11 @@ each, and the table of their measures.
     table.rows          # specc.run.measures.MeanMeasures, one per configuration x mission x world
     table.failures      # the runs whose mission failed, with why and their folder
 
-For the rover the rows are the means of seed 004 §4.1.4 (`specc.run.measures`); for the Hilare
-hunt, one row over the seeds: how many were tried, how many succeeded, and the means. Every run
-keeps its folder (log, report; pictures on request) so each failure can be read in its log.
+For a robot run from its system block, one row per mission x world over the seeds: how many
+were tried, how many succeeded, the mean time of the successful ones, and the means of the
+run's figures (its extension's too, e.g. the objects Hilare took). For the rover the rows are
+the means of seed 004 §4.1.4 (`specc.run.measures`). Every run keeps its folder (log, report;
+pictures on request) so each failure can be read in its log.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ from typing import Any
 
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
-from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
+from specc.run.mission import load_robot
+from specc.run.session import LEGACY_RUNNERS, RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
 from specc.runtime.ftplan import planner_processes_kept
 
 MISSIONS = ("M1", "M2", "M3", "M4")
@@ -40,16 +43,23 @@ class Failure:
 
 
 @dataclass(frozen=True)
-class HuntRow:
+class MissionRow:
+    """A mission in a world over the seeds."""
+
+    mission: str
+    world: str
+    configuration: str | None  # FTplan's, for a planned mission
     seeds: int
     succeeded: int
-    objects_taken: float  # mean
-    simulated_time: float  # mean, s, over the successful hunts
-    distance: float  # mean, m
+    simulated_time: float  # mean, s, over the successful runs
+    means: dict[str, float]  # the mean of each figure every run measured with a number
 
     @property
     def success_rate(self) -> float:
         return self.succeeded / self.seeds if self.seeds else 0.0
+
+    def to_json(self) -> dict[str, Any]:
+        return {**self.__dict__, "success_rate": self.success_rate}
 
 
 @dataclass
@@ -57,7 +67,7 @@ class SweepResult:
     robot: str
     outcomes: list[RunOutcome] = field(default_factory=list)
     rows: list[MeanMeasures] = field(default_factory=list)  # the rover's
-    hunt: HuntRow | None = None  # the hunt's
+    missions: list[MissionRow] = field(default_factory=list)  # a robot's run from its system block
 
     @property
     def failures(self) -> list[Failure]:
@@ -65,12 +75,15 @@ class SweepResult:
                 if not o.succeeded]
 
     def markdown(self) -> str:
-        if self.hunt is not None:
-            h = self.hunt
-            text = ("| seeds | succeeded | success rate | objects taken | time (s) | distance (m) |\n"
-                    "| --- | --- | --- | --- | --- | --- |\n"
-                    f"| {h.seeds} | {h.succeeded} | {100 * h.success_rate:.0f} % | {h.objects_taken:.2f} | "
-                    f"{h.simulated_time:.0f} | {h.distance:.1f} |\n")
+        if self.missions:
+            figures = list(dict.fromkeys(name for row in self.missions for name in row.means))
+            text = ("| mission | world | configuration | seeds | succeeded | success rate | time (s) | "
+                    + "".join(f"{name} | " for name in figures) + "\n"
+                    + "| --- " * (7 + len(figures)) + "|\n")
+            for row in self.missions:
+                text += (f"| {row.mission} | {row.world} | {row.configuration or '-'} | {row.seeds} | "
+                         f"{row.succeeded} | {100 * row.success_rate:.0f} % | {row.simulated_time:.1f} | "
+                         + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures) + "\n")
         else:
             text = markdown_table(self.rows)
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
@@ -84,21 +97,26 @@ class SweepResult:
     def to_json(self) -> dict[str, Any]:
         return {"robot": self.robot, "runs": [dict(o.report, folder=str(o.folder)) for o in self.outcomes],
                 "rows": [row.to_json() for row in self.rows],
-                "hunt": None if self.hunt is None else {**self.hunt.__dict__, "success_rate": self.hunt.success_rate}}
+                "missions": [row.to_json() for row in self.missions]}
 
 
-def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = MISSIONS, worlds: Sequence[str] = WORLDS,
-          configurations: Sequence[str] = CONFIGURATIONS, seeds: Sequence[int] = (0,),
-          step: Step | None = None) -> SweepResult:
+def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds: Sequence[str] = (),
+          configurations: Sequence[str] = (), seeds: Sequence[int] = (0,), step: Step | None = None) -> SweepResult:
     """Run `robot` (compiled into base.generated) on every combination, each run as `base` says
-    otherwise (its folder under base.runs). Names are checked before the first run."""
+    otherwise (its folder under base.runs). Names are checked before the first run. Empty means
+    all: every mission of the system (the rover's M1-M4, W1-W4 and four configurations), each
+    in its own world."""
     if not seeds:
         raise RunError("no seed to run: give at least one")
-    if robot == "atrv":
+    legacy = robot in LEGACY_RUNNERS and not (base.generated / robot / "systems").is_dir()
+    if legacy:
         requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
-                    for c, m, w, s in itertools.product(configurations, missions, worlds, seeds)]
+                    for c, m, w, s in itertools.product(configurations or CONFIGURATIONS, missions or MISSIONS,
+                                                        worlds or WORLDS, seeds)]
     else:
-        requests = [replace(base, seed=s) for s in seeds]
+        every = missions or tuple(load_robot(base.generated, base.specs, robot).system.missions)
+        requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
+                    for m, w, c, s in itertools.product(every, worlds or (None,), configurations or (None,), seeds)]
     if not requests:
         raise RunError("nothing to run: give at least one mission, world and configuration")
     planned = [plan_run(robot, request) for request in requests]  # a typo stops the table before any run
@@ -113,30 +131,44 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = MISSIONS, w
                 result.outcomes.append(crash.outcome)
     if step is not None:
         step(len(requests), len(requests), "")
-    if robot == "atrv":
+    if legacy:
         result.rows = measure_table([Measures.from_json(o.report["measures"]) for o in result.outcomes
                                      if "measures" in o.report])
     else:
-        result.hunt = _hunt_row(result.outcomes)
+        result.missions = mission_rows(result.outcomes)
     return result
 
 
 def _label(robot: str, request: RunRequest) -> str:
-    if robot == "atrv":
-        return f"{request.configuration} {request.mission} {request.world} seed {request.seed}"
-    return f"hunt seed {request.seed}"
+    configuration = f"{request.configuration} " if request.configuration else ""
+    world = f" {request.world}" if request.world else ""
+    return f"{configuration}{request.mission}{world} seed {request.seed}"
 
 
-def _hunt_row(outcomes: Sequence[RunOutcome]) -> HuntRow:
+def mission_rows(outcomes: Sequence[RunOutcome]) -> list[MissionRow]:
+    """One row per mission x world, in the order first run."""
     def mean(values: Sequence[float]) -> float:
         return math.fsum(values) / len(values) if values else 0.0
 
-    measures = [o.report["measures"] for o in outcomes if "measures" in o.report]
-    succeeded = [o for o in outcomes if o.succeeded]
-    return HuntRow(seeds=len(outcomes), succeeded=len(succeeded),
-                   objects_taken=mean([m["objects_taken"] for m in measures]),
-                   simulated_time=mean([o.report["simulated_time"] for o in succeeded]),
-                   distance=mean([m["distance"] for m in measures]))
+    groups: dict[tuple[str, str, str | None], list[RunOutcome]] = {}
+    for outcome in outcomes:
+        key = (str(outcome.report.get("mission")), str(outcome.report.get("world")),
+               outcome.report.get("configuration"))
+        groups.setdefault(key, []).append(outcome)
+    rows = []
+    for (mission, world, configuration), group in groups.items():
+        measured = [o.report["measures"] for o in group if isinstance(o.report.get("measures"), dict)]
+        numeric = [name for name in dict.fromkeys(n for m in measured for n in m)
+                   if measured and all(_is_number(m.get(name)) for m in measured)]
+        succeeded = [o for o in group if o.succeeded]
+        rows.append(MissionRow(mission, world, configuration, len(group), len(succeeded),
+                               mean([o.report["simulated_time"] for o in succeeded]),
+                               {name: mean([float(m[name]) for m in measured]) for name in numeric}))
+    return rows
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def write_table(result: SweepResult, path: Path) -> list[Path]:

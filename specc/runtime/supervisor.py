@@ -326,6 +326,7 @@ class Intention:
     # The latest entries only: a task that cycles for hours must not fill the memory.
     trace: deque[TraceEntry] = field(default_factory=lambda: deque(maxlen=TRACE_LENGTH))
     traced: int = 0  # entries ever recorded
+    requests: list[int] = field(default_factory=list)  # the ids of the services it asked the executive for
 
     def lines(self) -> list[str]:
         return [str(entry) for entry in self.trace]
@@ -396,6 +397,8 @@ class PrimitiveContext:
         if service == "INT":
             executive.interrupt(ident)
         else:
+            if self._frame is not None:
+                self._frame.intention.requests.append(ident)
             executive.request(service, ident, tuple(inputs))
 
     def new_id(self) -> int:
@@ -471,6 +474,26 @@ class Supervisor:
         self.intentions.append(intention)
         self._start(thread)
         return intention
+
+    def abandon(self, intention: Intention, why: str) -> None:
+        """Drop an intention still running, as the layer above that posted it gave up on it (an
+        action of a plan past its deadline, a safe state): its threads stop where they stand, the
+        services it asked the executive for and that still run are interrupted (INT, §3.9), and
+        the intention fails."""
+        if intention.status != "running":
+            return
+        if self.executive is not None:
+            for ident in intention.requests:
+                if ident in self.executive.activities:
+                    self.executive.interrupt(ident)
+        self._runnable = deque(t for t in self._runnable if t.intention is not intention)
+        for thread in [t for t in self._blocked if t.intention is intention]:
+            del self._blocked[thread]
+        when = self.kernel.now if self.kernel is not None else float(self._steps)
+        intention.trace.append(TraceEntry(when, "top", 0, f"abandoned: {why}"))
+        intention.traced += 1
+        intention.status = "failed"
+        self._version += 1
 
     def conclude(self, fact: Compound | str) -> None:
         """`=>fact` from the environment or the user; `(~ (P ...))` concludes a negation."""

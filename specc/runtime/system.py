@@ -8,19 +8,35 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from specc.runtime.body import RobotConfig
+from specc.runtime.ftplan.config import Term
 
 DEFAULT_HORIZON = 600.0  # s of simulated time a mission without a horizon may run
 
 
 @dataclass(frozen=True)
 class MissionSpec:
-    """What a mission asks: the goals posted to the supervisor together at the start, in one of
-    the system's worlds, for at most `horizon` seconds of simulated time."""
+    """What a mission asks: the goals posted to the supervisor together at the start, and/or the
+    mission of the ftplan block FTplan plans and carries out, in one of the system's worlds, for
+    at most `horizon` seconds of simulated time."""
 
     name: str
     world: str  # a name of SystemSpec.worlds
     goals: tuple[str, ...] = ()  # PRS goals, as text: "!(DELIVER A)"
     horizon: float | None = None
+    plan: str | None = None  # a mission of the ftplan block
+
+
+@dataclass(frozen=True)
+class BindingSpec:
+    """How the planners' task `task` is carried out: `kind` goal (the supervisor achieves the
+    goal `target`), service (the executive runs the service `target`) or request (the module
+    request `target`, module.request), with `target_args` made of the task's arguments."""
+
+    task: str
+    args: tuple[Term, ...]  # ?variables (or constants the action's arguments must equal)
+    kind: str
+    target: str
+    target_args: tuple[Term, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -34,3 +50,4 @@ class SystemSpec:
     body: RobotConfig = field(default_factory=RobotConfig)
     worlds: Mapping[str, str] = field(default_factory=dict)  # name -> world file, relative to the robot's folder
     missions: Mapping[str, MissionSpec] = field(default_factory=dict)
+    bindings: Mapping[str, BindingSpec] = field(default_factory=dict)  # by task

@@ -894,7 +894,7 @@ class Builder(Transformer[Token, Any]):
     def system(self, meta: Meta, children: list[Any]) -> m.System:
         name, *members = children
         props, rest = self.split(members)
-        sections: dict[str, tuple[m.Setting, ...]] = {}
+        sections: dict[str, m.Settings] = {}
         for section in (r for r in rest if isinstance(r, Section)):
             if section.name not in SYSTEM_SECTIONS:
                 self.diagnostics.append(error(
@@ -907,10 +907,25 @@ class Builder(Transformer[Token, Any]):
             else:
                 sections[section.name] = self.settings(section)
         missions = self.of(rest, m.SystemMission)
+        bindings = self.of(rest, m.Bindings)
+        for repeated in bindings[1:]:
+            self.diagnostics.append(error("duplicate-property", "section 'bindings' is given twice; merge them",
+                                          repeated.span))
         return self.apply_props(m.System, self.span(meta), props, name=str(name), body=sections.get("body"),
-                                worlds=sections.get("worlds", ()), missions=missions)
+                                worlds=sections.get("worlds"), missions=missions,
+                                bindings=bindings[0] if bindings else None)
 
-    def settings(self, section: Section) -> tuple[m.Setting, ...]:
+    def bindings(self, meta: Meta, children: list[Any]) -> m.Bindings:
+        return m.Bindings(entries=tuple(children), span=self.span(meta))
+
+    def binding(self, meta: Meta, children: list[Any]) -> m.Binding:
+        task, *rest = _present(children)
+        split = next(k for k, c in enumerate(rest) if isinstance(c, Token) and c.type == "BINDING_KIND")
+        target, *target_args = rest[split + 1:]
+        return m.Binding(task=str(task), args=tuple(rest[:split]), kind=str(rest[split]), target=target,
+                         target_args=tuple(target_args), span=self.span(meta))
+
+    def settings(self, section: Section) -> m.Settings:
         """`name: value;` entries, one value each."""
         entries = []
         for p in section.props:
@@ -919,7 +934,7 @@ class Builder(Transformer[Token, Any]):
                     "bad-property-value", f"'{p.key}' takes one value", p.values[0].span))
                 continue
             entries.append(m.Setting(name=p.key, value=p.values[0], span=p.span))
-        return tuple(entries)
+        return m.Settings(entries=tuple(entries), span=section.span)
 
     def system_mission(self, meta: Meta, children: list[Any]) -> m.SystemMission:
         name, *members = children

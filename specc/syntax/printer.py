@@ -693,16 +693,21 @@ class Printer:
     def p_System(self, node: m.System) -> None:
         with self.block(f"system {node.name}", node.span):
             self.props(node)
-            for section, settings in (("body", node.body), ("worlds", node.worlds or None)):
+            for section, settings in (("body", node.body), ("worlds", node.worlds)):
                 if settings is not None:
-                    with self.block(section, None):
-                        for entry in settings:
+                    with self.block(section, settings.span):
+                        for entry in settings.entries:
                             self.line(f"{entry.name}: {prop_value(entry.value)};", entry.span)
             for mission in node.missions:
                 with self.block(f"mission {mission.name}", mission.span):
                     self.props(mission)
                     for g in mission.goals:
                         self.line(f"goal: {goal(g)};", g.span)
+            if node.bindings is not None:
+                with self.block("bindings", node.bindings.span):
+                    for b in node.bindings.entries:
+                        self.line(f"{b.task}({ix_args(b.args)}) => {b.kind} {b.target.text}({ix_args(b.target_args)});",
+                                  b.span)
 
 
 def _runs(items: Iterable[Any], key: Callable[[Any], str]) -> list[tuple[str, list[Any]]]:

@@ -18,10 +18,12 @@ The ratio of the wall times is what the whole stack costs over the physics.
   forkserver is up (the first start, a few tenths, starts it): the forkserver has imported the
   modules of specc the program has, so a child running the program's main module again imports
   none of them anew.
-- The Hilare hunt (`specc.run.hunt.run_hunt`): the eight modules, the executive and the PRS
-  supervisor collecting five objects; seed 1 is the longest hunt of seeds 0-29. A one-second hunt
-  before it imports the compiled package (its 1.4 MB resource controller takes most of a second to
-  compile where no bytecode is cached).
+- The Hilare hunt (its mission `hunt` through the generic runner, `specc.run.mission`): the eight
+  modules, the executive and the PRS supervisor collecting five objects; seed 1 is the longest hunt
+  of seeds 0-29. A one-second run before each robot's imports its compiled package (Hilare's 1.4 MB
+  resource controller takes most of a second to compile where no bytecode is cached).
+- The warehouse tug (examples/tug, the same runner): its procedures delivering a cart, and FTplan
+  planning the same delivery with two planners (their processes' start counted in the wall time).
 No goal is asserted: the figures are printed."""
 
 from __future__ import annotations
@@ -30,20 +32,24 @@ import statistics
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import pytest
 
-from specc.run.hunt import run_hunt
+from specc.run.mission import load_robot, run_mission
+from specc.run.package import ensure_compiled
 from specc.run.rover import prepare_mission, run_rover_mission
 from specc.runtime.ftplan import ProcessPool
-from specc.runtime.sim import HILARE, RobotConfig, Simulation, World
+from specc.runtime.sim import RobotConfig, Simulation, World, load_world
+from tests.conftest import EXAMPLES, ROOT, hilare
 
 pytestmark = pytest.mark.bench
 
 # (configuration, mission, world, seed): the longest rover missions (see the docstring).
 MISSIONS = (("Robot1/2", "M4", "W2", 0), ("Robot1", "M4", "W3", 0), ("Robot1/2c", "M3", "W3", 0))
 HUNT_SEED = 1
+# The warehouse tug (examples/tug): its procedures alone, and FTplan's plans carried out by them.
+TUG_MISSIONS = (("deliver", "crowded"), ("shuttle", "crowded"))
 BASELINE_RUNS = 3  # median of; the bare simulation takes a fraction of a second
 ARC = (0.3, 0.1)  # m/s, rad/s: the bare robot drives a 3 m circle (runs into what lies on it)
 ISSUE_MISSION = 800.0  # s: the mission issue #9 speaks of
@@ -107,14 +113,18 @@ def rover_row(configuration: str, mission: str, world: str, seed: int) -> Row:
                simulated, wall, start_up, baseline)
 
 
-def hunt_row(seed: int) -> Row:
-    run_hunt(seed, 1, horizon=1.0)  # imports (and compiles) the hilare package: not the hunt's time
-    wall, result = timed(lambda: run_hunt(seed))
+def robot_row(robot: Any, mission: str, world: str | None, seed: int, label: str) -> Row:
+    """A mission of a robot run from its system block (`specc.run.mission`), against the bare
+    simulation of its body in the same world (with what the run's own draws put there)."""
+    spec = robot.mission(mission)
+    run_mission(robot, spec, seed, world=world, horizon=1.0)  # imports (and compiles) the package: not the run's
+    wall, result = timed(lambda: run_mission(robot, spec, seed, world=world))
     simulated = result.simulated_time
-    baseline = bare_simulation(result.world, HILARE, seed, simulated)  # the hunt's room and objects
-    taken = result.objects_taken
-    return Row(f"Hilare hunt seed {seed} ({result.outcome}, {taken} objects taken)",
-               simulated, wall, None, baseline)
+    ground = load_world(robot.world_file(world or spec.world))
+    prepare = robot.hook("prepare")
+    ground = prepare(ground, seed) if prepare is not None else ground
+    baseline = bare_simulation(ground, robot.system.body, seed, simulated)
+    return Row(f"{label} ({result.outcome})", simulated, wall, None, baseline)
 
 
 def table(rows: list[Row]) -> str:
@@ -132,11 +142,14 @@ def table(rows: list[Row]) -> str:
 
 def test_whole_missions_real_time_factor() -> None:
     rover = [rover_row(*mission) for mission in MISSIONS]
-    hunt = hunt_row(HUNT_SEED)
+    hunt = robot_row(hilare(), "hunt", None, HUNT_SEED, f"Hilare hunt seed {HUNT_SEED}")
+    tug = load_robot(ROOT / "generated", EXAMPLES / "tug", ensure_compiled(EXAMPLES / "tug", ROOT / "generated").robot)
+    tugs = [robot_row(tug, mission, world, 0, f"tug {mission} {world} seed 0")
+            for mission, world in TUG_MISSIONS]
     print("\nwhole missions, every level running: simulated seconds per wall second (factor), against the bare")
     print(f"simulation of the same robot in the same world for the same simulated time (its physics alone, "
           f"median of {BASELINE_RUNS})")
-    print(table([*rover, hunt]))
+    print(table([*rover, hunt, *tugs]))
     longest = max(rover, key=lambda r: r.simulated)
     print(f"issue #9: the longest rover mission found, {longest.simulated:.0f} s, ran in {longest.wall:.1f} s of "
           f"wall time with every level running: {longest.factor:.0f}x real time; an {ISSUE_MISSION:.0f} s mission "

@@ -93,7 +93,7 @@ def free_cells(room):
 def standing_cells(free, bounds):
     """The cells (row-major indices) where the robot can stand, as EXPLOR's calcObj requires of
     an object's cell (its centre on the cell's, §5.2.5): inside the room, clear of the grown
-    obstacles. Objects are placed on them, here and by the object hunt (specc.run.hunt)."""
+    obstacles. Objects are placed on them, here and by the object hunt (hunt.py's prepare)."""
     from hilare_codels.explor import candidate_cells, cells_in_box  # EXPLOR imports this module: import late
 
     xmin, xmax, ymin, ymax = bounds

@@ -7,7 +7,8 @@ World files are relative to the robot's folder (the one holding its specs).
 from __future__ import annotations
 
 from specc.runtime.body import RobotConfig
-from specc.runtime.system import MissionSpec, SystemSpec
+from specc.runtime.ftplan.config import Var  # noqa: F401
+from specc.runtime.system import BindingSpec, MissionSpec, SystemSpec  # noqa: F401
 
 SYSTEM = SystemSpec(
     name='hilare',
@@ -15,11 +16,14 @@ SYSTEM = SystemSpec(
     executive='hilare',
     supervisor='hilare_tasks',
     planning=None,
-    extension=None,
-    body=RobotConfig.from_spec('hilare', {}),
+    extension='hilare_codels.hunt',
+    body=RobotConfig.from_spec('hilare', {'radius': 0.35, 'mass': 80, 'wheel_base': 0.6, 'max_wheel_speed': 0.8, 'encoder_noise': 0.01, 'sonars': 32, 'sonar_range': 5, 'arm_joints': 6}),
     worlds={
         'room': 'worlds/room.toml',
     },
     missions={
+        'hunt': MissionSpec(name='hunt', world='room', goals=('!(COLLECT-OBJECTS 5)',), horizon=900.0),
+    },
+    bindings={
     },
 )

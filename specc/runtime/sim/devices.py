@@ -150,6 +150,10 @@ class Arm:
     def __init__(self, joints: int, speed: float) -> None:
         self.joints = [Axis(0.0, 0.0, speed) for _ in range(joints)]
         self.grip = "OPEN"
+        # Who commands the arm: the simulation asks its modules which activity's codel runs, so a
+        # log can say which request moved it.
+        self.commander: Callable[[], object] = lambda: None
+        self.moved_by: object = None  # what `commander` answered at the last command
 
     def reset(self, q: list[float]) -> None:
         """The arm is at `q` (where it stands when the robot starts)."""
@@ -160,6 +164,7 @@ class Arm:
     def move_to(self, q: list[float]) -> None:
         if len(q) != len(self.joints):
             raise ValueError(f"the arm has {len(self.joints)} joints, not {len(q)}")
+        self.moved_by = self.commander()
         for joint, target in zip(self.joints, q, strict=True):
             joint.target = target
 

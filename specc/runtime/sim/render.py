@@ -31,7 +31,7 @@ from specc.runtime.sim.world import Circle, Polygon, Target, Window, World
 CERTAINTY_COLOURS = ("#f4f1de", "#f2cc8f", "#81b29a")  # c < 1/3, 1/3 <= c < 2/3, c >= 2/3
 CERTAINTY_BANDS = (1 / 3, 2 / 3)  # Fig 5.11's three bands of certainty
 CERTAINTY_LABELS = ("c < 1/3", "1/3 <= c < 2/3", "c >= 2/3")
-# What became of an object, most advanced first (specc.run.hunt's HuntObject.state).
+# What became of an object, most advanced first (specc.run.render's LoggedObject.state).
 OBJECT_COLOURS = {"taken": "#16a34a", "retrieved": "#f97316", "detected": "#eab308", "undetected": "#9ca3af"}
 PATH_COLOUR = "#1d4ed8"
 WALL_COLOUR, OBSTACLE_COLOUR, OBSTACLE_EDGE = "#374151", "#6b7280", "#1f2937"

@@ -90,6 +90,8 @@ class Simulation:
             raise ValueError("the simulation and the modules must share one kernel: "
                              "create the Simulation with kernel=registry.kernel")
         registry.hardware = self
+        if self.arm is not None:
+            self.arm.commander = lambda: registry.current  # the activity whose codel moves it
         return self
 
     def _scatter(self, count: int, rng: np.random.Generator) -> list[tuple[float, float]]:
