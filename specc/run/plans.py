@@ -83,8 +83,8 @@ class KernelExecutor(abc.ABC):
         """Stop what carries the action out (it has overrun, or the system goes to a safe state)."""
 
     @abc.abstractmethod
-    def wind_down(self) -> None:
-        """Wait for what was interrupted to end (an action failed: the others go on)."""
+    def wind_down(self, failed: Running) -> None:
+        """Wait for what was interrupted to end once `failed` failed (the others go on)."""
 
     @abc.abstractmethod
     def come_to_rest(self) -> None:
@@ -126,8 +126,7 @@ class KernelExecutor(abc.ABC):
             if not upcoming and not self._live:  # an ordering no action ends: the plan is malformed
                 stuck = ", ".join(a.text() for a in waiting)
                 return Execution(False, now, waiting[0].id, f"{stuck} wait for actions that never end")
-            wake = min(upcoming + [r.deadline for r in self._live])
-            self.kernel.run_while(self.nothing_over, wake)
+            self.await_progress(min(upcoming + [r.deadline for r in self._live]))
             for run in self._live:
                 if run.finished is None and self.kernel.now >= run.deadline - OVERRUN_TOLERANCE:
                     self._overrun(run)
@@ -145,6 +144,11 @@ class KernelExecutor(abc.ABC):
                 self.record(run, "stopped", "stopped: the system was brought to a safe state")
         self.come_to_rest()
         return self.kernel.now
+
+    def await_progress(self, wake: float) -> None:
+        """Run the kernel until an action under way is over, or until `wake` (an action's
+        dispatch date or deadline)."""
+        self.kernel.run_while(self.nothing_over, wake)
 
     def nothing_over(self) -> bool:
         """After each kernel event: False once an action under way is over."""
@@ -172,7 +176,7 @@ class KernelExecutor(abc.ABC):
 
     def _conclude(self, run: Running, report: Callable[[Report], None]) -> None:
         if not run.ok:
-            self.wind_down()
+            self.wind_down(run)
         for said in self.reports(run):
             report(said)
         now = run.finished if run.ok and run.finished is not None else self.kernel.now
@@ -346,7 +350,7 @@ class BoundExecutor(KernelExecutor):
             return bool(run.handle.reply is None)
         return False
 
-    def wind_down(self) -> None:
+    def wind_down(self, failed: Running) -> None:
         self.kernel.run_while(lambda: any(self._still_running(r) for r in self._stopping),
                               self.kernel.now + SETTLE_LIMIT)
         self._stopping = [r for r in self._stopping if self._still_running(r)]

@@ -65,7 +65,7 @@ import numpy as np
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
-from specc.run.plans import FtplanJournal
+from specc.run.plans import FtplanJournal, KernelExecutor, Running
 from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
 from specc.run.render import draw_map
 from specc.run.rover_tasks import LINK, MOTION_INIT, MOVE, PAN_TILT, PHOTO, PTU_INIT, TASK_KINDS, task_text
@@ -82,7 +82,7 @@ from specc.runtime.ftplan import (
     planners_as_run,
 )
 from specc.runtime.ftplan.config import FtPlanConfig
-from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precedences
+from specc.runtime.ftplan.execution import Execution
 from specc.runtime.ftplan.facts import FactKey
 from specc.runtime.ftplan.state import SystemState, consequences, constant, constant_key
 from specc.runtime.ftplan.view import View
@@ -105,9 +105,6 @@ MOVE_TOLERANCE = 0.3  # m around a move's target that NDD counts as there (run_s
 OTHER_POSITION = (0.0, 0.5)
 SETTLE_LIMIT = 2.0  # s a stopped robot is given to come to rest (the motors ramp at 1 m/s²)
 STILL_SPEED = 1e-3  # m/s at the wheel rims: slower than this, the robot stands still
-# An action whose plan gives it no finite longest duration is stopped after this long (no task
-# of Modele1 or Modele2 is unbounded: a faulty model's action must not run for ever).
-UNBOUNDED_ACTION_LIMIT = 600.0
 WINDOW_STREAM = 0x57A7E11  # mixed with the seed for the windows' instants, apart from the simulator's streams
 POSITION_DIGITS = 2  # the odometry reported to FTplan, to the centimetre
 
@@ -471,140 +468,76 @@ def mission_goals(problem: pm.Problem, mission: str, state: SystemState | None =
 
 
 @dataclass
-class _Running:
-    """An action under way: its requests, sent one after the other."""
+class _Chain:
+    """The requests that carry an action out, sent one after the other."""
 
-    plan: int
-    action: Action
     requests: tuple[Request, ...]
-    started: float
-    deadline: float  # its start plus its planned longest duration
     step: int = 0
     rqst_id: int | None = None
-    finished: float | None = None  # when it ended or failed
-    ok: bool = False
-    why: str = ""
 
 
-class SimExecutor:
+class SimExecutor(KernelExecutor):
     """FTplan's `Executor` on the simulated ATRV: each action of a plan is carried out by the
-    generated modules on the simulation's kernel (see the module's docstring), in mission time.
-
-    Actions start at their dispatch date, or when the actions the plan orders before them end;
-    those the plan lets overlap run together on the kernel. The first action to fail ends the
-    execution; `safe_state` then stops whatever still runs and lets the robot come to rest."""
+    generated modules on the simulation's kernel (see the module's docstring), in mission time,
+    scheduled as `specc.run.plans.KernelExecutor` does for any robot."""
 
     def __init__(self, rover: Rover, tasks: RoverTasks, emit: Emit | None = None) -> None:
+        super().__init__(rover.kernel, emit)
         self.rover = rover
         self.tasks = tasks
-        self.emit = emit
-        self.kernel = rover.kernel
-        self.plans = 0
         self.photos: list[Photo] = []
         self.communications: list[Communication] = []
         self.actions: list[ExecutedAction] = []
         self.planned: list[PlannedTask] = []
-        self._live: list[_Running] = []  # actions under way, also after a failure ended the execution
         self._stopping: list[tuple[Any, int]] = []  # (client, request) interrupted, not yet ended
         self._replied_since = False  # a module answered a request of ours since the actions last advanced
         for client in rover.clients:
             client.final_listeners.append(self._final_reply)
 
-    # ------------------------------------------------------------ Executor
     def execute(self, plan: Plan, now: float, report: Callable[[Report], None]) -> Execution:
-        self.plans += 1
-        number = self.plans
-        self._catch_up(now)
+        number = self.plans + 1
         for action in plan.ordered():
             self.planned.append(PlannedTask(number, plan.domain, action.id, action.text(), action.dispatch,
                                             plan.ends_by(action)))
-        precedences = Precedences(plan)
-        waiting = plan.ordered()
-        ended_at: dict[str, float] = {}
-        while True:
-            for run in sorted((r for r in self._live if r.finished is not None), key=lambda r: (r.finished, r.started)):
-                self._live.remove(run)
-                self._conclude(run, report)
-                if not run.ok:
-                    return Execution(False, self.kernel.now, run.action.id, run.why)
-                assert run.finished is not None
-                ended_at[run.action.id] = run.finished
-            now = self.kernel.now
-            dates = [(date, a) for a in waiting if (date := precedences.start_date(a, ended_at, now)) is not None]
-            for date, action in sorted(dates, key=lambda d: (d[0], d[1].dispatch, d[1].id)):
-                if date <= now + OVERRUN_TOLERANCE:
-                    waiting.remove(action)
-                    self._start(number, plan, action, report)
-            if not waiting and not self._live:
-                return Execution(True, self.kernel.now)
-            if any(r.finished is not None for r in self._live):
-                continue  # an action that ended as it started (a control request)
-            upcoming = [date for date, action in dates if action in waiting]
-            if not upcoming and not self._live:  # an ordering no action ends: the plan is malformed
-                stuck = ", ".join(a.text() for a in waiting)
-                return Execution(False, now, waiting[0].id, f"{stuck} wait for actions that never end")
-            wake = min(upcoming + [r.deadline for r in self._live])
-            # Every action advanced after each kernel event in which a module answered (each
-            # sends its next request at the instant the one before ended), and once now for what
-            # was answered while the actions before concluded.
-            self._replied_since = True
-            self.kernel.run_while(lambda: not self._advance_answered(), wake)
-            for run in self._live:
-                if run.finished is None and self.kernel.now >= run.deadline - OVERRUN_TOLERANCE:
-                    self._overrun(run)
-
-    def safe_state(self, now: float) -> float:
-        """Interrupt every request still running, stop the wheels, and wait for the robot to stand
-        and the requests to end."""
-        self._catch_up(now)
-        for run in list(self._live):  # what ran beside the failed action: FTplan hears no more of it
-            self._live.remove(run)
-            if run.finished is not None:
-                self._record(run, "ended" if run.ok else "failed", run.why, run.finished)
-            else:
-                self._interrupt(run)
-                self._record(run, "stopped", "stopped: the system was brought to a safe state")
-        self._come_to_rest()
-        return self.kernel.now
+        return super().execute(plan, now, report)
 
     # ------------------------------------------------------------ one action
-    def _start(self, number: int, plan: Plan, action: Action, report: Callable[[Report], None]) -> None:
-        now = self.kernel.now
-        longest = action.duration[1] if math.isfinite(action.duration[1]) else UNBOUNDED_ACTION_LIMIT
-        run = _Running(number, action, (), now, now + longest)
-        report(Report("started", action.task, action.args, now, action.id))
-        self._event(now, "action", status="started", plan=number, id=action.id, task=action.task,
-                    args=list(action.args), latest_end=round(run.deadline, 6))
+    def begin(self, run: Running, plan: Plan) -> None:
         try:
-            run.requests = self.tasks.requests(plan, action)
+            run.handle = _Chain(self.tasks.requests(plan, run.action))
         except RunError as error:
-            run.finished, run.why = now, f"{action.text()} cannot be carried out: {error}"
-        self._live.append(run)
-        self._advance(run)
+            run.handle = _Chain(())
+            run.finished, run.why = run.started, f"{run.action.text()} cannot be carried out: {error}"
 
     def _final_reply(self, reply: rt.Reply) -> None:
         self._replied_since = True
 
-    def _advance_answered(self) -> bool:
-        """`_advance` every action if a module answered since the last call (an action waiting
-        for a reply has nothing to do before); True when one is over."""
-        if not self._replied_since:
-            return False
-        self._replied_since = False
-        return any([self._advance(r) for r in self._live])
+    def await_progress(self, wake: float) -> None:
+        # Every action advanced after each kernel event in which a module answered (each sends
+        # its next request at the instant the one before ended), and once now for what was
+        # answered while the actions before concluded.
+        self._replied_since = True
+        super().await_progress(wake)
 
-    def _advance(self, run: _Running) -> bool:
+    def nothing_over(self) -> bool:
+        """An action waiting for a reply has nothing to do before a module answered."""
+        if not self._replied_since:
+            return True
+        self._replied_since = False
+        return super().nothing_over()
+
+    def advance(self, run: Running) -> bool:
         """Send the action's next request when the one before has ended well; True when the
-        action is over (ended or failed). Called after each kernel event that brought a reply
-        while it runs."""
+        action is over (ended or failed)."""
         if run.finished is not None:
             return True
+        chain = run.handle
         while True:
-            request = run.requests[run.step]
+            request = chain.requests[chain.step]
             client = self.rover.client(request.module)
-            if run.rqst_id is None:
-                run.rqst_id = getattr(client, request.name)(*request.args)
-            reply = client.reply(run.rqst_id)
+            if chain.rqst_id is None:
+                chain.rqst_id = getattr(client, request.name)(*request.args)
+            reply = client.reply(chain.rqst_id)
             if reply.status is rt.Status.WAITING:
                 return False
             self._replied(run, request, reply)
@@ -612,53 +545,43 @@ class SimExecutor:
             if not reply.ok:
                 run.finished, run.why = self.kernel.now, self._failure(run, request, reply)
                 return True
-            run.step, run.rqst_id = run.step + 1, None
-            if run.step == len(run.requests):
+            chain.step, chain.rqst_id = chain.step + 1, None
+            if chain.step == len(chain.requests):
                 run.finished, run.ok = self.kernel.now, True
                 return True
 
-    def _overrun(self, run: _Running) -> None:
-        """Temporal execution control (seed 004 §3.2.2.2, IxTeT's): an action still running past
-        its planned latest end has failed; it is stopped then."""
-        low, high = run.action.duration
-        run.finished = self.kernel.now
-        run.why = (f"{run.action.text()} overran its planned duration [{low:.3g}, {high:.3g}] s: still running "
-                   f"{self.kernel.now - run.started:.3g} s after it started")
-        self._interrupt(run)
+    def interrupt(self, run: Running) -> None:
+        """Abort the action's request under way; `come_to_rest` waits for it to wind down."""
+        chain = run.handle
+        if chain.rqst_id is not None and chain.step < len(chain.requests):
+            client = self.rover.client(chain.requests[chain.step].module)
+            if client.reply(chain.rqst_id).status is rt.Status.WAITING:
+                client.abort(chain.rqst_id)
+                self._stopping.append((client, chain.rqst_id))
 
-    def _conclude(self, run: _Running, report: Callable[[Report], None]) -> None:
-        """The action's reports to FTplan: where the robot stands after a move (once it has
-        come to rest when the move failed), then its end or its failure."""
-        action = run.action
-        moved = TASK_KINDS.get(action.task) == MOVE
-        if moved and not run.ok:
-            self._come_to_rest()
-        now = run.finished if run.ok and run.finished is not None else self.kernel.now
-        if moved:
+    def wind_down(self, failed: Running) -> None:
+        """A move that failed: the robot comes to rest before it reports where it stands."""
+        if TASK_KINDS.get(failed.action.task) == MOVE:
+            self.come_to_rest()
+
+    def reports(self, run: Running) -> list[Report]:
+        """Where the robot stands after a move (once it has come to rest when the move failed),
+        then its end or its failure."""
+        said = super().reports(run)
+        if TASK_KINDS.get(run.action.task) == MOVE:
             x, y = self._odometry()
-            report(Report("report", "ROBOT_POSITION", (x, y), now, action.id))
-        status = "ended" if run.ok else "failed"
-        report(Report(status, action.task, action.args, now, action.id, "" if run.ok else run.why))
-        self._record(run, status, run.why, now)
+            said.insert(0, Report("report", "ROBOT_POSITION", (x, y), said[0].time, run.action.id))
+        return said
 
-    def _record(self, run: _Running, outcome: str, why: str, end: float | None = None) -> None:
+    def record(self, run: Running, outcome: str, why: str, end: float | None = None) -> None:
         end = self.kernel.now if end is None else end
         action = run.action
         self.actions.append(ExecutedAction(run.plan, action.id, action.task, action.args, run.started, end, outcome,
                                            why))
-        self._event(end, "action", status=outcome, plan=run.plan, id=action.id, task=action.task,
-                    args=list(action.args), **({"why": why} if why else {}))
-
-    def _interrupt(self, run: _Running) -> None:
-        """Abort the action's request under way; `_come_to_rest` waits for it to wind down."""
-        if run.rqst_id is not None and run.step < len(run.requests):
-            client = self.rover.client(run.requests[run.step].module)
-            if client.reply(run.rqst_id).status is rt.Status.WAITING:
-                client.abort(run.rqst_id)
-                self._stopping.append((client, run.rqst_id))
+        super().record(run, outcome, why, end)
 
     # ------------------------------------------------------------ what the modules answered
-    def _replied(self, run: _Running, request: Request, reply: rt.Reply) -> None:
+    def _replied(self, run: Running, request: Request, reply: rt.Reply) -> None:
         """Keep the photos and the communications as the modules report them."""
         if request.name == "TakePicture":
             x, y, _ = self.rover.sim.pose
@@ -668,18 +591,18 @@ class SimExecutor:
                           round(unit.tilt.position, 4), str(request.args[0]), seen, reply.ok,
                           "" if reply.ok else _reply_text(reply))
             self.photos.append(photo)
-            self._event(reply.time, "photo", target=photo.target, ok=photo.ok, seen=list(seen), x=photo.x, y=photo.y,
-                        pan=photo.pan, tilt=photo.tilt, **({"why": photo.why} if photo.why else {}))
+            self.event(reply.time, "photo", target=photo.target, ok=photo.ok, seen=list(seen), x=photo.x, y=photo.y,
+                       pan=photo.pan, tilt=photo.tilt, **({"why": photo.why} if photo.why else {}))
         elif request.name == "Communicate":
             window = format_value(run.action.args[0]) if run.action.args else ""
             link = reply.output.window if reply.ok else ""
             communication = Communication(window, run.started, reply.time, reply.ok, link,
                                           "" if reply.ok else _reply_text(reply))
             self.communications.append(communication)
-            self._event(reply.time, "communication", window=window, ok=reply.ok, start=round(run.started, 6),
-                        link=link, **({"why": communication.why} if communication.why else {}))
+            self.event(reply.time, "communication", window=window, ok=reply.ok, start=round(run.started, 6),
+                       link=link, **({"why": communication.why} if communication.why else {}))
 
-    def _failure(self, run: _Running, request: Request, reply: rt.Reply) -> str:
+    def _failure(self, run: Running, request: Request, reply: rt.Reply) -> str:
         """Why the action failed, in one line."""
         text = f"{run.action.text()} failed: {request.text()} -> {_reply_text(reply)}"
         if request.name == "GotoTarget":
@@ -702,7 +625,7 @@ class SimExecutor:
             x, y = snapshot.data.pose.x, snapshot.data.pose.y
         return round(x, POSITION_DIGITS) + 0.0, round(y, POSITION_DIGITS) + 0.0
 
-    def _come_to_rest(self) -> None:
+    def come_to_rest(self) -> None:
         """Stop the navigation and the wheels; wait (SETTLE_LIMIT at most) for the robot to stand
         and for the interrupted requests to end."""
         self.rover.clients.ndd.Stop()
@@ -714,16 +637,6 @@ class SimExecutor:
             return bool(self._stopping) or abs(rover.left_speed) + abs(rover.right_speed) > STILL_SPEED
 
         self.kernel.run_while(busy, self.kernel.now + SETTLE_LIMIT)
-
-    def _catch_up(self, now: float) -> None:
-        """The kernel at mission time `now`: time FTplan spent planning passes for the robot too."""
-        if now > self.kernel.now:
-            self.kernel.run_until(now)
-
-    # ------------------------------------------------------------ telling
-    def _event(self, time_: float, kind: str, **fields: Any) -> None:
-        if self.emit is not None:
-            self.emit(time_, kind, **fields)
 
 
 def _reply_text(reply: rt.Reply) -> str:
