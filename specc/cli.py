@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 app = typer.Typer(
     name="specc",
     help="Compile robot control-architecture specs (modules, executive, rules, procedures, "
-         "planning) into a Python package.\n\nExample: specc check examples/hilare",
+         "planning) into a Python package.\n\nExample: specc check examples/tug",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
@@ -58,7 +58,7 @@ def check(paths: PathsArg,
           ) -> None:
     """Parse and check specs; report every problem at once.
 
-    Example: specc check examples/hilare examples/atrv/model1.spec
+    Example: specc check examples/tug examples/generic/diagnosis.spec
     """
     started = time.perf_counter()
     loaded = load(paths)
@@ -79,7 +79,7 @@ def compile(paths: PathsArg,
             = None) -> None:
     """Check specs, then write the robot's Python package into OUTPUT/<robot>/.
 
-    Example: specc compile examples/hilare -o generated
+    Example: specc compile examples/tug -o generated
     """
     from specc.analysis.kheops import KheopsError
     from specc.backends import generate_all, package  # jinja2 and the back ends load only when compiling
@@ -174,9 +174,10 @@ def graph(paths: PathsArg,
     """Draw a picture of the spec: the service incompatibility graph (and print the service
     groups and the controller's state count), or the Petri net of the procedures.
 
-    Example: specc graph --incompat examples/hilare -o hilare-incompat.png
+    Example: specc graph --incompat examples/tug -o tug-incompat.png
 
-    Example: specc graph --net examples/hilare --goal '!(COLLECT-OBJECTS 1)' --ka TakeObject -o take.png
+    Example: specc graph --net ROBOT --goal '!(G ...)' --ka K -o net.png (procedures whose variables have
+    finite domains, as for specc verify --goal)
     """
     from specc.analysis.incompat import build_graph, service_groups, state_count
     from specc.pictures import draw_incompatibility_graph
@@ -256,7 +257,7 @@ def verify(paths: PathsArg,
 
     Example: specc verify examples/generic --executive generic
 
-    Example: specc verify examples/hilare --goal '!(COLLECT-OBJECTS 1)' --fail ARM-OBJ
+    Example: specc verify examples/tug --requests 2
     """
     if goal:
         verify_procedures(paths, goal, fact or [], fail or [], reach or [], procedures, max_states, pnml, strict,
@@ -552,7 +553,7 @@ def rules_report(paths: PathsArg,
 def skeleton(paths: PathsArg) -> None:
     """Write stubs for the codels a spec names but its codel modules lack; never rewrites code.
 
-    Example: specc skeleton examples/hilare
+    Example: specc skeleton examples/tug
     """
     from specc.backends import skeleton as stubs
 
@@ -590,7 +591,7 @@ def _run_error(error: Exception, code: int = 1) -> typer.Exit:
 
 @app.command()
 def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder (its specs, codels and "
-                                                   "worlds), e.g. examples/hilare.", show_default=False)],
+                                                   "worlds), e.g. examples/tug.", show_default=False)],
         mission: Annotated[Optional[str], typer.Option(help="One of the system block's missions (default: its only "
                                                             "one); M1..M4 for the rover.")] = None,
         world: Annotated[Optional[str], typer.Option(help="One of the system's worlds or a world file (default: "
@@ -616,8 +617,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
     planners) and write a run folder: events.jsonl, report.json, summary.txt, map.png, timeline.png.
     Exits 0 when the mission succeeded, 1 when it failed (the report says why), 2 on bad input.
 
-    Examples: specc run examples/hilare (its mission hunt); specc run examples/hilare --goal
-    '!(COLLECT-OBJECTS 2)' --seed 3; specc run examples/atrv --mission M1 --world W2 --config Robot1/2."""
+    Examples: specc run examples/tug --mission deliver; specc run examples/tug --goal '!(FETCH B C)' --seed 3;
+    specc run examples/tug --mission shuttle --world crowded --config Robot2."""
     from specc.run import RunError
     from specc.run.session import RunCrashed, RunRequest, run_in_folder
 
@@ -706,7 +707,7 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
 
 
 @app.command()
-def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder, e.g. examples/hilare.",
+def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder, e.g. examples/tug.",
                                                 show_default=False)],
           mission: Annotated[Optional[list[str]], typer.Option(help="A mission (repeatable; default: every mission "
                                                                     "of the system; M1-M4 for the rover).")] = None,
@@ -726,7 +727,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
     their measures: per mission and world, the success rate and the means of the runs' figures (for
     the rover, the measures of seed 004 §4.1.4).
 
-    Examples: specc table examples/hilare --seeds 10; specc table examples/atrv --mission M1 --world W2
+    Examples: specc table examples/tug --seeds 10; specc table examples/tug --mission shuttle --world hall
     --config Robot1."""
     from specc.run import RunError
     from specc.run.measures import rich_table
@@ -767,7 +768,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
 @app.command(name="mutants")
 def mutants_command(
         specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder (or files), e.g. "
-                                                                   "examples/atrv.", show_default=False)],
+                                                                   "examples/tug.", show_default=False)],
         domain: Annotated[str, typer.Option(help="The planning domain to mutate.")] = "model1",
         kinds: Annotated[Optional[list[str]], typer.Option(
             "--class", help="Keep this mutation class: numeric, variable, value, operator, deletion (repeatable; "
@@ -785,7 +786,7 @@ def mutants_command(
     """Mutate a planning domain on its model (seed 004 §4.1.3), print each mutant back as spec text and
     keep those that pass specc check: a table of counts per class, then the kept mutants.
 
-    Example: specc mutants examples/atrv --domain model1 --sample 28 --seed 1 -o mutants/
+    Example: specc mutants examples/tug --domain warehouse --sample 28 --seed 1 -o mutants/
     """
     from rich.table import Table
 

@@ -15,8 +15,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from specc.runtime import functional as rt
-from specc.runtime.sim import HILARE, Simulation, WorldError, load_world, parse_world, reliability
+from specc.runtime.sim import Simulation, WorldError, load_world, parse_world, reliability
 from specc.runtime.sim.rays import RayCaster
+from tests.conftest import hilare
+
+HILARE = hilare().system.body  # examples/hilare/system.spec's body block
 
 ROOT = Path(__file__).resolve().parent.parent
 ROOM = ROOT / "examples" / "hilare" / "worlds" / "room.toml"

@@ -14,15 +14,15 @@ from typing import Any
 
 import pytest
 
+from specc.run.rover import load_package
 from specc.runtime import functional as rt
-from specc.runtime.sim import ATRV as ATRV_ROBOT
 from specc.runtime.sim import Window, load_world, parse_world
 from specc.runtime.sim.world import Circle, Polygon
 from tests.conftest import EXAMPLES
 
 ATRV = EXAMPLES / "atrv"
 WORLDS = ATRV / "worlds"
-HALF_WIDTH = ATRV_ROBOT.width / 2.0  # m, the simulated ATRV's (1.05 m x 0.65 m)
+HALF_WIDTH = load_package().body.width / 2.0  # m, the simulated ATRV's (1.05 m x 0.65 m, system.spec)
 TOLERANCE = 0.3
 
 
@@ -227,7 +227,7 @@ def test_same_seed_same_trace_and_another_seed_another(run_sim: ModuleType) -> N
 
 
 def test_modules_work_without_a_simulator(run_sim: ModuleType) -> None:
-    modules = run_sim.import_generated()
+    modules = run_sim.import_generated().modules
     registry = rt.Registry()
     made = modules.create_all(registry)
     client = {name: modules.MODULES[name].client(module) for name, module in made.items()}

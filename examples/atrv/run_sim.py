@@ -37,12 +37,12 @@ class UsageError(Exception):
 
 
 def import_generated() -> Any:
-    """The generated package `atrv.modules`, with the codels of this folder."""
+    """The generated package (`atrv.modules`, `.body`...), with the codels of this folder."""
     from specc.run import RunError
     from specc.run.rover import load_package
 
     try:
-        return load_package(ROOT / "generated", HERE).modules
+        return load_package(ROOT / "generated", HERE)
     except RunError as exc:
         raise UsageError(str(exc)) from None
 
@@ -53,8 +53,9 @@ def build(world: Any, seed: int = 0) -> Any:
     from specc.run import RunError
     from specc.run.rover import build_rover
 
+    package = import_generated()
     try:
-        return build_rover(import_generated(), world, seed)
+        return build_rover(package.modules, world, seed, package.body)
     except RunError as exc:  # what the world asks cannot be built (objects without room)
         raise UsageError(str(exc)) from None
 
@@ -158,7 +159,6 @@ def run(argv: list[str] | None = None) -> int:
     args = parser().parse_args(_glue_negative_goals(list(sys.argv[1:] if argv is None else argv)))
     from specc.run import RunError
     from specc.run.rover import resolve_world
-    from specc.runtime.sim import ATRV
 
     try:  # W1..W4 name the example worlds; anything else is a world file
         world = resolve_world(args.world, WORLDS)
@@ -170,9 +170,10 @@ def run(argv: list[str] | None = None) -> int:
         if not (xmin < x < xmax and ymin < y < ymax):
             raise UsageError(f"--goal {x:g},{y:g} is outside the walls of {world.name} "
                              f"([{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}])")
-        if world.clearance(x, y) < ATRV.width / 2.0:
+        half_width = import_generated().body.width / 2.0
+        if world.clearance(x, y) < half_width:
             raise UsageError(f"--goal {x:g},{y:g} is inside an obstacle of {world.name} or too near one "
-                             f"for the rover ({ATRV.width / 2.0:g} m at least)")
+                             f"for the rover ({half_width:g} m at least)")
     for option, picture, suffix in (("-o", args.output, ".png"), ("--gif", args.gif, ".gif")):
         if picture is not None and Path(picture).suffix.lower() != suffix:
             raise UsageError(f"{option} {picture}: the file name must end in {suffix}")

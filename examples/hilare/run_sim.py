@@ -21,13 +21,14 @@ HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE.parent.parent / "generated"), str(HERE)]
 
 from hilare import modules  # noqa: E402
+from hilare.systems import SYSTEMS  # noqa: E402
 from hilare.modules.pilo import PiloClient  # noqa: E402
 from hilare.modules.plan import Box, PlanClient, Posit  # noqa: E402
 from hilare.modules.visual import VisualClient  # noqa: E402
 from hilare_codels.plan import CLEARANCE  # noqa: E402
 
 from specc.runtime import functional as rt  # noqa: E402
-from specc.runtime.sim import HILARE, Simulation, World, WorldError, load_world  # noqa: E402
+from specc.runtime.sim import Simulation, World, WorldError, load_world  # noqa: E402
 from specc.runtime.sim.render import animate, draw  # noqa: E402
 
 WORLD = HERE / "worlds" / "room.toml"
@@ -65,7 +66,8 @@ def run(world: World, goals: list[tuple[float, float]], seed: int, budget: float
     too); the log of replies, and whether every request succeeded."""
     world_file = world.source
     registry = rt.Registry()
-    sim = Simulation(world, HILARE, seed=seed, kernel=registry.kernel).attach(registry)
+    body = SYSTEMS["hilare"].body  # system.spec's body block
+    sim = Simulation(world, body, seed=seed, kernel=registry.kernel).attach(registry)
     made = modules.create_all(registry)
     plan, pilo, visual = PlanClient(made["plan"]), PiloClient(made["pilo"]), VisualClient(made["visual"])
     xmin, xmax, ymin, ymax = world.bounds

@@ -70,7 +70,7 @@ def _listed(manifest: Path) -> set[str]:
 
 
 def describe_sources(paths: list[str]) -> str:
-    """`examples/hilare/*.spec (12 files)` rather than twelve names on one line."""
+    """`examples/tug/*.spec (9 files)` rather than nine names on one line."""
     folders = sorted({str(PurePosixPath(p).parent) for p in paths})
     if len(paths) == 1:
         return paths[0]

@@ -1,5 +1,5 @@
 """Every top-level name once per kind. Kinds have separate namespaces: a system refers to each
-block through a typed property (`executive: hilare`), so robot and executive may share a name."""
+block through a typed property (`executive: tug`), so robot and executive may share a name."""
 
 from __future__ import annotations
 

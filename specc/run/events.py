@@ -36,7 +36,7 @@ A robot's extension (`specc.run.mission`) may log kinds of its own; these are dr
 | `object-retrieved` | the robot goes for an object | `object`, `x`, `y` (null: none there), ... |
 | `object-taken` | the object is on the robot | `object`, `x`, `y`, `taken` |
 | `trajectory` | a trajectory is planned | `service`, `points` ([x, y] ...) |
-| `model` | a model with certainty cells (Hilare's EXPLOR, Fig 5.11) | `goal` ([x, y] or null), `certainty` (**) |
+| `model` | a model with certainty cells (seed 000's Fig 5.11) | `goal` ([x, y] or null), `certainty` (**) |
 | `mark` | something worth a marker on the path | `label`, `at` (a time of the run) |
 
 (*) the world whole, as `specc.runtime.sim.parse_world` reads it, so a log can be redrawn alone.

@@ -2,9 +2,9 @@
 
 "Stale" is decided by content, not by dates (a fresh clone gives every file the same date): the
 specs are compiled in memory and the package on disk is rewritten only when some file differs.
-A compilation takes about a second for the rover and several for Hilare (whose controller is
-the longest to build), so each one leaves a stamp (in the user's cache): the digests of
-the specs, of the compiler and of every file written. While all three still match, the package
+A compilation takes about a second for a small robot and several for one with a large
+executive (its controller is the longest to build), so each one leaves a stamp (in the user's
+cache): the digests of the specs, of the compiler and of every file written. While all three still match, the package
 is current without compiling; anything else compiles again, so an outdated package never runs.
 """
 
@@ -41,7 +41,7 @@ def ensure_compiled(specs: Path, output: Path) -> Compiled:
     from specc.pipeline import load
 
     if not specs.exists():
-        raise RunError(f"no spec file or folder '{specs}': name a robot's spec folder, e.g. examples/atrv")
+        raise RunError(f"no spec file or folder '{specs}': name a robot's spec folder, e.g. examples/tug")
     stamp = _Stamp(specs, output)
     stamped = stamp.still_current()
     if stamped is not None:

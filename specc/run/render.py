@@ -398,7 +398,7 @@ def service_bars(events: Events) -> list[ServiceBar]:
 
 
 def last_model(events: Events) -> tuple[Certainty | None, tuple[float, float] | None]:
-    """The last `model` event's certainty grid and observation goal (Hilare's EXPLOR writes one
+    """The last `model` event's certainty grid and observation goal (a robot's extension writes one
     at the end, Fig 5.11); nothing when the log has none."""
     model = next((e for e in reversed(events) if e.get("kind") == "model"), None)
     if model is None:

@@ -1,7 +1,7 @@
 """`specc replay RUN`: a run's event log played back as readable lines, and its pictures drawn
 again from the log alone (`specc.run.render`).
 
-    folder, events = load_run(Path("runs/atrv-M1-W2-Robot1-2-s0"))
+    folder, events = load_run(Path("runs/tug-shuttle-hall-Robot1-2-s0"))
     for event in select(events, kinds=("action", "ftplan")):
         print(describe(event))
 """

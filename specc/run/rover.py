@@ -70,6 +70,7 @@ from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
 from specc.run.render import draw_map
 from specc.run.rover_tasks import LINK, MOTION_INIT, MOVE, PAN_TILT, PHOTO, PTU_INIT, TASK_KINDS, task_text
 from specc.runtime import functional as rt
+from specc.runtime.body import RobotConfig
 from specc.runtime.ftplan import (
     HUNG_PLANNER_SECONDS,
     FtPlan,
@@ -88,7 +89,7 @@ from specc.runtime.ftplan.state import SystemState, consequences, constant, cons
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
-from specc.runtime.sim import ATRV, Simulation, Target, Window, World, WorldError, load_world
+from specc.runtime.sim import Simulation, Target, Window, World, WorldError, load_world
 
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"  # where `specc compile examples/atrv -o generated` writes the package
@@ -244,12 +245,18 @@ class AtrvPackage(NamedTuple):
     modules: ModuleType  # atrv.modules
     planner: ModuleType  # atrv.planner
     ftplan: ModuleType  # atrv.ftplan.rover
+    systems: ModuleType  # atrv.systems: the body
+
+    @property
+    def body(self) -> RobotConfig:
+        body: RobotConfig = self.systems.SYSTEMS[ROBOT].body
+        return body
 
 
 def load_package(generated: Path = GENERATED, example: Path = EXAMPLE) -> AtrvPackage:
     """The compiled atrv package imported from `generated`, the codels from `example`."""
     return AtrvPackage(*import_generated(generated, example, ROBOT, CODELS,
-                                         ("modules", "planner", f"ftplan.{FTPLAN_BLOCK}")))
+                                         ("modules", "planner", f"ftplan.{FTPLAN_BLOCK}", "systems")))
 
 
 def resolve_world(world: str | Path | World, worlds: Path = WORLDS) -> World:
@@ -301,11 +308,12 @@ class Rover:
         return getattr(self.clients, module)
 
 
-def build_rover(modules: ModuleType, world: World, seed: int) -> Rover:
-    """The six generated modules with the simulated ATRV in `world` (run_sim.py's `build`)."""
+def build_rover(modules: ModuleType, world: World, seed: int, body: RobotConfig) -> Rover:
+    """The six generated modules with the simulated ATRV (`body`, its system block's) in `world`
+    (run_sim.py's `build`)."""
     registry = rt.Registry()
     try:
-        sim = Simulation(world, ATRV, seed=seed, kernel=registry.kernel).attach(registry)
+        sim = Simulation(world, body, seed=seed, kernel=registry.kernel).attach(registry)
     except WorldError as error:  # what the world asks cannot be built (objects without room)
         raise RunError(str(error)) from None
     made = modules.create_all(registry)
@@ -706,7 +714,7 @@ def check_mission(configuration: str, mission: str, world: str | Path | World, s
     tasks = RoverTasks.of(setup.config, setup.problem, mission, ground)
     # The antenna's windows, and those the picture's time strip shows.
     ground = dataclasses.replace(ground, windows=mission_windows(setup.problem, seed))
-    return CheckedMission(setup, ground, tasks, package.modules)
+    return CheckedMission(setup, ground, tasks, package.modules, package.body)
 
 
 class CheckedMission(NamedTuple):
@@ -714,6 +722,7 @@ class CheckedMission(NamedTuple):
     world: World  # with the windows nature drew
     tasks: RoverTasks
     modules: ModuleType  # the generated atrv.modules
+    body: RobotConfig  # the simulated rover's, as its system block says
 
 
 def prepare_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
@@ -723,7 +732,7 @@ def prepare_mission(configuration: str, mission: str, world: str | Path | World,
     checked = check_mission(configuration, mission, world, seed, generated=generated, example=example,
                             domains=domains)
     return PreparedMission(configuration, mission, seed, checked.setup, checked.world,
-                           build_rover(checked.modules, checked.world, seed), checked.tasks)
+                           build_rover(checked.modules, checked.world, seed, checked.body), checked.tasks)
 
 
 def run_rover_mission(configuration: str, mission: str, world: str | Path | World, seed: int = 0, *,
@@ -749,7 +758,7 @@ def run_rover_mission(configuration: str, mission: str, world: str | Path | Worl
     journal = _Journal(log, progress, len(SystemState.from_problem(setup.problem).goals))
     executor = SimExecutor(rover, prepared.tasks, journal.emit)
     started = time.perf_counter()
-    log.emit(rover.kernel.now, "mission-start", robot=ROBOT, body=dataclasses.asdict(ATRV),
+    log.emit(rover.kernel.now, "mission-start", robot=ROBOT, body=dataclasses.asdict(rover.sim.robot),
              configuration=configuration, mission=mission,
              **world_fields(prepared.world), seed=seed, timing=timing, policy=setup.config.policy,
              planners=[f"{p.name} ({p.domain})" for p in setup.config.planners],

@@ -1,9 +1,9 @@
 """One run of a compiled robot, as `specc run` does it: compile if stale, run the mission, and
 leave a run folder behind.
 
-    outcome = run_in_folder(RunRequest(Path("examples/atrv"), mission="M1", world="W2",
+    outcome = run_in_folder(RunRequest(Path("examples/tug"), mission="shuttle", world="hall",
                                        configuration="Robot1/2"))
-    outcome.folder            # runs/atrv-M1-W2-Robot1-2-s0/
+    outcome.folder            # runs/tug-shuttle-hall-Robot1-2-s0/
     outcome.report["outcome"], outcome.summary, outcome.pictures
 
 The folder holds `events.jsonl` (the event log, written as the run goes, so a run that crashes
@@ -94,7 +94,7 @@ def compile_robot(specs: Path, generated: Path, note: Callable[[str], None] | No
 
     if not specs.is_dir():
         raise RunError(f"'{specs}' is not a robot's spec folder: give the folder holding its specs, codels "
-                       "and worlds, e.g. examples/atrv")
+                       "and worlds, e.g. examples/tug")
     compiled = ensure_compiled(specs, generated)
     if compiled.rewritten and note is not None:
         note(f"compiled {specs} into {compiled.folder} (it was stale)")
@@ -124,7 +124,7 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     RunError when one is wrong. Nothing is written."""
     from specc.run.mission import load_robot
 
-    if robot in LEGACY_RUNNERS and not _has_systems(request.generated, robot):
+    if legacy_runner(robot, request):
         plan = _plan_rover(request)
     else:
         plan = _plan_system(load_robot(request.generated, request.specs, robot), request)
@@ -199,8 +199,15 @@ class _Plan:
     run: Callable[[EventLog, Progress | None], tuple[dict[str, Any], str]]
 
 
-def _has_systems(generated: Path, robot: str) -> bool:
-    return (generated / robot / "systems" / "__init__.py").is_file()
+def legacy_runner(robot: str, request: RunRequest) -> bool:
+    """Whether `robot` runs through a runner of its own: its system block declares no mission yet."""
+    from specc.run.mission import load_robot
+
+    if robot not in LEGACY_RUNNERS:
+        return False
+    if not (request.generated / robot / "systems" / "__init__.py").is_file():
+        return True
+    return not load_robot(request.generated, request.specs, robot).system.missions
 
 
 def _plan_system(robot: Any, request: RunRequest) -> _Plan:

@@ -1,13 +1,13 @@
 """`specc table`: every mission x world x configuration x seed of a robot run, one run folder
 each, and the table of their measures.
 
-    table = sweep(Path("examples/atrv"), missions=["M1", "M2"], worlds=["W1"], configurations=["Robot1"])
-    table.rows          # specc.run.measures.MeanMeasures, one per configuration x mission x world
+    table = sweep("tug", RunRequest(Path("examples/tug")), missions=["shuttle"], worlds=["hall", "crowded"])
+    table.missions      # one MissionRow per mission x world x configuration (the rover's: table.rows)
     table.failures      # the runs whose mission failed, with why and their folder
 
 For a robot run from its system block, one row per mission x world over the seeds: how many
 were tried, how many succeeded, the mean time of the successful ones, and the means of the
-run's figures (its extension's too, e.g. the objects Hilare took). For the rover the rows are
+run's figures (its extension's too, e.g. the objects a hunt took). For the rover the rows are
 the means of seed 004 §4.1.4 (`specc.run.measures`). Every run keeps its folder (log, report;
 pictures on request) so each failure can be read in its log.
 """
@@ -25,7 +25,7 @@ from typing import Any
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
 from specc.run.mission import load_robot
-from specc.run.session import LEGACY_RUNNERS, RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
+from specc.run.session import RunCrashed, RunOutcome, RunRequest, legacy_runner, plan_run, run_planned
 from specc.runtime.ftplan import planner_processes_kept
 
 MISSIONS = ("M1", "M2", "M3", "M4")
@@ -108,7 +108,7 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
     in its own world."""
     if not seeds:
         raise RunError("no seed to run: give at least one")
-    legacy = robot in LEGACY_RUNNERS and not (base.generated / robot / "systems").is_dir()
+    legacy = legacy_runner(robot, base)
     if legacy:
         requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
                     for c, m, w, s in itertools.product(configurations or CONFIGURATIONS, missions or MISSIONS,

@@ -65,8 +65,11 @@ class RobotConfig:
         for angles), every other key at its default. KeyError for a key that is no body key."""
         converted: dict[str, Any] = {}
         for key, value in values.items():
-            unit = BODY_KEYS[key].unit
-            converted[key] = math.radians(value) if unit in (ANGLE, TURN_RATE) else value
+            spec = BODY_KEYS[key]
+            if spec.is_count:
+                converted[key] = int(value)
+            else:  # a float field holds a float (`mass: 120` is 120.0), as a log writes it
+                converted[key] = math.radians(value) if spec.unit in (ANGLE, TURN_RATE) else float(value)
         return cls(name=name, **converted)
 
 

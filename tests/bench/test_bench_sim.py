@@ -22,7 +22,10 @@ import pymunk
 import pytest
 
 from specc.runtime import functional as rt
-from specc.runtime.sim import HILARE, Simulation, load_world
+from specc.runtime.sim import Simulation, load_world
+from tests.conftest import hilare
+
+HILARE = hilare().system.body  # examples/hilare/system.spec's body block
 
 pytestmark = pytest.mark.bench
 

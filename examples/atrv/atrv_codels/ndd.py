@@ -43,10 +43,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from specc.runtime.sim import ATRV
+from atrv_codels import LENGTH, WIDTH
+
 
 PERIOD = 0.1  # s, NavTask period
-HALF_LENGTH, HALF_WIDTH = ATRV.length / 2.0, ATRV.width / 2.0  # m, the ATRV's body (1.05 m x 0.65 m)
+HALF_LENGTH, HALF_WIDTH = LENGTH / 2.0, WIDTH / 2.0  # m, the ATRV's body (1.05 m x 0.65 m)
 RADIUS = math.hypot(HALF_LENGTH, HALF_WIDTH)  # its bounding circle: what turning in place sweeps
 MARGIN = 0.15  # m kept between that circle and obstacles along a chosen direction
 CLEARANCE = RADIUS + MARGIN  # the disc a direction's free length is measured with

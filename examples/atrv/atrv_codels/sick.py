@@ -10,12 +10,13 @@ import math
 
 import numpy as np
 
-from specc.runtime.sim import ATRV
+from atrv_codels import LENGTH
+
 
 BEAMS = 181
 FIELD = math.pi  # rad, centred on the heading
 MAX_RANGE = 30.0  # m (SICK LMS)
-MOUNT = ATRV.length / 2.0  # m from the centre to the front edge, where ranges start
+MOUNT = LENGTH / 2.0  # m from the centre to the front edge, where ranges start
 FALLBACK_RANGE = 20.0  # m: the far walls of note 3, when no simulator gives a scan
 
 

@@ -3,7 +3,7 @@ their own processes, a planning watchdog, a plan analyzer, action-failure detect
 verification, successive (Fig 3.1) and concurrent (Fig 3.2) recovery.
 
     from specc.runtime.ftplan import FtPlan, ProcessPool, ScriptedExecutor, mission_setup
-    setup = mission_setup(rover.CONFIGURATIONS, "Robot1/2", "M1", atrv.planner)
+    setup = mission_setup(depot.CONFIGURATIONS, "Robot1/2", "shuttle", robot.planner)  # generated modules
     with ProcessPool(planners_as_run(setup.config, "model"), setup.domains) as pool:
         result = FtPlan(setup.config, setup.problem, pool, ScriptedExecutor(), problems=setup.problems,
                         wall_limit=HUNG_PLANNER_SECONDS).run()

@@ -8,7 +8,7 @@ mission runs as fast as the computer allows (seed 004 §4.2.2 could only run Gaz
 from __future__ import annotations
 
 from specc.runtime.sim.devices import reliability
-from specc.runtime.sim.rover import ATRV, HILARE, ROBOTS, RobotConfig, Rover
+from specc.runtime.sim.rover import RobotConfig, Rover
 from specc.runtime.sim.simulation import Simulation, Trace
 from specc.runtime.sim.world import (
     Circle,
@@ -22,5 +22,5 @@ from specc.runtime.sim.world import (
     world_data,
 )
 
-__all__ = ["ATRV", "HILARE", "ROBOTS", "Circle", "Polygon", "RobotConfig", "Rover", "Simulation", "Target",
+__all__ = ["Circle", "Polygon", "RobotConfig", "Rover", "Simulation", "Target",
            "Trace", "Window", "World", "WorldError", "load_world", "parse_world", "reliability", "world_data"]

@@ -69,8 +69,8 @@ class Wheels:
 
 
 class RangeSensor:
-    """Range finders around or in front of the robot, occluded by the world's obstacles: Hilare's
-    ring of sonars, the ATRV's laser scanner. Angles are relative to the robot's heading; each
+    """Range finders around or in front of the robot, occluded by the world's obstacles: a ring
+    of sonars, a laser scanner. Angles are relative to the robot's heading; each
     beam is cast from the robot's centre and its range read from `offset` along it (the body's
     edge), so a reading r puts the echo at r + offset from the centre."""
 

@@ -1,7 +1,7 @@
 """Vectorised ray casting against a world's static edges and circles.
 
-One numpy pass intersects every ray with every edge and circle: for the 32 sonars of Hilare
-that is a few dozen microseconds, where 32 `Space.segment_query_first` calls of pymunk would
+One numpy pass intersects every ray with every edge and circle: for a ring of 32 sonars that
+is a few dozen microseconds, where 32 `Space.segment_query_first` calls of pymunk would
 dominate the simulation step (each crosses the Python/C boundary and allocates a result). At
 that size numpy's cost is per operation, not per element, so the pass is arranged to take few
 operations: the rays of a sensor are its fixed unit directions turned by the heading, and one

@@ -23,18 +23,6 @@ from specc.runtime.sim.world import Circle, World
 GRAVITY = 9.81
 
 
-# Hilare 2 (seed 000 §2.3, §5.2): two drive wheels, odometry, a belt of 32 sonars, a camera and a
-# (simulated) arm. Its size and speeds are not in the thesis: INVENTED, typical of the robot.
-HILARE = RobotConfig(name="hilare", radius=0.35, mass=80.0, wheel_base=0.6, max_wheel_speed=0.8,
-                     encoder_noise=0.01, sonars=32, sonar_range=5.0, arm_joints=6)
-# The ATRV of seed 004 §4.1.1: a laser scanner (SICK), odometry (RFLEX), a pan-tilt camera and an
-# antenna. Size: an iRobot ATRV is about 1.05 m x 0.65 m; speed limit INVENTED (0.5 m/s).
-ATRV = RobotConfig(name="atrv", radius=0.62, length=1.05, width=0.65, mass=120.0, wheel_base=0.55,
-                   max_wheel_speed=0.6, encoder_noise=0.01, laser_beams=181, laser_range=30.0,
-                   camera_r_min=0.5, camera_r_max=8.0, camera_open=math.radians(50))
-ROBOTS = {r.name: r for r in (HILARE, ATRV)}
-
-
 class Rover:
     def __init__(self, world: World, config: RobotConfig, rng: np.random.Generator,
                  blocked_after: float = 2.0) -> None:

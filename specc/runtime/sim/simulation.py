@@ -1,6 +1,6 @@
 """A simulated robot in a world, stepping on the event kernel the modules run on.
 
-    sim = Simulation(load_world("worlds/W2.toml"), ATRV, seed=7)
+    sim = Simulation(load_world("worlds/W2.toml"), RobotConfig(radius=0.3, laser_beams=181), seed=7)
     sim.attach(registry)          # codels reach the devices as `sdi.hardware`
     registry.kernel.run_for(60.0)
     sim.trace                     # what happened, for pictures and tests
@@ -22,7 +22,7 @@ import numpy as np
 from specc.runtime.kernel import Kernel
 from specc.runtime.sim.devices import Antenna, Arm, Camera, Encoders, PanTilt, RangeSensor, Wheels
 from specc.runtime.sim.rays import RayCaster
-from specc.runtime.sim.rover import HILARE, RobotConfig, Rover
+from specc.runtime.sim.rover import RobotConfig, Rover
 from specc.runtime.sim.world import World, WorldError
 
 PHYSICS_PRIORITY = -1000  # before the exec tasks of the same instant
@@ -50,9 +50,10 @@ class Trace:
 
 
 class Simulation:
-    def __init__(self, world: World, robot: RobotConfig = HILARE, *, seed: int = 0, kernel: Kernel | None = None,
+    def __init__(self, world: World, robot: RobotConfig | None = None, *, seed: int = 0, kernel: Kernel | None = None,
                  physics_period: float = 0.025, trace_period: float = 0.1) -> None:
         self.world = world
+        robot = robot if robot is not None else RobotConfig()
         self.robot = robot
         self.seed = seed
         self.kernel = kernel or Kernel()

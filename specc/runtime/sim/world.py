@@ -5,7 +5,7 @@ robot lives among (seed 000 §5.6, seed 004 §4.1.2.1), read from TOML.
 [world]                      # optional
 name = "W2"
 description = "a few cylinders"
-[room]                       # walls around [0, width] x [0, height] (Hilare's room) ...
+[room]                       # walls around [0, width] x [0, height] ...
 width = 12.0
 height = 9.0
 [bounds]                     # ... or around [xmin, xmax] x [ymin, ymax]
