@@ -229,7 +229,8 @@ systems = st.builds(
                              plan=st.none() | refs, doc=st.none() | strings, goals=small(goals))),
     bindings=st.none() | st.builds(m.Bindings, entries=small(st.builds(
         m.Binding, task=upper, args=small(ixexprs), kind=st.sampled_from(["goal", "service", "request"]),
-        target=refs | dotted, target_args=small(ixexprs)))))
+        target=refs | dotted, target_args=small(ixexprs),
+        report=st.none() | st.builds(m.BindingReport, name=upper, values=small(dotted))))))
 
 items = st.one_of(modules, executives, rule_bases, procedures, planning_items, ftplans, systems)
 source_files = st.builds(m.SourceFile, path=st.just("generated.spec"), items=small(items, 1, 3))

@@ -87,6 +87,7 @@ def start(sdi, request):
 def step(sdi, request):
     sim = sdi.hardware
     x, y, theta = sim.pose
+    sdi.x, sdi.y = x, y  # the Pose poster
     dx, dy = request.x - x, request.y - y
     if math.hypot(dx, dy) < ARRIVED:
         sim.wheels.drive(0.0, 0.0)
@@ -112,6 +113,8 @@ PLANNING = """
 domain carting {
   attribute AT() { ?value in {DOCK, A, B}; }
   attribute DELIVERED(?p) { ?p in {A, B}; ?value in {NO, YES}; }
+  attribute POS_X() { ?value in [-100, 100]; }
+  attribute POS_Y() { ?value in [-100, 100]; }
   task GOTO(?from, ?to) (t_start, t_end) {
     ?from in {DOCK, A, B};
     ?to in {DOCK, A, B};
@@ -143,6 +146,7 @@ ftplan rounds {
   state {
     on ended GOTO(?from, ?to) => AT() := ?to;
     on ended DROP(?p) => DELIVERED(?p) := YES;
+    on report WHERE(?x, ?y) => POS_X() := ?x, POS_Y() := ?y;
   }
   mission round_a { p1: round_a; }
 }
@@ -152,7 +156,7 @@ PLANNED_SPEC = SPEC.replace("""  mission deliver { world: shop; horizon: 120 s; 
   planning: rounds;
   mission round { world: shop; plan: round_a; horizon: 300 s; }
   bindings {
-    GOTO(?from, ?to) => goal GO-PLACE(?to);
+    GOTO(?from, ?to) => goal GO-PLACE(AT()) report WHERE(drive.Pose.x, drive.Pose.y);
     DROP(?p) => request drive.Drop(?p);
   }
 }""").replace("""  exec_task Motion""", """  request Drop {
@@ -163,7 +167,8 @@ PLANNED_SPEC = SPEC.replace("""  mission deliver { world: shop; horizon: 120 s; 
     codel exec: drop;
   }
   exec_task Motion""").replace("""module drive {""", """module drive {
-  internal_data { dropCycles: int; }""").replace("""  ka Goto {""", """\
+  internal_data { dropCycles: int; x: double; y: double; }
+  poster Pose { update: auto; data: x, y; activity: step; }""").replace("""  ka Goto {""", """\
   ka GoDock { invocation: !(GO-PLACE DOCK); body { !(GO 1 1); } }
   ka GoA { invocation: !(GO-PLACE A); body { !(GO 4 4); } }
   ka GoB { invocation: !(GO-PLACE B); body { !(GO 2 5); } }
@@ -309,6 +314,10 @@ def test_ftplan_plans_and_the_bindings_carry_each_action_out(planned_cart: Path)
     last = [e for e in events if e["kind"] == "pose"][-1]
     assert math.hypot(last["x"] - 1, last["y"] - 1) < 0.2  # back at the dock
     assert (folder / "timeline.png").is_file()
+    # After each move, where DRIVE's Pose poster says the cart stands, reported to FTplan.
+    reports = [e["text"] for e in events if e["kind"] == "ftplan" and e["event"] == "report"
+               and e["text"].startswith("report WHERE")]
+    assert len(reports) == 2, reports
 
 
 def test_an_action_past_its_planned_duration_is_stopped_and_fails(tmp_path: Path) -> None:
@@ -333,10 +342,14 @@ def test_an_action_past_its_planned_duration_is_stopped_and_fails(tmp_path: Path
 @pytest.mark.parametrize(("change", "code"), [
     (("    DROP(?p) => request drive.Drop(?p);\n", ""), "missing-binding"),
     (("request drive.Drop(?p)", "request drive.Drop(?p, 2)"), "arity-mismatch"),
-    (("goal GO-PLACE(?to)", "goal GO-PLAZA(?to)"), "undefined-goal"),
-    (("goal GO-PLACE(?to)", "goal GO-PLACE(?where)"), "unbound-variable"),
+    (("goal GO-PLACE(AT())", "goal GO-PLAZA(AT())"), "undefined-goal"),
+    (("goal GO-PLACE(AT())", "goal GO-PLACE(?where)"), "unbound-variable"),
     (("DROP(?p) => request", "DROOP(?p) => request"), "undefined-task"),
     (("plan: round_a;", "plan: round_b;"), "undefined-mission"),
+    (("goal GO-PLACE(AT())", "goal GO-PLACE(AT_PLACE())"), "undefined-attribute"),
+    (("report WHERE(drive.Pose.x, drive.Pose.y)", "report THERE(drive.Pose.x, drive.Pose.y)"), "undefined-report"),
+    (("report WHERE(drive.Pose.x, drive.Pose.y)", "report WHERE(drive.Pose.x)"), "arity-mismatch"),
+    (("report WHERE(drive.Pose.x, drive.Pose.y)", "report WHERE(drive.Place.x, drive.Pose.y)"), "undefined-poster"),
 ])
 def test_bindings_that_cannot_run_are_refused_by_check(tmp_path: Path, change: tuple[str, str], code: str) -> None:
     old, new = change

@@ -6,14 +6,14 @@ from __future__ import annotations
 import posixpath
 from dataclasses import dataclass
 
-from specc.analysis.ftplan import terms
+from specc.analysis.ftplan import term, terms
 from specc.backends.env import render
 from specc.backends.manifest import HEADER, Output
 from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
-from specc.runtime.ftplan.config import Var
-from specc.runtime.system import BindingSpec, MissionSpec
+from specc.runtime.ftplan.config import Term, Var
+from specc.runtime.system import BindingSpec, MissionSpec, ReportSpec, StateValue
 from specc.syntax.printer import goal as goal_text
 from specc.syntax.printer import prop_value
 
@@ -93,9 +93,17 @@ class SystemView:
     def bindings(self) -> list[tuple[str, str]]:
         """(task, BindingSpec), each as a Python literal."""
         entries = self.system.bindings.entries if self.system.bindings is not None else ()
-        return [(repr(b.task), literal(BindingSpec(b.task, terms(b.args), b.kind, b.target.text,
-                                                   terms(b.target_args)), (Var,), 8, len(repr(b.task)) + 2))
-                for b in entries]
+        return [(repr(b.task), literal(BindingSpec(
+            b.task, terms(b.args), b.kind, b.target.text, tuple(binding_argument(a) for a in b.target_args),
+            ReportSpec(b.report.name, tuple(v.text for v in b.report.values)) if b.report is not None else None),
+            (Var, StateValue, ReportSpec), 8, len(repr(b.task)) + 2)) for b in entries]
+
+
+def binding_argument(e: m.IxExpr) -> Term | StateValue:
+    """A ?variable or a constant, or `ATTR(...)`: FTplan's state after the action."""
+    if isinstance(e, m.IxCall):
+        return StateValue(e.function, terms(e.args))
+    return term(e)
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> None:

@@ -179,12 +179,17 @@ def check_bound(ctx: Context, binding: tuple[m.IxExpr, ...], used: tuple[m.IxExp
 
 
 def planned_tasks(ctx: Context, ftplan: m.FtPlan) -> DomainTables:
-    """Every task the planners of `ftplan` may put in a plan (their domains', includes expanded)."""
+    """Every task the planners of `ftplan` may put in a plan (their domains', includes expanded),
+    and the attributes of FTplan's state (those of the planners without a view)."""
     found = DomainTables()
+    viewed = viewed_planners(ftplan)
     for planner in ftplan.planners:
         domain = ctx.named(m.Domain).get(planner.domain.text) if planner.domain is not None else None
         if domain is not None:
-            found.tasks.update(tables(_quiet(ctx), domain.members).tasks)
+            tabled = tables(_quiet(ctx), domain.members)
+            found.tasks.update(tabled.tasks)
+            if planner.name not in viewed:
+                found.attributes.update(tabled.attributes)
     return found
 
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from specc.check.codels import python_functions
 from specc.check.context import Context
-from specc.check.executive import resolve_request
-from specc.check.ftplan import check_bound, check_task, check_terms, planned_tasks
+from specc.check.executive import resolve_poster, resolve_request
+from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
@@ -169,11 +169,20 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
                        "G(...); }'", (system.bindings or system).span)
     goals = achievable_goals(supervisor) if supervisor is not None else {}
     services = {s.name: s for s in executive.services} if executive is not None else {}
+    reports = {u.task: len(u.args) for u in ftplan.state_updates if u.report == "report"}
     for binding in bindings:
         check_task(ctx, tasks, binding.task, binding.span, binding.args)
-        check_terms(ctx, (*binding.args, *binding.target_args))
-        check_bound(ctx, binding.args, binding.target_args, f"task '{binding.task}'")
+        plain = tuple(a for a in binding.target_args if not isinstance(a, m.IxCall))
+        # `ATTR(...)`: FTplan's state after the action, an attribute of its vocabulary
+        after = [a for a in binding.target_args if isinstance(a, m.IxCall)]
+        for call in after:
+            check_attribute(ctx, tasks, call.function, len(call.args), call.span)
+        inner = tuple(x for call in after for x in call.args)
+        check_terms(ctx, (*binding.args, *plain, *inner))
+        check_bound(ctx, binding.args, (*plain, *inner), f"task '{binding.task}'")
         check_binding_target(ctx, system, binding, goals, services)
+        if binding.report is not None:
+            check_binding_report(ctx, binding.report, reports)
 
 
 def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goals: dict[str, int],
@@ -203,6 +212,21 @@ def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goa
         if request is not None and len(request.inputs) != given:
             ctx.report("arity-mismatch", f"request '{target.text}' takes {len(request.inputs)} input(s) "
                        f"({', '.join(i.name for i in request.inputs) or 'none'}), {given} given", target.span)
+
+
+def check_binding_report(ctx: Context, report: m.BindingReport, reports: dict[str, int]) -> None:
+    """A report FTplan's state rules read (`on report NAME(...)`), of posters that exist."""
+    if report.name not in reports:
+        ctx.unknown("undefined-report", "report", report.name, reports, report.span,
+                    " (no `on report` rule of the ftplan block reads it)")
+    elif reports[report.name] != len(report.values):
+        ctx.report("arity-mismatch", f"the state rules read {report.name} with {reports[report.name]} value(s), "
+                   f"{len(report.values)} given", report.span)
+    for value in report.values:
+        if len(value.parts) < 3:
+            ctx.report("bad-reference", f"'{value.text}' should be written module.Poster.field", value.span)
+        else:
+            resolve_poster(ctx, value)
 
 
 def achievable_goals(procedures: m.Procedures) -> dict[str, int]:

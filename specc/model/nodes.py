@@ -949,7 +949,16 @@ class Binding(Node):
     args: tuple[IxExpr, ...] = ()
     kind: str  # goal | service | request
     target: Ref
-    target_args: tuple[IxExpr, ...] = ()
+    target_args: tuple[IxExpr, ...] = ()  # ?variables, constants, or ATTR(...): FTplan's state after the action
+    report: BindingReport | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class BindingReport(Node):
+    """`report NAME(module.Poster.field, ...)`: posters read when the action is over, reported to FTplan."""
+
+    name: str
+    values: tuple[Ref, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -366,7 +366,7 @@ def _plan_and_execute(robot: Robot, setup: Any, timing: str, journal: FtplanJour
     from specc.runtime.ftplan import HUNG_PLANNER_SECONDS, FtPlan, ProcessPool, planners_as_run
 
     executor = BoundExecutor(registry.kernel, robot.system.bindings, registry, executive, supervisor, sim.rover,
-                             journal.emit)
+                             setup.config, journal.emit)
     with ProcessPool(planners_as_run(setup.config, timing), setup.domains) as pool:
         ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems,
                         wall_limit=HUNG_PLANNER_SECONDS if timing == "model" else None)

@@ -30,11 +30,13 @@ from typing import Any
 from specc.run.recording import Emit
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
-from specc.runtime.ftplan.config import Var
+from specc.runtime.ftplan.config import FtPlanConfig, Var
 from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precedences, Report
-from specc.runtime.ftplan.facts import match, substitute
+from specc.runtime.ftplan.facts import FactKey, match, substitute
+from specc.runtime.ftplan.state import consequences
+from specc.runtime.ftplan.view import View
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
-from specc.runtime.system import BindingSpec
+from specc.runtime.system import BindingSpec, StateValue
 
 # An action whose plan gives it no finite longest duration is stopped after this long: a faulty
 # model's action must not run for ever.
@@ -246,13 +248,25 @@ class Call:
         return f"{self.target}({', '.join(format_value(a) for a in self.args)})"
 
 
-def bound_call(binding: BindingSpec, action: Action) -> Call:
-    """The call `binding` makes of `action`; ValueError when the action's arguments do not fit."""
+def bound_call(binding: BindingSpec, action: Action, after: Callable[[], Mapping[FactKey, Value]]) -> Call:
+    """The call `binding` makes of `action`; `after()` gives FTplan's state changes when the action
+    ends (for `ATTR(...)` arguments). ValueError when the action's arguments do not fit."""
     found = match(binding.args, action.args)
     if found is None:
         raise ValueError(f"{action.text()} does not match the binding of {binding.task}"
                          f"({', '.join(_term_text(a) for a in binding.args)})")
-    return Call(binding.kind, binding.target, tuple(substitute(a, found) for a in binding.target_args))
+    values: list[Value] = []
+    for arg in binding.target_args:
+        if isinstance(arg, StateValue):
+            key = (arg.attribute, tuple(substitute(a, found) for a in arg.args))
+            changes = after()
+            if key not in changes:
+                raise ValueError(f"FTplan's state rules do not say what {arg.attribute}"
+                                 f"({', '.join(format_value(v) for v in key[1])}) becomes when {action.text()} ends")
+            values.append(changes[key])
+        else:
+            values.append(substitute(arg, found))
+    return Call(binding.kind, binding.target, tuple(values))
 
 
 def _term_text(term: Any) -> str:
@@ -263,9 +277,11 @@ class BoundExecutor(KernelExecutor):
     """Each action carried out as the system's bindings say (see the module's docstring)."""
 
     def __init__(self, kernel: Any, bindings: Mapping[str, BindingSpec], registry: rt.Registry,
-                 executive: rx.Executive | None, supervisor: Any, robot: Any, emit: Emit | None = None) -> None:
+                 executive: rx.Executive | None, supervisor: Any, robot: Any, config: FtPlanConfig,
+                 emit: Emit | None = None) -> None:
         super().__init__(kernel, emit)
         self.bindings = bindings
+        self.config = config  # FTplan's on the mission: its state rules and its planners' views
         self.registry = registry
         self.executive = executive
         self.supervisor = supervisor
@@ -286,7 +302,7 @@ class BoundExecutor(KernelExecutor):
         try:
             if binding is None:
                 raise ValueError(f"the system binds no way to carry out task {action.task}")
-            call = bound_call(binding, action)
+            call = bound_call(binding, action, lambda: self.effects(plan, action))
         except ValueError as error:
             run.finished, run.why = run.started, f"{action.text()} cannot be carried out: {error}"
             return
@@ -329,6 +345,37 @@ class BoundExecutor(KernelExecutor):
                                         f"{reply.status.value} {reply.report.code}{detail}"
         run.finished = self.kernel.now
         return True
+
+    def effects(self, plan: Plan, action: Action) -> dict[FactKey, Value]:
+        """What FTplan's state becomes when the action ends, in FTplan's vocabulary (through the
+        view of the planner whose model made the plan)."""
+        planner = next((p for p in self.config.planners if p.domain == plan.domain), None)
+        view = View(planner.view) if planner is not None and planner.view else None
+        return dict(consequences(self.config.state_rules, "ended", action.task, action.args, view))
+
+    def reports(self, run: Running) -> list[Report]:
+        """The binding's report (posters read now), then the action's end or failure."""
+        said = super().reports(run)
+        binding = self.bindings.get(run.action.task)
+        if binding is not None and binding.report is not None:
+            try:
+                values = tuple(self._read(path) for path in binding.report.paths)
+            except (ValueError, AttributeError) as error:  # FTplan goes on without it; the log says so
+                self.event(self.kernel.now, "alarm", what="report", detail=f"{binding.report.name}: {error}")
+            else:
+                said.insert(0, Report("report", binding.report.name, values, said[0].time, run.action.id))
+        return said
+
+    def _read(self, path: str) -> Value:
+        """A poster's field, `module.Poster.field.subfield` (a number or a word)."""
+        module, poster, *fields = path.split(".")
+        snapshot = self.registry.read_poster(f"{module}.{poster}")
+        if snapshot is None:
+            raise ValueError(f"poster {module}.{poster} has not been written yet: nothing to report")
+        value: Any = snapshot.data
+        for name in fields:
+            value = getattr(value, name)
+        return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else str(value)
 
     def interrupt(self, run: Running) -> None:
         if run.kind == "goal":

@@ -27,6 +27,23 @@ class MissionSpec:
 
 
 @dataclass(frozen=True)
+class StateValue:
+    """A binding's argument: the value FTplan's state rules give `attribute(args)` when the action
+    ends (in FTplan's vocabulary, whichever planner's task it is)."""
+
+    attribute: str
+    args: tuple[Term, ...] = ()
+
+
+@dataclass(frozen=True)
+class ReportSpec:
+    """`report NAME(module.Poster.field, ...)`: what is reported to FTplan when the action is over."""
+
+    name: str
+    paths: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class BindingSpec:
     """How the planners' task `task` is carried out: `kind` goal (the supervisor achieves the
     goal `target`), service (the executive runs the service `target`) or request (the module
@@ -36,7 +53,8 @@ class BindingSpec:
     args: tuple[Term, ...]  # ?variables (or constants the action's arguments must equal)
     kind: str
     target: str
-    target_args: tuple[Term, ...] = ()
+    target_args: tuple[Term | StateValue, ...] = ()
+    report: ReportSpec | None = None
 
 
 @dataclass(frozen=True)

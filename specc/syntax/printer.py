@@ -706,8 +706,10 @@ class Printer:
             if node.bindings is not None:
                 with self.block("bindings", node.bindings.span):
                     for b in node.bindings.entries:
-                        self.line(f"{b.task}({ix_args(b.args)}) => {b.kind} {b.target.text}({ix_args(b.target_args)});",
-                                  b.span)
+                        report = f" report {b.report.name}({', '.join(v.text for v in b.report.values)})" \
+                            if b.report is not None else ""
+                        self.line(f"{b.task}({ix_args(b.args)}) => {b.kind} {b.target.text}({ix_args(b.target_args)})"
+                                  f"{report};", b.span)
 
 
 def _runs(items: Iterable[Any], key: Callable[[Any], str]) -> list[tuple[str, list[Any]]]:
