@@ -115,8 +115,12 @@ rule_bases = st.builds(
 logic_vars = st.builds(m.LogicVar, name=hyphenated.map(lambda s: "$" + s))
 program_vars = st.builds(m.ProgramVar, name=hyphenated.map(lambda s: "@" + s))
 symbols = st.builds(m.Ref, parts=st.tuples(hyphenated))
+# A PRS argument may be negative (`!(GO -3 4)`); -0.0 would print as -0, read back as 0.
+negative_numbers = st.builds(m.Number, value=st.one_of(
+    st.integers(-10**6, -1), st.floats(min_value=-1e6, max_value=-1e-3, allow_nan=False)))
 sexps = st.recursive(
-    st.builds(m.SExp, head=hyphenated, args=small(st.one_of(logic_vars, program_vars, symbols, numbers, strings))),
+    st.builds(m.SExp, head=hyphenated, args=small(st.one_of(logic_vars, program_vars, symbols, numbers, strings,
+                                                           negative_numbers))),
     lambda inner: st.builds(m.SExp, head=st.one_of(hyphenated, st.sampled_from(["&", "|", "~", "<", "+", "="])),
                             args=small(st.one_of(inner, logic_vars, symbols))),
     max_leaves=5)

@@ -84,6 +84,11 @@ class Builder(Transformer[Token, Any]):
     def number(self, meta: Meta, children: list[Token]) -> m.Number:
         return m.Number(value=self.number_value(children[0]), span=self.span(meta))
 
+    def signed_number(self, meta: Meta, children: list[Token]) -> m.Number:
+        sign, number = children
+        value = self.number_value(number)
+        return m.Number(value=-value if str(sign) == "-" else value, span=self.span(meta))
+
     def duration(self, meta: Meta, children: list[Any]) -> m.Duration:
         number, unit = children
         return m.Duration(value=self.number_value(number), unit=unit, span=self.span(meta))
