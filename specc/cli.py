@@ -769,7 +769,8 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
 def mutants_command(
         specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder (or files), e.g. "
                                                                    "examples/tug.", show_default=False)],
-        domain: Annotated[str, typer.Option(help="The planning domain to mutate.")] = "model1",
+        domain: Annotated[Optional[str], typer.Option(help="The planning domain to mutate (default: the one "
+                                                            "the FTplan block's first planner plans in).")] = None,
         kinds: Annotated[Optional[list[str]], typer.Option(
             "--class", help="Keep this mutation class: numeric, variable, value, operator, deletion (repeatable; "
                             "default: all).")] = None,
@@ -814,7 +815,7 @@ def mutants_command(
         chosen = next((x for x in wanted if x.id == show), None)
         if chosen is None:
             span = f"{wanted[0].id} .. {wanted[-1].id}" if wanted else "none"
-            raise _run_error(ValueError(f"no mutant '{show}' of {domain} (its mutants: {span})"), 2)
+            raise _run_error(ValueError(f"no mutant '{show}' of {target.domain.name} (its mutants: {span})"), 2)
         found = verdict(target, chosen.text) if chosen.text != target.original_text else (
             "identical", "prints as the original")
         out.print(f"{chosen.id} [{chosen.kind}] {chosen.description}", markup=False)
@@ -826,10 +827,10 @@ def mutants_command(
     with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} checked") as progress:
         def step(done: int, total: int) -> None:
             if progress is not None:
-                progress(done, total, f"checking {domain}'s mutants")
+                progress(done, total, f"checking {target.domain.name}'s mutants")
 
         result = keep_valid(wanted, workers=count, progress=step)
-    table = Table(title=f"mutants of {domain} ({target.source.path})")
+    table = Table(title=f"mutants of {target.domain.name} ({target.source.path})")
     for k, column in enumerate(("class", "generated", "identical", "duplicate", "failed check", "equivalent",
                                 "kept")):
         table.add_column(column, justify="left" if k == 0 else "right")

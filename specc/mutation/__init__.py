@@ -6,7 +6,7 @@ numeric, variable, value, operator, deletion; see `specc.mutation.edits`), each 
 back as spec text, and the text goes through the same parse and checks as `specc check`.
 
     from specc.mutation import enumerate_mutants, keep_valid, mutant_domain
-    mutants = enumerate_mutants(Path("examples/atrv"), domain="model1")
+    mutants = enumerate_mutants(Path("examples/tug"), domain="warehouse")
     kept = keep_valid(mutants)                # counts per class: kept.counts()
     chosen = kept.sample(28, seed=1)          # stratified by class
     Planner(mutant_domain(chosen[0])).plan(problem)

@@ -207,11 +207,12 @@ def draw_kept(mutants: Sequence[Mutant], n: int, seed: int = 0,
 # ---------------------------------------------------------------- enumeration
 
 
-def mutation_target(robot: Robot, domain: str = "model1", base_dirs: dict[str, Path] | None = None
+def mutation_target(robot: Robot, domain: str | None = None, base_dirs: dict[str, Path] | None = None
                     ) -> MutationTarget:
-    """The domain `domain` of the robot: spec files or folders (loaded and checked), a `Loaded`,
-    or a `Program` (its files found again from the paths its spans name, for the codel checks,
-    unless `base_dirs` says where each file is)."""
+    """The domain `domain` of the robot (default: the one its FTplan block's first planner plans
+    in, else its only domain): spec files or folders (loaded and checked), a `Loaded`, or a
+    `Program` (its files found again from the paths its spans name, for the codel checks, unless
+    `base_dirs` says where each file is)."""
     sources: dict[str, str] = {}
     comments: dict[str, list[Token]] = {}
     if isinstance(robot, m.Program):
@@ -229,6 +230,7 @@ def mutation_target(robot: Robot, domain: str = "model1", base_dirs: dict[str, P
         sources, comments = loaded.sources, loaded.comments
     if errors:
         raise MutationError(f"{_first_error(errors)}; the specs must check clean to be mutated")
+    domain = domain if domain is not None else default_domain(program)
     for file_index, source in enumerate(program.files):
         for item_index, item in enumerate(source.items):
             if isinstance(item, m.Domain) and item.name == domain:
@@ -238,6 +240,18 @@ def mutation_target(robot: Robot, domain: str = "model1", base_dirs: dict[str, P
                                       tuple(comments.get(source.path, ())))
     known = sorted(i.name for i in program.items if isinstance(i, m.Domain))
     raise MutationError(f"no domain '{domain}' in these specs (domains: {', '.join(known) or 'none'})")
+
+
+def default_domain(program: m.Program) -> str:
+    """The domain the first planner of the robot's FTplan block plans in, else its only domain."""
+    planners = [p for item in program.items if isinstance(item, m.FtPlan) for p in item.planners
+                if p.domain is not None]
+    if planners:
+        return planners[0].domain.text  # type: ignore[union-attr]
+    domains = sorted(i.name for i in program.items if isinstance(i, m.Domain))
+    if len(domains) != 1:
+        raise MutationError(f"name the domain to mutate with --domain (domains: {', '.join(domains) or 'none'})")
+    return domains[0]
 
 
 def _written(source: m.SourceFile) -> tuple[dict[str, str], dict[str, list[Token]]]:
@@ -261,7 +275,7 @@ def _first_error(errors: list[Diagnostic]) -> str:
     return f"{first.span}: {first.message} [{first.code}]{more}"
 
 
-def enumerate_mutants(robot: Robot | MutationTarget, domain: str = "model1", *,
+def enumerate_mutants(robot: Robot | MutationTarget, domain: str | None = None, *,
                       classes: Iterable[str] | None = None, random_values: int = 3,
                       seed: int = 0) -> list[Mutant]:
     """Every mutant of the domain, in a deterministic order (class by class, then in source
