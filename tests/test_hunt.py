@@ -201,14 +201,14 @@ def test_objects_lie_where_hilare_can_stand_and_move_with_the_seed() -> None:
     from hilare_codels import visual
 
     room = load_world(EXAMPLES / "hilare" / "worlds" / "room.toml")
-    placed = extension.prepare(room, 4)
+    placed = extension.place_objects(room, 4)
     assert placed.random_objects == 0 and len(placed.objects) == room.random_objects == 10
     standing = set(visual.standing_cells(visual.free_cells(room), room.bounds))
     cells = {int(y // visual.CELL) * visual.NX + int(x // visual.CELL) for x, y in placed.objects}
     assert len(cells) == 10 and cells <= standing
     assert min(math.dist(a, b) for a in placed.objects for b in placed.objects if a != b) >= 0.45
-    assert extension.prepare(room, 4) == placed
-    assert extension.prepare(room, 5).objects != placed.objects
+    assert extension.place_objects(room, 4) == placed
+    assert extension.place_objects(room, 5).objects != placed.objects
 
 
 def test_a_ghost_object_fails_the_hunt_although_its_goal_succeeded() -> None:

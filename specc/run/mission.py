@@ -15,7 +15,8 @@ relative to it, as the specs name their worlds.
 A robot's own Python beyond its codels, when a run needs it, is its system's `extension:` module
 (beside the codels), whose functions, each optional, the runner calls:
 
-- `prepare(world, seed) -> World`: the world as the run's own random draws make it;
+- `prepare(world, setup) -> World`: the world as the run's own random draws make it (`setup`: a
+  `RunSetup`, the seed, the mission, and for a planned mission FTplan's setup: its problem);
 - `attach(run)`: once everything is built, with a `RunContext` (the kernel, simulation, modules,
   executive, supervisor; `run.emit(kind, **fields)` logs an event of its own kind,
   `run.at_end(callback)` is called when the mission ends);
@@ -137,6 +138,16 @@ def load_robot(generated: Path, folder: Path, robot: str, system: str | None = N
     if system not in systems:
         raise RunError(f"robot '{robot}' has no system '{system}' (its systems: {', '.join(systems)})")
     return Robot(robot, folder.resolve(), systems[system], package)
+
+
+@dataclass(frozen=True)
+class RunSetup:
+    """What a run is, before anything is built (an extension's `prepare`)."""
+
+    robot: Robot
+    mission: MissionSpec
+    seed: int
+    planning: Any = None  # specc.runtime.ftplan.MissionSetup for a planned mission (`.problem`...)
 
 
 @dataclass
@@ -273,7 +284,7 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
     prepare = robot.hook("prepare")
     if prepare is not None:  # the robot's own random draws (where its objects lie...)
         try:
-            ground = prepare(ground, seed)
+            ground = prepare(ground, RunSetup(robot, mission, seed, checked.planning))
         except WorldError as error:  # what the world asks cannot be drawn
             raise RunError(str(error)) from None
     events = log if log is not None else EventLog()

@@ -36,7 +36,7 @@ from typing import Any, TypeVar
 
 import pytest
 
-from specc.run.mission import load_robot, run_mission
+from specc.run.mission import RunSetup, load_robot, run_mission
 from specc.run.package import ensure_compiled
 from specc.run.rover import prepare_mission, run_rover_mission
 from specc.runtime.ftplan import ProcessPool
@@ -122,7 +122,7 @@ def robot_row(robot: Any, mission: str, world: str | None, seed: int, label: str
     simulated = result.simulated_time
     ground = load_world(robot.world_file(world or spec.world))
     prepare = robot.hook("prepare")
-    ground = prepare(ground, seed) if prepare is not None else ground
+    ground = prepare(ground, RunSetup(robot, spec, seed)) if prepare is not None else ground
     baseline = bare_simulation(ground, robot.system.body, seed, simulated)
     return Row(f"{label} ({result.outcome})", simulated, wall, None, baseline)
 

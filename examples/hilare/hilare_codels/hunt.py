@@ -3,7 +3,7 @@
 The system block names this module as its `extension:`; specc's generic runner
 (`specc.run.mission`) runs the mission `hunt` (`!(COLLECT-OBJECTS 5)` in the room) and calls:
 
-- `prepare(world, seed)`: the room's objects, placed from the seed on cells where Hilare can
+- `prepare(world, setup)`: the room's objects, placed from the seed on cells where Hilare can
   stand. §5.2.5 assumes "que le centre du robot doit être dans le centre de la cellule de l'objet
   à saisir", and EXPLOR's calcObj refuses any other cell (UNREACHABLE_CELL), which fails the
   take-object cycle and the hunt with it (§5.4.1). (The simulator's own scattering only keeps
@@ -55,7 +55,12 @@ COLLECT = re.compile(r"^!\(COLLECT-OBJECTS (\d+)\)$")
 # ---------------------------------------------------------------- the run's hooks
 
 
-def prepare(world: World, seed: int) -> World:
+def prepare(world: World, setup: Any) -> World:
+    """The room with its random objects placed from the run's seed (`setup.seed`)."""
+    return place_objects(world, setup.seed)
+
+
+def place_objects(world: World, seed: int) -> World:
     """The room with its random objects placed from `seed` on cells where Hilare can stand,
     each within OBJECT_JITTER of its cell's centre and, as the simulator places its own,
     OBJECT_CLEARANCE from the others (VISUAL tells objects apart by where it sees them)."""
