@@ -229,6 +229,8 @@ systems = st.builds(
     planning=st.none() | refs, doc=st.none() | strings,
     body=st.none() | st.builds(m.Settings, entries=small(st.builds(m.Setting, name=lower, value=numbers))),
     worlds=st.none() | st.builds(m.Settings, entries=small(st.builds(m.Setting, name=lower, value=strings))),
+    devices=st.none() | st.builds(m.DeviceGrants, entries=small(st.builds(m.DeviceGrant, module=lower,
+                                                                          devices=small(refs, 1)))),
     missions=small(st.builds(m.SystemMission, name=lower, world=st.none() | refs, horizon=st.none() | durations,
                              plan=st.none() | refs, doc=st.none() | strings, goals=small(goals))),
     bindings=st.none() | st.builds(m.Bindings, entries=small(st.builds(

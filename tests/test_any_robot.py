@@ -359,6 +359,17 @@ def test_bindings_that_cannot_run_are_refused_by_check(tmp_path: Path, change: t
     assert result.returncode == 1 and f"[{code}]" in result.stdout + result.stderr, result.stdout + result.stderr
 
 
+def test_a_module_drives_only_the_devices_the_system_gives_it(tmp_path: Path) -> None:
+    """`devices { drive: pose; }`: DRIVE's codels may read the pose, not drive the wheels."""
+    spec = SPEC.replace("  worlds { shop:", "  devices { drive: pose; }\n  worlds { shop:")
+    robot = write_robot(tmp_path, spec)
+    result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 1, result.stderr
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "failed"
+    assert "module 'drive' has no device 'wheels': the system gives it pose" in report["why"], report["why"]
+
+
 def test_the_minimal_robot_formats_to_itself() -> None:
     from specc.syntax.parser import parse_text
     from specc.syntax.printer import print_source

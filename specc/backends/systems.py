@@ -55,6 +55,13 @@ class SystemView:
         return repr(self.system.extension.value if self.system.extension is not None else None)
 
     @property
+    def devices(self) -> str:
+        grants = self.system.devices
+        if grants is None:
+            return "None"
+        return repr({g.module: tuple(d.text for d in g.devices) for g in grants.entries})
+
+    @property
     def body(self) -> str:
         entries = self.system.body.entries if self.system.body is not None else ()
         values = {s.name: s.value.value for s in entries if isinstance(s.value, m.Number)}

@@ -14,6 +14,7 @@ from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
 from specc.runtime.body import BODY_KEYS, body_problem
+from specc.runtime.sim.simulation import DEVICES
 from specc.runtime.sim.world import WorldError, load_world
 
 # The PRS domains a request input of each type accepts (seed 000 §4.2: the task level passes
@@ -31,6 +32,7 @@ def check(ctx: Context) -> None:
     for system in systems:
         check_blocks(ctx, system)
         check_body(ctx, system)
+        check_devices(ctx, system)
         worlds = check_worlds(ctx, system)
         check_missions(ctx, system, worlds)
         executive = ctx.named(m.Executive).get(system.executive.text) if system.executive else None
@@ -69,6 +71,29 @@ def check_blocks(ctx: Context, system: m.System) -> None:
         if module is not None and module not in listed and module in ctx.named(m.Module):
             ctx.report("undefined-module", f"service '{service.name}' runs a request of module '{module}', which "
                        f"system '{system.name}' does not list: add it to 'modules:'", service.request.span)  # type: ignore[union-attr]
+
+
+def check_devices(ctx: Context, system: m.System) -> None:
+    """Each grant names one of the system's modules and devices of the simulated body."""
+    if system.devices is None:
+        return
+    ctx.duplicates(system.devices.entries, "devices of module", key="module")
+    listed = {ref.text for ref in system.modules}
+    body = {e.name: e.value for e in system.body.entries} if system.body is not None else {}
+    present = {"sonars": "sonars", "laser": "laser_beams", "arm": "arm_joints"}  # devices a body may lack
+    for grant in system.devices.entries:
+        if grant.module not in listed:
+            ctx.unknown("undefined-module", "module", grant.module, listed, grant.span,
+                        f" of system '{system.name}' (its modules get devices)")
+        for device in grant.devices:
+            if device.text not in DEVICES:
+                ctx.unknown("undefined-device", "device", device.text, DEVICES, device.span,
+                            f"; the simulated body has {', '.join(DEVICES)}")
+            elif device.text in present:
+                count = body.get(present[device.text])
+                if not (isinstance(count, m.Number) and count.value > 0):
+                    ctx.report("undefined-device", f"module '{grant.module}' is given the {device.text}, but the body "
+                               f"has none: give it '{present[device.text]}: N;'", device.span)
 
 
 def check_body(ctx: Context, system: m.System) -> None:

@@ -941,6 +941,19 @@ class Settings(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class DeviceGrant(Node):
+    """`module: device, ...;` in a system's `devices { }`: what the module's codels may drive."""
+
+    module: str
+    devices: tuple[Ref, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class DeviceGrants(Node):
+    entries: tuple[DeviceGrant, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
 class Binding(Node):
     """`TASK(?a, ?b) => goal G(?a);`: how a planning task is carried out (kind: goal, service or
     request), with the target's arguments made from the task's."""
@@ -992,6 +1005,7 @@ class System(Node):
     worlds: Settings | None = None  # `worlds { room: "worlds/room.toml"; }`, relative to the spec
     missions: tuple[SystemMission, ...] = ()
     bindings: Bindings | None = None  # how the planners' tasks are carried out
+    devices: DeviceGrants | None = None  # which module's codels drive which device (default: all, all)
 
 
 Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment, FtPlan, System]

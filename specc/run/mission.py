@@ -295,7 +295,7 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
     with contextlib.chdir(robot.folder):
         registry = rt.Registry()
         try:
-            sim = Simulation(ground, system.body, seed=seed, kernel=registry.kernel).attach(registry)
+            sim = Simulation(ground, system.body, seed=seed, kernel=registry.kernel).attach(registry, system.devices)
         except WorldError as error:  # what the world asks cannot be built (objects without room)
             raise RunError(str(error)) from None
         kernel = registry.kernel

@@ -359,7 +359,10 @@ class InternalData:
         """The robot's devices when a simulator (`specc.runtime.sim.Simulation`) or a driver is
         attached to the registry, else None (codels then fall back on their own models)."""
         module = self._module
-        return module.registry.hardware if module is not None else None
+        if module is None:
+            return None
+        registry = module.registry
+        return registry.hardware_for[module.name] if registry.hardware_for is not None else registry.hardware
 
     def send_request(self, name: str, **inputs: Any) -> RequestHandle:
         """Send `"module.request"` from the running codel: the new activity is its child."""
@@ -943,6 +946,7 @@ class Registry:
         self.current: Activity | None = None  # the activity whose codel is running
         self.incidents: list[str] = []
         self.hardware: Any = None  # the devices codels drive (`sdi.hardware`): a simulation, a driver
+        self.hardware_for: Any = None  # module -> its own view of them, when the system grants devices
         self._ids = itertools.count(1)
 
     def new_id(self) -> int:

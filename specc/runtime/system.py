@@ -69,3 +69,4 @@ class SystemSpec:
     worlds: Mapping[str, str] = field(default_factory=dict)  # name -> world file, relative to the robot's folder
     missions: Mapping[str, MissionSpec] = field(default_factory=dict)
     bindings: Mapping[str, BindingSpec] = field(default_factory=dict)  # by task
+    devices: Mapping[str, tuple[str, ...]] | None = None  # module -> the devices its codels drive; None: all

@@ -37,7 +37,7 @@ class Section:
 
 
 SERVICE_SECTIONS = ("args", "conflicts", "timeout")
-SYSTEM_SECTIONS = ("body", "worlds")
+SYSTEM_SECTIONS = ("body", "worlds", "devices")
 
 
 def _present(children: list[Any]) -> list[Any]:
@@ -87,6 +87,9 @@ class Builder(Transformer[Token, Any]):
     def signed_number(self, meta: Meta, children: list[Token]) -> m.Number:
         sign, number = children
         value = self.number_value(number)
+        if str(sign) not in ("-", "+"):  # IxTeT's dotted operators are no sign
+            self.diagnostics.append(error("unexpected-token", f"unexpected '{sign}': a number's sign is - or +",
+                                          self.tspan(sign)))
         return m.Number(value=-value if str(sign) == "-" else value, span=self.span(meta))
 
     def duration(self, meta: Meta, children: list[Any]) -> m.Duration:
@@ -899,7 +902,7 @@ class Builder(Transformer[Token, Any]):
     def system(self, meta: Meta, children: list[Any]) -> m.System:
         name, *members = children
         props, rest = self.split(members)
-        sections: dict[str, m.Settings] = {}
+        sections: dict[str, Any] = {}
         for section in (r for r in rest if isinstance(r, Section)):
             if section.name not in SYSTEM_SECTIONS:
                 self.diagnostics.append(error(
@@ -909,6 +912,10 @@ class Builder(Transformer[Token, Any]):
             elif section.name in sections:
                 self.diagnostics.append(error(
                     "duplicate-property", f"section '{section.name}' is given twice; merge them", section.span))
+            elif section.name == "devices":
+                sections[section.name] = m.DeviceGrants(entries=tuple(
+                    m.DeviceGrant(module=p.key, devices=tuple(v for v in p.values if isinstance(v, m.Ref)),
+                                  span=p.span) for p in section.props), span=section.span)
             else:
                 sections[section.name] = self.settings(section)
         missions = self.of(rest, m.SystemMission)
@@ -917,7 +924,7 @@ class Builder(Transformer[Token, Any]):
             self.diagnostics.append(error("duplicate-property", "section 'bindings' is given twice; merge them",
                                           repeated.span))
         return self.apply_props(m.System, self.span(meta), props, name=str(name), body=sections.get("body"),
-                                worlds=sections.get("worlds"), missions=missions,
+                                worlds=sections.get("worlds"), devices=sections.get("devices"), missions=missions,
                                 bindings=bindings[0] if bindings else None)
 
     def bindings(self, meta: Meta, children: list[Any]) -> m.Bindings:

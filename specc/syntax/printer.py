@@ -698,6 +698,10 @@ class Printer:
                     with self.block(section, settings.span):
                         for entry in settings.entries:
                             self.line(f"{entry.name}: {prop_value(entry.value)};", entry.span)
+            if node.devices is not None:
+                with self.block("devices", node.devices.span):
+                    for grant in node.devices.entries:
+                        self.line(f"{grant.module}: {', '.join(d.text for d in grant.devices)};", grant.span)
             for mission in node.missions:
                 with self.block(f"mission {mission.name}", mission.span):
                     self.props(mission)

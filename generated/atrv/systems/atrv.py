@@ -18,6 +18,7 @@ SYSTEM = SystemSpec(
     planning=None,
     extension=None,
     body=RobotConfig.from_spec('atrv', {'radius': 0.62, 'length': 1.05, 'width': 0.65, 'mass': 120, 'wheel_base': 0.55, 'max_wheel_speed': 0.6, 'encoder_noise': 0.01, 'laser_beams': 181, 'laser_range': 30, 'camera_r_min': 0.5, 'camera_r_max': 8, 'camera_open': 50}),
+    devices=None,
     worlds={
         'W1': 'worlds/W1.toml',
         'W2': 'worlds/W2.toml',

@@ -18,6 +18,7 @@ SYSTEM = SystemSpec(
     planning=None,
     extension='hilare_codels.hunt',
     body=RobotConfig.from_spec('hilare', {'radius': 0.35, 'mass': 80, 'wheel_base': 0.6, 'max_wheel_speed': 0.8, 'encoder_noise': 0.01, 'sonars': 32, 'sonar_range': 5, 'arm_joints': 6}),
+    devices=None,
     worlds={
         'room': 'worlds/room.toml',
     },

@@ -18,6 +18,7 @@ SYSTEM = SystemSpec(
     planning='depot',
     extension=None,
     body=RobotConfig.from_spec('tug', {'length': 0.9, 'width': 0.6, 'mass': 90, 'wheel_base': 0.5, 'max_wheel_speed': 0.8, 'encoder_noise': 0.01, 'laser_beams': 61, 'laser_fov': 180, 'laser_range': 10}),
+    devices={'drive': ('wheels', 'pose'), 'scanner': ('laser',), 'lift': ('objects', 'pose')},
     worlds={
         'hall': 'worlds/hall.toml',
         'crowded': 'worlds/crowded.toml',

@@ -14,6 +14,7 @@ run, and drawing more sonar noise does not change where the objects are.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,6 +29,45 @@ from specc.runtime.sim.world import World, WorldError
 PHYSICS_PRIORITY = -1000  # before the exec tasks of the same instant
 OBJECT_CLEARANCE = 0.45  # m: random objects are placed at least this far from walls and obstacles
 SCATTER_TRIES = 1000  # random places tried in a row for one object before giving up
+
+
+# What a system's `devices { module: device, ...; }` may give a module's codels (`sdi.hardware`):
+# actuators and sensors, the robot's true pose (a localisation), the world's objects. Whatever a
+# module is given, it also sees the world, the body, the trace and the clock (COMMON).
+DEVICES = ("wheels", "encoders", "sonars", "laser", "camera", "pan_tilt", "arm", "antenna", "pose", "objects")
+COMMON = ("world", "robot", "trace", "now", "physics_period", "kernel", "seed")
+
+
+class DeviceView:
+    """A module's view of the simulation: the devices the system gives it, and COMMON."""
+
+    def __init__(self, sim: Simulation, module: str, devices: tuple[str, ...]) -> None:
+        object.__setattr__(self, "_sim", sim)
+        object.__setattr__(self, "_module", module)
+        object.__setattr__(self, "_allowed", frozenset(devices) | frozenset(COMMON))
+
+    def __getattr__(self, name: str) -> Any:
+        if name not in self._allowed:
+            given = ", ".join(sorted(self._allowed - frozenset(COMMON))) or "none"
+            raise AttributeError(f"module '{self._module}' has no device '{name}': the system gives it {given} "
+                                 f"(add it to the system's devices {{ {self._module}: ...; }})")
+        return getattr(self._sim, name)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"module '{self._module}' cannot replace the simulation's '{name}'")
+
+
+class _Grants(dict[str, DeviceView]):
+    """Each module's view, made when its codels first ask (a module no grant names gets none)."""
+
+    def __init__(self, sim: Simulation, devices: Mapping[str, tuple[str, ...]]) -> None:
+        super().__init__()
+        self.sim = sim
+        self.devices = devices
+
+    def __missing__(self, module: str) -> DeviceView:
+        view = self[module] = DeviceView(self.sim, module, tuple(self.devices.get(module, ())))
+        return view
 
 
 @dataclass
@@ -85,12 +125,16 @@ class Simulation:
         self.kernel.call_every(physics_period, self._tick, PHYSICS_PRIORITY)
 
     # ------------------------------------------------------------ set-up
-    def attach(self, registry: Any) -> Simulation:
-        """Give a module registry's codels this robot's devices (`sdi.hardware`)."""
+    def attach(self, registry: Any, devices: Mapping[str, tuple[str, ...]] | None = None) -> Simulation:
+        """Give a module registry's codels this robot's devices (`sdi.hardware`): every device to
+        every module, or when `devices` is given (module -> device names, DEVICES), to each
+        module those it names alone (a module it does not name gets none)."""
         if registry.kernel is not self.kernel:
             raise ValueError("the simulation and the modules must share one kernel: "
                              "create the Simulation with kernel=registry.kernel")
         registry.hardware = self
+        if devices is not None:
+            registry.hardware_for = _Grants(self, devices)
         if self.arm is not None:
             self.arm.commander = lambda: registry.current  # the activity whose codel moves it
         return self
