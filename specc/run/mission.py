@@ -327,13 +327,13 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         planning: list[Any] = []  # FTplan's result, once it has run
         recorder.start(lambda: sum(1 for _, i in intentions if i.status != "running") + len(planning))
         PoseRecorder(journal.emit, sim).start()
-        ended: set[str] = set()
+        ended: set[int] = set()  # the goals whose end is logged, by their place (one goal may be posted twice)
 
         def running() -> bool:
             recorder.poll()
-            for goal, intention in intentions:
-                if intention.status != "running" and goal not in ended:
-                    ended.add(goal)
+            for k, (goal, intention) in enumerate(intentions):
+                if intention.status != "running" and k not in ended:
+                    ended.add(k)
                     journal.emit(kernel.now, "goal", goal=goal, status=intention.status)
             return any(i.status == "running" for _, i in intentions)
 
