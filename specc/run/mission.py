@@ -49,7 +49,7 @@ from typing import Any, NamedTuple
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_robot
-from specc.run.plans import BoundExecutor, FtplanJournal
+from specc.run.plans import BoundExecutor, FtplanJournal, run_ftplan
 from specc.run.recording import PoseRecorder, world_fields
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
@@ -374,18 +374,9 @@ def _plan_and_execute(robot: Robot, setup: Any, timing: str, journal: FtplanJour
                       executive: rx.Executive | None, supervisor: Any, sim: Any) -> Any:
     """FTplan plans the mission with the configuration's planners, each in its own process, and
     the system's bindings carry every plan out (`specc.run.plans`); FTplan's result."""
-    from specc.runtime.ftplan import HUNG_PLANNER_SECONDS, FtPlan, ProcessPool, planners_as_run
-
     executor = BoundExecutor(registry.kernel, robot.system.bindings, registry, executive, supervisor, sim.rover,
                              setup.config, journal.emit)
-    with ProcessPool(planners_as_run(setup.config, timing), setup.domains) as pool:
-        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems,
-                        wall_limit=HUNG_PLANNER_SECONDS if timing == "model" else None)
-        journal.ftplan = ftplan
-        result = ftplan.run()
-    journal.catch_up()
-    executor.safe_state(result.now)  # nothing runs past the plan's end; the robot idles to its last instant
-    return result
+    return run_ftplan(setup, executor, journal, timing)[1]
 
 
 def _outcome(intentions: list[tuple[str, Any]], horizon: float,

@@ -233,6 +233,22 @@ class FtplanJournal:
             self._forwarded += 1
 
 
+def run_ftplan(setup: Any, executor: KernelExecutor, journal: FtplanJournal, timing: str) -> tuple[Any, Any]:
+    """FTplan on the mission `setup` (specc.runtime.ftplan.MissionSetup) with its configuration's
+    planners, each in its own process, `executor` carrying its plans out; then the safe state
+    (nothing runs past the plan's end). The FtPlan and its MissionResult."""
+    from specc.runtime.ftplan import HUNG_PLANNER_SECONDS, FtPlan, ProcessPool, planners_as_run
+
+    with ProcessPool(planners_as_run(setup.config, timing), setup.domains) as pool:
+        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems,
+                        wall_limit=HUNG_PLANNER_SECONDS if timing == "model" else None)
+        journal.ftplan = ftplan
+        result = ftplan.run()
+    journal.catch_up()
+    executor.safe_state(result.now)  # the robot idles to the mission's last instant
+    return ftplan, result
+
+
 @dataclass(frozen=True)
 class Call:
     """What a binding makes of one action: the goal, service or request and its arguments."""

@@ -65,22 +65,18 @@ import numpy as np
 from specc.run import RunError
 from specc.run.events import EventLog
 from specc.run.package import import_generated
-from specc.run.plans import FtplanJournal, KernelExecutor, Running
+from specc.run.plans import FtplanJournal, KernelExecutor, Running, run_ftplan
 from specc.run.recording import Emit, PoseRecorder, true_path, world_fields
 from specc.run.render import draw_map
 from specc.run.rover_tasks import LINK, MOTION_INIT, MOVE, PAN_TILT, PHOTO, PTU_INIT, TASK_KINDS, task_text
 from specc.runtime import functional as rt
 from specc.runtime.body import RobotConfig
 from specc.runtime.ftplan import (
-    HUNG_PLANNER_SECONDS,
-    FtPlan,
     MissionResult,
     MissionSetup,
-    ProcessPool,
     Report,
     UnknownName,
     mission_setup,
-    planners_as_run,
 )
 from specc.runtime.ftplan.config import FtPlanConfig
 from specc.runtime.ftplan.execution import Execution
@@ -765,13 +761,7 @@ def run_rover_mission(configuration: str, mission: str, world: str | Path | Worl
              windows=[[w.name, w.start, w.end] for w in windows],
              targets=[[t.name, t.x, t.y] for t in prepared.tasks.targets.values()])
     PoseRecorder(journal.emit, rover.sim).start()
-    with ProcessPool(planners_as_run(setup.config, timing), setup.domains) as pool:
-        ftplan = FtPlan(setup.config, setup.problem, pool, executor, timing=timing, problems=setup.problems,
-                        wall_limit=HUNG_PLANNER_SECONDS if timing == "model" else None)
-        journal.ftplan = ftplan
-        result = ftplan.run()
-    journal.catch_up()
-    executor.safe_state(result.now)  # nothing runs past the mission's end; the robot idles to its last instant
+    ftplan, result = run_ftplan(setup, executor, journal, timing)
     goals = mission_goals(setup.problem, mission, ftplan.state)
     sim = rover.sim
     if result.failure:

@@ -295,14 +295,8 @@ class Builder(Transformer[Token, Any]):
                                 timeout=timeout, args=tuple(args), conflicts=tuple(conflicts))
 
     def arguments(self, section: Section) -> list[m.Argument]:
-        entries = []
-        for p in section.props:
-            if len(p.values) != 1:
-                self.diagnostics.append(error(
-                    "bad-property-value", f"argument '{p.key}' takes one value", p.values[0].span))
-                continue
-            entries.append(m.Argument(name=p.key, value=p.values[0], span=p.span))
-        return entries
+        return [m.Argument(name=p.key, value=p.values[0], span=p.span)
+                for p in self.single_valued(section, "argument ")]
 
     def conflict_entries(self, section: Section) -> list[m.Conflict]:
         entries = []
@@ -944,14 +938,19 @@ class Builder(Transformer[Token, Any]):
 
     def settings(self, section: Section) -> m.Settings:
         """`name: value;` entries, one value each."""
-        entries = []
+        return m.Settings(entries=tuple(m.Setting(name=p.key, value=p.values[0], span=p.span)
+                                        for p in self.single_valued(section, "")), span=section.span)
+
+    def single_valued(self, section: Section, what: str) -> list[Prop]:
+        """The section's `name: value;` entries; one with several values is reported and left out."""
+        kept = []
         for p in section.props:
             if len(p.values) != 1:
-                self.diagnostics.append(error(
-                    "bad-property-value", f"'{p.key}' takes one value", p.values[0].span))
-                continue
-            entries.append(m.Setting(name=p.key, value=p.values[0], span=p.span))
-        return m.Settings(entries=tuple(entries), span=section.span)
+                self.diagnostics.append(error("bad-property-value", f"{what}'{p.key}' takes one value",
+                                              p.values[0].span))
+            else:
+                kept.append(p)
+        return kept
 
     def system_mission(self, meta: Meta, children: list[Any]) -> m.SystemMission:
         name, *members = children
