@@ -160,6 +160,7 @@ def check_missions(ctx: Context, system: m.System, worlds: dict[str, m.Setting])
                            f"'{system.name}' has no supervisor to achieve it: give it 'supervisor: NAME;'", goal.span)
             elif supervisor is not None:
                 check_mission_goal(ctx, goal, goals, supervisor.name)
+                check_goal_values(ctx, goal, supervisor)
 
 
 def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | None,
@@ -278,6 +279,33 @@ def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], proced
     elif goal.op == "!" and goals[body.head] != len(body.args):
         ctx.report("arity-mismatch", f"'{body.head}' takes {goals[body.head]} argument(s), {len(body.args)} given",
                    body.span)
+
+
+def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures) -> None:
+    """A mission's constant arguments lie in the finite domains the goal's predicate declares."""
+    declared = next((p for p in procedures.predicates if p.name == goal.body.head), None)
+    if declared is None or len(declared.params) != len(goal.body.args):
+        return
+    for param, arg in zip(declared.params, goal.body.args, strict=True):
+        allowed = finite_values(procedures, param.domain)
+        value = arg.value if isinstance(arg, m.Number) else arg.text if isinstance(arg, m.Ref) else None
+        if allowed is not None and value is not None and value not in allowed:
+            shown = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
+            ctx.report("bad-argument", f"{value} is not in the domain of '{param.name}' of {declared.name} "
+                       f"({shown})", arg.span)
+
+
+def finite_values(procedures: m.Procedures, domain: m.PDomain, seen: frozenset[str] = frozenset()
+                  ) -> tuple[str | int, ...] | None:
+    """The values of a finite domain (a set, a range, a type naming one); None when unbounded."""
+    if isinstance(domain, m.SymbolSet):
+        return tuple(int(v) if v.lstrip("-").isdigit() else v for v in domain.values)
+    if isinstance(domain, m.IntRange):
+        return tuple(range(domain.low, domain.high + 1))
+    declared = next((t.domain for t in procedures.types if t.name == domain.name), None)
+    if declared is None or domain.name in seen:
+        return None
+    return finite_values(procedures, declared, seen | {domain.name})
 
 
 def check_service_actions(ctx: Context, procedures: m.Procedures, executives: list[m.Executive],
