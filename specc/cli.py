@@ -439,7 +439,9 @@ def plan(paths: PathsArg,
              help="strong: the plan holds whatever nature does; pseudo (IxTeT's): the problem's contingent "
                   "instants one at a time, each anywhere in its bounds.")] = Controllability.strong) -> None:
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
-    checked by the independent validator."""
+    checked by the independent validator.
+
+    Example: specc plan examples/tug --problem shuttle -o build/shuttle.png"""
     from specc.plan_report import print_result, solve
 
     loaded = load(paths)
@@ -475,7 +477,9 @@ def export_problem(paths: PathsArg,
                    domain: Annotated[Optional[str], typer.Option(help="Keep the problems of this domain.")] = None,
                    ) -> None:
     """Export a planning domain and problem through unified-planning to PDDL 2.1, saying what could not
-    be expressed."""
+    be expressed.
+
+    Example: specc export examples/tug --problem shuttle -o build/pddl"""
     from specc.analysis.planning import domain_block, domain_model, problem_model
     from specc.analysis.planning_export import constant_set_names, export, write_pddl
     from specc.plan_report import choose_problem
@@ -593,11 +597,12 @@ def _run_error(error: Exception, code: int = 1) -> typer.Exit:
 def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder (its specs, codels and "
                                                    "worlds), e.g. examples/tug.", show_default=False)],
         mission: Annotated[Optional[str], typer.Option(help="One of the system block's missions (default: its only "
-                                                            "one); M1..M4 for the rover.")] = None,
+                                                            "one).")] = None,
         world: Annotated[Optional[str], typer.Option(help="One of the system's worlds or a world file (default: "
-                                                          "the mission's); W1..W4 for the rover.")] = None,
-        config: Annotated[Optional[str], typer.Option(help="The rover's configuration: Robot1, Robot2, Robot1/2 "
-                                                           "(default), Robot1/2c.")] = None,
+                                                          "the mission's).")] = None,
+        config: Annotated[Optional[str], typer.Option(help="FTplan's configuration for a planned mission: Robot1, "
+                                                           "Robot2 (one planner), Robot1/2 (successive), Robot1/2c "
+                                                           "(concurrent); default: the ftplan block's own.")] = None,
         seed: Annotated[int, typer.Option(min=0, help="Draws the run's randomness: one seed, one event log.")] = 0,
         generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to (compiled "
                                                 "first when stale).")] = Path("generated"),
@@ -679,7 +684,9 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
            render: Annotated[bool, typer.Option(help="Draw the pictures again from the log.")] = True,
            output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Where the pictures go "
                                                           "(default: the run folder).")] = None) -> None:
-    """Play a run's event log back, then draw its pictures again from the log alone."""
+    """Play a run's event log back, then draw its pictures again from the log alone.
+
+    Example: specc replay runs/tug-shuttle-crowded-Robot1-2-s0 --kind action --kind ftplan --to 60"""
     from specc.run import RunError
     from specc.run.replay import check_kinds, describe, load_run, select
 
@@ -710,11 +717,12 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
 def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's folder, e.g. examples/tug.",
                                                 show_default=False)],
           mission: Annotated[Optional[list[str]], typer.Option(help="A mission (repeatable; default: every mission "
-                                                                    "of the system; M1-M4 for the rover).")] = None,
-          world: Annotated[Optional[list[str]], typer.Option(help="A world (repeatable; default: each mission's; "
-                                                                  "W1-W4 for the rover).")] = None,
-          config: Annotated[Optional[list[str]], typer.Option(help="The rover's configuration (repeatable; "
-                                                                   "default: all four).")] = None,
+                                                                    "of the system).")] = None,
+          world: Annotated[Optional[list[str]], typer.Option(help="A world (repeatable; default: each mission's "
+                                                                  "own).")] = None,
+          config: Annotated[Optional[list[str]], typer.Option(help="FTplan's configuration of the planned missions "
+                                                                   "(repeatable; default: the ftplan block's "
+                                                                   "own).")] = None,
           seeds: Annotated[int, typer.Option(min=1, help="Seeds 0..N-1 for every combination.")] = 1,
           generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
           = Path("generated"),
@@ -724,11 +732,11 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
           pictures: Annotated[bool, typer.Option(help="Draw every run's pictures.")] = False,
           quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
     """Run every mission x world (x configuration) x seed, one run folder each, and print the table of
-    their measures: per mission and world, the success rate and the means of the runs' figures (for
-    the rover, the measures of seed 004 §4.1.4).
+    their measures: per mission and world, the success rate and the means of the runs' figures (the
+    means of seed 004 §4.1.4 when the robot's extension measures them, as the rover's does).
 
     Examples: specc table examples/tug --seeds 10; specc table examples/tug --mission shuttle --world hall
-    --config Robot1."""
+    --config Robot1 --config Robot1/2."""
     from specc.run import RunError
     from specc.run.measures import rich_table
     from specc.run.session import RunRequest, compile_robot
@@ -749,16 +757,16 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
         written = write_table(result, output or runs / f"{robot}-table.md")
     except RunError as error:
         raise _run_error(error, 2) from None
-    if result.missions:
+    if result.rows:
+        # A file or pipe gets the whole table, not one squeezed into 80 columns.
+        (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(rich_table(result.rows))
+    else:
         for row in result.missions:
             configuration = f" with {row.configuration}" if row.configuration else ""
             out.print(f"{robot}'s mission {row.mission} in {row.world}{configuration}: {row.succeeded} of "
                       f"{row.seeds} seed(s) "
                       f"succeeded ({100 * row.success_rate:.0f} %), {row.simulated_time:.0f} s per successful run",
                       markup=False)
-    else:
-        # A file or pipe gets the whole table, not one squeezed into 80 columns.
-        (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(rich_table(result.rows))
     for failure in result.failures:
         out.print(f"failed: {failure.name}: {failure.why}", markup=False)
     for path in written:
@@ -871,17 +879,23 @@ def _names(text: str) -> tuple[str, ...]:
 
 @app.command()
 def campaign(
-        specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder, e.g. examples/atrv.",
+        specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's spec folder, e.g. examples/tug.",
                                               show_default=False)],
         mutants: Annotated[str, typer.Option(help="How many mutants to draw among those that pass specc check "
                                                   "(stratified by class), or 'all'.")] = "40",
-        missions: Annotated[str, typer.Option(help="Comma-separated missions.")] = "M1,M2,M3,M4",
-        worlds: Annotated[str, typer.Option(help="Comma-separated worlds.")] = "W1,W2,W3,W4",
+        missions: Annotated[Optional[str], typer.Option(help="Comma-separated missions (default: every planned "
+                                                             "mission of the system).")] = None,
+        worlds: Annotated[Optional[str], typer.Option(help="Comma-separated worlds (default: every world of the "
+                                                           "system).")] = None,
+        set_apart: Annotated[str, typer.Option(help="Comma-separated worlds the means are also given without "
+                                                    "(seed 004 set W4 apart).")] = "",
         runs: Annotated[int, typer.Option(min=1, help="Runs (seeds 0..N-1) of every activity.")] = 3,
-        configs: Annotated[str, typer.Option(help="Comma-separated configurations; the first one judges the "
-                                                  "mutants (add -noanalyzer to one for it without the plan "
-                                                  "analyzer).")] = "Robot1,Robot1/2",
-        domain: Annotated[str, typer.Option(help="The planning model faults are injected into.")] = "model1",
+        configs: Annotated[Optional[str], typer.Option(help="Comma-separated configurations; the first one judges "
+                                                            "the mutants (add -noanalyzer to one for it without the "
+                                                            "plan analyzer). Default: Robot1 (the first planner "
+                                                            "alone), then every planner (Robot1/2...).")] = None,
+        domain: Annotated[Optional[str], typer.Option(help="The planning model faults are injected into (default: "
+                                                           "the first planner's).")] = None,
         seed: Annotated[int, typer.Option(help="Draws the mutants.")] = 0,
         workers: Annotated[Optional[int], typer.Option(min=1, help="Experiments at once (default: one per "
                                                                    "CPU).")] = None,
@@ -902,12 +916,14 @@ def campaign(
                                                                         "half-way says so).")] = False,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
     """Inject faults into a planning model by mutation and run every configuration x mutant x mission x
-    world x run (seed 004 ch. 4); then the report: the measures over sets of activities with and without
-    W4, per mutant, the mutants set aside, the bar charts of Fig 4.14 and the headline.
+    world x run (seed 004 ch. 4) of a robot with an ftplan block; then the report: the measures over sets
+    of activities (with and without the worlds set apart), per mutant, the mutants set aside, the bar
+    charts of Fig 4.14 and the headline.
 
-    Example: specc campaign examples/atrv --mutants 40 --runs 3 --configs Robot1,Robot1/2
+    Examples: specc campaign examples/tug --mutants 5 --runs 1;
+    specc campaign examples/tug --mutants 40 --runs 3 --configs Robot1,Robot1/2 --set-apart crowded
     """
-    from specc.campaign.campaign import Campaign, CampaignPlan, check_names, select_mutants
+    from specc.campaign.campaign import Campaign, CampaignPlan, campaign_defaults, check_names, select_mutants
     from specc.campaign.engines import DaskEngine, LocalEngine
     from specc.campaign.experiments import Setting
     from specc.campaign.report import build_report
@@ -922,16 +938,18 @@ def campaign(
         def robot_name() -> str:
             return compile_robot(specs, generated, lambda text: err.print(text, markup=False))
 
-        if report_only:  # the store is all a report needs: the robot compiles only to name the default one
-            _campaign_report(store or Path("campaigns") / f"{robot_name()}-{domain}-{mutants}.sqlite", output)
-            return
         robot = robot_name()
-        if robot != "atrv":
-            raise RunError(f"robot '{robot}' has no planning campaign: campaigns run the rover's missions (atrv)")
-        setting = Setting(generated.resolve(), specs.resolve())
+        defaults = campaign_defaults(generated, specs, robot)
+        domain = domain or defaults.domain
+        if report_only:  # the store is all a report needs
+            _campaign_report(store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite", output)
+            return
+        setting = Setting(generated.resolve(), specs.resolve(), robot)
         plan = CampaignPlan(specs, setting, domain, None if mutants == "all" else int(mutants), seed,
-                            _names(missions), _names(worlds), runs, _names(configs))
-        check_names(plan, setting.generated, setting.example)
+                            _names(missions) if missions is not None else defaults.missions,
+                            _names(worlds) if worlds is not None else defaults.worlds, runs,
+                            _names(configs) if configs is not None else defaults.configurations, _names(set_apart))
+        check_names(plan)
         count = workers or default_workers()
         engine = (LocalEngine(setting, count, timeout) if scheduler is None
                   else DaskEngine(setting, scheduler, count, timeout))

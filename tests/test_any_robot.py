@@ -350,6 +350,11 @@ def test_an_action_past_its_planned_duration_is_stopped_and_fails(tmp_path: Path
     (("report WHERE(drive.Pose.x, drive.Pose.y)", "report THERE(drive.Pose.x, drive.Pose.y)"), "undefined-report"),
     (("report WHERE(drive.Pose.x, drive.Pose.y)", "report WHERE(drive.Pose.x)"), "arity-mismatch"),
     (("report WHERE(drive.Pose.x, drive.Pose.y)", "report WHERE(drive.Place.x, drive.Pose.y)"), "undefined-poster"),
+    # `where ATTR(?v) := VALUE`: an attribute of FTplan's state, its arity, the value's variables bound
+    (("request drive.Drop(?p)", "request drive.Drop(?q) where DELIVERD(?q) := YES"), "undefined-attribute"),
+    (("request drive.Drop(?p)", "request drive.Drop(?q) where DELIVERED(?q, ?r) := YES"), "arity-mismatch"),
+    (("request drive.Drop(?p)", "request drive.Drop(?q) where DELIVERED(?q) := ?z"), "unbound-variable"),
+    (("request drive.Drop(?p)", "request drive.Drop(?q) where DELIVERED(?p) := YES"), "unbound-variable"),
 ])
 def test_bindings_that_cannot_run_are_refused_by_check(tmp_path: Path, change: tuple[str, str], code: str) -> None:
     old, new = change
@@ -357,6 +362,18 @@ def test_bindings_that_cannot_run_are_refused_by_check(tmp_path: Path, change: t
     robot = write_robot(tmp_path, PLANNED_SPEC.replace(old, new), CODELS + DROP_CODELS)
     result = specc(tmp_path, "check", robot)
     assert result.returncode == 1 and f"[{code}]" in result.stdout + result.stderr, result.stdout + result.stderr
+
+
+def test_a_binding_s_where_takes_its_variables_from_ftplan_s_state(tmp_path: Path) -> None:
+    """`DROP(?p) => request drive.Drop(?q) where DELIVERED(?q) := YES`: the place the drop makes
+    DELIVERED, read from FTplan's state rules, is what the request is given."""
+    spec = PLANNED_SPEC.replace("request drive.Drop(?p)", "request drive.Drop(?q) where DELIVERED(?q) := YES")
+    robot = write_robot(tmp_path, spec, CODELS + DROP_CODELS)
+    result = specc(tmp_path, "run", robot, "--mission", "round", "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 0, result.stderr
+    events = read_events(tmp_path / "run" / "events.jsonl")
+    drops = [e for e in events if e["kind"] == "action" and e["status"] == "started" and e["task"] == "DROP"]
+    assert drops and all(e["request"] == f"drive.Drop({e['args'][0]})" for e in drops)
 
 
 def test_a_module_drives_only_the_devices_the_system_gives_it(tmp_path: Path) -> None:

@@ -24,7 +24,7 @@ from tests.conftest import is_png
 
 ROOT = Path(__file__).resolve().parents[1]
 ATRV = ROOT / "examples" / "atrv"
-SETTING = Setting(ROOT / "generated", ATRV)
+SETTING = Setting(ROOT / "generated", ATRV, "atrv")
 ONE = Experiment("Robot1", ORIGINAL, "M1", "W1", 0)
 # A small real campaign: three mutants drawn, one activity, one run, Robot1 then Robot1/2.
 SMALL = ["--mutants", "3", "--missions", "M1", "--worlds", "W1", "--runs", "1", "--configs", "Robot1,Robot1/2",
@@ -178,16 +178,17 @@ def test_an_experiment_is_a_pure_function_wherever_it_runs(tmp_path: Path) -> No
 def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path: Path) -> None:
     with ResultStore(tmp_path / "r.sqlite") as store:
         store.describe({"robot": "atrv", "domain": "model1", "configurations": ["Robot1", "Robot1/2"],
-                        "missions": ["M1"], "worlds": ["W1", "W4"], "runs": 1})
+                        "missions": ["M1"], "worlds": ["W1", "W4"], "runs": 1, "set_apart": ["W4"]})
         store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
         store.judge([("model1-0001", KEPT, "")])
 
         def one(configuration: str, mutant: str, world: str, success: bool) -> None:
             goals = {"asked": 1, "met": 1 if success else 0}
             store.record(Outcome(Experiment(configuration, mutant, "M1", world, 0), "done", {
-                "configuration": configuration, "mission": "M1", "world": world, "seed": 0, "photos": goals,
-                "communications": goals, "home": goals, "kappa": 0, "replannings": 0, "activity_time": 10.0,
-                "distance": 5.0, "mission_time": 100.0, "planner_failures": 0, "believed": goals}, 1.0))
+                "configuration": configuration, "mission": "M1", "world": world, "seed": 0,
+                "goals": [{"kind": kind, **goals} for kind in "pch"], "kappa": 0, "replannings": 0,
+                "activity_time": 10.0, "distance": 5.0, "mission_time": 100.0, "planner_failures": 0,
+                "believed": goals}, 1.0))
 
         for configuration in ("Robot1", "Robot1/2"):
             for world in ("W1", "W4"):
@@ -210,6 +211,7 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     assert "**not finished: Robot1/2c.**" in markdown(partial)
     assert "Robot1/2 succeeds in 50% of missions against Robot1's 0%: +50 points" in text
     assert "| model1-0001 | numeric |" in text and "| 0% | 50% |" in text
+    assert "| σ̄_p | σ̄_c | σ̄_h | ν̄ | κ̄ |" in text
     written = write_report(report, tmp_path / "out")
     assert [p.name for p in written] == ["campaign.md", "campaign.json", "campaign.png"] and is_png(written[2])
 
@@ -238,12 +240,32 @@ def test_bad_campaign_input_is_one_line_and_exit_2(tmp_path: Path, args: list[st
 
 
 def test_a_configuration_without_its_plan_analyzer_is_named_by_a_suffix() -> None:
-    from specc.run.rover import check_mission
+    from specc.run.mission import check_mission, load_robot
 
-    kwargs = {"generated": SETTING.generated, "example": SETTING.example}
-    with_analyzer = check_mission("Robot1/2", "M1", "W1", **kwargs).setup.config  # type: ignore[arg-type]
-    without = check_mission("Robot1/2-noanalyzer", "M1", "W1", **kwargs).setup.config  # type: ignore[arg-type]
+    robot = load_robot(SETTING.generated, SETTING.example, SETTING.robot)
+    m1 = robot.mission("M1")
+    with_analyzer = check_mission(robot, m1, "W1", 0, None, "Robot1/2").planning.config
+    without = check_mission(robot, m1, "W1", 0, None, "Robot1/2-noanalyzer").planning.config
     assert with_analyzer.analyzer and without.analyzer == ()
     assert without.planners == with_analyzer.planners and without.policy == with_analyzer.policy
     with pytest.raises(RunError, match="add -noanalyzer to one"):
-        check_mission("Robot3-noanalyzer", "M1", "W1", **kwargs)  # type: ignore[arg-type]
+        check_mission(robot, m1, "W1", 0, None, "Robot3-noanalyzer")
+
+
+def test_a_small_campaign_on_the_tug(tmp_path: Path) -> None:
+    """Any robot with an ftplan block has a campaign: the tug's (examples/tug), with its defaults
+    (its planned missions, Robot1 then Robot1/2, faults in its first planner's model) on one
+    mission and world; its goals are counted by FTplan's attributes, as its ledger judged them."""
+    store = tmp_path / "tug.sqlite"
+    result = specc("campaign", ROOT / "examples" / "tug", "--mutants", "2", "--missions", "shuttle", "--worlds",
+                   "hall", "--runs", "1", "--workers", "2", "--store", store, "-q")
+    assert result.returncode == 0, result.stderr
+    with ResultStore(store) as results:
+        description = results.description()
+        assert (description["domain"], description["configurations"]) == ("warehouse", ["Robot1", "Robot1/2"])
+        outcomes = list(results.outcomes())
+        original = next(o for o in outcomes if o.experiment == Experiment("Robot1", ORIGINAL, "shuttle", "hall", 0))
+    assert original.status == "done" and original.measures is not None and original.measures["nu"] == 1
+    assert {g["kind"] for g in original.measures["goals"]} == {"CART_AT", "AT"} and original.measures["distance"] > 5.0
+    report = (tmp_path / "tug.md").read_text()
+    assert "faults injected into warehouse of tug" in report and "σ̄_CART_AT" in report

@@ -34,7 +34,7 @@ from specc.mutation.edits import DomainTables, domain_edits, value_pool
 from specc.mutation.mutants import draw_kept, verdict
 from specc.mutation.tree import replace_at
 from specc.run import RunError
-from specc.run.rover import check_mission
+from specc.run.mission import check_mission, load_robot
 from specc.runtime.planner import Planner
 from specc.syntax.parser import parse_text
 from tests.atrv import ATRV, atrv_models, mutation_1_592, program
@@ -385,12 +385,13 @@ def test_a_mutant_domain_takes_the_place_of_the_generated_one_in_a_mission() -> 
         setup.domains["model1"], source="")
     mutant = of_kind(model1_mutants(), "deletion")[0]
     # A rover mission runs with the mutant in place of the domain of the same name.
-    changed = check_mission("Robot1/2", "M1", "W1", 0, generated=ROOT / "generated", example=ATRV,
-                            domains={"model1": mutant_domain(mutant)}).setup
+    robot = load_robot(ROOT / "generated", ATRV, "atrv")
+    changed = check_mission(robot, robot.mission("M1"), "W1", 0, None, "Robot1/2",
+                            domains={"model1": mutant_domain(mutant)}).planning
     assert changed.domains["model1"] == mutant_domain(mutant) != setup.domains["model1"]
     assert changed.domains["model2_M1"] == setup.domains["model2_M1"] and changed.problem == setup.problem
     with pytest.raises(RunError, match="plans in model1, model2_M1, not in model9"):
-        check_mission("Robot1/2", "M1", "W1", 0, generated=ROOT / "generated", example=ATRV,
+        check_mission(robot, robot.mission("M1"), "W1", 0, None, "Robot1/2",
                       domains={"model9": replace(mutant_domain(mutant), name="model9")})
 
 

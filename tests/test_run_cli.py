@@ -50,15 +50,15 @@ def test_a_rover_mission_leaves_a_run_folder_with_log_report_and_pictures(m1_w2:
     assert report["outcome"] == "succeeded" and report["configuration"] == "Robot1/2"
     measures = report["measures"]
     assert measures["nu"] == 1 and measures["kappa"] == 0
-    assert (measures["photos"], measures["communications"], measures["home"]) == (
-        {"asked": 3, "met": 3}, {"asked": 2, "met": 2}, {"asked": 1, "met": 1})
+    assert measures["goals"] == [{"kind": "p", "asked": 3, "met": 3}, {"kind": "c", "asked": 2, "met": 2},
+                                 {"kind": "h", "asked": 1, "met": 1}]
     events = read_events(folder / "events.jsonl")
     assert events[0]["kind"] == "mission-start" and events[-1]["kind"] == "mission-end"
     # The report agrees with the log it was measured from.
     assert report["simulated_time"] == pytest.approx(events[-1]["t"], abs=1e-3)
     assert measures["distance"] == pytest.approx(events[-1]["distance"], abs=1e-3)
     summary = (folder / "summary.txt").read_text()
-    assert "mission succeeded" in summary and "photos 3/3" in summary
+    assert "mission succeeded" in summary and "p 3/3 (sigma_p 100 %)" in summary
     for picture in report["pictures"]:
         path = folder / picture
         assert is_png(path) and f"picture: {path}" in result.stdout
@@ -119,11 +119,11 @@ def test_a_table_of_the_hunt_over_seeds(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(("args", "message"), [
-    (("--mission", "M9", "--world", "W2"), "error: ftplan 'rover' has no mission 'M9' (it has: M1, M2, M3, M4)"),
-    (("--mission", "M1", "--world", "W9"), "error: unknown world 'W9': give W1, W2, W3, W4"),
+    (("--mission", "M9", "--world", "W2"), "error: robot 'atrv' has no mission 'M9' (its missions: M1, M2, M3, M4)"),
+    (("--mission", "M1", "--world", "W9"), "error: robot 'atrv' has no world 'W9' (its worlds: W1, W2, W3, W4;"),
     (("--mission", "M1", "--world", "W1", "--config", "Robot3"), "error: no robot configuration 'Robot3'"),
-    (("--mission", "M1",), "error: the rover needs --mission (M1, M2, M3, M4) and --world"),
-    (("--mission", "M1", "--world", "W1", "--horizon", "60"), "error: --horizon: a rover mission ends with its plan"),
+    ((), "error: robot 'atrv' needs --mission (M1, M2, M3, M4) or --goal"),
+    (("--mission", "M1", "--horizon", "-60"), "error: horizon -60.0: give a positive number of simulated seconds"),
 ])
 def test_unknown_names_are_one_line_and_leave_no_run_folder(args: tuple[str, ...], message: str,
                                                             tmp_path: Path) -> None:
@@ -196,29 +196,30 @@ def test_a_robot_stuck_in_a_pocket_fails_its_mission_with_a_report(tmp_path: Pat
     trap = toml_world(dataclasses.replace(w4, name="W4-trap", obstacles=pocket), tmp_path / "trap.toml")
     result = specc("run", ATRV, "--mission", "M2", "--world", trap, "--config", "Robot1", "--runs", tmp_path)
     assert result.returncode == 1 and "Traceback" not in result.stderr
-    folder = tmp_path / "atrv-M2-W4-trap-Robot1-s0"  # named after the world's own name
+    folder = tmp_path / "atrv-M2-trap-Robot1-s0"  # named after the world file
     report = json.loads((folder / "report.json").read_text())
-    assert report["outcome"] == "failed" and report["measures"]["photos"]["met"] < 3
+    photos = next(g for g in report["measures"]["goals"] if g["kind"] == "p")
+    assert report["outcome"] == "failed" and photos["met"] < 3
     failed = [e for e in read_events(folder / "events.jsonl") if e["kind"] == "action" and e["status"] == "failed"]
     assert failed and "NO_PROGRESS" in failed[0]["why"]
     assert "map.png" in report["pictures"]
 
 
 def test_a_run_that_crashes_keeps_its_log_and_says_so(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A fault inside the runtime half-way through (the rover's executor breaks at its third
+    """A fault inside the runtime half-way through (the plans' executor breaks at its third
     action): the run folder keeps the log up to there and a report saying what broke."""
-    from specc.run import rover
+    from specc.run import plans
 
-    started = rover.SimExecutor._start
+    started = plans.KernelExecutor._start
     calls = []
 
-    def breaking(self: rover.SimExecutor, *args: object) -> None:
+    def breaking(self: plans.KernelExecutor, *args: object) -> None:
         calls.append(args)
         if len(calls) == 3:
             raise ZeroDivisionError("injected")
         started(self, *args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(rover.SimExecutor, "_start", breaking)
+    monkeypatch.setattr(plans.KernelExecutor, "_start", breaking)
     request = RunRequest(ATRV, "M1", "W1", "Robot1", folder=tmp_path / "run", pictures=False)
     with pytest.raises(RunCrashed, match="the run crashed: ZeroDivisionError: injected") as crash:
         run_compiled("atrv", request)
@@ -228,6 +229,23 @@ def test_a_run_that_crashes_keeps_its_log_and_says_so(tmp_path: Path, monkeypatc
     assert events[0]["kind"] == "mission-start" and sum(
         e["kind"] == "action" and e["status"] == "started" for e in events) == 2
     assert crash.value.outcome.report == report
+
+
+def test_a_planned_mission_stops_at_its_horizon(tmp_path: Path) -> None:
+    """A horizon shorter than the plan: the action under way is stopped there, FTplan's mission
+    ends, and the run's outcome says so (not a planning failure)."""
+    result = specc("run", ATRV, "--mission", "M1", "--config", "Robot1", "--horizon", "60", "--runs", tmp_path,
+                   "--no-pictures")
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    folder = tmp_path / "atrv-M1-W1-Robot1-s0-horizon60"
+    report = json.loads((folder / "report.json").read_text())
+    assert report["outcome"] == "horizon" and "the run's horizon (60 s) was reached" in report["why"]
+    assert report["measures"]["kappa"] == 0 and report["measures"]["nu"] == 0
+    events = read_events(folder / "events.jsonl")
+    stopped = [e for e in events if e["kind"] == "action" and e["status"] == "stopped"]
+    assert stopped and all(e["t"] == pytest.approx(60.0, abs=0.2) for e in stopped)
+    assert not [e for e in events if e["kind"] == "action" and e["status"] == "started" and e["t"] > 60.0]
+    assert events[-1]["t"] < 70.0
 
 
 def test_the_table_of_measures_comes_from_one_command(tmp_path: Path) -> None:
@@ -246,7 +264,7 @@ def test_the_table_of_measures_comes_from_one_command(tmp_path: Path) -> None:
 def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
     result = specc("table", ATRV, "--mission", "M1", "--mission", "M7", "--world", "W1", "--config", "Robot1",
                    "--runs", tmp_path)
-    assert_clean_failure(result, 2, "error: ftplan 'rover' has no mission 'M7'")
+    assert_clean_failure(result, 2, "error: robot 'atrv' has no mission 'M7'")
     assert not any(tmp_path.iterdir())  # every name is checked before the first run
     assert_clean_failure(specc("table", HILARE, "--world", "W1"), 2, "robot 'hilare' has no world 'W1'")
     assert_clean_failure(specc("table", HILARE, "--config", "Robot1"), 2, "--config: mission hunt of robot 'hilare' "

@@ -14,15 +14,16 @@ from typing import Any
 
 import pytest
 
-from specc.run.rover import load_package
+from specc.run.mission import load_robot
 from specc.runtime import functional as rt
 from specc.runtime.sim import Window, load_world, parse_world
 from specc.runtime.sim.world import Circle, Polygon
-from tests.conftest import EXAMPLES
+from tests.conftest import EXAMPLES, ROOT
 
 ATRV = EXAMPLES / "atrv"
 WORLDS = ATRV / "worlds"
-HALF_WIDTH = load_package().body.width / 2.0  # m, the simulated ATRV's (1.05 m x 0.65 m, system.spec)
+# m, the simulated ATRV's (1.05 m x 0.65 m, system.spec)
+HALF_WIDTH = load_robot(ROOT / "generated", ATRV, "atrv").system.body.width / 2.0
 TOLERANCE = 0.3
 
 

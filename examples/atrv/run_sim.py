@@ -20,7 +20,7 @@ import re
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -36,27 +36,69 @@ class UsageError(Exception):
     """A bad command line: reported in one line, exit status 2."""
 
 
-def import_generated() -> Any:
-    """The generated package (`atrv.modules`, `.body`...), with the codels of this folder."""
+class Package(NamedTuple):
+    """The compiled atrv package: its modules, and the body its system block gives the rover."""
+
+    modules: Any  # atrv.modules
+    body: Any  # specc.runtime.body.RobotConfig
+
+
+class Rover(NamedTuple):
+    """The six modules on one registry with the simulated rover, a client per module."""
+
+    registry: Any
+    sim: Any
+    clients: Any  # .rflex, .ndd, ... : each module's client
+    modules: dict[str, Any]  # the module instances, by name (their SDI)
+
+    @property
+    def kernel(self) -> Any:
+        return self.registry.kernel
+
+
+def import_generated() -> Package:
+    """The generated package (`specc compile examples/atrv -o generated`), with the codels of
+    this folder on the import path."""
     from specc.run import RunError
-    from specc.run.rover import load_package
+    from specc.run.mission import load_robot
 
     try:
-        return load_package(ROOT / "generated", HERE)
+        robot = load_robot(ROOT / "generated", HERE, "atrv")
     except RunError as exc:
         raise UsageError(str(exc)) from None
+    return Package(robot.part("modules"), robot.system.body)
 
 
-def build(world: Any, seed: int = 0) -> Any:
-    """The ATRV's six modules and the simulated rover in `world`, a client per module
-    (`specc.run.rover.Rover`: `.sim`, `.kernel`, `.clients.ndd` ...)."""
-    from specc.run import RunError
-    from specc.run.rover import build_rover
+def build(world: Any, seed: int = 0) -> Rover:
+    """The ATRV's six modules and the simulated rover in `world`."""
+    from types import SimpleNamespace
+
+    from specc.runtime import functional as rt
+    from specc.runtime.sim import Simulation, WorldError
 
     package = import_generated()
+    registry = rt.Registry()
     try:
-        return build_rover(package.modules, world, seed, package.body)
-    except RunError as exc:  # what the world asks cannot be built (objects without room)
+        sim = Simulation(world, package.body, seed=seed, kernel=registry.kernel).attach(registry)
+    except WorldError as exc:  # what the world asks cannot be built (objects without room)
+        raise UsageError(str(exc)) from None
+    made = package.modules.create_all(registry)
+    clients = SimpleNamespace(**{name: package.modules.MODULES[name].client(module) for name, module in made.items()})
+    return Rover(registry, sim, clients, dict(made))
+
+
+def resolve_world(name: str) -> Any:
+    """W1..W4 (this folder's worlds) or a world file."""
+    from specc.runtime.sim import WorldError, load_world
+
+    named = {p.stem.upper(): p for p in sorted(WORLDS.glob("*.toml"))}
+    path = named.get(name.upper(), Path(name))
+    if name.upper() not in named and path.suffix != ".toml":
+        raise UsageError(f"unknown world '{name}': give {', '.join(p.stem for p in named.values())} or a world "
+                         "file (.toml)")
+    try:
+        return load_world(path)
+    except WorldError as exc:
         raise UsageError(str(exc)) from None
 
 
@@ -157,13 +199,7 @@ class Mission:
 
 def run(argv: list[str] | None = None) -> int:
     args = parser().parse_args(_glue_negative_goals(list(sys.argv[1:] if argv is None else argv)))
-    from specc.run import RunError
-    from specc.run.rover import resolve_world
-
-    try:  # W1..W4 name the example worlds; anything else is a world file
-        world = resolve_world(args.world, WORLDS)
-    except RunError as exc:
-        raise UsageError(str(exc)) from None
+    world = resolve_world(args.world)  # W1..W4 name the example worlds; anything else is a world file
     goals = [parse_goal(g) for g in args.goal] or (TRAP if world.name == "W4" else TOUR)
     xmin, xmax, ymin, ymax = world.bounds
     for x, y in goals:

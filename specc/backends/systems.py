@@ -13,7 +13,7 @@ from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
 from specc.runtime.ftplan.config import Term, Var
-from specc.runtime.system import BindingSpec, MissionSpec, ReportSpec, StateValue
+from specc.runtime.system import BindingSpec, MissionSpec, ReportSpec, StateCondition, StateValue
 from specc.syntax.printer import goal as goal_text
 from specc.syntax.printer import prop_value
 
@@ -102,8 +102,10 @@ class SystemView:
         entries = self.system.bindings.entries if self.system.bindings is not None else ()
         return [(repr(b.task), literal(BindingSpec(
             b.task, terms(b.args), b.kind, b.target.text, tuple(binding_argument(a) for a in b.target_args),
-            ReportSpec(b.report.name, tuple(v.text for v in b.report.values)) if b.report is not None else None),
-            (Var, StateValue, ReportSpec), 8, len(repr(b.task)) + 2)) for b in entries]
+            ReportSpec(b.report.name, tuple(v.text for v in b.report.values)) if b.report is not None else None,
+            StateCondition(b.where.attribute, terms(b.where.args), term(b.where.value)) if b.where is not None
+            else None),
+            (Var, StateValue, ReportSpec, StateCondition), 8, len(repr(b.task)) + 2)) for b in entries]
 
 
 def binding_argument(e: m.IxExpr) -> Term | StateValue:

@@ -3,7 +3,7 @@ configuration x mission x world x run, each experiment in a process with a hard 
 results in a SQLite store as they finish (an interrupted campaign resumes), locally or on Dask
 distributed, and the seed's measures averaged over sets of activities.
 
-    specc campaign examples/atrv --mutants 40 --runs 3 --configs Robot1,Robot1/2
+    specc campaign examples/tug --mutants 40 --runs 3 --configs Robot1,Robot1/2
 
 `experiments` runs one experiment, `store` keeps the results, `engines` runs many (local pool,
 Dask), `campaign` orders them and applies the seed's filters, `report` writes the tables and the

@@ -22,9 +22,6 @@ from specc.run import RunError
 from specc.runtime.planner import model as pm
 
 KEPT, NEVER_PLANS, EQUIVALENT, UNJUDGED = "kept", "never-plans", "equivalent", ""
-MISSIONS = ("M1", "M2", "M3", "M4")
-WORLDS = ("W1", "W2", "W3", "W4")
-CONFIGURATIONS = ("Robot1", "Robot1/2")
 
 Progress = Callable[[int, int, Outcome | None], None]  # (done, total, the outcome just recorded)
 
@@ -33,19 +30,21 @@ Progress = Callable[[int, int, Outcome | None], None]  # (done, total, the outco
 class CampaignPlan:
     robot: Path  # the robot's spec folder
     setting: Setting
-    domain: str = "model1"  # the planning model faults are injected into
-    mutants: int | None = None  # how many mutants to draw (None: every kept one)
-    sample_seed: int = 0
-    missions: tuple[str, ...] = MISSIONS
-    worlds: tuple[str, ...] = WORLDS
-    runs: int = 3  # seeds 0 .. runs-1 of each activity
-    configurations: tuple[str, ...] = CONFIGURATIONS
+    domain: str  # the planning model faults are injected into
+    mutants: int | None  # how many mutants to draw (None: every kept one)
+    sample_seed: int
+    missions: tuple[str, ...]  # planned missions of the robot's system block
+    worlds: tuple[str, ...]  # the system's worlds (or world files)
+    runs: int  # seeds 0 .. runs-1 of each activity
+    configurations: tuple[str, ...]  # FTplan's (Robot1, Robot1/2...); the first judges the mutants
+    set_apart: tuple[str, ...] = ()  # worlds the means are also given without (seed 004 set W4 apart)
 
     def description(self, mutant_ids: Sequence[str]) -> dict[str, Any]:
         """What makes two campaigns the same (the store refuses to mix two different ones)."""
         return {"robot": self.robot.name, "domain": self.domain, "mutants": list(mutant_ids),
                 "missions": list(self.missions), "worlds": list(self.worlds), "runs": self.runs,
-                "configurations": list(self.configurations), "timing": self.setting.timing}
+                "configurations": list(self.configurations), "timing": self.setting.timing,
+                "set_apart": list(self.set_apart)}
 
     def experiments(self, configuration: str, mutants: Iterable[str]) -> list[Experiment]:
         return [Experiment(configuration, mutant, mission, world, seed) for mutant in mutants
@@ -151,9 +150,37 @@ class Campaign:
         return verdicts
 
 
-def check_names(plan: CampaignPlan, generated: Path, example: Path) -> None:
+@dataclass(frozen=True)
+class Defaults:
+    """What a campaign on a robot covers unless told otherwise."""
+
+    domain: str  # the first planner's
+    missions: tuple[str, ...]  # every planned mission of the system
+    worlds: tuple[str, ...]  # every world of the system
+    configurations: tuple[str, ...]  # the first planner alone, then all of them (successive)
+
+
+def campaign_defaults(generated: Path, folder: Path, robot_name: str) -> Defaults:
+    """The defaults of a campaign on the compiled robot; RunError when it plans nothing."""
+    from specc.run.mission import load_robot
+
+    robot = load_robot(generated, folder, robot_name)
+    system = robot.system
+    planned = tuple(name for name, mission in system.missions.items() if mission.plan is not None)
+    if system.planning is None or not planned:
+        raise RunError(f"robot '{robot.name}' has no planned mission: a campaign injects faults into the planning "
+                       "model FTplan plans its missions in (give its system 'planning: <ftplan block>;' and a "
+                       "mission with 'plan: ...;')")
+    block = robot.part("ftplan").FTPLANS[system.planning]
+    planners = block.CONFIG.planners
+    configurations = ("Robot1",) + (("Robot" + "/".join(str(k) for k in range(1, len(planners) + 1)),)
+                                    if len(planners) > 1 else ())
+    return Defaults(planners[0].domain, planned, tuple(system.worlds), configurations)
+
+
+def check_names(plan: CampaignPlan) -> None:
     """Every configuration, mission and world named, checked before anything runs (RunError)."""
-    from specc.run.rover import check_mission
+    from specc.run.mission import check_mission, load_robot
 
     if plan.runs < 1:
         raise RunError(f"--runs {plan.runs}: give at least 1")
@@ -161,11 +188,18 @@ def check_names(plan: CampaignPlan, generated: Path, example: Path) -> None:
                          ("--worlds", plan.worlds)):
         if not values:
             raise RunError(f"{name}: give at least one")
+    unknown = sorted(set(plan.set_apart) - set(plan.worlds))
+    if unknown:
+        raise RunError(f"--set-apart {', '.join(unknown)}: not among the campaign's worlds ({', '.join(plan.worlds)})")
+    robot = load_robot(plan.setting.generated, plan.setting.example, plan.setting.robot)
     for configuration in plan.configurations:
-        for mission in plan.missions:
+        for name in plan.missions:
+            mission = robot.mission(name)
+            if mission.plan is None:
+                raise RunError(f"mission {mission.name} of robot '{robot.name}' is not planned: a campaign injects "
+                               "faults into the planning model of planned missions")
             for world in plan.worlds:
-                planned_in = check_mission(configuration, mission, world, 0, generated=generated,
-                                           example=example).setup.planned_in
+                planned_in = check_mission(robot, mission, world, 0, None, configuration).planning.planned_in
                 if plan.domain not in planned_in:
                     raise RunError(f"configuration {configuration} does not plan in '{plan.domain}' (it plans in "
                                    f"{', '.join(sorted(planned_in))}): a campaign injects faults into the model "

@@ -4,6 +4,7 @@ those five values: the same experiment gives the same measures wherever it runs.
 
 from __future__ import annotations
 
+import functools
 import time
 import traceback
 from dataclasses import dataclass
@@ -49,26 +50,39 @@ class Outcome:
 
 @dataclass(frozen=True)
 class Setting:
-    """Where every experiment of a campaign finds the robot: the compiled package's parent folder
-    and the robot's spec folder (codels, worlds), plus FTplan's planning charge."""
+    """Where every experiment of a campaign finds the robot: the compiled package's parent folder,
+    the robot's spec folder (codels, worlds) and its package name, plus FTplan's planning charge."""
 
     generated: Path
     example: Path
+    robot: str
     timing: str = "model"
+
+
+@functools.cache
+def _robot(setting: Setting) -> Any:
+    """The compiled robot, imported once per process."""
+    from specc.run.mission import load_robot
+
+    return load_robot(setting.generated, setting.example, setting.robot)
 
 
 def run_experiment(experiment: Experiment, domain: pm.PlanningDomain | None, setting: Setting) -> Outcome:
     """Run the experiment with `domain` (the mutant's planning domain; None: the original model)
-    in place of the generated domain of the same name. Never raises: a failure is the outcome."""
-    from specc.run.measures import measure
-    from specc.run.rover import run_rover_mission
+    in place of the generated domain of the same name. Its measures are those of seed 004 §4.1.4:
+    the robot's extension's when it measures them, else FTplan's goals as its ledger counted them
+    (`specc.run.measures.planned_measures`). Never raises: a failure is the outcome."""
+    from specc.run.measures import Measures, planned_measures
+    from specc.run.mission import run_mission
 
     started = time.perf_counter()
     try:
-        run = run_rover_mission(experiment.configuration, experiment.mission, experiment.world, experiment.seed,
-                                generated=setting.generated, example=setting.example, timing=setting.timing,
-                                domains={domain.name: domain} if domain is not None else None)
-        measures = measure(run).to_json()
+        robot = _robot(setting)
+        run = run_mission(robot, robot.mission(experiment.mission), experiment.seed, world=experiment.world,
+                          configuration=experiment.configuration, timing=setting.timing,
+                          domains={domain.name: domain} if domain is not None else None)
+        measured = dict(run.extension_measures)
+        measures = measured if Measures.readable(measured) else planned_measures(run.events).to_json()
     except RunError as error:
         return Outcome(experiment, "crashed", None, time.perf_counter() - started, str(error))
     except Exception as error:  # an experiment must never take the campaign with it

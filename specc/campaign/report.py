@@ -1,9 +1,10 @@
 """The report of a campaign, from its results store alone (seed 004 §4.2.2.3, Fig 4.14).
 
 The measures of §4.1.4 are averaged over sets of activities in the seed's notation: σ̄_p({W*, M*},
-F*) is the mean photo quotient over every world and mission and over F*, the kept mutants (∅: the
-original model). Each mean is given with W4 and without it (the seed set W4 apart for its
-adversity), for each configuration; the headlines are the change of mission success ν̄ from the
+F*) is the mean quotient of goals of kind p (the rover's photos) met over every world and mission
+and over F*, the kept mutants (∅: the original model). Each mean is given over every world and,
+when the campaign sets worlds apart (`--set-apart W4`: the seed set W4 apart for its adversity),
+without them, for each configuration; the headlines are the change of mission success ν̄ from the
 first configuration to each other one under injected faults, absolute (points) and relative,
 beside the fault-free figures."""
 
@@ -18,10 +19,9 @@ from typing import Any
 from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED
 from specc.campaign.experiments import ORIGINAL, Outcome
 from specc.campaign.store import MutantRecord, ResultStore
-from specc.run.measures import MeanMeasures, Measures, aggregate
+from specc.run.measures import MeanMeasures, Measures, aggregate, kinds_of
 
 FAULTY, FAULT_FREE = "F*", "∅"
-QUOTIENTS = (("sigma_p", "σ̄_p"), ("sigma_c", "σ̄_c"), ("sigma_h", "σ̄_h"), ("nu", "ν̄"))
 # The seed's headline (§4.2.2.3, without W4): FTplan raised ν̄ by 19 points, 41 % relative.
 SEED_HEADLINE = (0.19, 0.41)
 
@@ -30,7 +30,7 @@ SEED_HEADLINE = (0.19, 0.41)
 class Mean:
     configuration: str
     faults: str  # FAULTY or FAULT_FREE
-    worlds: str  # "W*" or "W* \\ W4"
+    worlds: str  # "W*", or "W* \\ W4" without the worlds set apart
     experiments: int
     means: MeanMeasures | None  # None when no experiment is in the set
 
@@ -99,13 +99,13 @@ def build_report(store: ResultStore) -> CampaignReport:
     configurations: list[str] = list(description.get("configurations", []))
     kept = {m.id for m in mutants if m.verdict == KEPT}
     measures = [(o, Measures.from_json(o.measures)) for o in outcomes if o.status == "done" and o.measures]
-    world_sets = (("W*", None), ("W* \\ W4", "W4"))
+    world_sets = world_subsets(description)
     means = []
     for configuration in configurations:
         for faults, wanted in ((FAULTY, kept), (FAULT_FREE, {ORIGINAL})):
             for label, left_out in world_sets:
                 chosen = [m for o, m in measures if o.experiment.configuration == configuration
-                          and o.experiment.mutant in wanted and o.experiment.world != left_out]
+                          and o.experiment.mutant in wanted and o.experiment.world not in left_out]
                 means.append(Mean(configuration, faults, label, len(chosen), aggregate(chosen) if chosen else None))
     per_mutant = []
     for mutant in (m for m in mutants if m.id in kept):
@@ -125,6 +125,24 @@ def build_report(store: ResultStore) -> CampaignReport:
                 headlines.append(Headline(label, first, second, faulty, free))  # type: ignore[arg-type]
     return CampaignReport(description, mutants, outcomes, tuple(means), tuple(per_mutant), tuple(headlines),
                           coverage(description, mutants, outcomes))
+
+
+def world_subsets(description: dict[str, Any]) -> tuple[tuple[str, frozenset[str]], ...]:
+    """The sets of worlds the means are taken over: every one (W*), and without those the
+    campaign sets apart (W* \\ W4) when it does."""
+    apart = frozenset(description.get("set_apart", []))
+    every: tuple[tuple[str, frozenset[str]], ...] = (("W*", frozenset()),)
+    return every + ((f"W* \\ {', '.join(sorted(apart))}", apart),) if apart else every
+
+
+def quotients(report: CampaignReport) -> list[tuple[str, str]]:
+    """(kind or "nu", label) of the quotients the report shows: σ̄ of each kind of goal, then ν̄."""
+    kinds = kinds_of(m.means for m in report.means if m.means is not None)
+    return [(kind, f"σ̄_{kind}") for kind in kinds] + [("nu", "ν̄")]
+
+
+def _quotient(mean: MeanMeasures, name: str) -> float:
+    return mean.nu if name == "nu" else mean.sigma_of(name)
 
 
 def coverage(description: dict[str, Any], mutants: Iterable[MutantRecord],
@@ -171,16 +189,17 @@ def markdown(report: CampaignReport) -> str:
         lines += ["## Headline", ""]
         lines += [f"- {h.text()}" for h in report.headlines]
         seed_abs, seed_rel = SEED_HEADLINE
-        lines += [f"- seed 004 (W* \\ W4): +{seed_abs * 100:.0f} points ({seed_rel:+.0%} relative), still below "
-                  "fault-free", ""]
+        lines += [f"- for reference, seed 004's own campaign (W* \\ W4, its rover and missions): "
+                  f"+{seed_abs * 100:.0f} points ({seed_rel:+.0%} relative), still below fault-free", ""]
+    shown = quotients(report)
+    header = [label for _, label in shown] + ["κ̄", "R̄", "T̄ (s)", "D̄ (m)"]
     lines += ["## Means over sets of activities", "",
-              "| configuration | faults | worlds | experiments | σ̄_p | σ̄_c | σ̄_h | ν̄ | κ̄ | R̄ | T̄ (s) | D̄ (m) |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "| configuration | faults | worlds | experiments | " + " | ".join(header) + " |",
+              "| --- | --- | --- | --- | " + " | ".join("---" for _ in header) + " |"]
     for mean in report.means:
         m = mean.means
-        cells = ["-"] * 8 if m is None else [_pct(m.sigma_p), _pct(m.sigma_c), _pct(m.sigma_h), _pct(m.nu),
-                                              _pct(m.kappa), f"{m.replannings:.2f}", f"{m.activity_time:.0f}",
-                                              f"{m.distance:.1f}"]
+        cells = ["-"] * len(header) if m is None else [_pct(_quotient(m, name)) for name, _ in shown] + [
+            _pct(m.kappa), f"{m.replannings:.2f}", f"{m.activity_time:.0f}", f"{m.distance:.1f}"]
         lines.append(f"| {mean.configuration} | {mean.faults} | {mean.worlds} | {mean.experiments} | "
                      + " | ".join(cells) + " |")
     configurations = list(d.get("configurations", []))
@@ -234,20 +253,22 @@ def draw(report: CampaignReport, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    panels = ("W*", "W* \\ W4")
+    panels = tuple(label for label, _ in world_subsets(report.description))
+    shown = quotients(report)
     series = [(c, f) for c in dict.fromkeys(m.configuration for m in report.means) for f in (FAULT_FREE, FAULTY)]
-    figure, axes = plt.subplots(1, len(panels), figsize=(12, 4.2), sharey=True)
+    figure, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4.2), sharey=True, squeeze=False)
+    axes = axes[0]
     width = 0.8 / max(1, len(series))
     for axis, worlds in zip(axes, panels, strict=True):
         for k, (configuration, faults) in enumerate(series):
             mean = next((m.means for m in report.means if (m.configuration, m.faults, m.worlds)
                          == (configuration, faults, worlds)), None)
-            values = [getattr(mean, name) if mean is not None else 0.0 for name, _ in QUOTIENTS]
-            xs = [i + (k - (len(series) - 1) / 2) * width for i in range(len(QUOTIENTS))]
+            values = [_quotient(mean, name) if mean is not None else 0.0 for name, _ in shown]
+            xs = [i + (k - (len(series) - 1) / 2) * width for i in range(len(shown))]
             bars = axis.bar(xs, values, width, label=f"{configuration}, {faults}",
                             hatch="//" if faults == FAULTY else None, edgecolor="black", linewidth=0.5)
             axis.bar_label(bars, labels=[f"{v:.0%}" for v in values], fontsize=6, padding=1)
-        axis.set_xticks(range(len(QUOTIENTS)), [label for _, label in QUOTIENTS])
+        axis.set_xticks(range(len(shown)), [label for _, label in shown])
         axis.set_ylim(0, 1.1)
         axis.set_title(f"{{{worlds}, M*}}")
         axis.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))

@@ -204,8 +204,16 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
         for call in after:
             check_attribute(ctx, tasks, call.function, len(call.args), call.span)
         inner = tuple(x for call in after for x in call.args)
+        # `where ATTR(?o, ...) := VALUE` binds the ?variables of its pattern too
+        where = binding.where
+        binders: tuple[m.IxExpr, ...] = binding.args
+        if where is not None:
+            check_attribute(ctx, tasks, where.attribute, len(where.args), where.span)
+            check_terms(ctx, (*where.args, where.value))
+            binders = (*binding.args, *where.args)
+            check_bound(ctx, binders, (where.value,), f"task '{binding.task}'")
         check_terms(ctx, (*binding.args, *plain, *inner))
-        check_bound(ctx, binding.args, (*plain, *inner), f"task '{binding.task}'")
+        check_bound(ctx, binders, (*plain, *inner), f"task '{binding.task}'")
         check_binding_target(ctx, system, binding, goals, services)
         if binding.report is not None:
             check_binding_report(ctx, binding.report, reports)

@@ -963,7 +963,18 @@ class Binding(Node):
     kind: str  # goal | service | request
     target: Ref
     target_args: tuple[IxExpr, ...] = ()  # ?variables, constants, or ATTR(...): FTplan's state after the action
+    where: BindingWhere | None = None
     report: BindingReport | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class BindingWhere(Node):
+    """`where ATTR(?o, ...) := VALUE`: ?variables bound by the first of FTplan's state changes at
+    the action's end that reads so."""
+
+    attribute: str
+    args: tuple[IxExpr, ...] = ()
+    value: IxExpr
 
 
 @dataclass(frozen=True, kw_only=True)

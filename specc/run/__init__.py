@@ -2,10 +2,9 @@
 
 - `specc.run.events`: the JSONL event log every run writes, stamped with simulated time.
 - `specc.run.mission`: any robot's mission, from its system block (`load_robot`, `run_mission`),
-  with the robot's own extension hooks.
-- `specc.run.rover`: the rover missions of seed 004 on the simulated ATRV (`run_rover_mission`);
-  `specc.run.rover_tasks`: their planning models' tasks by kind.
-- `specc.run.measures`: the measures of seed 004 §4.1.4 and their tables.
+  with the robot's own extension hooks; `specc.run.plans`: FTplan's plans carried out as the
+  system's bindings say.
+- `specc.run.measures`: the measures of seed 004 §4.1.4 of a planned mission and their tables.
 - `specc.run.render`: every picture of a run, drawn from its event log alone (`render_run`);
   `specc.run.pictures`: the state of Fig 5.11.
 - `specc.run.session`: `specc run` (compile if stale, run, write the run folder);

@@ -1,6 +1,8 @@
-"""The measures of seed 004 §4.1.4, from rover runs (`specc.run.rover`).
+"""The measures of seed 004 §4.1.4 for a planned mission, and their means over runs.
 
-For one run (`measure(run)`):
+A robot's extension measures one run from its log (its `measure(events)` returns
+`Measures(...).to_json()`, e.g. seed 004's rover, beside its codels), with
+`activity_time(events)` for T. The figures:
 
 - u_i of v_i goals met per kind i: photos (p), communications (c), the return home (h); the
   quotients sigma_i = u_i / v_i of goals met and phi_i = 1 - sigma_i of goals failed;
@@ -17,11 +19,9 @@ For one run (`measure(run)`):
 - D, the distance the robot travelled.
 
 The goals are judged on what really happened in the simulation, as the thesis took its measures
-from the simulator's logs, not on what FTplan believes (`believed`, counted apart): a photo is met
-when an image CAMERA took shows its target, a communication when its window held one of ANTENNA's
-links, the return when the robot really stands within HOME_TOLERANCE of home at the end.
-The two differ when FTplan's state is wrong: a communication a faulty plan sent in another window
-than its own, a robot whose odometry says home when it is not.
+from the simulator's logs, not on what FTplan believes (`believed`, counted apart). The two
+differ when FTplan's state is wrong: a communication a faulty plan sent in another window than
+its own, a robot whose odometry says home when it is not.
 
 For many runs, the thesis' means (§4.1.4: sigma-bar_p(A, F) over n executions):
 `aggregate(measures)` and `measure_table(measures, by=...)` (one row per configuration x mission x
@@ -32,7 +32,7 @@ world, or grouped over any of them: "*" stands for all, as the thesis' M*, W*), 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -41,9 +41,6 @@ from specc.run import RunError
 if TYPE_CHECKING:
     from rich.table import Table
 
-    from specc.run.rover import MissionGoal, RoverRun
-
-HOME_TOLERANCE = 0.5  # m: NDD stops within 0.3 m of its goal by odometry, which drifts (INVENTED)
 GROUPS = ("configuration", "mission", "world")
 ALL = "*"  # a dimension the row groups over
 
@@ -71,15 +68,15 @@ class GoalCount:
 
 @dataclass(frozen=True)
 class Measures:
-    """The measures of one run (seed 004 §4.1.4)."""
+    """The measures of one run (seed 004 §4.1.4). The goals are counted by kind, each kind named
+    as the robot's measures name it (the rover's: p photos, c communications, h the return home;
+    without an extension of its own, each of FTplan's goal attributes is a kind)."""
 
     configuration: str
     mission: str
     world: str
     seed: int
-    photos: GoalCount  # p
-    communications: GoalCount  # c
-    home: GoalCount  # h
+    goals: tuple[tuple[str, GoalCount], ...]  # (kind, u of v), in the robot's order
     kappa: int  # 1: no plan could be given in time (the mission exception)
     replannings: int  # R
     activity_time: float  # T, s
@@ -88,9 +85,13 @@ class Measures:
     planner_failures: int  # FTplan's detections: watchdog, crash, no plan, invalid plan
     believed: GoalCount  # every goal, as FTplan's ledger counted them
 
+    def count(self, kind: str) -> GoalCount:
+        """The goals of `kind` (none asked when the run had none)."""
+        return dict(self.goals).get(kind, GoalCount(0, 0))
+
     @property
     def success(self) -> bool:
-        return all(count.met == count.asked for count in (self.photos, self.communications, self.home))
+        return all(count.met == count.asked for _, count in self.goals)
 
     @property
     def nu(self) -> int:
@@ -102,32 +103,42 @@ class Measures:
 
     def to_json(self) -> dict[str, Any]:
         data = asdict(self)
-        for kind, count in (("p", self.photos), ("c", self.communications), ("h", self.home)):
+        # a list, not an object: the kinds keep the robot's order through JSON with sorted keys
+        data["goals"] = [{"kind": kind, **asdict(count)} for kind, count in self.goals]
+        for kind, count in self.goals:
             data[f"sigma_{kind}"] = round(count.sigma, 6)
             data[f"phi_{kind}"] = round(count.phi, 6)
         data.update(mu=self.mu, nu=self.nu, activity_time=round(self.activity_time, 3),
                     distance=round(self.distance, 3), mission_time=round(self.mission_time, 3))
         return data
 
+    @staticmethod
+    def readable(data: Mapping[str, Any]) -> bool:
+        """Whether `data` holds the measures `to_json` writes (a robot's extension may not)."""
+        try:
+            Measures.from_json(data)
+        except RunError:
+            return False
+        return True
+
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> Measures:
         """The measures `to_json` wrote (a run folder's report.json keeps them)."""
         try:
-            counts = {name: GoalCount(int(data[name]["asked"]), int(data[name]["met"]))
-                      for name in ("photos", "communications", "home", "believed")}
+            goals = tuple((str(c["kind"]), GoalCount(int(c["asked"]), int(c["met"]))) for c in data["goals"])
+            believed = GoalCount(int(data["believed"]["asked"]), int(data["believed"]["met"]))
             return cls(configuration=str(data["configuration"]), mission=str(data["mission"]),
-                       world=str(data["world"]), seed=int(data["seed"]), kappa=int(data["kappa"]),
+                       world=str(data["world"]), seed=int(data["seed"]), goals=goals, kappa=int(data["kappa"]),
                        replannings=int(data["replannings"]), activity_time=float(data["activity_time"]),
                        distance=float(data["distance"]), mission_time=float(data["mission_time"]),
-                       planner_failures=int(data["planner_failures"]), **counts)
-        except (KeyError, TypeError, ValueError) as error:
-            raise RunError(f"not the measures of a rover run ({type(error).__name__}: {error})") from None
+                       planner_failures=int(data["planner_failures"]), believed=believed)
+        except (KeyError, TypeError, ValueError, AttributeError) as error:
+            raise RunError(f"not the measures of seed 004 §4.1.4 ({type(error).__name__}: {error})") from None
 
     def summary(self) -> str:
         outcome = "succeeded" if self.success else "failed"
-        counts = ", ".join(f"{label} {count.text()} ({symbol} {_percent(count.sigma)})" for label, symbol, count in (
-            ("photos", "sigma_p", self.photos), ("communications", "sigma_c", self.communications),
-            ("return", "sigma_h", self.home)))
+        counts = ", ".join(f"{kind} {count.text()} (sigma_{kind} {_percent(count.sigma)})"
+                           for kind, count in self.goals) or "none asked"
         return "\n".join([
             f"{self.configuration} on {self.mission} in {self.world} (seed {self.seed}): mission {outcome} "
             f"(nu = {self.nu}, mu = {self.mu})",
@@ -140,38 +151,88 @@ class Measures:
         ])
 
 
-def measure(run: RoverRun) -> Measures:
-    """The measures of one rover run, its goals judged on what happened in the simulation."""
-    counts = {kind: GoalCount(0, 0) for kind in ("photo", "communication", "return")}
-    for goal in run.goals:
-        count = counts[goal.kind]
-        counts[goal.kind] = GoalCount(count.asked + 1, count.met + achieved(run, goal))
-    result = run.result
+@dataclass(frozen=True)
+class PlannedGoal:
+    """A goal FTplan was given (the log's mission-start `planned_goals`), and whether its ledger
+    counted it met at the end (mission-figures' `planned_goals_met_each`)."""
+
+    attribute: str
+    args: tuple[Any, ...]
+    value: Any
+    believed: bool
+
+
+# What a robot's judgement makes of one of FTplan's goals: its kind and whether it was really met,
+# or None to leave it out (a goal counted with another, as the rover's return home is two).
+Judgement = Callable[[PlannedGoal], "tuple[str, bool] | None"]
+
+
+def planned_goals(events: Sequence[Mapping[str, Any]]) -> list[PlannedGoal]:
+    """FTplan's goals of a planned run, from its log."""
+    start = events[0]
+    figures: Mapping[str, Any] = next((e for e in reversed(events) if e["kind"] == "mission-figures"), {})
+    met = list(figures.get("planned_goals_met_each", []))
+    return [PlannedGoal(str(attribute), tuple(args), value, bool(met[k]) if k < len(met) else False)
+            for k, (attribute, args, value) in enumerate(start.get("planned_goals", []))]
+
+
+def believed(goal: PlannedGoal) -> tuple[str, bool]:
+    """The judgement of a robot without one of its own: the goal's attribute is its kind, and it
+    was met when FTplan's ledger says so."""
+    return goal.attribute, goal.believed
+
+
+def planned_measures(events: Sequence[Mapping[str, Any]], judge: Judgement = believed,
+                     kinds: Sequence[str] = ()) -> Measures:
+    """The measures of a planned run from its log alone: the goals as `judge` counts them (by
+    default, as FTplan believed them; `kinds` first, in that order, then the others as met),
+    FTplan's figures, T from the actions, D."""
+    start = events[0]
+    figures = next((e for e in reversed(events) if e["kind"] == "mission-figures"), None)
+    if start.get("kind") != "mission-start" or figures is None or "planned_goals" not in start:
+        raise RunError("not the log of a planned mission: it needs mission-start's planned_goals and "
+                       "mission-figures")
+    counts: dict[str, GoalCount] = {}
+    goals = planned_goals(events)
+    for goal in goals:
+        judged = judge(goal)
+        if judged is None:
+            continue
+        kind, met = judged
+        count = counts.get(kind, GoalCount(0, 0))
+        counts[kind] = GoalCount(count.asked + 1, count.met + int(met))
     return Measures(
-        configuration=run.configuration, mission=run.mission, world=run.world, seed=run.seed,
-        photos=counts["photo"], communications=counts["communication"], home=counts["return"],
-        kappa=int(bool(result.failure)), replannings=run.result.replannings, activity_time=activity_time(run),
-        distance=run.distance, mission_time=run.simulated_time, planner_failures=result.planner_failures,
-        believed=GoalCount(len(result.met) + len(result.missed), len(result.met)))
+        configuration=str(start.get("configuration", "")), mission=str(start["mission"]), world=str(start["world"]),
+        seed=int(start["seed"]), goals=tuple(sorted(counts.items(), key=lambda item: _rank(item[0], kinds))),
+        kappa=int(bool(figures.get("planning_failure"))),
+        replannings=int(figures.get("replannings", 0)), activity_time=activity_time(events),
+        distance=float(figures.get("distance", 0.0)), mission_time=float(figures["t"]),
+        planner_failures=int(figures.get("planner_failures", 0)),
+        believed=GoalCount(len(goals), sum(g.believed for g in goals)))
 
 
-def achieved(run: RoverRun, goal: MissionGoal) -> bool:
-    """Whether the goal was really met in the simulation."""
-    if goal.kind == "photo":
-        return any(photo.ok and goal.name in photo.seen for photo in run.photos)
-    if goal.kind == "communication":
-        return any(link.ok and link.link == goal.name for link in run.communications)
-    if goal.kind == "return":
-        x, y = run.final_position
-        home = goal.point or (0.0, 0.0)
-        return math.hypot(x - home[0], y - home[1]) <= HOME_TOLERANCE
-    raise ValueError(f"no judgement for goals of kind '{goal.kind}'")
+def _rank(kind: str, kinds: Sequence[str]) -> int:
+    return kinds.index(kind) if kind in kinds else len(kinds)
 
 
-def activity_time(run: RoverRun) -> float:
-    """How long at least one action ran: the union of the actions' intervals."""
+def activity_time(events: Iterable[Mapping[str, Any]]) -> float:
+    """How long at least one action of a plan ran (the log's `action` events): the union of the
+    actions' intervals, from each start to its end, failure or stop (or the log's end)."""
+    began: dict[tuple[int, str], float] = {}
+    intervals = []
+    last = 0.0
+    for event in events:
+        last = event["t"]
+        if event["kind"] != "action":
+            continue
+        key = (event["plan"], event["id"])
+        if event["status"] == "started":
+            began[key] = event["t"]
+        elif key in began:
+            intervals.append((began.pop(key), event["t"]))
+    intervals += [(start, last) for start in began.values()]
     total, reached = 0.0, -math.inf
-    for start, end in sorted((a.start, a.end) for a in run.actions):
+    for start, end in sorted(intervals):
         if end > reached:
             total += end - max(start, reached)
             reached = end
@@ -183,47 +244,44 @@ def activity_time(run: RoverRun) -> float:
 
 @dataclass(frozen=True)
 class MeanMeasures:
-    """The means of the measures over runs (seed 004 §4.1.4): sigma-bar, phi-bar, mu-bar, nu-bar,
-    kappa-bar, R-bar, T-bar, D-bar. A dimension the runs differ in reads ALL."""
+    """The means of the measures over runs (seed 004 §4.1.4): sigma-bar (per kind of goal),
+    phi-bar, mu-bar, nu-bar, kappa-bar, R-bar, T-bar, D-bar. A dimension the runs differ in reads ALL."""
 
     configuration: str
     mission: str
     world: str
     runs: int
-    sigma_p: float
-    sigma_c: float
-    sigma_h: float
+    sigma: tuple[tuple[str, float], ...]  # (kind, sigma-bar): the mean quotient of its goals met
     nu: float
     kappa: float
     replannings: float  # R-bar
     activity_time: float  # T-bar, s
     distance: float  # D-bar, m
 
-    @property
-    def phi_p(self) -> float:
-        return 1.0 - self.sigma_p
+    def sigma_of(self, kind: str) -> float:
+        """sigma-bar of `kind` (1: no run asked for any)."""
+        return dict(self.sigma).get(kind, 1.0)
 
-    @property
-    def phi_c(self) -> float:
-        return 1.0 - self.sigma_c
-
-    @property
-    def phi_h(self) -> float:
-        return 1.0 - self.sigma_h
+    def phi_of(self, kind: str) -> float:
+        return 1.0 - self.sigma_of(kind)
 
     @property
     def mu(self) -> float:
         return 1.0 - self.nu
 
     def to_json(self) -> dict[str, Any]:
-        data: dict[str, Any] = {k: round(v, 6) if isinstance(v, float) else v for k, v in asdict(self).items()}
-        data.update(phi_p=round(self.phi_p, 6), phi_c=round(self.phi_c, 6), phi_h=round(self.phi_h, 6),
-                    mu=round(self.mu, 6))
+        data: dict[str, Any] = {k: round(v, 6) if isinstance(v, float) else v for k, v in asdict(self).items()
+                                if k != "sigma"}
+        for kind, value in self.sigma:
+            data[f"sigma_{kind}"] = round(value, 6)
+            data[f"phi_{kind}"] = round(1.0 - value, 6)
+        data.update(mu=round(self.mu, 6))
         return data
 
 
 def aggregate(measures: Sequence[Measures]) -> MeanMeasures:
-    """The means of `measures` (the arithmetic means of the thesis, quotient by quotient)."""
+    """The means of `measures` (the arithmetic means of the thesis, quotient by quotient; a kind
+    of goal a run did not ask for counts as met in it, sigma = 1)."""
     if not measures:
         raise RunError("no run to take the means of")
 
@@ -235,11 +293,12 @@ def aggregate(measures: Sequence[Measures]) -> MeanMeasures:
         listed = list(values)
         return math.fsum(listed) / len(listed)
 
+    kinds = list(dict.fromkeys(kind for m in measures for kind, _ in m.goals))
     return MeanMeasures(
         configuration=label("configuration"), mission=label("mission"), world=label("world"), runs=len(measures),
-        sigma_p=mean(m.photos.sigma for m in measures), sigma_c=mean(m.communications.sigma for m in measures),
-        sigma_h=mean(m.home.sigma for m in measures), nu=mean(m.nu for m in measures),
-        kappa=mean(m.kappa for m in measures), replannings=mean(m.replannings for m in measures),
+        sigma=tuple((kind, mean(m.count(kind).sigma for m in measures)) for kind in kinds),
+        nu=mean(m.nu for m in measures), kappa=mean(m.kappa for m in measures),
+        replannings=mean(m.replannings for m in measures),
         activity_time=mean(m.activity_time for m in measures), distance=mean(m.distance for m in measures))
 
 
@@ -255,20 +314,30 @@ def measure_table(measures: Iterable[Measures], by: Sequence[str] = GROUPS) -> l
     return [aggregate(runs) for runs in groups.values()]
 
 
-COLUMNS = ("configuration", "mission", "world", "runs", "ν", "φ_p", "φ_c", "φ_h", "κ", "R", "T (s)", "D (m)")
+def kinds_of(rows: Iterable[MeanMeasures]) -> list[str]:
+    """The kinds of goal the rows count, in the order first met."""
+    return list(dict.fromkeys(kind for row in rows for kind, _ in row.sigma))
 
 
-def _cells(row: MeanMeasures) -> list[str]:
-    return [row.configuration, row.mission, row.world, str(row.runs), _percent(row.nu), _percent(row.phi_p),
-            _percent(row.phi_c), _percent(row.phi_h), _percent(row.kappa), f"{row.replannings:.2f}",
+def columns(kinds: Sequence[str]) -> list[str]:
+    return ["configuration", "mission", "world", "runs", "ν", *(f"φ_{kind}" for kind in kinds), "κ", "R", "T (s)",
+            "D (m)"]
+
+
+def _cells(row: MeanMeasures, kinds: Sequence[str]) -> list[str]:
+    return [row.configuration, row.mission, row.world, str(row.runs), _percent(row.nu),
+            *(_percent(row.phi_of(kind)) for kind in kinds), _percent(row.kappa), f"{row.replannings:.2f}",
             f"{row.activity_time:.0f}", f"{row.distance:.1f}"]
 
 
 def markdown_table(rows: Iterable[MeanMeasures]) -> str:
-    """The rows as a Markdown table: mission success nu and failed-goal quotients phi (the
-    measures of Fig 4.5) in %, kappa in %, R, T and D (Fig 4.6) as means."""
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "|".join(" --- " for _ in COLUMNS) + "|"]
-    lines += ["| " + " | ".join(_cells(row)) + " |" for row in rows]
+    """The rows as a Markdown table: mission success nu and failed-goal quotients phi per kind
+    (the measures of Fig 4.5) in %, kappa in %, R, T and D (Fig 4.6) as means."""
+    listed = list(rows)
+    kinds = kinds_of(listed)
+    header = columns(kinds)
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(" --- " for _ in header) + "|"]
+    lines += ["| " + " | ".join(_cells(row, kinds)) + " |" for row in listed]
     return "\n".join(lines) + "\n"
 
 
@@ -276,11 +345,13 @@ def rich_table(rows: Iterable[MeanMeasures], title: str = "Measures of seed 004 
     """The rows as a rich Table, for a terminal."""
     from rich.table import Table
 
+    listed = list(rows)
+    kinds = kinds_of(listed)
     table = Table(title=title)
-    for k, column in enumerate(COLUMNS):
+    for k, column in enumerate(columns(kinds)):
         table.add_column(column, justify="left" if k < 3 else "right")
-    for row in rows:
-        table.add_row(*_cells(row), style=None if row.nu == 1.0 else "yellow")
+    for row in listed:
+        table.add_row(*_cells(row, kinds), style=None if row.nu == 1.0 else "yellow")
     return table
 
 

@@ -28,7 +28,8 @@ goals, horizon), each `goal` posted and ended, every `request`, `activity`, `rep
 `warning` of the executive, every `fact` the procedures conclude or retract, `robot-motion`
 and `arm-motion` from the simulator's true state, `pose` every 0.5 s, an `alarm` for every
 incident (a permanent codel or a listener that raised, the executive's ERROR state, the robot
-blocked), and `mission-end`.
+blocked), `mission-figures` (the distance, the requests, the incidents, FTplan's figures: what
+the extension's `measure` reads), and `mission-end`.
 """
 
 from __future__ import annotations
@@ -106,7 +107,8 @@ class Robot:
                            f"({type(error).__name__}: {error})") from None
 
     def hook(self, name: str) -> Callable[..., Any] | None:
-        """The extension's function `name` (one of EXTENSION_HOOKS), None when it has none."""
+        """The extension's function `name` (prepare, attach, measure or judge: the module's
+        docstring), None when it has none."""
         function = getattr(self.extension, name, None)
         return function if callable(function) else None
 
@@ -209,9 +211,20 @@ class MissionRun:
         lines.append(f"  {self.distance:.1f} m travelled, {self.requests} service request(s), "
                      f"{len(self.incidents)} incident(s)")
         lines += [f"  incident: {text}" for text in self.incidents[:5]]
-        lines += [f"  {name}: {value}" for name, value in self.extension_measures.items()]
+        lines += self._measure_lines()
         lines.append(f"  {self.simulated_time:.0f} s of mission in {self.wall_time:.1f} s of wall time")
         return "\n".join(lines)
+
+
+    def _measure_lines(self) -> list[str]:
+        """The run's figures: seed 004 §4.1.4's as its notation reads when the extension measured
+        them; else each figure that is a number or a word."""
+        from specc.run.measures import Measures
+
+        if Measures.readable(self.extension_measures):
+            return ["  " + line for line in Measures.from_json(self.extension_measures).summary().splitlines()]
+        return [f"  {name}: {value}" for name, value in self.extension_measures.items()
+                if isinstance(value, int | float | str) and value != ""]
 
 
 @dataclass(frozen=True)
@@ -224,10 +237,13 @@ TIMINGS = ("model", "wall")  # FtPlan's: a deterministic planning charge, or the
 
 
 def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: int, horizon: float | None,
-                  configuration: str | None = None, timing: str = "model") -> CheckedMission:
+                  configuration: str | None = None, timing: str = "model",
+                  domains: Mapping[str, Any] | None = None) -> CheckedMission:
     """Check what a run is asked before anything is built: the world file (the mission's unless
     `world` names another), the seed, the horizon, and for a planned mission FTplan's
-    configuration (default: every planner, in the block's policy); RunError when one is wrong."""
+    configuration (default: every planner, in the block's policy) and the planning `domains`
+    that replace the generated ones of the same names (a mutant, seed 004 §4.1.3); RunError when
+    one is wrong."""
     from specc.runtime.ftplan import UnknownName, mission_setup
 
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
@@ -241,9 +257,9 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
         raise RunError(f"timing '{timing}': give {' or '.join(TIMINGS)}")
     world_file = robot.world_file(world or mission.world)
     if mission.plan is None:
-        if configuration is not None:
-            raise RunError(f"--config: mission {mission.name} of robot '{robot.name}' is not planned (a "
-                           "configuration is FTplan's)")
+        if configuration is not None or domains:
+            raise RunError(f"{'--config' if configuration is not None else 'a planning domain'}: mission "
+                           f"{mission.name} of robot '{robot.name}' is not planned (FTplan plans in them)")
         return CheckedMission(world_file)
     block = robot.part("ftplan").FTPLANS[robot.system.planning]
     try:
@@ -251,6 +267,12 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
                               robot.part("planner"))
     except UnknownName as error:
         raise RunError(str(error)) from None
+    if domains:
+        unused = sorted(set(domains) - setup.planned_in)
+        if unused:
+            raise RunError(f"configuration {configuration or default_configuration(block)} plans in "
+                           f"{', '.join(sorted(setup.planned_in))}, not in {', '.join(unused)}")
+        setup = dataclasses.replace(setup, domains={**setup.domains, **domains})
     return CheckedMission(world_file, setup)
 
 
@@ -266,15 +288,16 @@ def default_configuration(block: ModuleType) -> str:
 def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str | None = None,
                 horizon: float | None = None, log: EventLog | None = None,
                 progress: Callable[[MissionProgress], None] | None = None, configuration: str | None = None,
-                timing: str = "model") -> MissionRun:
+                timing: str = "model", domains: Mapping[str, Any] | None = None) -> MissionRun:
     """Run `mission` on `robot` (see the module's docstring), in `world` (a name of the system's
     worlds or a world file) instead of the mission's when given, for `horizon` seconds of
     simulated time instead of the mission's; a planned mission with FTplan's `configuration`
-    (Robot1, Robot1/2...) and planning charge `timing`. Bad arguments raise RunError before
-    anything runs."""
-    from specc.runtime.sim import Simulation, WorldError, load_world
+    (Robot1, Robot1/2...), planning charge `timing`, and `domains` (planning domains by name)
+    in place of the generated ones. Bad arguments raise RunError before anything runs."""
+    from specc.runtime.ftplan.state import SystemState
+    from specc.runtime.sim import WorldError, load_world
 
-    checked = check_mission(robot, mission, world, seed, horizon, configuration, timing)
+    checked = check_mission(robot, mission, world, seed, horizon, configuration, timing, domains)
     world_path = checked.world
     limit = horizon if horizon is not None else mission.horizon if mission.horizon is not None else DEFAULT_HORIZON
     try:
@@ -293,25 +316,20 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
     system = robot.system
     started = time.perf_counter()
     with contextlib.chdir(robot.folder):
-        registry = rt.Registry()
-        try:
-            sim = Simulation(ground, system.body, seed=seed, kernel=registry.kernel).attach(registry, system.devices)
-        except WorldError as error:  # what the world asks cannot be built (objects without room)
-            raise RunError(str(error)) from None
+        parts = assemble(robot, ground, world_path, seed, log=lambda text: recorder.operator(text))
+        registry, sim, executive, supervisor = parts.registry, parts.sim, parts.executive, parts.supervisor
         kernel = registry.kernel
-        robot.part("modules").create_all(registry)
-        executive = robot.part("executive").EXECUTIVES[system.executive].create(
-            registry, world=str(world_path.resolve())) if system.executive else None
         recorder = Recorder(journal, sim, registry, executive, limit, len(mission.goals) + bool(mission.plan),
                             progress)
-        supervisor = robot.part("supervisor").LIBRARIES[system.supervisor].create(
-            kernel=kernel, executive=executive, seed=seed, log=recorder.operator) if system.supervisor else None
         if supervisor is not None:
             recorder.watch_facts(supervisor.database)
         setup = checked.planning
         planned = {"plan": mission.plan, "configuration": configuration or default_configuration(
             robot.part("ftplan").FTPLANS[system.planning]), "timing": timing,
-                   "planners": [f"{p.name} ({p.domain})" for p in setup.config.planners]} if setup else {}
+                   "planners": [f"{p.name} ({p.domain})" for p in setup.config.planners],
+                   # what FTplan is to achieve: attribute, arguments, value
+                   "planned_goals": [[g.attribute, list(g.args), g.value]
+                                     for g in SystemState.from_problem(setup.problem).goals]} if setup else {}
         journal.emit(kernel.now, "mission-start", robot=robot.name, mission=mission.name, seed=seed,
                      goals=list(mission.goals), horizon=limit, body=dataclasses.asdict(system.body),
                      objects=[list(o) for o in sim.objects], **planned, **world_fields(ground))
@@ -338,7 +356,7 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
             return any(i.status == "running" for _, i in intentions)
 
         if setup is not None:
-            planning.append(_plan_and_execute(robot, setup, timing, journal, registry, executive, supervisor, sim))
+            planning.append(_plan_and_execute(robot, setup, timing, journal, parts, limit))
         kernel.run_while(running, max(kernel.now, limit))
         recorder.poll()
         for callback in context.ending:
@@ -347,22 +365,35 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
     outcome, why = _outcome(intentions, limit, events.events)
     planned_figures: dict[str, Any] = {}
     if planning:
-        result = planning[0]
+        result, stopped = planning[0]
+        met = set(result.met)
         planned_figures = {"planned_goals_met": len(result.met), "planned_goals": len(result.met) + len(result.missed),
+                           # mission-start's planned_goals, each as FTplan's ledger judged it at the end
+                           "planned_goals_met_each": [g.text() in met for g in SystemState.from_problem(
+                               checked.planning.problem).goals],
                            "plannings": result.plannings, "replannings": result.replannings,
-                           "planner_failures": result.planner_failures}
-        if outcome == "succeeded" and (result.failure or result.missed):
+                           "planner_failures": result.planner_failures,
+                           # the mission exception: no plan in time (not the horizon stopping the run)
+                           "planning_failure": "" if stopped else result.failure}
+        if stopped:
+            outcome, why = "horizon", f"{result.failure}: {len(result.met)} of {len(met) + len(result.missed)} " \
+                                      "planned goal(s) met"
+        elif outcome == "succeeded" and (result.failure or result.missed):
             outcome, why = "failed", result.failure or f"{len(result.missed)} planned goal(s) missed: " + "; ".join(
                 f"{goal}: {reason}" for goal, reason in result.missed.items())
         elif outcome == "succeeded":
-            why = f"every goal achieved ({len(intentions)} posted, {len(result.met)} planned)"
+            why = f"every goal achieved ({len(intentions)} posted, {len(result.met)} planned)" if intentions \
+                else f"every planned goal achieved ({len(result.met)})"
+    # What the run measured, logged before the robot's own measures and judgement read the log.
+    figures = {"distance": round(sim.rover.distance, 3), "requests": recorder.requests,
+               "incidents": len(recorder.incidents), **planned_figures}
+    journal.emit(kernel.now, "mission-figures", **figures)
     measure, judge = robot.hook("measure"), robot.hook("judge")
     extension_measures = dict(measure(events.events)) if measure is not None else {}
     if judge is not None:  # the robot's own success criteria, on top of its goals'
         outcome, why = judge(events.events, extension_measures, outcome, why)
     journal.emit(kernel.now, "mission-end", outcome=outcome, why=why, goals=[list(s) for s in statuses],
-                 distance=round(sim.rover.distance, 3), requests=recorder.requests,
-                 incidents=len(recorder.incidents), **planned_figures)
+                 **figures)
     recorder.report(kernel.now)
     return MissionRun(robot.name, mission.name, ground.name, seed, outcome, why, statuses, kernel.now,
                       time.perf_counter() - started, sim.rover.distance, recorder.requests,
@@ -370,13 +401,50 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
                       {**planned_figures, **extension_measures})
 
 
-def _plan_and_execute(robot: Robot, setup: Any, timing: str, journal: FtplanJournal, registry: rt.Registry,
-                      executive: rx.Executive | None, supervisor: Any, sim: Any) -> Any:
+@dataclass
+class Assembly:
+    """A robot's parts on one kernel, nothing run yet."""
+
+    registry: rt.Registry
+    sim: Any  # specc.runtime.sim.Simulation
+    executive: rx.Executive | None
+    supervisor: Any  # specc.runtime.supervisor.Supervisor, or None
+
+    @property
+    def kernel(self) -> Any:
+        return self.registry.kernel
+
+
+def assemble(robot: Robot, ground: Any, world_path: Path, seed: int,
+             log: Callable[[str], None] | None = None) -> Assembly:
+    """The robot's modules on one kernel with the simulated body in `ground` (the world as the run
+    draws it, from `world_path`), its executive and its supervisor (`log` hears what the
+    procedures tell the operator), as its system block says. Call it with the robot's folder as
+    the working directory: codels name their files relative to it."""
+    from specc.runtime.sim import Simulation, WorldError
+
+    system = robot.system
+    registry = rt.Registry()
+    try:
+        sim = Simulation(ground, system.body, seed=seed, kernel=registry.kernel).attach(registry, system.devices)
+    except WorldError as error:  # what the world asks cannot be built (objects without room)
+        raise RunError(str(error)) from None
+    robot.part("modules").create_all(registry)
+    executive = robot.part("executive").EXECUTIVES[system.executive].create(
+        registry, world=str(world_path.resolve())) if system.executive else None
+    supervisor = robot.part("supervisor").LIBRARIES[system.supervisor].create(
+        kernel=registry.kernel, executive=executive, seed=seed, log=log) if system.supervisor else None
+    return Assembly(registry, sim, executive, supervisor)
+
+
+def _plan_and_execute(robot: Robot, setup: Any, timing: str, journal: FtplanJournal, parts: Assembly,
+                      horizon: float) -> tuple[Any, bool]:
     """FTplan plans the mission with the configuration's planners, each in its own process, and
-    the system's bindings carry every plan out (`specc.run.plans`); FTplan's result."""
-    executor = BoundExecutor(registry.kernel, robot.system.bindings, registry, executive, supervisor, sim.rover,
-                             setup.config, journal.emit)
-    return run_ftplan(setup, executor, journal, timing)[1]
+    the system's bindings carry every plan out (`specc.run.plans`) until the run's horizon;
+    FTplan's result, and whether the horizon stopped it."""
+    executor = BoundExecutor(parts.kernel, robot.system.bindings, parts.registry, parts.executive, parts.supervisor,
+                             parts.sim.rover, setup.config, journal.emit, horizon)
+    return run_ftplan(setup, executor, journal, timing)[1], executor.horizon_reached
 
 
 def _outcome(intentions: list[tuple[str, Any]], horizon: float,

@@ -16,27 +16,30 @@ subclass's: `BoundExecutor` does it as the system block's `bindings` say,
 
 What the log holds: every `action` as it starts and as it ends, fails or is stopped (`status`,
 `plan`, `id`, `task`, `args`, `latest_end` at its start, `why`, and how it was carried out:
-`goal`, `service` and `request` ids).
+`goal`, `service` or `request` at its start, and at its end `requests`: the ids of the executive's
+requests that carried it out).
 """
 
 from __future__ import annotations
 
 import abc
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from specc.run.recording import Emit
 from specc.runtime import executive as rx
 from specc.runtime import functional as rt
+from specc.runtime.ftplan.component import MissionFailure
 from specc.runtime.ftplan.config import FtPlanConfig, Var
 from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precedences, Report
 from specc.runtime.ftplan.facts import FactKey, match, substitute
 from specc.runtime.ftplan.state import consequences
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
-from specc.runtime.system import BindingSpec, StateValue
+from specc.runtime.planner.validate import normalise, same
+from specc.runtime.system import BindingSpec, StateCondition, StateValue
 
 # An action whose plan gives it no finite longest duration is stopped after this long: a faulty
 # model's action must not run for ever.
@@ -61,13 +64,22 @@ class Running:
     said: dict[str, Any] = field(default_factory=dict)  # what the log says of how it runs
 
 
+class HorizonReached(MissionFailure):
+    """The run's horizon came before FTplan's mission ended: what ran was stopped, and FTplan's
+    mission ends there (it catches this as its mission exception)."""
+
+
 class KernelExecutor(abc.ABC):
     """The scheduling of a plan's actions on the kernel (see the module's docstring); subclasses
-    say how one action is begun, followed, interrupted, and how the robot comes to rest."""
+    say how one action is begun, followed, interrupted, and how the robot comes to rest. Nothing
+    runs past `horizon` (mission time): the actions under way are stopped there and HorizonReached
+    ends FTplan's mission."""
 
-    def __init__(self, kernel: Any, emit: Emit | None = None) -> None:
+    def __init__(self, kernel: Any, emit: Emit | None = None, horizon: float = math.inf) -> None:
         self.kernel = kernel
         self.emit = emit
+        self.horizon = horizon
+        self.horizon_reached = False
         self.plans = 0
         self._live: list[Running] = []  # actions under way, also after a failure ended the execution
 
@@ -103,6 +115,7 @@ class KernelExecutor(abc.ABC):
         self.plans += 1
         number = self.plans
         self.catch_up(now)
+        self._check_horizon()
         precedences = Precedences(plan)
         waiting = plan.ordered()
         ended_at: dict[str, float] = {}
@@ -128,10 +141,24 @@ class KernelExecutor(abc.ABC):
             if not upcoming and not self._live:  # an ordering no action ends: the plan is malformed
                 stuck = ", ".join(a.text() for a in waiting)
                 return Execution(False, now, waiting[0].id, f"{stuck} wait for actions that never end")
-            self.await_progress(min(upcoming + [r.deadline for r in self._live]))
+            self.await_progress(min(upcoming + [r.deadline for r in self._live] + [self.horizon]))
+            self._check_horizon()
             for run in self._live:
                 if run.finished is None and self.kernel.now >= run.deadline - OVERRUN_TOLERANCE:
                     self._overrun(run)
+
+    def _check_horizon(self) -> None:
+        """At the horizon: stop what runs and end FTplan's mission."""
+        if self.kernel.now < self.horizon - OVERRUN_TOLERANCE:
+            return
+        self.horizon_reached = True
+        why = f"the run's horizon ({self.horizon:g} s) was reached"
+        for run in list(self._live):
+            self._live.remove(run)
+            if run.finished is None:
+                self.interrupt(run)
+            self.record(run, "stopped", f"stopped: {why}")
+        raise HorizonReached(why)
 
     def safe_state(self, now: float) -> float:
         """Interrupt everything still running for the plan, and wait for the robot to stand and
@@ -188,12 +215,17 @@ class KernelExecutor(abc.ABC):
         end = self.kernel.now if end is None else end
         action = run.action
         self.event(end, "action", status=outcome, plan=run.plan, id=action.id, task=action.task,
-                   args=list(action.args), **({"why": why} if why else {}))
+                   args=list(action.args), **({"why": why} if why else {}), **self.carried_out_by(run))
+
+    def carried_out_by(self, run: Running) -> dict[str, Any]:
+        """What the log says, at the action's end, of what carried it out (a subclass's)."""
+        return {}
 
     def catch_up(self, now: float) -> None:
-        """The kernel at mission time `now`: time FTplan spent planning passes for the robot too."""
+        """The kernel at mission time `now`: time FTplan spent planning passes for the robot too
+        (up to the horizon: the run stops there)."""
         if now > self.kernel.now:
-            self.kernel.run_until(now)
+            self.kernel.run_until(min(now, self.horizon))
 
     def event(self, time_: float, kind: str, **fields: Any) -> None:
         if self.emit is not None:
@@ -271,6 +303,8 @@ def bound_call(binding: BindingSpec, action: Action, after: Callable[[], Mapping
     if found is None:
         raise ValueError(f"{action.text()} does not match the binding of {binding.task}"
                          f"({', '.join(_term_text(a) for a in binding.args)})")
+    if binding.where is not None:
+        found = _where(binding.where, found, action, after())
     values: list[Value] = []
     for arg in binding.target_args:
         if isinstance(arg, StateValue):
@@ -285,6 +319,22 @@ def bound_call(binding: BindingSpec, action: Action, after: Callable[[], Mapping
     return Call(binding.kind, binding.target, tuple(values))
 
 
+def _where(condition: StateCondition, found: Mapping[str, Value], action: Action,
+           changes: Mapping[FactKey, Value]) -> dict[str, Value]:
+    """`found` extended by the first state change at the action's end that reads
+    `condition` (in the state rules' order); ValueError when none does."""
+    for (attribute, args), value in changes.items():
+        if attribute != condition.attribute or not same(normalise(value), normalise(substitute(condition.value,
+                                                                                                 found))):
+            continue
+        extended = match(condition.args, args, dict(found))
+        if extended is not None:
+            return extended
+    pattern = ", ".join(_term_text(a) for a in condition.args)
+    raise ValueError(f"FTplan's state rules make no {condition.attribute}({pattern}) "
+                     f"{_term_text(condition.value)} when {action.text()} ends")
+
+
 def _term_text(term: Any) -> str:
     return term.name if isinstance(term, Var) else format_value(term)
 
@@ -294,8 +344,8 @@ class BoundExecutor(KernelExecutor):
 
     def __init__(self, kernel: Any, bindings: Mapping[str, BindingSpec], registry: rt.Registry,
                  executive: rx.Executive | None, supervisor: Any, robot: Any, config: FtPlanConfig,
-                 emit: Emit | None = None) -> None:
-        super().__init__(kernel, emit)
+                 emit: Emit | None = None, horizon: float = math.inf) -> None:
+        super().__init__(kernel, emit, horizon)
         self.bindings = bindings
         self.config = config  # FTplan's on the mission: its state rules and its planners' views
         self.registry = registry
@@ -342,7 +392,8 @@ class BoundExecutor(KernelExecutor):
             if status == "running":
                 return False
             run.ok = status == "succeeded"
-            run.why = "" if run.ok else f"{run.action.text()} failed: {run.said['goal']} {status}"
+            run.why = "" if run.ok else f"{run.action.text()} failed: {run.said['goal']} {status}" \
+                                        f"{self._refused(run.handle.requests)}"
         elif kind == "service":
             reply = self._replies.pop(run.handle, None)
             if reply is None:
@@ -361,6 +412,26 @@ class BoundExecutor(KernelExecutor):
                                         f"{reply.status.value} {reply.report.code}{detail}"
         run.finished = self.kernel.now
         return True
+
+    def carried_out_by(self, run: Running) -> dict[str, Any]:
+        """The executive's request ids that carried the action out: those its goal's procedures
+        asked for, or its service's (the log's `request` events with those ids name the module
+        request each ran)."""
+        if run.kind == "goal" and run.handle is not None:
+            return {"requests": list(run.handle.requests)}
+        if run.kind == "service" and run.handle is not None:
+            return {"requests": [run.handle]}
+        return {}
+
+    def _refused(self, requests: Iterable[int]) -> str:
+        """The last reply other than OK to the services a goal's procedures asked for: most likely
+        what they failed on."""
+        replies = [self._replies[i] for i in requests if i in self._replies and self._replies[i].result != "OK"]
+        if not replies:
+            return ""
+        reply = replies[-1]
+        detail = f" ({reply.detail})" if reply.detail else ""
+        return f" ({reply.service} answered {reply.result}{detail})"
 
     def effects(self, plan: Plan, action: Action) -> dict[FactKey, Value]:
         """What FTplan's state becomes when the action ends, in FTplan's vocabulary (through the
@@ -414,17 +485,20 @@ class BoundExecutor(KernelExecutor):
         return False
 
     def wind_down(self, failed: Running) -> None:
-        self.kernel.run_while(lambda: any(self._still_running(r) for r in self._stopping),
-                              self.kernel.now + SETTLE_LIMIT)
+        """What was interrupted ends and the robot comes to rest before FTplan hears of the failure
+        (a report then says where the robot stands), unless other actions still run: they go on."""
+        others = any(r.finished is None for r in self._live)
+        busy = (lambda: any(self._still_running(r) for r in self._stopping)) if others else self._busy
+        self.kernel.run_while(busy, self.kernel.now + SETTLE_LIMIT)
         self._stopping = [r for r in self._stopping if self._still_running(r)]
 
     def come_to_rest(self) -> None:
-        def busy() -> bool:
-            moving = abs(self.robot.left_speed) + abs(self.robot.right_speed) > STILL_SPEED
-            return moving or any(self._still_running(r) for r in self._stopping)
-
-        self.kernel.run_while(busy, self.kernel.now + SETTLE_LIMIT)
+        self.kernel.run_while(self._busy, self.kernel.now + SETTLE_LIMIT)
         self._stopping.clear()
+
+    def _busy(self) -> bool:
+        moving = abs(self.robot.left_speed) + abs(self.robot.right_speed) > STILL_SPEED
+        return moving or any(self._still_running(r) for r in self._stopping)
 
 
 class _ModuleCall:

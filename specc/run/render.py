@@ -32,6 +32,7 @@ nothing: tests and other tools can use them alone.
 from __future__ import annotations
 
 import dataclasses
+import re
 import textwrap
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -41,7 +42,6 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from specc.run import RunError, pictures
-from specc.run.rover_tasks import TASK_KINDS, task_text
 from specc.runtime.body import RobotConfig
 from specc.runtime.planner.plan import Value, format_value
 from specc.runtime.sim import Target, Window, World, WorldError, parse_world
@@ -228,14 +228,17 @@ class ActionBar:
     outcome: str  # ended | failed | stopped | running
     latest_end: float | None  # its planned bound: start + its longest duration
     why: str = ""
+    via: str = ""  # how it was carried out: the goal, service or request its binding made of it
 
     @property
     def kind(self) -> str:
-        """What the task is for the executor (a move, a photo...); its name when unknown."""
-        return TASK_KINDS.get(self.task, self.task)
+        """The timeline's row: what carried the action out (the goal's head, the service, the
+        module request), so the tasks of two models bound alike share a row; else the task."""
+        found = re.match(r"[!?]?\(?\s*([^\s()]+)", self.via)
+        return found.group(1) if found else self.task
 
     def text(self) -> str:
-        return task_text(self.task, self.args)
+        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
 
 
 def action_bars(events: Events) -> list[ActionBar]:
@@ -255,9 +258,11 @@ def action_bars(events: Events) -> list[ActionBar]:
         assert begun is not None
         latest = begun.get("latest_end")
         said = last or begun
+        via = next((str(begun[k]) for k in ("goal", "service", "request") if begun.get(k)), "")
         bars.append(ActionBar(key[0], key[1], str(said["task"]), tuple(said.get("args", ())), float(begun["t"]),
                               float(last["t"]) if last else end, str(last["status"]) if last else "running",
-                              float(latest) if latest is not None else None, str(last.get("why", "")) if last else ""))
+                              float(latest) if latest is not None else None, str(last.get("why", "")) if last else "",
+                              via))
     return sorted(bars, key=lambda b: (b.start, b.plan, b.id))
 
 

@@ -12,9 +12,8 @@ keeps what it logged), `report.json` (the request, the outcome, the measures), `
 the timeline; the state of Fig 5.11 when the log holds a model).
 
 A robot runs the missions of its system block (`specc.run.mission`), or goals given with
-`--goal`. The rover of seed 004 still has its own runner until its system block says how its
-plans are carried out: `atrv` runs M1..M4 in W1..W4 with the configurations Robot1, Robot2,
-Robot1/2, Robot1/2c (`specc.run.rover`), measured as §4.1.4 says (`specc.run.measures`).
+`--goal`; a planned mission with one of FTplan's configurations (`--config`, default: the ftplan
+block as written).
 """
 
 from __future__ import annotations
@@ -36,9 +35,6 @@ SUMMARY = "summary.txt"
 RUN_FILES = (LOG, REPORT, SUMMARY, "map.png", "timeline.png", "state.png")  # what a run writes in its folder
 RUNS = Path("runs")  # where run folders go by default, under the working directory
 GENERATED = Path("generated")  # where the specs compile to by default (`specc compile -o generated`)
-DEFAULT_CONFIGURATION = "Robot1/2"  # seed 004's fault-tolerant configuration (two models, successive)
-# Robots whose runs are not yet driven by their system block: their own runner, by package name.
-LEGACY_RUNNERS = {"atrv": "the rover missions of seed 004 (examples/atrv)"}
 
 PLANNER_FAILURES = ("watchdog", "invalid-plan")  # FTplan's events for a planner that gave no usable plan
 Progress = Callable[[float, float | None, str], None]  # mission time, horizon (None: unknown), what
@@ -55,15 +51,15 @@ class RunCrashed(RunError):
 @dataclass(frozen=True)
 class RunRequest:
     specs: Path  # the robot's spec folder (its codels and worlds beside the specs)
-    mission: str | None = None  # M1..M4, or `hunt`
-    world: str | None = None  # W1..W4 or a world file; `room` for the hunt
-    configuration: str | None = None  # the rover's; default DEFAULT_CONFIGURATION
+    mission: str | None = None  # a mission of the robot's system block
+    world: str | None = None  # one of its worlds, or a world file; default: the mission's
+    configuration: str | None = None  # FTplan's, for a planned mission; default: the ftplan block's own
     seed: int = 0
     generated: Path = GENERATED
     runs: Path = RUNS
     folder: Path | None = None  # the run folder itself, instead of runs/<name>
-    timing: str = "model"  # FTplan's planning charge (the rover): model (deterministic) or wall
-    horizon: float | None = None  # s of simulated time (the hunt's default: 900; a mission's: its own)
+    timing: str = "model"  # FTplan's planning charge: model (deterministic) or wall
+    horizon: float | None = None  # s of simulated time; default: the mission's own
     goals: tuple[str, ...] = ()  # PRS goals to post instead of a mission's (`--goal '!(...)'`)
     pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
 
@@ -124,10 +120,7 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     RunError when one is wrong. Nothing is written."""
     from specc.run.mission import load_robot
 
-    if legacy_runner(robot, request):
-        plan = _plan_rover(request)
-    else:
-        plan = _plan_system(load_robot(request.generated, request.specs, robot), request)
+    plan = _plan_system(load_robot(request.generated, request.specs, robot), request)
     if request.folder is not None:
         return PlannedRun(robot, request, plan, request.folder)
     # Options that change what a run does name its folder too: it never holds another run's files.
@@ -190,24 +183,13 @@ def _finish(outcome: RunOutcome, request: RunRequest, plan: _Plan, report: dict[
         raise RunError(f"cannot write the report into '{folder}': {error.strerror or error}") from None
 
 
-# ---------------------------------------------------------------- the two kinds of mission
+# ---------------------------------------------------------------- a mission of the system block
 
 
 @dataclass(frozen=True)
 class _Plan:
     name_parts: tuple[str, str, str | None]  # mission, world, configuration
     run: Callable[[EventLog, Progress | None], tuple[dict[str, Any], str]]
-
-
-def legacy_runner(robot: str, request: RunRequest) -> bool:
-    """Whether `robot` runs through a runner of its own: its system block declares no mission yet."""
-    from specc.run.mission import load_robot
-
-    if robot not in LEGACY_RUNNERS:
-        return False
-    if not (request.generated / robot / "systems" / "__init__.py").is_file():
-        return True
-    return not load_robot(request.generated, request.specs, robot).system.missions
 
 
 def _plan_system(robot: Any, request: RunRequest) -> _Plan:
@@ -247,7 +229,11 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
 
         result = run_mission(robot, mission, request.seed, world=request.world, horizon=request.horizon, log=log,
                              progress=tell, configuration=configuration, timing=request.timing)
-        report = {"outcome": "succeeded" if result.outcome == "succeeded" else result.outcome, "why": result.why,
+        why = result.why
+        planners_said = [e["text"] for e in result.events if e["kind"] == "ftplan" and e["event"] in PLANNER_FAILURES]
+        if result.extension_measures.get("planning_failure") and planners_said:  # what the planner itself said
+            why += f" (last planner failure: {planners_said[-1]})"
+        report = {"outcome": "succeeded" if result.outcome == "succeeded" else result.outcome, "why": why,
                   "simulated_time": round(result.simulated_time, 3), "goals": [list(g) for g in result.goals],
                   "measures": result.measures(), "incidents": list(result.incidents)}
         return report, result.summary()
@@ -285,47 +271,6 @@ def _has_variables(term: Any) -> bool:
     from specc.runtime.procedures import Compound, Var
 
     return isinstance(term, Var) or isinstance(term, Compound) and any(_has_variables(a) for a in term.args)
-
-
-def _plan_rover(request: RunRequest) -> _Plan:
-    from specc.run.measures import measure
-    from specc.run.rover import TIMINGS, check_mission, run_rover_mission
-
-    if request.mission is None or request.world is None:
-        raise RunError("the rover needs --mission (M1, M2, M3, M4) and --world (W1, W2, W3, W4 or a world file)")
-    if request.timing not in TIMINGS:
-        raise RunError(f"timing '{request.timing}': give {' or '.join(TIMINGS)}")
-    if request.horizon is not None:
-        raise RunError("--horizon: a rover mission ends with its plan")
-    configuration = request.configuration or DEFAULT_CONFIGURATION
-    example = request.specs.resolve()
-    # Every name checked before the run folder is made: a typo leaves nothing behind.
-    checked = check_mission(configuration, request.mission, request.world, request.seed,
-                            generated=request.generated, example=example)
-
-    def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
-        def tell(step: Any) -> None:
-            if progress is not None:
-                progress(step.time, None, f"goals {step.goals_met}/{step.goals}: {step.what}")
-
-        rover_run = run_rover_mission(configuration, request.mission or "", request.world or "", request.seed,
-                                      log=log, progress=tell, generated=request.generated, example=example,
-                                      timing=request.timing)
-        measures = measure(rover_run)
-        result = rover_run.result
-        why = result.failure or ("; ".join(f"{goal}: {reason}" for goal, reason in result.missed.items())
-                                 or f"every goal met ({len(result.met)})")
-        planners_said = [e.text for e in result.events if e.kind in PLANNER_FAILURES]
-        if result.failure and planners_said:  # what the planner itself said is the useful part
-            why += f" (last planner failure: {planners_said[-1]})"
-        report = {"outcome": "succeeded" if measures.success else "failed", "why": why,
-                  "simulated_time": round(rover_run.simulated_time, 3), "measures": measures.to_json(),
-                  "photos": [[p.target, p.ok] for p in rover_run.photos],
-                  "communications": [[c.window, c.ok] for c in rover_run.communications]}
-        return report, measures.summary() + ("" if measures.success else f"\n  why: {why}") + \
-            f"\n  {rover_run.simulated_time:.0f} s of mission in {rover_run.wall_time:.1f} s of wall time"
-
-    return _Plan((request.mission, checked.world.name, configuration), run)
 
 
 def load_report(folder: Path) -> Mapping[str, Any]:

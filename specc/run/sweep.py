@@ -2,13 +2,14 @@
 each, and the table of their measures.
 
     table = sweep("tug", RunRequest(Path("examples/tug")), missions=["shuttle"], worlds=["hall", "crowded"])
-    table.missions      # one MissionRow per mission x world x configuration (the rover's: table.rows)
+    table.missions      # one MissionRow per mission x world x configuration
     table.failures      # the runs whose mission failed, with why and their folder
 
-For a robot run from its system block, one row per mission x world over the seeds: how many
-were tried, how many succeeded, the mean time of the successful ones, and the means of the
-run's figures (its extension's too, e.g. the objects a hunt took). For the rover the rows are
-the means of seed 004 §4.1.4 (`specc.run.measures`). Every run keeps its folder (log, report;
+One row per mission x world x configuration over the seeds: how many were tried, how many
+succeeded, the mean time of the successful ones, and the means of the run's figures (its
+extension's too, e.g. the objects a hunt took). When every run's extension measured seed 004
+§4.1.4's figures (`specc.run.measures.Measures`, as the rover's does), the table is theirs: the
+means sigma-bar, nu-bar, kappa-bar, R-bar, T-bar, D-bar. Every run keeps its folder (log, report;
 pictures on request) so each failure can be read in its log.
 """
 
@@ -25,12 +26,8 @@ from typing import Any
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
 from specc.run.mission import load_robot
-from specc.run.session import RunCrashed, RunOutcome, RunRequest, legacy_runner, plan_run, run_planned
+from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
 from specc.runtime.ftplan import planner_processes_kept
-
-MISSIONS = ("M1", "M2", "M3", "M4")
-WORLDS = ("W1", "W2", "W3", "W4")
-CONFIGURATIONS = ("Robot1", "Robot2", "Robot1/2", "Robot1/2c")
 
 Step = Callable[[int, int, str], None]  # runs done, runs in all, the run under way (or just ended)
 
@@ -66,8 +63,8 @@ class MissionRow:
 class SweepResult:
     robot: str
     outcomes: list[RunOutcome] = field(default_factory=list)
-    rows: list[MeanMeasures] = field(default_factory=list)  # the rover's
-    missions: list[MissionRow] = field(default_factory=list)  # a robot's run from its system block
+    rows: list[MeanMeasures] = field(default_factory=list)  # seed 004's means, when the runs measured them
+    missions: list[MissionRow] = field(default_factory=list)
 
     @property
     def failures(self) -> list[Failure]:
@@ -75,7 +72,9 @@ class SweepResult:
                 if not o.succeeded]
 
     def markdown(self) -> str:
-        if self.missions:
+        if self.rows:
+            text = markdown_table(self.rows)
+        else:
             figures = list(dict.fromkeys(name for row in self.missions for name in row.means))
             text = ("| mission | world | configuration | seeds | succeeded | success rate | time (s) | "
                     + "".join(f"{name} | " for name in figures) + "\n"
@@ -84,8 +83,6 @@ class SweepResult:
                 text += (f"| {row.mission} | {row.world} | {row.configuration or '-'} | {row.seeds} | "
                          f"{row.succeeded} | {100 * row.success_rate:.0f} % | {row.simulated_time:.1f} | "
                          + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures) + "\n")
-        else:
-            text = markdown_table(self.rows)
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
         if crashed:
             text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
@@ -103,20 +100,13 @@ class SweepResult:
 def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds: Sequence[str] = (),
           configurations: Sequence[str] = (), seeds: Sequence[int] = (0,), step: Step | None = None) -> SweepResult:
     """Run `robot` (compiled into base.generated) on every combination, each run as `base` says
-    otherwise (its folder under base.runs). Names are checked before the first run. Empty means
-    all: every mission of the system (the rover's M1-M4, W1-W4 and four configurations), each
-    in its own world."""
+    otherwise (its folder under base.runs). Names are checked before the first run. No missions:
+    every mission of the system; no worlds: each in its own; no configurations: FTplan's default."""
     if not seeds:
         raise RunError("no seed to run: give at least one")
-    legacy = legacy_runner(robot, base)
-    if legacy:
-        requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
-                    for c, m, w, s in itertools.product(configurations or CONFIGURATIONS, missions or MISSIONS,
-                                                        worlds or WORLDS, seeds)]
-    else:
-        every = missions or tuple(load_robot(base.generated, base.specs, robot).system.missions)
-        requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
-                    for m, w, c, s in itertools.product(every, worlds or (None,), configurations or (None,), seeds)]
+    every = missions or tuple(load_robot(base.generated, base.specs, robot).system.missions)
+    requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
+                for c, m, w, s in itertools.product(configurations or (None,), every, worlds or (None,), seeds)]
     if not requests:
         raise RunError("nothing to run: give at least one mission, world and configuration")
     planned = [plan_run(robot, request) for request in requests]  # a typo stops the table before any run
@@ -131,11 +121,10 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
                 result.outcomes.append(crash.outcome)
     if step is not None:
         step(len(requests), len(requests), "")
-    if legacy:
-        result.rows = measure_table([Measures.from_json(o.report["measures"]) for o in result.outcomes
-                                     if "measures" in o.report])
-    else:
-        result.missions = mission_rows(result.outcomes)
+    result.missions = mission_rows(result.outcomes)
+    measured = [o.report.get("measures") for o in result.outcomes if o.report.get("outcome") != "crashed"]
+    if measured and all(isinstance(m, dict) and Measures.readable(m) for m in measured):
+        result.rows = measure_table([Measures.from_json(m) for m in measured if m is not None])
     return result
 
 

@@ -44,6 +44,16 @@ class ReportSpec:
 
 
 @dataclass(frozen=True)
+class StateCondition:
+    """`where ATTR(?o, ...) := VALUE`: the first of FTplan's state changes at the action's end
+    that reads so binds the ?variables of `args`."""
+
+    attribute: str
+    args: tuple[Term, ...]
+    value: Term
+
+
+@dataclass(frozen=True)
 class BindingSpec:
     """How the planners' task `task` is carried out: `kind` goal (the supervisor achieves the
     goal `target`), service (the executive runs the service `target`) or request (the module
@@ -55,6 +65,7 @@ class BindingSpec:
     target: str
     target_args: tuple[Term | StateValue, ...] = ()
     report: ReportSpec | None = None
+    where: StateCondition | None = None
 
 
 @dataclass(frozen=True)

@@ -927,10 +927,15 @@ class Builder(Transformer[Token, Any]):
     def binding(self, meta: Meta, children: list[Any]) -> m.Binding:
         task, *rest = _present(children)
         report = rest.pop() if rest and isinstance(rest[-1], m.BindingReport) else None
+        where = rest.pop() if rest and isinstance(rest[-1], m.BindingWhere) else None
         split = next(k for k, c in enumerate(rest) if isinstance(c, Token) and c.type == "BINDING_KIND")
         target, *target_args = rest[split + 1:]
         return m.Binding(task=str(task), args=tuple(rest[:split]), kind=str(rest[split]), target=target,
-                         target_args=tuple(target_args), report=report, span=self.span(meta))
+                         target_args=tuple(target_args), where=where, report=report, span=self.span(meta))
+
+    def binding_where(self, meta: Meta, children: list[Any]) -> m.BindingWhere:
+        attribute, *args, value = _present(children)
+        return m.BindingWhere(attribute=str(attribute), args=tuple(args), value=value, span=self.span(meta))
 
     def binding_report(self, meta: Meta, children: list[Any]) -> m.BindingReport:
         name, *values = _present(children)

@@ -712,8 +712,10 @@ class Printer:
                     for b in node.bindings.entries:
                         report = f" report {b.report.name}({', '.join(v.text for v in b.report.values)})" \
                             if b.report is not None else ""
+                        where = f" where {b.where.attribute}({ix_args(b.where.args)}) := {ixexpr(b.where.value)}" \
+                            if b.where is not None else ""
                         self.line(f"{b.task}({ix_args(b.args)}) => {b.kind} {b.target.text}({ix_args(b.target_args)})"
-                                  f"{report};", b.span)
+                                  f"{where}{report};", b.span)
 
 
 def _runs(items: Iterable[Any], key: Callable[[Any], str]) -> list[tuple[str, list[Any]]]:

@@ -24,7 +24,7 @@ from specc.campaign.experiments import ORIGINAL, Experiment, Outcome, Setting, r
 pytestmark = pytest.mark.bench
 
 ROOT = Path(__file__).resolve().parents[2]
-SETTING = Setting(ROOT / "generated", ROOT / "examples" / "atrv")
+SETTING = Setting(ROOT / "generated", ROOT / "examples" / "atrv", "atrv")
 EXPERIMENTS = [Experiment("Robot1", ORIGINAL, mission, world, 0)
                for mission in ("M1", "M2", "M3", "M4") for world in ("W1", "W2", "W3", "W4")]
 SEED_CAMPAIGN = 3500  # experiments (seed 004 ch. 4: "more than 3,500")

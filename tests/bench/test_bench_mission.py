@@ -4,20 +4,20 @@ simulation of the same robot in the same world for the same simulated time, its 
 the physics alone (no module, no sensor read; the wheels held on one arc so that the body moves).
 The ratio of the wall times is what the whole stack costs over the physics.
 
-- The rover (`specc.run.rover.run_rover_mission`, FTplan's deterministic "model" timing): FTplan
-  with its planners in their own processes, the CasADi planner, the six generated ATRV modules
-  and the pymunk rover on one kernel. The missions are the longest of M1-M4 x W1-W3 x Robot1,
-  Robot1/2, Robot1/2c in simulated time (W4 too; seeds 0-5 last within 2 s of each other): M4,
-  whose plan is back home at about 467 s (its horizon ends in [420, 700] s), and M3 in W3, whose
-  failed photos make Robot1/2c plan 8 times. None lasts 800 s: a mission ends when its plan's last
-  action (the return home) ends, not at the horizon's end (M1's and M2's is in [330, 800] s; they
-  end at 280 and 377-392 s), so the summary line extrapolates an 800 s mission from the longest
-  one's factor. Each mission's wall time includes the start of its planner processes, printed
-  apart (measured by starting and closing the same pool alone, before the mission: it also warms
-  the imports up). A planner process starts in a few hundredths of a second once multiprocessing's
-  forkserver is up (the first start, a few tenths, starts it): the forkserver has imported the
-  modules of specc the program has, so a child running the program's main module again imports
-  none of them anew.
+- The rover (its missions through the generic runner, `specc.run.mission`, FTplan's deterministic
+  "model" timing): FTplan with its planners in their own processes, the CasADi planner, the PRS
+  procedures, the executive, the six generated ATRV modules and the pymunk rover on one kernel. The
+  missions are the longest of M1-M4 x W1-W3 x Robot1, Robot1/2, Robot1/2c in simulated time (W4 too;
+  seeds 0-5 last within 2 s of each other): M4, whose plan is back home at about 467 s (its horizon
+  ends in [420, 700] s), and M3 in W3, whose failed moves make Robot1/2c replan. None lasts 800 s: a
+  mission ends when its plan's last action (the return home) ends, not at the horizon's end (M1's
+  and M2's is in [330, 800] s; they end at 280 and 377-392 s), so the summary line extrapolates an
+  800 s mission from the longest one's factor. Each mission's wall time includes the start of its
+  planner processes, printed apart (measured by starting and closing the same pool alone, before the
+  mission: it also warms the imports up). A planner process starts in a few hundredths of a second
+  once multiprocessing's forkserver is up (the first start, a few tenths, starts it): the forkserver
+  has imported the modules of specc the program has, so a child running the program's main module
+  again imports none of them anew.
 - The Hilare hunt (its mission `hunt` through the generic runner, `specc.run.mission`): the eight
   modules, the executive and the PRS supervisor collecting five objects; seed 1 is the longest hunt
   of seeds 0-29. A one-second run before each robot's imports its compiled package (Hilare's 1.4 MB
@@ -36,9 +36,8 @@ from typing import Any, TypeVar
 
 import pytest
 
-from specc.run.mission import RunSetup, load_robot, run_mission
+from specc.run.mission import RunSetup, check_mission, load_robot, run_mission
 from specc.run.package import ensure_compiled
-from specc.run.rover import prepare_mission, run_rover_mission
 from specc.runtime.ftplan import ProcessPool
 from specc.runtime.sim import RobotConfig, Simulation, World, load_world
 from tests.conftest import EXAMPLES, ROOT, hilare
@@ -93,38 +92,31 @@ def bare_simulation(world: World, robot: RobotConfig, seed: int, seconds: float)
     return statistics.median(walls)
 
 
-def planners_start_up(configuration: str, mission: str, world: str, seed: int) -> float:
-    setup = prepare_mission(configuration, mission, world, seed).setup
+def planners_start_up(setup: Any) -> float:
+    """The start of a planned mission's planner processes alone (it warms the imports up too)."""
     started = time.perf_counter()
     with ProcessPool(setup.config.planners, setup.domains):
         pass
     return time.perf_counter() - started
 
 
-def rover_row(configuration: str, mission: str, world: str, seed: int) -> Row:
-    start_up = planners_start_up(configuration, mission, world, seed)
-    wall, run = timed(lambda: run_rover_mission(configuration, mission, world, seed=seed))
-    simulated = run.simulated_time
-    sim = run.simulation
-    baseline = bare_simulation(sim.world, sim.robot, seed, simulated)
-    result = run.result
-    goals = f"{len(result.met)}/{len(result.met) + len(result.missed)} goals"
-    return Row(f"rover {configuration} {mission} {world} seed {seed} ({result.plannings} planning(s), {goals})",
-               simulated, wall, start_up, baseline)
-
-
-def robot_row(robot: Any, mission: str, world: str | None, seed: int, label: str) -> Row:
+def robot_row(robot: Any, mission: str, world: str | None, seed: int, label: str,
+              configuration: str | None = None) -> Row:
     """A mission of a robot run from its system block (`specc.run.mission`), against the bare
     simulation of its body in the same world (with what the run's own draws put there)."""
     spec = robot.mission(mission)
-    run_mission(robot, spec, seed, world=world, horizon=1.0)  # imports (and compiles) the package: not the run's
-    wall, result = timed(lambda: run_mission(robot, spec, seed, world=world))
+    checked = check_mission(robot, spec, world, seed, None, configuration)
+    start_up = planners_start_up(checked.planning) if checked.planning is not None else None
+    if checked.planning is None:
+        run_mission(robot, spec, seed, world=world, horizon=1.0)  # imports (and compiles) the package: not the run's
+    wall, result = timed(lambda: run_mission(robot, spec, seed, world=world, configuration=configuration))
     simulated = result.simulated_time
-    ground = load_world(robot.world_file(world or spec.world))
+    ground = load_world(checked.world)
     prepare = robot.hook("prepare")
-    ground = prepare(ground, RunSetup(robot, spec, seed)) if prepare is not None else ground
+    ground = prepare(ground, RunSetup(robot, spec, seed, checked.planning)) if prepare is not None else ground
     baseline = bare_simulation(ground, robot.system.body, seed, simulated)
-    return Row(f"{label} ({result.outcome})", simulated, wall, None, baseline)
+    planned = f", {result.extension_measures['plannings']} planning(s)" if checked.planning is not None else ""
+    return Row(f"{label} ({result.outcome}{planned})", simulated, wall, start_up, baseline)
 
 
 def table(rows: list[Row]) -> str:
@@ -141,11 +133,13 @@ def table(rows: list[Row]) -> str:
 
 
 def test_whole_missions_real_time_factor() -> None:
-    rover = [rover_row(*mission) for mission in MISSIONS]
+    atrv = load_robot(ROOT / "generated", EXAMPLES / "atrv", ensure_compiled(EXAMPLES / "atrv",
+                                                                             ROOT / "generated").robot)
+    rover = [robot_row(atrv, mission, world, seed, f"rover {configuration} {mission} {world} seed {seed}",
+                       configuration) for configuration, mission, world, seed in MISSIONS]
     hunt = robot_row(hilare(), "hunt", None, HUNT_SEED, f"Hilare hunt seed {HUNT_SEED}")
     tug = load_robot(ROOT / "generated", EXAMPLES / "tug", ensure_compiled(EXAMPLES / "tug", ROOT / "generated").robot)
-    tugs = [robot_row(tug, mission, world, 0, f"tug {mission} {world} seed 0")
-            for mission, world in TUG_MISSIONS]
+    tugs = [robot_row(tug, mission, world, 0, f"tug {mission} {world} seed 0") for mission, world in TUG_MISSIONS]
     print("\nwhole missions, every level running: simulated seconds per wall second (factor), against the bare")
     print(f"simulation of the same robot in the same world for the same simulated time (its physics alone, "
           f"median of {BASELINE_RUNS})")

@@ -5,7 +5,7 @@
 How the values are obtained (reverse-engineered from the annex's M1 table, see README.md):
 
 * Singular points O1..On: O1 is the start/lander (0, 0); O2.. are the mission's photo targets
-  in the order of /work/shared/missions.md (in M1 the first target is (0, 0) itself, so the
+  in the order of ../shared/missions.md (in M1 the first target is (0, 0) itself, so the
   annex uses O1 for both: M1 is kept verbatim in missions/M1_model2.spec, not generated).
 * distance (MOVE_NOMINAL, O_i -> O_j): Euclidean distance + 2 m, truncated to 2 decimals
   (annex: O1-O2 4 -> 6, O1-O3 4.24 -> 6.24, O2-O3 3.16 -> 5.16). One DIST symbol per ordered

@@ -8,17 +8,24 @@ from __future__ import annotations
 
 from specc.runtime.body import RobotConfig
 from specc.runtime.ftplan.config import Var  # noqa: F401
-from specc.runtime.system import BindingSpec, MissionSpec, ReportSpec, StateValue, SystemSpec  # noqa: F401
+from specc.runtime.system import (  # noqa: F401
+    BindingSpec,
+    MissionSpec,
+    ReportSpec,
+    StateCondition,
+    StateValue,
+    SystemSpec,
+)
 
 SYSTEM = SystemSpec(
     name='atrv',
     modules=('rflex', 'sick', 'ndd', 'platine', 'camera', 'antenna'),
-    executive=None,
-    supervisor=None,
-    planning=None,
-    extension=None,
+    executive='atrv',
+    supervisor='rover_tasks',
+    planning='rover',
+    extension='atrv_codels.missions',
     body=RobotConfig.from_spec('atrv', {'radius': 0.62, 'length': 1.05, 'width': 0.65, 'mass': 120, 'wheel_base': 0.55, 'max_wheel_speed': 0.6, 'encoder_noise': 0.01, 'laser_beams': 181, 'laser_range': 30, 'camera_r_min': 0.5, 'camera_r_max': 8, 'camera_open': 50}),
-    devices=None,
+    devices={'rflex': ('wheels', 'encoders'), 'sick': ('laser',), 'platine': ('pan_tilt',), 'camera': ('camera', 'pan_tilt'), 'antenna': ('antenna',)},
     worlds={
         'W1': 'worlds/W1.toml',
         'W2': 'worlds/W2.toml',
@@ -26,7 +33,80 @@ SYSTEM = SystemSpec(
         'W4': 'worlds/W4.toml',
     },
     missions={
+        'M1': MissionSpec(name='M1', world='W1', horizon=900.0, plan='M1'),
+        'M2': MissionSpec(name='M2', world='W1', horizon=900.0, plan='M2'),
+        'M3': MissionSpec(name='M3', world='W1', horizon=900.0, plan='M3'),
+        'M4': MissionSpec(name='M4', world='W1', horizon=900.0, plan='M4'),
     },
     bindings={
+        'MOVE': BindingSpec(
+            task='MOVE',
+            args=(Var('?x1'), Var('?y1'), Var('?x2'), Var('?y2')),
+            kind='goal',
+            target='MOVE-TO',
+            target_args=(Var('?x2'), Var('?y2')),
+            report=ReportSpec('ROBOT_POSITION', ('rflex.Robot.pose.x', 'rflex.Robot.pose.y')),
+        ),
+        'MOVE_NOMINAL': BindingSpec(
+            task='MOVE_NOMINAL',
+            args=(Var('?p1'), Var('?p2')),
+            kind='goal',
+            target='MOVE-TO',
+            target_args=(StateValue('AT_ROBOT_X'), StateValue('AT_ROBOT_Y')),
+            report=ReportSpec('ROBOT_POSITION', ('rflex.Robot.pose.x', 'rflex.Robot.pose.y')),
+        ),
+        'MOVE_RECOV': BindingSpec(
+            task='MOVE_RECOV',
+            args=(Var('?p1'), Var('?p2')),
+            kind='goal',
+            target='MOVE-TO',
+            target_args=(StateValue('AT_ROBOT_X'), StateValue('AT_ROBOT_Y')),
+            report=ReportSpec('ROBOT_POSITION', ('rflex.Robot.pose.x', 'rflex.Robot.pose.y')),
+        ),
+        'MOVE_PAN_TILT_UNIT': BindingSpec(
+            task='MOVE_PAN_TILT_UNIT',
+            args=(Var('?from'), Var('?to')),
+            kind='goal',
+            target='POINT-CAMERA',
+            target_args=(Var('?to'),),
+        ),
+        'MOVE_PTU': BindingSpec(
+            task='MOVE_PTU',
+            args=(Var('?pan1'), Var('?tilt1'), Var('?pan2'), Var('?tilt2')),
+            kind='goal',
+            target='POINT-CAMERA-DEG',
+            target_args=(Var('?pan2'), Var('?tilt2')),
+        ),
+        'TAKE_PICTURE': BindingSpec(
+            task='TAKE_PICTURE',
+            args=(Var('?o'), Var('?x'), Var('?y')),
+            kind='goal',
+            target='PHOTOGRAPH',
+            target_args=(Var('?o'),),
+        ),
+        'TAKE_SHOT': BindingSpec(
+            task='TAKE_SHOT',
+            args=(Var('?shot'),),
+            kind='goal',
+            target='PHOTOGRAPH',
+            target_args=(Var('?o'),),
+            where=StateCondition('PICTURE', (Var('?o'), Var('?x'), Var('?y')), 'DONE'),
+        ),
+        'COMMUNICATE': BindingSpec(task='COMMUNICATE', args=(Var('?w'),), kind='goal', target='TRANSMIT'),
+        'COMMUNICATE_ANTENNA': BindingSpec(
+            task='COMMUNICATE_ANTENNA',
+            args=(Var('?w'),),
+            kind='goal',
+            target='TRANSMIT',
+        ),
+        'INIT_PTU_DRIVER': BindingSpec(task='INIT_PTU_DRIVER', args=(), kind='goal', target='INIT-PAN-TILT'),
+        'INIT_PTU': BindingSpec(task='INIT_PTU', args=(), kind='goal', target='INIT-PAN-TILT'),
+        'INIT_MVT_GENERATION': BindingSpec(
+            task='INIT_MVT_GENERATION',
+            args=(),
+            kind='goal',
+            target='INIT-MOTION',
+        ),
+        'INIT_FRAME': BindingSpec(task='INIT_FRAME', args=(), kind='goal', target='INIT-MOTION'),
     },
 )

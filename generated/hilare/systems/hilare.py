@@ -8,7 +8,14 @@ from __future__ import annotations
 
 from specc.runtime.body import RobotConfig
 from specc.runtime.ftplan.config import Var  # noqa: F401
-from specc.runtime.system import BindingSpec, MissionSpec, ReportSpec, StateValue, SystemSpec  # noqa: F401
+from specc.runtime.system import (  # noqa: F401
+    BindingSpec,
+    MissionSpec,
+    ReportSpec,
+    StateCondition,
+    StateValue,
+    SystemSpec,
+)
 
 SYSTEM = SystemSpec(
     name='hilare',
@@ -18,7 +25,7 @@ SYSTEM = SystemSpec(
     planning=None,
     extension='hilare_codels.hunt',
     body=RobotConfig.from_spec('hilare', {'radius': 0.35, 'mass': 80, 'wheel_base': 0.6, 'max_wheel_speed': 0.8, 'encoder_noise': 0.01, 'sonars': 32, 'sonar_range': 5, 'arm_joints': 6}),
-    devices=None,
+    devices={'loco': ('wheels', 'encoders'), 'us': ('sonars',), 'arm': ('arm',), 'visual': ('camera', 'pan_tilt', 'objects')},
     worlds={
         'room': 'worlds/room.toml',
     },

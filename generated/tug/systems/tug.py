@@ -8,7 +8,14 @@ from __future__ import annotations
 
 from specc.runtime.body import RobotConfig
 from specc.runtime.ftplan.config import Var  # noqa: F401
-from specc.runtime.system import BindingSpec, MissionSpec, ReportSpec, StateValue, SystemSpec  # noqa: F401
+from specc.runtime.system import (  # noqa: F401
+    BindingSpec,
+    MissionSpec,
+    ReportSpec,
+    StateCondition,
+    StateValue,
+    SystemSpec,
+)
 
 SYSTEM = SystemSpec(
     name='tug',
