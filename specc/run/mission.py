@@ -501,6 +501,7 @@ class Recorder:
         self._next_progress = self.kernel.now + PROGRESS_PERIOD
         self._database: Any = None
         self._facts: dict[str, list[Any]] = {}
+        self._facts_seen = -1  # the database's `changes` when the facts were last compared
         if executive is not None:
             executive.observers.append(self._activity)
             executive.listeners.append(self._message)
@@ -537,13 +538,14 @@ class Recorder:
     def watch_facts(self, database: Any) -> None:
         """The facts the procedures share (closed and functional predicates): the supervisor has
         no listener for its database, so it is compared after each kernel event and before each
-        executive event is logged."""
+        executive event is logged, when its count of changes says it changed."""
         self._database = database
         self._facts = {p.name: [] for p in database.predicates.values() if p.kind in ("closed", "functional")}
 
     def poll_facts(self) -> None:
-        if self._database is None:
+        if self._database is None or self._database.changes == self._facts_seen:
             return
+        self._facts_seen = self._database.changes
         for head, before in self._facts.items():
             now = self._database.facts(head)
             if now == before:

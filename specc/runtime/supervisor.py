@@ -214,6 +214,7 @@ class Database:
         self._affirmed: dict[str, list[tuple[Any, ...]]] = {}
         self._negated: dict[str, list[tuple[Any, ...]]] = {}
         self._events: dict[str, list[_Occurrence]] = {}
+        self.changes = 0  # how many times the stored facts changed: an observer compares it
 
     def kind(self, head: str) -> str:
         predicate = self.predicates.get(head)
@@ -247,6 +248,11 @@ class Database:
 
     # The supervisor's side: each returns whether the database changed.
     def _store(self, fact: Compound, negative: bool) -> bool:
+        changed = self._stored(fact, negative)
+        self.changes += changed
+        return changed
+
+    def _stored(self, fact: Compound, negative: bool) -> bool:
         kind = self.kind(fact.head)
         affirmed = self._affirmed.setdefault(fact.head, [])
         if kind == "standard":
@@ -269,12 +275,15 @@ class Database:
 
     def _remove(self, fact: Compound, negative: bool) -> bool:
         if negative:
-            return _discard(self._negated.get(fact.head, []), fact.args)
-        occurrences = self._events.get(fact.head, [])
-        used = [o for o in occurrences if o.fact == fact]
-        for occurrence in used:
-            occurrences.remove(occurrence)
-        return _discard(self._affirmed.get(fact.head, []), fact.args) or bool(used)
+            changed = _discard(self._negated.get(fact.head, []), fact.args)
+        else:
+            occurrences = self._events.get(fact.head, [])
+            used = [o for o in occurrences if o.fact == fact]
+            for occurrence in used:
+                occurrences.remove(occurrence)
+            changed = _discard(self._affirmed.get(fact.head, []), fact.args) or bool(used)
+        self.changes += changed
+        return changed
 
     def _add_event(self, fact: Compound) -> None:
         self._events.setdefault(fact.head, []).append(_Occurrence(fact))

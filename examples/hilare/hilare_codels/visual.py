@@ -139,11 +139,28 @@ def startSearch(sdi, request):
     return "exec" if sdi.image.valid else "NO_IMAGE"
 
 
+# The cells' centres, for the certainty update: only the cells the camera may see are computed
+# cell by cell (about 90 of the 4096), found with a slightly wider test so that a cell on the
+# field's edge is never missed by rounding (the exact test is `reliability`'s, as before).
+_CELLS = np.arange(NX * NY)
+_CELL_X, _CELL_Y = (_CELLS % NX + 0.5) * CELL, (_CELLS // NX + 0.5) * CELL
+_EDGE = 1e-6
+
+
+def _cells_in_view(x, y, heading):
+    """The indexes of the cells that may lie in the camera's field from (x, y), in order."""
+    dx, dy = _CELL_X - x, _CELL_Y - y
+    r = np.hypot(dx, dy)
+    bearing = np.angle(np.exp(1j * (np.arctan2(dy, dx) - heading)))  # wrapped to [-pi, pi]
+    near = (r >= R_MIN - _EDGE) & (r <= R_MAX + _EDGE) & (np.abs(bearing) <= THETA_OPEN / 2.0 + _EDGE)
+    return np.flatnonzero(near).tolist()
+
+
 def analyseImage(sdi, request):
     """searchObject exec: detect objects in view with probability f, update certainties."""
     pose, found = sdi.image.pose, 0
     heading = pose.theta + sdi.image.pan
-    for k in range(NX * NY):
+    for k in _cells_in_view(pose.x, pose.y, heading):
         x, y = (k % NX + 0.5) * CELL, (k // NX + 0.5) * CELL
         r = math.hypot(x - pose.x, y - pose.y)
         f = reliability(r, math.remainder(math.atan2(y - pose.y, x - pose.x) - heading, math.tau))

@@ -393,6 +393,9 @@ class Node:
         # a new event the links; a pair shown harmless stays so in every descendant (constraints
         # only tighten and bindings only narrow down a branch), so it is dropped for good.
         self.pending: set[tuple[int, int]] = set()  # (link index, event id) not yet shown harmless
+        # Pairs of resource uses shown apart (another resource, arguments that differ, or ordered
+        # one after the other) stay so in every descendant, for the same reason: never scanned again.
+        self.uses_apart: set[tuple[int, int]] = set()  # (use id, use id)
         # Indexes by attribute, so that finding producers and threats reads only the attribute's
         # own events and links, not the whole plan.
         self.events: dict[str, tuple[int, ...]] = {}  # attribute -> ids of the events on it, oldest first
@@ -416,6 +419,7 @@ class Node:
         other.durations = dict(self.durations)
         other.provisional = dict(self.provisional)
         other.pending = set(self.pending)
+        other.uses_apart = set(self.uses_apart)
         other.events = dict(self.events)
         other.links_on = dict(self.links_on)
         other.places = dict(self.places)
@@ -740,14 +744,21 @@ class Node:
 
     def resource_conflicts(self) -> Iterator[tuple[Assertion, Assertion]]:
         uses = [a for a in self.assertions if a.kind == "use"]
+        apart = self.uses_apart
         for a, b in itertools.combinations(uses, 2):
+            pair = (a.id, b.id)
+            if pair in apart:
+                continue
             if a.attribute != b.attribute or not all(
                     self.bindings.possibly_equal(x, y) for x, y in zip(a.args, b.args, strict=False)):
+                apart.add(pair)
                 continue
+            # Not settled for good: an amount still a variable may be bound to more.
             amount = _number(self.bindings.resolve(a.value)) + _number(self.bindings.resolve(b.value))
             if amount <= self.ctx.capacity.get(a.attribute, 1.0) + TOLERANCE:
                 continue
             if self.bounds(a.end, b.start)[0] >= -SURELY or self.bounds(b.end, a.start)[0] >= -SURELY:
+                apart.add(pair)
                 continue
             yield a, b
 
