@@ -193,3 +193,19 @@ executive ex { service S0 { request: m.R0; } service S1 { request: m.R1; } servi
                             text=True, env={**os.environ, "PYTHONHASHSEED": str(seed)}, check=True).stdout
              for seed in range(1, 9)}
     assert found == {"[('S0', 'S3'), ('S1',)]\n"}
+
+
+def test_a_service_that_takes_inputs_is_explored_like_any_other(tmp_path: Path) -> None:
+    """`takes: x;` (inputs the task level gives with each request): the explorer's requests give
+    one for each, so a rule that breaks exclusion between two such services is found, where a
+    request without its inputs would be refused before it ever ran."""
+    paths = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";')
+    spec = paths[0]
+    text = spec.read_text()
+    spec.write_text(text.replace("request Go { type: exec;", "request Go { type: exec; input: x: double;")
+                    .replace("request Back { type: exec;", "request Back { type: exec; input: y: double;")
+                    .replace("service GO { request: arm.Go; }", "service GO { request: arm.Go; takes: x; }")
+                    .replace("service BACK { request: arm.Back;", "service BACK { request: arm.Back; takes: y;"))
+    result = run(paths, "shop", 2)
+    assert "exclusion" in result.violations, result
+    assert any("BACK" in step for step in result.violations["exclusion"].trace)

@@ -466,7 +466,10 @@ Key = tuple[Any, ...]
 
 
 def _request(service: str, world: World) -> None:
-    world.executive.request(service, world.next_id)
+    # The inputs the task level gives (`takes:`): the abstract modules read no input, but a
+    # request given fewer than its service takes would be refused before it ever ran.
+    takes = world.executive.spec.services[service].takes
+    world.executive.request(service, world.next_id, (None,) * len(takes))
 
 
 def _interrupt(ident: int, world: World) -> None:
