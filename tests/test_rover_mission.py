@@ -205,6 +205,19 @@ def test_robot2_photographs_with_modele2s_own_angles(robot: Robot) -> None:
     assert link.start < shot.start < shot.end < link.end
 
 
+def test_the_rover_s_procedures_take_goals_of_their_own(robot: Robot) -> None:
+    """Without FTplan (`specc run --goal`): a goal of the procedures, carried out through the
+    executive; the extension measures nothing it has no mission for, and the goal decides."""
+    from specc.runtime.system import MissionSpec
+
+    done = run_mission(robot, MissionSpec("goal", "W1", ("!(POINT-CAMERA AT_MY_FEET)", "!(MOVE-TO 2 1)")), 0)
+    assert done.outcome == "succeeded", done.why
+    requests = [(e["service"], e["request"]) for e in of_kind(done.events, "request")]
+    assert sorted(requests) == [("GOTO", "ndd.GotoTarget"), ("PTU-MOVE", "platine.MoveTo")]  # posted together
+    assert math.dist(final_position(done.events), (2.0, 1.0)) < 0.4
+    assert not Measures.readable(done.extension_measures)
+
+
 @pytest.mark.parametrize("configuration, mission, world, message", [
     ("Robot3", "M1", "W1", "no robot configuration 'Robot3' (known: Robot1, Robot2, Robot1/2, Robot1/2c; add"),
     ("Robot1", "M9", "W1", "robot 'atrv' has no mission 'M9' (its missions: M1, M2, M3, M4)"),

@@ -112,6 +112,14 @@ def check_body(ctx: Context, system: m.System) -> None:
         problem = body_problem(entry.name, float(value.value))
         if problem is not None:
             ctx.report("bad-property-value", problem, value.span)
+    # A box footprint takes both sides: one alone would leave the simulator a box of width 0.
+    box = {e.name: e for e in body if e.name in ("length", "width") and isinstance(e.value, m.Number)
+           and float(e.value.value) > 0}
+    if len(box) == 1:
+        (given, entry), = box.items()
+        other = "width" if given == "length" else "length"
+        ctx.report("bad-property-value", f"a box footprint needs both length and width: give '{other}: N;' too "
+                   f"(or neither, for the disc of 'radius')", entry.span)
 
 
 def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
