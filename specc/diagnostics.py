@@ -7,6 +7,7 @@ Tests assert `code`, never the wording.
 from __future__ import annotations
 
 import difflib
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -53,13 +54,22 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> str:
 
 
 def render(diagnostic: Diagnostic, sources: dict[str, str]) -> str:
-    """The headline, the source line and a `^~~~` marker under the span."""
-    lines = [diagnostic.headline()]
+    """The headline, the source line and a `^~~~` marker under the span. Control characters a
+    spec holds never reach the terminal: one line each (a line break as `\\n`), and an ESC or NUL
+    in the source line shows as `?` (the marker stays under its column)."""
+    lines = [_one_line(diagnostic.headline())]
     lines += _excerpt(diagnostic.span, sources)
     for span, note in diagnostic.notes:
-        lines.append(f"{span}: note: {note}")
+        lines.append(_one_line(f"{span}: note: {note}"))
         lines += _excerpt(span, sources)
     return "\n".join(lines)
+
+
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
+
+
+def _one_line(text: str) -> str:
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text.replace("\r", "\\r").replace("\n", "\\n"))
 
 
 def _excerpt(span: Span, sources: dict[str, str]) -> list[str]:
@@ -76,7 +86,7 @@ def _excerpt(span: Span, sources: dict[str, str]) -> list[str]:
     else:
         width = max(len(line) - start, 1)
     width = max(1, min(width, max(len(line) - start, 1)))
-    return [f"    {line}", "    " + " " * start + "^" + "~" * (width - 1)]
+    return [f"    {_CONTROL.sub('?', line)}", "    " + " " * start + "^" + "~" * (width - 1)]
 
 
 def sort_key(diagnostic: Diagnostic) -> tuple[str, int, int, str]:

@@ -26,11 +26,11 @@ SOURCES = (
     "examples/atrv/procedures.spec",
     "examples/atrv/system.spec",
 )
-MODULES = ('antenna', 'camera', 'ndd', 'platine', 'rflex', 'sick')
-EXECUTIVES = ('atrv',)
+MODULES = ("antenna", "camera", "ndd", "platine", "rflex", "sick")
+EXECUTIVES = ("atrv",)
 RULE_BASES = ()
-PROCEDURES = ('rover_tasks',)
-DOMAINS = ('model1', 'model2_M1', 'model2_M2', 'model2_M3', 'model2_M4')
-PROBLEMS = ('M1_model1', 'M1_model2', 'M2_model1', 'M2_model2', 'M3_model1', 'M3_model2', 'M4_model1', 'M4_model2')
-FTPLANS = ('rover',)
-SYSTEMS = ('atrv',)
+PROCEDURES = ("rover_tasks",)
+DOMAINS = ("model1", "model2_M1", "model2_M2", "model2_M3", "model2_M4")
+PROBLEMS = ("M1_model1", "M1_model2", "M2_model1", "M2_model2", "M3_model1", "M3_model2", "M4_model1", "M4_model2")
+FTPLANS = ("rover",)
+SYSTEMS = ("atrv",)

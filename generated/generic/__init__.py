@@ -8,9 +8,9 @@ SOURCES = (
     "examples/generic/fig35.spec",
     "examples/generic/generic.spec",
 )
-MODULES = ('graph35', 'mod1', 'mod2')
-EXECUTIVES = ('fig35', 'generic')
-RULE_BASES = ('diagnosis', 'generic_controller')
+MODULES = ("graph35", "mod1", "mod2")
+EXECUTIVES = ("fig35", "generic")
+RULE_BASES = ("diagnosis", "generic_controller")
 PROCEDURES = ()
 DOMAINS = ()
 PROBLEMS = ()

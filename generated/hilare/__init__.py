@@ -16,11 +16,11 @@ SOURCES = (
     "examples/hilare/us.spec",
     "examples/hilare/visual.spec",
 )
-MODULES = ('arm', 'avoid', 'explor', 'loco', 'pilo', 'plan', 'us', 'visual')
-EXECUTIVES = ('hilare',)
-RULE_BASES = ('hilare_controller',)
-PROCEDURES = ('hilare_tasks',)
+MODULES = ("arm", "avoid", "explor", "loco", "pilo", "plan", "us", "visual")
+EXECUTIVES = ("hilare",)
+RULE_BASES = ("hilare_controller",)
+PROCEDURES = ("hilare_tasks",)
 DOMAINS = ()
 PROBLEMS = ()
 FTPLANS = ()
-SYSTEMS = ('hilare',)
+SYSTEMS = ("hilare",)

@@ -10,8 +10,8 @@ from typing import Any
 from specc.analysis import kheops as k
 from specc.analysis.controller import Controller, executive_controller
 from specc.analysis.service_list import executive_spec
-from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.env import Code, render
+from specc.backends.manifest import Output, header
 from specc.backends.rules import DecisionView, python_name, warn_unsettled
 from specc.model import nodes as m
 from specc.runtime import executive as rx
@@ -26,8 +26,9 @@ def source(value: Any) -> str:
     return repr(value)
 
 
-def arguments(record: Any) -> list[str]:
-    return [f"{f.name}={source(getattr(record, f.name))}" for f in dataclasses.fields(record)]
+def arguments(record: Any) -> list[Code]:
+    """`field=value` for every field of a runtime record, each value a Python literal (`repr`)."""
+    return [Code(f"{f.name}={source(getattr(record, f.name))}") for f in dataclasses.fields(record)]
 
 
 @dataclass
@@ -39,7 +40,7 @@ class ExecutiveView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=self.executive.span.file)
+        return header(self.executive.span.file)
 
     @property
     def name(self) -> str:
@@ -68,24 +69,25 @@ class ExecutiveView:
                          for name, services in self.spec.groups.items()) or "none"
 
     @property
-    def services(self) -> list[tuple[str, list[str]]]:
+    def services(self) -> list[tuple[str, list[Code]]]:
         return [(name, arguments(service)) for name, service in self.spec.services.items()]
 
     @property
-    def groups(self) -> list[tuple[str, str]]:
-        return [(name, repr(services)) for name, services in self.spec.groups.items()]
+    def groups(self) -> list[tuple[str, Code]]:
+        return [(name, Code(repr(services))) for name, services in self.spec.groups.items()]
 
     @property
-    def reflexes(self) -> list[str]:
-        return [f"rt.ReflexSpec({', '.join(arguments(r))})" for r in self.spec.reflexes]
+    def reflexes(self) -> list[Code]:
+        return [Code(f"rt.ReflexSpec({', '.join(arguments(r))})") for r in self.spec.reflexes]
 
     @property
-    def parameters(self) -> list[tuple[str, str]]:
-        return [(name, f"rt.ParameterSpec({', '.join(arguments(p))})") for name, p in self.spec.parameters.items()]
+    def parameters(self) -> list[tuple[str, Code]]:
+        return [(name, Code(f"rt.ParameterSpec({', '.join(arguments(p))})"))
+                for name, p in self.spec.parameters.items()]
 
     @property
-    def codel_module(self) -> str:
-        return repr(self.spec.codel_module)
+    def codel_module(self) -> Code:
+        return Code(repr(self.spec.codel_module))
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> None:
@@ -105,4 +107,4 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     if executives:
         output.add(BACKEND, "executive/__init__.py", render(
             "executive/__init__.py.j2", names=[python_name(e.name) for e in executives],
-            header=HEADER.format(sources="the executive blocks")))
+            header=header("the executive blocks")))

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from specc.analysis.ftplan import ftplan_config
 from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.manifest import Output, header
 from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
@@ -26,7 +26,7 @@ class FtPlanView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=self.block.span.file)
+        return header(self.block.span.file)
 
     @property
     def summary(self) -> str:
@@ -48,4 +48,4 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     if blocks:
         output.add(BACKEND, "ftplan/__init__.py", render(
             "ftplan/__init__.py.j2", names=[python_name(b.name) for b in blocks],
-            header=HEADER.format(sources="the ftplan blocks")))
+            header=header("the ftplan blocks")))

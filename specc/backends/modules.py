@@ -7,11 +7,12 @@ binding it to the user's codels. Names are computed here; the templates only lay
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cached_property
 
-from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output, describe_sources
+from specc.backends.env import Code, ident, py, render
+from specc.backends.manifest import Output, describe_sources, header
 from specc.model import nodes as m
 
 BACKEND = "modules"
@@ -40,12 +41,12 @@ class FieldView:
     size: str  # "None" or the array length
 
     @property
-    def declaration(self) -> str:
-        return f"{self.name}: {self.annotation} = {self.default}"
+    def declaration(self) -> Code:
+        return Code(f"{ident(self.name)}: {self.annotation} = {self.default}")
 
     @property
-    def check(self) -> str:
-        return f'("{self.name}", {self.kind}, {self.size})'
+    def check(self) -> Code:
+        return Code(f'({py(self.name)}, {self.kind}, {self.size})')
 
 
 @dataclass(frozen=True)
@@ -56,9 +57,9 @@ class RecordView:
     doc: str = ""
 
     @property
-    def checks(self) -> str:
+    def checks(self) -> Code:
         inner = ", ".join(f.check for f in self.fields)
-        return f"({inner},)" if self.fields else "()"
+        return Code(f"({inner},)" if self.fields else "()")
 
 
 class ModuleView:
@@ -70,7 +71,7 @@ class ModuleView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=self.source)
+        return header(self.source)
 
     @property
     def name(self) -> str:
@@ -140,7 +141,7 @@ class ModuleView:
     @property
     def sdi(self) -> RecordView:
         return RecordView(f"{self.prefix}Data", tuple(self.field(f.name, f.type) for f in self.module.internal_data),
-                          base="rt.InternalData", doc=f"The internal data (SDI) of module {self.name}.")
+                          base=Code("rt.InternalData"), doc=f"The internal data (SDI) of module {self.name}.")
 
     @property
     def requests(self) -> list[RequestView]:
@@ -155,14 +156,14 @@ class ModuleView:
         return records
 
     @property
-    def tasks(self) -> list[str]:
+    def tasks(self) -> list[Code]:
         specs = []
         for task in self.module.exec_tasks:
             codels = {c.state: c.function for c in task.codels}
-            specs.append(
-                f'rt.ExecTaskSpec(name="{task.name}", period={seconds(task.period)}, delay={seconds(task.delay)}, '
+            specs.append(Code(
+                f'rt.ExecTaskSpec(name={py(task.name)}, period={seconds(task.period)}, delay={seconds(task.delay)}, '
                 f'priority={int(task.priority.value) if task.priority else 0}, init={quoted(codels.get("init"))}, '
-                f'permanent={quoted(codels.get("permanent"))})')
+                f'permanent={quoted(codels.get("permanent"))})'))
         return specs
 
     @property
@@ -202,26 +203,27 @@ class RequestView:
         return found
 
     @property
-    def spec(self) -> str:
+    def spec(self) -> Code:
         r = self.request
-        codels = ", ".join(f'"{c.state}": "{c.function}"' for c in r.codels)
-        yields = ", ".join(f'"{c.state}": {tuple_literal(c.yields)}' for c in r.codels if c.yields)
-        return (f'rt.RequestSpec(name="{r.name}", kind="{self.kind}", input_type={self.input_class}, '
+        codels = ", ".join(f'{py(c.state)}: {py(c.function)}' for c in r.codels)
+        yields = ", ".join(f'{py(c.state)}: {tuple_literal(c.yields)}' for c in r.codels if c.yields)
+        return Code(f'rt.RequestSpec(name={py(r.name)}, kind={py(self.kind)}, input_type={self.input_class}, '
                 f'output_type={self.output_class}, validate={quoted(r.validate.text if r.validate else None)}, '
                 f"codels={{{codels}}}, yields={{{yields}}}, fail={tuple_literal(f.text for f in r.fail)}, "
                 f"incompatible={tuple_literal(i.text for i in r.incompatible_with)}, "
                 f"task={quoted(r.task.text if r.task else None)}, sends={tuple_literal(s.text for s in r.sends)})")
 
     @property
-    def parameters(self) -> str:
-        params = "".join(f"{t.name}: {self.module.field(t.name, t.type).annotation}, " for t in self.request.inputs)
-        return params
+    def parameters(self) -> Code:
+        return Code("".join(f"{ident(t.name)}: {self.module.field(t.name, t.type).annotation}, "
+                            for t in self.request.inputs))
 
     @property
-    def arguments(self) -> str:
+    def arguments(self) -> Code:
         if self.input_class is None:
-            return "None"
-        return f"{self.input_class}(" + ", ".join(f"{t.name}={t.name}" for t in self.request.inputs) + ")"
+            return Code("None")
+        return Code(f"{self.input_class}(" + ", ".join(f"{ident(t.name)}={ident(t.name)}" for t in self.request.inputs)
+                    + ")")
 
     @property
     def doc(self) -> str:
@@ -250,25 +252,23 @@ class PosterView:
         return RecordView(self.cls, fields, doc=f"The content of poster {self.module.name}.{self.name}.")
 
     @property
-    def spec(self) -> str:
+    def spec(self) -> Code:
         p = self.poster
-        return (f'rt.PosterSpec(name="{p.name}", type={self.cls}, fields={tuple_literal(d.parts[0] for d in p.data)}, '
-                f'update="{p.update or "auto"}", activity={quoted(p.activity.text if p.activity else None)})')
+        fields = tuple_literal(d.parts[0] for d in p.data)
+        return Code(f'rt.PosterSpec(name={py(p.name)}, type={self.cls}, fields={fields}, '
+                    f'update={py(p.update or "auto")}, activity={quoted(p.activity.text if p.activity else None)})')
 
 
 def seconds(duration: m.Duration | None) -> str:
     return repr(duration.seconds) if duration is not None else "0.0"
 
 
-def quoted(text: str | None) -> str:
-    return "None" if text is None else f'"{text}"'
+def quoted(text: str | None) -> Code:
+    return py(text)
 
 
-def tuple_literal(items: object) -> str:
-    values = [f'"{item}"' for item in items]  # type: ignore[attr-defined]
-    if not values:
-        return "()"
-    return "(" + ", ".join(values) + ("," if len(values) == 1 else "") + ")"
+def tuple_literal(items: Iterable[object]) -> Code:
+    return py(tuple(str(item) for item in items))
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> None:
@@ -281,4 +281,4 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
         return
     sources = sorted({module.span.file for module in modules})
     output.add(BACKEND, "modules/__init__.py", render(
-        "modules/__init__.py.j2", names=names, header=HEADER.format(sources=describe_sources(sources))))
+        "modules/__init__.py.j2", names=names, header=header(describe_sources(sources))))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output, describe_sources
+from specc.backends.manifest import Output, describe_sources, header
 from specc.model import nodes as m
 
 BACKEND = "package"
@@ -24,26 +24,22 @@ class PackageView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=describe_sources(self.sources))
+        return header(describe_sources(self.sources))
 
     def names(self, kind: type) -> list[str]:
         return sorted(item.name for item in self.program.items if isinstance(item, kind))
 
     @property
-    def blocks(self) -> list[tuple[str, str]]:
-        """(CONSTANT, Python tuple literal of block names) for each block kind."""
+    def blocks(self) -> list[tuple[str, tuple[str, ...]]]:
+        """(CONSTANT, the block names) for each block kind."""
         kinds = (("MODULES", m.Module), ("EXECUTIVES", m.Executive), ("RULE_BASES", m.RuleBase),
                  ("PROCEDURES", m.Procedures), ("DOMAINS", m.Domain), ("PROBLEMS", m.Problem),
                  ("FTPLANS", m.FtPlan), ("SYSTEMS", m.System))
-        return [(constant, python_tuple(self.names(kind))) for constant, kind in kinds]
+        return [(constant, tuple(self.names(kind))) for constant, kind in kinds]
 
     @property
     def sources(self) -> list[str]:
         return sorted(f.path for f in self.program.files)
-
-
-def python_tuple(names: list[str]) -> str:
-    return repr(tuple(names))
 
 
 def robot_name(program: m.Program, fallback: str) -> str:

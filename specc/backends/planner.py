@@ -10,7 +10,7 @@ from typing import Any
 
 from specc.analysis.planning import domain_model, problem_model
 from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.manifest import Output, header
 from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
@@ -29,7 +29,7 @@ class DomainView:
     @property
     def header(self) -> str:
         files = sorted({self.domain.span.file} | {p.source for p in self.problems})
-        return HEADER.format(sources=", ".join(files))
+        return header(", ".join(files))
 
     @property
     def name(self) -> str:
@@ -54,4 +54,4 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     if domains:
         output.add(BACKEND, "planner/__init__.py", render(
             "planner/__init__.py.j2", names=[python_name(d.name) for d in domains],
-            header=HEADER.format(sources="the domain and problem blocks")))
+            header=header("the domain and problem blocks")))

@@ -8,21 +8,28 @@ import dataclasses
 import math
 from typing import Any
 
+from specc.backends.env import Code
+
 WIDTH = 110
 
 
-def literal(value: Any, positional: tuple[type, ...] = (), indent: int = 0, prefix: int = 0) -> str:
+def literal(value: Any, positional: tuple[type, ...] = (), indent: int = 0, prefix: int = 0) -> Code:
     """Source for `value` on a line indented by `indent` whose first `prefix` characters are
-    taken; records of a `positional` type are written without field names."""
+    taken; records of a `positional` type are written without field names. Every value inside
+    is written by `repr`, so the source holds no text of the spec's that is not a literal."""
+    return Code(_literal(value, positional, indent, prefix))
+
+
+def _literal(value: Any, positional: tuple[type, ...], indent: int, prefix: int) -> str:
     flat = _flat(value, positional)
     if indent + prefix + len(flat) <= WIDTH:
         return flat
     pad = " " * (indent + 4)
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        items = [f"{name}={literal(v, positional, indent + 4, len(name) + 1)}" for name, v in _fields(value)]
+        items = [f"{name}={_literal(v, positional, indent + 4, len(name) + 1)}" for name, v in _fields(value)]
         return f"{type(value).__name__}(\n" + "".join(f"{pad}{item},\n" for item in items) + " " * indent + ")"
     if isinstance(value, tuple) and value:
-        return "(\n" + "".join(f"{pad}{literal(v, positional, indent + 4)},\n" for v in value) + " " * indent + ")"
+        return "(\n" + "".join(f"{pad}{_literal(v, positional, indent + 4, 0)},\n" for v in value) + " " * indent + ")"
     return flat
 
 

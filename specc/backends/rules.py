@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from specc.analysis import kheops as k
-from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.env import Code, render
+from specc.backends.manifest import Output, header
 from specc.model import nodes as m
 
 BACKEND = "rules"
@@ -54,7 +54,7 @@ class DecisionView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=self.source)
+        return header(self.source)
 
     @property
     def name(self) -> str:
@@ -74,22 +74,24 @@ class DecisionView:
                    for n in self.nodes.values())
 
     @property
-    def leaf_constants(self) -> list[str]:
+    def leaf_constants(self) -> list[Code]:
         lines = []
         for leaf, name in self.leaves.items():
             outputs = {o: None for o in self.outputs} | dict(leaf.outputs)
             shown = ", ".join(f"{o!r}: {literal(v)}" for o, v in outputs.items())
-            lines.append(f"{name} = Decision(MappingProxyType({{{shown}}}), {leaf.inconsistent!r}, "
-                         f"{leaf.incomplete!r}, {leaf.impossible!r})")
+            lines.append(Code(f"{name} = Decision(MappingProxyType({{{shown}}}), {leaf.inconsistent!r}, "
+                              f"{leaf.incomplete!r}, {leaf.impossible!r})"))
         return lines
 
     @property
-    def root_body(self) -> list[str]:
-        return self.body(self.compiled.root, 1, root=True)
+    def root_body(self) -> list[Code]:
+        """The decision function's lines: Python the compiler wrote from the rules' names and
+        their values written as literals (`repr`)."""
+        return [Code(line) for line in self.body(self.compiled.root, 1, root=True)]
 
     @property
-    def shared_functions(self) -> list[tuple[str, list[str]]]:
-        return [(f"_node_{self.numbers[key]}", self.body(self.nodes[key], 1, root=True))
+    def shared_functions(self) -> list[tuple[Code, list[Code]]]:
+        return [(Code(f"_node_{self.numbers[key]}"), [Code(line) for line in self.body(self.nodes[key], 1, root=True)])
                 for key in sorted(self.shared, key=self.numbers.__getitem__)]
 
     @property
@@ -206,5 +208,5 @@ def generate(program: m.Program, output: Output, robot: str = "") -> list[k.Comp
     if bases:
         output.add(BACKEND, "rules/__init__.py", render(
             "rules/__init__.py.j2", names=[python_name(b.name) for b in bases],
-            header=HEADER.format(sources="the rule bases")))
+            header=header("the rule bases")))
     return compiled_all

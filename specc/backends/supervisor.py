@@ -9,7 +9,7 @@ from typing import Any
 
 from specc.analysis.procedures import library
 from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.manifest import Output, header
 from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
@@ -29,7 +29,7 @@ class SupervisorView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=self.procedures.span.file)
+        return header(self.procedures.span.file)
 
     @property
     def name(self) -> str:
@@ -59,4 +59,4 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     if blocks:
         output.add(BACKEND, "supervisor/__init__.py", render(
             "supervisor/__init__.py.j2", names=[python_name(b.name) for b in blocks],
-            header=HEADER.format(sources="the procedures blocks")))
+            header=header("the procedures blocks")))

@@ -7,8 +7,8 @@ import posixpath
 from dataclasses import dataclass
 
 from specc.analysis.ftplan import term, terms
-from specc.backends.env import render
-from specc.backends.manifest import HEADER, Output
+from specc.backends.env import Code, render
+from specc.backends.manifest import Output, header
 from specc.backends.records import literal
 from specc.backends.rules import python_name
 from specc.model import nodes as m
@@ -34,56 +34,56 @@ class SystemView:
 
     @property
     def header(self) -> str:
-        return HEADER.format(sources=self.system.span.file)
+        return header(self.system.span.file)
 
     @property
     def name(self) -> str:
         return self.system.name
 
     @property
-    def name_literal(self) -> str:
-        return repr(self.system.name)
+    def name_literal(self) -> Code:
+        return Code(repr(self.system.name))
 
-    def names(self, refs: tuple[m.Ref, ...]) -> str:
+    def names(self, refs: tuple[m.Ref, ...]) -> Code:
         return literal(tuple(r.text for r in refs))
 
-    def optional(self, ref: m.Ref | None) -> str:
-        return repr(ref.text if ref is not None else None)
+    def optional(self, ref: m.Ref | None) -> Code:
+        return Code(repr(ref.text if ref is not None else None))
 
     @property
-    def extension(self) -> str:
-        return repr(self.system.extension.value if self.system.extension is not None else None)
+    def extension(self) -> Code:
+        return Code(repr(self.system.extension.value if self.system.extension is not None else None))
 
     @property
-    def devices(self) -> str:
+    def devices(self) -> Code:
         grants = self.system.devices
         if grants is None:
-            return "None"
-        return repr({g.module: tuple(d.text for d in g.devices) for g in grants.entries})
+            return Code("None")
+        return Code(repr({g.module: tuple(d.text for d in g.devices) for g in grants.entries}))
 
     @property
-    def body(self) -> str:
+    def body(self) -> Code:
         entries = self.system.body.entries if self.system.body is not None else ()
         values = {s.name: s.value.value for s in entries if isinstance(s.value, m.Number)}
-        return f"RobotConfig.from_spec({self.name!r}, {values!r})"
+        return Code(f"RobotConfig.from_spec({self.name!r}, {values!r})")
 
     @property
     def worlds_declared(self) -> tuple[m.Setting, ...]:
         return self.system.worlds.entries if self.system.worlds is not None else ()
 
     @property
-    def worlds(self) -> list[tuple[str, str]]:
+    def worlds(self) -> list[tuple[Code, Code]]:
         """(name, path relative to the robot's folder), each as a Python literal."""
         here = posixpath.dirname(self.system.span.file) or "."
         shown = []
         for entry in self.worlds_declared:
             written = prop_value(entry.value) if not isinstance(entry.value, m.String) else entry.value.value
             path = posixpath.relpath(posixpath.normpath(posixpath.join(here, written)), self.root)
-            shown.append((repr(entry.name), repr(path)))
+            shown.append((Code(repr(entry.name)), Code(repr(path))))
         return shown
 
     @property
-    def missions(self) -> list[tuple[str, str]]:
+    def missions(self) -> list[tuple[Code, Code]]:
         worlds = self.worlds_declared
         only_world = worlds[0].name if len(worlds) == 1 else ""
         shown = []
@@ -92,15 +92,15 @@ class SystemView:
                                tuple(goal_text(g) for g in mission.goals),
                                mission.horizon.seconds if mission.horizon is not None else None,
                                mission.plan.text if mission.plan is not None else None)
-            shown.append((repr(mission.name), literal(spec, (), 8, len(repr(mission.name)) + 2)))
+            shown.append((Code(repr(mission.name)), literal(spec, (), 8, len(repr(mission.name)) + 2)))
         return shown
 
 
     @property
-    def bindings(self) -> list[tuple[str, str]]:
+    def bindings(self) -> list[tuple[Code, Code]]:
         """(task, BindingSpec), each as a Python literal."""
         entries = self.system.bindings.entries if self.system.bindings is not None else ()
-        return [(repr(b.task), literal(BindingSpec(
+        return [(Code(repr(b.task)), literal(BindingSpec(
             b.task, terms(b.args), b.kind, b.target.text, tuple(binding_argument(a) for a in b.target_args),
             ReportSpec(b.report.name, tuple(v.text for v in b.report.values)) if b.report is not None else None,
             StateCondition(b.where.attribute, terms(b.where.args), term(b.where.value)) if b.where is not None
@@ -124,4 +124,4 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     if systems:
         output.add(BACKEND, "systems/__init__.py", render(
             "systems/__init__.py.j2", names=[python_name(s.name) for s in systems],
-            header=HEADER.format(sources="the system blocks")))
+            header=header("the system blocks")))
