@@ -242,7 +242,10 @@ def verify(paths: PathsArg,
                help="Can these hold together? 'KA:LINE [?(condition)]; KA:LINE ...' (repeatable).")] = None,
            procedures: Annotated[Optional[str], typer.Option(help="Which procedures, when there are several.")]
            = None,
-           pnml: Annotated[Optional[Path], typer.Option(help="Also write the net as ISO 15909 PNML.")] = None,
+           pnml: Annotated[Optional[Path], typer.Option(help="Also write the net explored (reduced: its state count "
+                                                            "is the one printed) as ISO 15909 PNML.")] = None,
+           pnml_full: Annotated[Optional[Path], typer.Option(help="Also write the full unfolded net as PNML (more "
+                                                                 "states than the reduced one).")] = None,
            strict: Annotated[bool, typer.Option(help="Exit 1 when there is any finding.")] = False,
            steps: Annotated[int, typer.Option(min=1, help="Trace steps shown per finding (the last ones).")] = 12,
            ) -> None:
@@ -260,8 +263,8 @@ def verify(paths: PathsArg,
     Example: specc verify examples/tug --requests 2
     """
     if goal:
-        verify_procedures(paths, goal, fact or [], fail or [], reach or [], procedures, max_states, pnml, strict,
-                          steps)
+        verify_procedures(paths, goal, fact or [], fail or [], reach or [], procedures, max_states, pnml, pnml_full,
+                          strict, steps)
         return
     from rich.status import Status
 
@@ -345,7 +348,8 @@ def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], fac
 
 
 def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], failing: list[str], reach: list[str],
-                      name: str | None, max_states: int, pnml: Path | None, strict: bool, steps: int) -> None:
+                      name: str | None, max_states: int, pnml: Path | None, pnml_full: Path | None, strict: bool,
+                      steps: int) -> None:
     from rich.status import Status
 
     from specc.analysis import petri
@@ -362,21 +366,28 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
     started = time.perf_counter()
     translation = translate_procedures(loaded, name, goals, facts, failing)
     net = translation.net
-    out.print(f"net of {', '.join(translation.kas)}: {len(net.places)} places, {len(net.transitions)} transitions",
-              markup=False)
-    if pnml is not None:
-        try:
-            pnml.write_text(petri.to_pnml(net), encoding="utf-8")
-        except OSError as exc:
-            err.print(f"error: cannot write '{pnml}': {exc}", markup=False)
-            raise typer.Exit(1) from None
-        out.print(f"wrote {pnml}", markup=False)
+    full = net.unfold()
+    out.print(f"net of {', '.join(translation.kas)}: {len(net.places)} places, {len(net.transitions)} transitions "
+              f"(unfolded: {len(full.slots)} places, {len(full.steps)} transitions)", markup=False)
     with Status("exploring", console=err) as status:
         try:
             result = analyse(translation, queries, max_states, lambda n: status.update(f"exploring: {n} states"))
         except ValueError as exc:
             err.print(f"error: {exc}", markup=False)
             raise typer.Exit(1) from None
+    explored = result.space.unfolded
+    out.print(f"explored: the reduced net, {len(explored.slots)} places and {len(explored.steps)} transitions "
+              "(places no firing marks dropped, single-consumer places merged: the same deadlocks, ends and "
+              "cycles)", markup=False)
+    for path, chosen, what in ((pnml, explored, "the reduced net explored"), (pnml_full, full, "the full net")):
+        if path is None:
+            continue
+        try:
+            path.write_text(petri.to_pnml(chosen), encoding="utf-8")
+        except OSError as exc:
+            err.print(f"error: cannot write '{path}': {exc}", markup=False)
+            raise typer.Exit(1) from None
+        out.print(f"wrote {path} ({what})", markup=False)
     for finding in result.findings:
         out.print(f"{finding.kind}: {finding.message}", markup=False)
         print_trace(finding.trace, finding.where, steps)
@@ -386,14 +397,15 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
     elapsed = time.perf_counter() - started
     if not result.space.complete:
         # Only a growing place is a finding before every marking is known.
-        out.print(f"{result.states} states in {elapsed:.1f} s, and more not explored", markup=False)
+        out.print(f"{result.states} states of the reduced net in {elapsed:.1f} s, and more not explored", markup=False)
         err.print(f"warning: stopped at {result.states} states: deadlocks, cycles and dead statements are not "
                   "established; raise --max-states (or post a smaller goal) to explore them all", markup=False)
         raise typer.Exit(1 if strict else 0)
     if not result.findings:
         out.print("no finding: no deadlock, no unbounded place, no statement that never runs or never succeeds, "
                   "no endless cycle", markup=False)
-    out.print(f"{result.states} states in {elapsed:.1f} s; ends: {result.succeeded} with the goal achieved, "
+    out.print(f"{result.states} states of the reduced net in {elapsed:.1f} s; ends: {result.succeeded} with the goal "
+              f"achieved, "
               f"{result.failed} with it failed; {result.bound_summary()}; {'a' if result.home else 'no'} home marking",
               markup=False)
     raise typer.Exit(1 if strict and result.findings else 0)
@@ -615,6 +627,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
                                                               "the mission's).")] = None,
         goal: Annotated[Optional[list[str]], typer.Option(help="Post this PRS goal instead of a mission's, e.g. "
                                                                "'!(GO 3 4)' (repeatable: posted together).")] = None,
+        wall_limit: Annotated[float, typer.Option(help="Wall-clock seconds before the run is stopped (a codel "
+                                                       "stuck in a loop): its report says so.")] = 3600.0,
         pictures: Annotated[bool, typer.Option(help="Draw the map and timeline now (else: specc replay "
                                                     "RUN).")] = True,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
@@ -629,14 +643,14 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
 
     request = RunRequest(specs, mission=mission, world=world, configuration=config, seed=seed, generated=generated,
                          runs=runs, folder=folder, timing=timing, horizon=horizon,
-                         goals=tuple(goal or ()), pictures=pictures)
+                         goals=tuple(goal or ()), pictures=pictures, wall_limit=wall_limit)
     try:
         with ProgressDisplay(quiet) as progress:
             outcome = run_in_folder(request, progress, compiled_note=lambda text: err.print(text, markup=False))
     except RunCrashed as crash:
         if os.environ.get("SPECC_DEBUG") and crash.__cause__ is not None:
             raise crash.__cause__ from crash  # the traceback the one-line message offers
-        raise _run_error(crash, 1) from None
+        raise _run_error(crash, crash.exit_code) from None
     except RunError as error:
         raise _run_error(error, 2) from None
     out.print(outcome.summary, markup=False)
@@ -739,7 +753,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
     --config Robot1 --config Robot1/2."""
     from specc.run import RunError
     from specc.run.measures import rich_table
-    from specc.run.session import RunRequest, compile_robot
+    from specc.run.session import RunCrashed, RunRequest, compile_robot
     from specc.run.sweep import sweep, write_table
 
     try:
@@ -755,6 +769,8 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
             result = sweep(robot, base, missions=mission or (), worlds=world or (), configurations=config or (),
                            seeds=range(seeds), step=step)
         written = write_table(result, output or runs / f"{robot}-table.md")
+    except RunCrashed as crash:  # stopped by a signal: the runs so far keep their folders
+        raise _run_error(crash, crash.exit_code) from None
     except RunError as error:
         raise _run_error(error, 2) from None
     if result.rows:

@@ -4,7 +4,32 @@ from __future__ import annotations
 
 import ast
 import functools
+import keyword
+import sys
 from pathlib import Path
+
+
+def python_name(base: str) -> str:
+    """The Python name a spec name becomes in the generated package (`a-b` -> `a_b`)."""
+    return "".join(c if c.isalnum() else "_" for c in base)
+
+
+def python_name_problem(name: str) -> str | None:
+    """Why the spec name `name` cannot name something of the generated package (None when it can):
+    a Python keyword, or a dunder (Python's own names: `__init__`, `__dict__`...)."""
+    generated = python_name(name)
+    if keyword.iskeyword(generated):
+        return f"'{generated}' is a Python keyword"
+    if generated.startswith("__") and generated.endswith("__"):
+        return f"'{generated}' is one of Python's own (dunder) names"
+    if not generated.isidentifier():
+        return f"'{generated}' is not a Python identifier"
+    return None
+
+
+def shadowed_by_the_standard_library(package: str) -> bool:
+    """A package named like a standard module (`os`) is never imported: the standard one is."""
+    return package in sys.stdlib_module_names
 
 
 def find_module(dotted: str, start: Path) -> Path | None:

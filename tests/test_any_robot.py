@@ -397,3 +397,69 @@ def test_the_minimal_robot_formats_to_itself() -> None:
     assert again.source is not None
     assert print_source(again.source) == print_source(parsed.source)
     assert textwrap.dedent(print_source(parsed.source)).count("mission deliver") == 1
+
+
+# A second exec task whose permanent codel raises now and then (every 20th period).
+FAULTY_TASK = ("  exec_task Motion { period: 50 ms; priority: 10; }\n",
+               "  exec_task Motion { period: 50 ms; priority: 10; }\n"
+               "  exec_task Watch { period: 100 ms; codel permanent: watch; }\n")
+FAULTY_CODEL = '''
+
+WATCHED = [0]
+
+
+def watch(sdi):
+    WATCHED[0] += 1
+    if WATCHED[0] % 20 == 0:
+        raise ZeroDivisionError("the watch codel divided by zero")
+'''
+
+
+def test_a_permanent_codel_that_raises_is_in_the_log_the_report_and_the_summary(tmp_path: Path) -> None:
+    """The robot goes on (a permanent codel is retried every period); the run says which module
+    and codel raised, where a person and a program look."""
+    robot = write_robot(tmp_path, SPEC.replace(*FAULTY_TASK), CODELS + FAULTY_CODEL)
+    result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "--no-pictures")
+    assert result.returncode == 0, result.stderr  # the mission itself succeeds
+    events = read_events(tmp_path / "run" / "events.jsonl")
+    alarms = [e for e in events if e["kind"] == "alarm" and e["what"] == "incident"]
+    assert alarms and all("drive: permanent codel 'watch'" in e["detail"] and "ZeroDivisionError" in e["detail"]
+                          for e in alarms)
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["measures"]["incidents"] == len(alarms) == len(report["incidents"])
+    assert "permanent codel 'watch'" in (tmp_path / "run" / "summary.txt").read_text()
+    assert "incident: " in result.stdout
+
+
+LOOPING_CODEL = CODELS.replace('def step(sdi, request):\n', 'def step(sdi, request):\n    while True:\n'
+                               '        pass\n')
+
+
+def test_a_codel_stuck_in_a_loop_is_stopped_by_the_wall_clock_limit(tmp_path: Path) -> None:
+    robot = write_robot(tmp_path, SPEC, LOOPING_CODEL)
+    result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "--wall-limit", "3", "--no-pictures")
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert "wall-clock limit of 3 s" in result.stderr
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "interrupted" and "wall-clock limit" in report["why"]
+    assert "wall-clock limit" in (tmp_path / "run" / "summary.txt").read_text()
+    assert read_events(tmp_path / "run" / "events.jsonl")[0]["kind"] == "mission-start"
+
+
+def test_a_run_stopped_by_sigterm_leaves_its_report(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    robot = write_robot(tmp_path, SPEC, LOOPING_CODEL)
+    run = subprocess.Popen([sys.executable, "-m", "specc.cli", "run", str(robot), "--folder", str(tmp_path / "run"),
+                            "--no-pictures"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True)
+    deadline = time.monotonic() + 120
+    while not (tmp_path / "run" / "events.jsonl").is_file() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(1.0)  # into the loop
+    run.send_signal(signal.SIGTERM)
+    _, stderr = run.communicate(timeout=60)
+    assert run.returncode == 130 and "Traceback" not in stderr, stderr
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "interrupted" and report["why"] == "stopped by SIGTERM"

@@ -210,6 +210,9 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     assert partial.coverage[-1] == Coverage("Robot1/2c", 0, 4)
     assert "**not finished: Robot1/2c.**" in markdown(partial)
     assert "Robot1/2 succeeds in 50% of missions against Robot1's 0%: +50 points" in text
+    # The seed's basis (§4.2.2.3): the cut in the failure rate, next to the rise in success.
+    assert "failures cut from 100% to 50%, 50% relative (the seed's basis)" in text
+    assert "its Robot1 succeeded in about 54% of missions under faults, its Robot1/2 in about 73%" in text
     assert "| model1-0001 | numeric |" in text and "| 0% | 50% |" in text
     assert "| σ̄_p | σ̄_c | σ̄_h | ν̄ | κ̄ |" in text
     written = write_report(report, tmp_path / "out")
@@ -269,3 +272,42 @@ def test_a_small_campaign_on_the_tug(tmp_path: Path) -> None:
     assert {g["kind"] for g in original.measures["goals"]} == {"CART_AT", "AT"} and original.measures["distance"] > 5.0
     report = (tmp_path / "tug.md").read_text()
     assert "faults injected into warehouse of tug" in report and "σ̄_CART_AT" in report
+
+
+def test_a_damaged_or_foreign_store_is_one_clear_message_and_loses_no_verdict(tmp_path: Path) -> None:
+    good = tmp_path / "good.sqlite"
+    with ResultStore(good) as store:
+        store.describe({"robot": "atrv", "configurations": ["Robot1"]})
+        store.add_mutants([MutantRecord("model1-0001", "numeric", "a mutant", "")])
+        store.judge([("model1-0001", KEPT, "")])
+        store.record(Outcome(ONE, "done", {"kappa": 0}, 1.0))
+    # Not a database at all.
+    garbage = tmp_path / "garbage.sqlite"
+    garbage.write_bytes(b"this is not SQLite" * 100)
+    with pytest.raises(RunError, match="cannot open the results store .*is it a results store"):
+        ResultStore(garbage)
+    # Another program's database.
+    foreign = tmp_path / "foreign.sqlite"
+    db = sqlite3.connect(foreign)
+    db.execute("CREATE TABLE results (id INTEGER, payload BLOB)")
+    db.commit()
+    db.close()
+    with pytest.raises(RunError, match="is not a specc results store: its table 'results' has the columns"):
+        ResultStore(foreign)
+    # A row whose measures are not JSON, a row with a status no campaign writes, a verdict no filter gives.
+    for column, value, message in (("measures", "{broken", "the measures of experiment .* is not JSON"),
+                                   ("status", "weird", "has the status 'weird'")):
+        damaged = tmp_path / f"{column}.sqlite"
+        damaged.write_bytes(good.read_bytes())
+        db = sqlite3.connect(damaged)
+        db.execute(f"UPDATE results SET {column} = ?", (value,))
+        db.commit()
+        db.close()
+        with ResultStore(damaged) as store, pytest.raises(RunError, match=message):
+            list(store.outcomes())
+        with ResultStore(damaged) as store:  # the verdicts are still there, untouched
+            assert [(m.id, m.verdict) for m in store.mutants()] == [("model1-0001", KEPT)]
+    # Through the command: one line, exit 2, no traceback.
+    damaged = tmp_path / "status.sqlite"
+    result = specc("campaign", ATRV, *SMALL, "--store", damaged, "--report-only", "-o", tmp_path / "out")
+    assert result.returncode == 2 and "has the status 'weird'" in result.stderr and "Traceback" not in result.stderr

@@ -4,6 +4,7 @@ deterministic output."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -273,7 +274,13 @@ def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Pa
                    "--reach", "Explore:254; TakeObject:236", "--steps", "3", "--pnml", str(pnml))
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
-    assert lines[0].startswith("net of CollectObjects") and f"wrote {pnml}" in lines
+    assert lines[0].startswith("net of CollectObjects") and f"wrote {pnml} (the reduced net explored)" in lines
+    # The PNML is the net whose states are counted: the reduced one, as printed.
+    explored = next(line for line in lines if line.startswith("explored: the reduced net, "))
+    places, transitions = (int(n) for n in re.findall(r"(\d+) (?:places|transitions)", explored))
+    written = pnml.read_text(encoding="utf-8")
+    assert written.count("<place ") == places and written.count("<transition ") == transitions
+    assert any(re.match(r"\d+ states of the reduced net in ", line) for line in lines)
     assert any(line.startswith("no-way-out: Explore, Modelise cycle forever") for line in lines)
     assert any(line.startswith("reach Explore:254; TakeObject:236: yes") for line in lines)
     assert "    goal COLLECT-OBJECTS: CollectObjects fails" in lines  # the last of the trace's 3 steps
@@ -314,7 +321,8 @@ def test_graph_draws_the_procedures_net_or_one_ka(tmp_path: Path) -> None:
 
 def test_verify_procedures_says_when_it_stopped_short() -> None:
     short = specc("verify", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--max-states", "500")
-    assert short.returncode == 0 and "500 states in" in short.stdout and "more not explored" in short.stdout
+    assert short.returncode == 0 and "500 states of the reduced net in" in short.stdout
+    assert "more not explored" in short.stdout
     assert "no finding" not in short.stdout  # nothing is established about what was not explored
     assert "deadlocks, cycles and dead statements are not established" in short.stderr
 

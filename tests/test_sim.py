@@ -306,3 +306,24 @@ def test_hilare_reaches_goals_among_obstacles_through_its_modules(hilare):
     assert math.hypot(sim.pose[0] - 2.0, sim.pose[1] - 7.0) < 0.3
     assert min(room.clearance(x, y) for x, y, _ in sim.trace.poses) > HILARE.radius - 0.01  # no collision
     assert sim.trace.certainty is not None and max(sim.trace.certainty[3]) > 0.5  # images were analysed
+
+
+def test_the_executive_s_reflex_stops_the_robot_when_the_sonar_watch_replies(hilare):
+    """The same watch with Hilare's executive over the modules: its reflex emergencyStop (on reply
+    us.watchObstacle == OK, the monitor's positive reply) sends loco.Stop by itself."""
+    from hilare.executive import EXECUTIVES
+    from hilare.modules.loco import LocoClient, Ref
+    from hilare.modules.us import UsClient
+
+    sim, made = robot(hilare, world(start={"x": 5.0, "y": 0.0}))
+    registry = made["loco"].registry
+    executive = EXECUTIVES["hilare"].create(registry, world=str(ROOT / "examples" / "hilare" / "worlds" / "room.toml"))
+    loco, us = LocoClient(made["loco"]), UsClient(made["us"])
+    us.scan()
+    watch = us.watchObstacle(0.4)
+    loco.final(loco.GoTo(Ref(x=12.0, y=0.0)))  # beyond the wall at x = 10
+    assert us.final(watch, timeout=30.0).ok
+    registry.kernel.run_for(3.0)
+    assert executive.reflex_replies and executive.reflex_replies[0].request == "Stop"  # the reflex's, not ours
+    x, _, _ = sim.pose
+    assert x + HILARE.radius < 10.0 and not sim.rover.in_contact

@@ -564,10 +564,12 @@ PNML = "http://www.pnml.org/version-2009/grammar/pnml"
 PTNET = "http://www.pnml.org/version-2009/grammar/ptnet"
 
 
-def to_pnml(net: Net) -> str:
+def to_pnml(net: Net | Unfolded) -> str:
     """The unfolded net as an ISO/IEC 15909-2 place/transition net (one place per place and
-    colour, one transition per binding), readable by PNML tools."""
-    unfolded = net.unfold()
+    colour, one transition per binding), readable by PNML tools. Given an `Unfolded` (the reduced
+    net `specc verify` explores), that one: its transitions are the fused steps."""
+    unfolded = net.unfold() if isinstance(net, Net) else net
+    net = unfolded.net
     ET.register_namespace("", PNML)
     root = ET.Element(f"{{{PNML}}}pnml")
     element = ET.SubElement(root, f"{{{PNML}}}net", id=_xml_id(net.name), type=PTNET)

@@ -16,13 +16,10 @@ from specc.analysis import kheops as k
 from specc.backends.env import Code, render
 from specc.backends.manifest import Output, header
 from specc.model import nodes as m
+from specc.pysource import python_name
 
 BACKEND = "rules"
 INDENT = "    "
-
-
-def python_name(base: str) -> str:
-    return "".join(c if c.isalnum() else "_" for c in base)
 
 
 @dataclass

@@ -17,11 +17,9 @@ from typing import Any
 
 from specc.campaign.engines import Engine
 from specc.campaign.experiments import ORIGINAL, Experiment, Outcome, Setting
-from specc.campaign.store import MutantRecord, ResultStore
+from specc.campaign.store import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED, MutantRecord, ResultStore
 from specc.run import RunError
 from specc.runtime.planner import model as pm
-
-KEPT, NEVER_PLANS, EQUIVALENT, UNJUDGED = "kept", "never-plans", "equivalent", ""
 
 Progress = Callable[[int, int, Outcome | None], None]  # (done, total, the outcome just recorded)
 

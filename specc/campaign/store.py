@@ -18,7 +18,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from specc.campaign.experiments import Experiment, Outcome
+from specc.campaign.experiments import STATUSES, Experiment, Outcome
 from specc.run import RunError
 
 # What a resumed campaign may add to (see ResultStore.describe), and whether the first must stay.
@@ -28,6 +28,16 @@ GROWING = {"configurations": True, "mutants": False}
 def _grows(key: str, stored: Any, given: Any) -> bool:
     return (isinstance(stored, list) and isinstance(given, list) and set(stored) <= set(given)
             and (not GROWING[key] or given[:1] == stored[:1]))
+# The columns each table holds, in order (what SCHEMA creates).
+EXPECTED_COLUMNS = {
+    "campaign": ("name", "value"),
+    "mutants": ("id", "kind", "description", "diff", "verdict", "detail"),
+    "results": ("key", "configuration", "mutant", "mission", "world", "seed", "status", "measures", "seconds", "why",
+                "finished"),
+}
+# The filters' verdicts on a mutant (seed 004 §4.2.2.1), UNJUDGED while its results are incomplete.
+KEPT, NEVER_PLANS, EQUIVALENT, UNJUDGED = "kept", "never-plans", "equivalent", ""
+VERDICTS = (UNJUDGED, KEPT, NEVER_PLANS, EQUIVALENT)
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS campaign (name TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS mutants (
@@ -60,7 +70,26 @@ class ResultStore:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.executescript(SCHEMA)
         except (OSError, sqlite3.Error) as error:
-            raise RunError(f"cannot open the results store '{path}': {error}") from None
+            raise RunError(f"cannot open the results store '{path}': {error} (is it a results store? give "
+                           "another --store)") from None
+        self._check_schema()
+
+    def _check_schema(self) -> None:
+        """A file made by something else than specc (or an older specc) is refused by name."""
+        for table, columns in EXPECTED_COLUMNS.items():
+            found = tuple(row[1] for row in self._rows(f"PRAGMA table_info({table})"))
+            if found != columns:
+                self.db.close()
+                raise RunError(f"'{self.path}' is not a specc results store: its table '{table}' has the columns "
+                               f"({', '.join(found)}), not ({', '.join(columns)}); give another --store")
+
+    def _rows(self, query: str, *args: Any) -> list[Any]:
+        """The rows of `query`; RunError when the file is damaged (what SQLite says, in one line)."""
+        try:
+            return list(self.db.execute(query, args))
+        except sqlite3.Error as error:
+            raise RunError(f"the results store '{self.path}' is damaged ({error}): its results cannot be read; "
+                           "restore it or give another --store") from None
 
     def __enter__(self) -> ResultStore:
         return self
@@ -95,7 +124,15 @@ class ResultStore:
                                 [(name, json.dumps(value)) for name, value in description.items()])
 
     def description(self) -> dict[str, Any]:
-        return {name: json.loads(value) for name, value in self.db.execute("SELECT name, value FROM campaign")}
+        return {name: self._json(value, f"the campaign's '{name}'")
+                for name, value in self._rows("SELECT name, value FROM campaign")}
+
+    def _json(self, text: Any, what: str) -> Any:
+        try:
+            return json.loads(text)
+        except (TypeError, ValueError) as error:
+            raise RunError(f"the results store '{self.path}' is damaged: {what} is not JSON ({error}); restore it "
+                           "or give another --store") from None
 
     def add_mutants(self, mutants: Iterable[MutantRecord]) -> None:
         with self.db:
@@ -109,8 +146,13 @@ class ResultStore:
                                 [(verdict, detail, mutant) for mutant, verdict, detail in verdicts])
 
     def mutants(self) -> list[MutantRecord]:
-        return [MutantRecord(*row) for row in
-                self.db.execute("SELECT id, kind, description, diff, verdict, detail FROM mutants ORDER BY id")]
+        records = [MutantRecord(*row) for row in
+                   self._rows("SELECT id, kind, description, diff, verdict, detail FROM mutants ORDER BY id")]
+        for record in records:
+            if record.verdict not in VERDICTS:
+                raise RunError(f"the results store '{self.path}' is damaged: mutant {record.id} has the verdict "
+                               f"'{record.verdict}' (known: {', '.join(v or 'none yet' for v in VERDICTS)})")
+        return records
 
     # ------------------------------------------------------------ results
     def record(self, outcome: Outcome) -> None:
@@ -127,15 +169,19 @@ class ResultStore:
             raise RunError(f"experiment {e.key} is already in '{self.path}'") from None
 
     def done(self) -> set[str]:
-        return {key for (key,) in self.db.execute("SELECT key FROM results")}
+        return {key for (key,) in self._rows("SELECT key FROM results")}
 
     def outcomes(self) -> Iterator[Outcome]:
-        rows = self.db.execute("SELECT configuration, mutant, mission, world, seed, status, measures, seconds, why "
-                               "FROM results ORDER BY key")
-        for configuration, mutant, mission, world, seed, status, measures, seconds, why in rows:
+        rows = self._rows("SELECT key, configuration, mutant, mission, world, seed, status, measures, seconds, why "
+                          "FROM results ORDER BY key")
+        for key, configuration, mutant, mission, world, seed, status, measures, seconds, why in rows:
+            if status not in STATUSES:
+                raise RunError(f"the results store '{self.path}' is damaged: experiment {key} has the status "
+                               f"'{status}' (known: {', '.join(STATUSES)}); restore it or give another --store")
             yield Outcome(Experiment(configuration, mutant, mission, world, seed), status,
-                          json.loads(measures) if measures is not None else None, seconds, why)
+                          self._json(measures, f"the measures of experiment {key}") if measures is not None
+                          else None, seconds, why)
 
     def count(self) -> int:
-        (n,) = self.db.execute("SELECT COUNT(*) FROM results").fetchone()
+        ((n,),) = self._rows("SELECT COUNT(*) FROM results")
         return int(n)

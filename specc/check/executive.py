@@ -133,13 +133,34 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
         ctx.report(problem.code, problem.message, problem.node.span)
 
 
+# The report codes a module's final reply may carry beside OK and the request's declared fail
+# messages (specc.runtime.functional): its own failures, and an interruption's cause.
+RUNTIME_CODES = frozenset({"ABORT", "INTERRUPTED", "BAD_INPUT", "CODEL_ERROR", "NO_EXEC_TASK", "UNDECLARED_STATE",
+                           "UNKNOWN_ACTIVITY", "UNKNOWN_ID", "UNKNOWN_MODULE", "UNKNOWN_REQUEST", "ZOMBIE",
+                           "MODULE_FROZEN"})
+
+
 def check_reflex(ctx: Context, reflex: m.Reflex, services: dict[str, m.Service]) -> None:
     source = reflex.source
+    request: m.Request | None = None
     if len(source.parts) == 1:
         if source.text not in services:
             ctx.unknown("undefined-service", "service", source.text, services, source.span)
+        else:
+            ran = services[source.text].request
+            request = resolve_request(ctx, ran) if ran is not None else None
     else:
-        resolve_request(ctx, source)
+        request = resolve_request(ctx, source)
+    comparison = reflex.comparison
+    if reflex.trigger == "reply" and comparison is not None and comparison.op == "==" and request is not None:
+        value = comparison.value.text if isinstance(comparison.value, m.Ref) else None
+        module = next((mod for mod in ctx.items(m.Module) if request in mod.requests), None)
+        replies = {"OK"} | {f.text for f in request.fail} | RUNTIME_CODES | {
+            r.name for r in (module.requests if module is not None else ())}
+        if value is not None and value not in replies:
+            ctx.warn("reflex-never-fires", f"'{source.text}' never replies '{value}' (its fail messages: "
+                     f"{', '.join(f.text for f in request.fail) or 'none'}): this reflex cannot fire; declare the "
+                     "fail message or fix the name", comparison.span)
     for action in reflex.actions:
         target = action.target
         if action.verb == "request":

@@ -6,6 +6,7 @@ import keyword
 
 from specc.check.context import Context
 from specc.model import nodes as m
+from specc.pysource import python_name_problem
 
 BUILTIN_TYPES = frozenset({"double", "float", "int", "long", "bool", "string", "char"})
 STANDARD_STATES = ("start", "exec", "end", "inter")
@@ -36,24 +37,86 @@ ACTIVITY_ATTRIBUTES = frozenset({"id", "spec", "module", "input", "output", "sta
                                  "fail_report", "task", "live_children"})
 
 
+# What the generated module imports or defines at top level beside the spec's types.
+MODULE_NAMES = frozenset({"annotations", "enum", "dataclass", "field", "Any", "rt", "SPEC", "create", "client"})
+# Names an Enum refuses, or keeps out of its members: `mro`, and the _sunder_ and __dunder__ ones.
+ENUM_REFUSED = frozenset({"mro"})
+
+
+def camel(name: str) -> str:
+    """As the generated module capitalises a module's, request's or poster's name for a class."""
+    return name[:1].upper() + name[1:]
+
+
 def check_names(ctx: Context, module: m.Module) -> None:
-    """Requests, fields and types become Python names in the generated module."""
-    named: list[tuple[str, m.Span, str]] = [(module.name, module.span, "module")]
-    named += [(r.name, r.span, "request") for r in module.requests]
+    """Requests, fields, types and enum values become Python names in the generated module."""
+    named: list[tuple[str, m.Span, str]] = [(r.name, r.span, "request") for r in module.requests]
     named += [(f.name, f.span, "field") for s in module.structs for f in s.fields]
     named += [(f.name, f.span, "internal data field") for f in module.internal_data]
     named += [(t.name, t.span, "input or output") for r in module.requests for t in r.inputs + r.outputs]
+    named += [(t.name, t.span, "type") for t in module.structs]
+    named += [(t.name, t.span, "type") for t in module.enums]
+    accessors = {f"poster_{p.name}" for p in module.posters}
+    generated = MODULE_NAMES | {f"{camel(module.name)}Data", f"{camel(module.name)}Client"} | {
+        f"{camel(r.name)}{part}" for r in module.requests for part in ("Input", "Output")} | {
+        f"{camel(p.name)}Poster" for p in module.posters}
     for name, span, what in named:
-        if keyword.iskeyword(name) or (what == "request" and name in RESERVED):
-            ctx.report("reserved-name", f"{what} '{name}' would clash with a Python keyword or a method of the "
-                       "generated client; rename it", span)
+        problem = python_name_problem(name)
+        if problem is not None:
+            ctx.report("reserved-name", f"{what} '{name}' cannot be a name of the generated code: {problem}; "
+                       "rename it", span)
+        elif what == "request" and name in RESERVED:
+            ctx.report("reserved-name", f"request '{name}' would clash with a method of the generated client; "
+                       "rename it", span)
         elif what == "input or output" and name in ACTIVITY_ATTRIBUTES:
             ctx.report("reserved-name", f"{what} '{name}' would be hidden by the activity's own '{name}' "
                        "when a codel reads request.{name}; rename it", span)
+        elif what == "request" and name in accessors:
+            ctx.report("reserved-name", f"request '{name}' would be hidden by the client's accessor of poster "
+                       f"'{name.removeprefix('poster_')}'; rename it", span)
+        elif what == "type" and name in generated:
+            ctx.report("reserved-name", f"type '{name}' would replace a name the generated module defines or "
+                       "imports; rename it", span)
+    for decl in module.enums:
+        seen: set[str] = set()
+        for value in decl.values:
+            problem = python_name_problem(value)
+            if problem is None and (value in ENUM_REFUSED or value.startswith("_")):
+                problem = f"'{value}' is a name an enum keeps for itself"
+            if problem is not None:
+                ctx.report("reserved-name", f"enum value '{value}' of '{decl.name}' cannot be a member of the "
+                           f"generated Enum: {problem}; rename it", decl.span)
+            elif value in seen:
+                ctx.report("duplicate-definition", f"enum '{decl.name}' lists '{value}' twice", decl.span)
+            seen.add(value)
+
+
+def check_recursion(ctx: Context, module: m.Module) -> None:
+    """A struct may not contain itself, directly or through others: its default value would be
+    built for ever (and its class would be used before it exists)."""
+    structs = {s.name: s for s in module.structs}
+    done: set[str] = set()
+
+    def visit(name: str, path: tuple[str, ...]) -> None:
+        if name in path:
+            cycle = " -> ".join((*path[path.index(name):], name))
+            ctx.report("recursive-type", f"struct '{name}' contains itself ({cycle}): a record holds a value, "
+                       "not a reference; break the cycle", structs[name].span)
+            return
+        if name in done:
+            return
+        for f in structs[name].fields:
+            if f.type.name in structs:
+                visit(f.type.name, (*path, name))
+        done.add(name)
+
+    for struct in module.structs:
+        visit(struct.name, ())
 
 
 def check_module(ctx: Context, module: m.Module) -> None:
     check_names(ctx, module)
+    check_recursion(ctx, module)
     ctx.duplicates(module.structs + module.enums, "type")  # type: ignore[operator]
     ctx.duplicates(module.internal_data, "internal data field")
     ctx.duplicates(module.requests, "request")

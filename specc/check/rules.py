@@ -143,6 +143,11 @@ def check(ctx: Context) -> None:
         visitor = RuleVisitor(ctx, base)
         visitor.visit(base)
         for attr in base.attributes:
+            domain = attr.domain
+            if isinstance(domain, m.NumericDomain) and isinstance(domain.low, m.Number) \
+                    and isinstance(domain.high, m.Number) and domain.low.value > domain.high.value:
+                ctx.report("empty-domain", f"[{domain.low.value:g}, {domain.high.value:g}] holds no value of "
+                           f"'{attr.name}': write the low bound first", domain.span)
             if attr.role == "outputs" and attr.name not in visitor.restricted and base.name not in completed:
                 ctx.report("output-never-set", f"no rule deduces output '{attr.name}'", attr.span)
         for init in base.inits:

@@ -18,10 +18,14 @@ block as written).
 
 from __future__ import annotations
 
+import contextlib
 import json
+import math
 import re
+import signal
+import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,12 +44,56 @@ PLANNER_FAILURES = ("watchdog", "invalid-plan")  # FTplan's events for a planner
 Progress = Callable[[float, float | None, str], None]  # mission time, horizon (None: unknown), what
 
 
+DEFAULT_WALL_LIMIT = 3600.0  # s of wall time a run may take: far past any example's, short of "for ever"
+
+
 class RunCrashed(RunError):
     """The run broke half-way; its folder holds the log so far and a report saying so."""
 
-    def __init__(self, message: str, outcome: RunOutcome) -> None:
+    def __init__(self, message: str, outcome: RunOutcome, exit_code: int = 1) -> None:
         super().__init__(message)
         self.outcome = outcome
+        self.exit_code = exit_code  # 130 when a signal stopped it, as a shell says of Ctrl-C
+
+
+class Stopped(BaseException):
+    """A signal or the wall-clock limit stopped the run (raised in the main thread by its handler,
+    wherever the run was: in a codel stuck in a loop too). Not an Exception: nothing the run
+    catches may swallow it."""
+
+    def __init__(self, why: str, exit_code: int) -> None:
+        super().__init__(why)
+        self.why = why
+        self.exit_code = exit_code
+
+
+@contextlib.contextmanager
+def stoppable(wall_limit: float | None) -> Iterator[None]:
+    """While the run goes: SIGTERM, SIGINT and the wall-clock limit raise Stopped in it. Only the
+    main thread can take signals: elsewhere (a worker thread) the run goes unguarded."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_signal(number: int, frame: Any) -> None:
+        del frame
+        raise Stopped(f"stopped by {signal.Signals(number).name}", 130)
+
+    def on_limit(number: int, frame: Any) -> None:
+        del number, frame
+        raise Stopped(f"stopped: the run took longer than its wall-clock limit of {wall_limit:g} s (--wall-limit)", 1)
+
+    before = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
+    before_alarm = signal.signal(signal.SIGALRM, on_limit)
+    if wall_limit is not None:
+        signal.setitimer(signal.ITIMER_REAL, wall_limit)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, before_alarm)
+        for number, handler in before.items():
+            signal.signal(number, handler)
 
 
 @dataclass(frozen=True)
@@ -61,6 +109,7 @@ class RunRequest:
     timing: str = "model"  # FTplan's planning charge: model (deterministic) or wall
     horizon: float | None = None  # s of simulated time; default: the mission's own
     goals: tuple[str, ...] = ()  # PRS goals to post instead of a mission's (`--goal '!(...)'`)
+    wall_limit: float | None = DEFAULT_WALL_LIMIT  # s of wall time before the run is stopped (None: no limit)
     pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
 
 
@@ -120,6 +169,8 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     RunError when one is wrong. Nothing is written."""
     from specc.run.mission import load_robot
 
+    if request.wall_limit is not None and not (request.wall_limit > 0 and math.isfinite(request.wall_limit)):
+        raise RunError(f"--wall-limit {request.wall_limit:g}: give a positive number of seconds")
     plan = _plan_system(load_robot(request.generated, request.specs, robot), request)
     if request.folder is not None:
         return PlannedRun(robot, request, plan, request.folder)
@@ -148,7 +199,14 @@ def run_planned(planned: PlannedRun, progress: Progress | None = None) -> RunOut
     started = time.perf_counter()
     with EventLog(folder / LOG) as log:
         try:
-            report, summary = plan.run(log, progress)
+            with stoppable(request.wall_limit):
+                report, summary = plan.run(log, progress)
+        except Stopped as stop:  # a signal, or the wall-clock limit: the report says so, nothing is lost
+            report = {"outcome": "interrupted", "why": stop.why}
+            summary = f"the run was {stop.why} at {log.events[-1]['t'] if log.events else 0.0:.1f} s of mission"
+            _finish(outcome, request, plan, report, summary, log, started)
+            raise RunCrashed(f"the run was {stop.why} (what it logged is in {folder / LOG}, the report in "
+                             f"{folder / REPORT})", outcome, stop.exit_code) from None
         except Exception as error:  # a failure half-way (even a RunError): keep what the log holds, say what broke
             report = {"outcome": "crashed", "why": f"{type(error).__name__}: {error}"}
             summary = f"the run crashed at {log.events[-1]['t'] if log.events else 0.0:.1f} s: {report['why']}"

@@ -119,6 +119,8 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
                 result.outcomes.append(run_planned(run))
             except RunCrashed as crash:  # one broken run is a failure of the table, not the end of it
                 result.outcomes.append(crash.outcome)
+                if crash.exit_code == 130:  # but a signal (Ctrl-C) stops the table: its runs so far are kept
+                    raise
     if step is not None:
         step(len(requests), len(requests), "")
     result.missions = mission_rows(result.outcomes)

@@ -1125,6 +1125,10 @@ def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
     """The user's codel module: the one given, else imported by the name the spec declares."""
     if codels is not None:
         return codels
+    if not spec.codel_module:  # a module naming no codel function needs no codel module (checked)
+        import types
+
+        return types.SimpleNamespace()
     import importlib
 
     try:

@@ -109,6 +109,11 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
         line, column = max(len(last), 1), len(last[-1]) + 1
         span = Span(path, line, column, line, column + 1)
         expected = describe_expected(getattr(exc, "expected", set()) or set(), keyword_texts())
+        unclosed = _unclosed_brace(text)
+        if unclosed is not None:
+            at = Span(path, *unclosed, unclosed[0], unclosed[1] + 1)
+            return error("unexpected-end", f"the file ends too early: expected {expected}; the '{{' of line "
+                         f"{unclosed[0]} is never closed", span, (at, "opened here: close it with '}'"))
         return error("unexpected-end", f"the file ends too early: expected {expected}; is a '}}' missing?", span)
     position = max(getattr(exc, "pos_in_stream", None) or 0, 0)
     # An unclosed `/*` is lexed as `/` then `*`, and neither may follow the other anywhere.
@@ -130,10 +135,83 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
                      f"unexpected character '{char}' here; expected {expected}", span)
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
+    unit = _unit_typo(text, position)
+    if unit is not None:
+        start, word = unit
+        line, column = _line_column(text, start)
+        return error("unknown-unit", f"'{word}' is not a unit of time: write us, ms, s or min (e.g. 50 ms)",
+                     Span(path, line, column, line, column + len(word)))
+    if "SEMICOLON" in exc.expected and _line_column(text, position)[0] > 1:
+        end = _end_of_previous_line(text, position)
+        if end is not None:  # the statement before ends on an earlier line, without its `;`
+            next_line = line
+            line, column = _line_column(text, end)
+            return error("missing-semicolon", f"expected ';' at the end of this line (before "
+                         f"{describe_token(token)} on line {next_line})", Span(path, line, column, line, column + 1))
     width = max(len(str(token)), 1)
     span = Span(path, line, column, line, column + width)
     expected = describe_expected(exc.expected, keyword_texts())
     return error("unexpected-token", f"unexpected {describe_token(token)}; expected {expected}", span)
+
+
+UNITS = ("us", "ms", "s", "min")
+
+
+def _unit_typo(text: str, position: int) -> tuple[int, str] | None:
+    """(start, word) when the unexpected token is inside a word written right after a number
+    (`50 mss`, `30 sec`): a unit of time misspelt."""
+    start = position
+    while start > 0 and text[start - 1].isalpha():
+        start -= 1
+    end = position
+    while end < len(text) and text[end].isalpha():
+        end += 1
+    word = text[start:end]
+    before = text[:start].rstrip(" \t")
+    if not word or word in UNITS or not before or not before[-1].isdigit():
+        return None
+    return start, word
+
+
+def _end_of_previous_line(text: str, position: int) -> int | None:
+    """The position of the last character of the last line before `position`'s that holds
+    something other than a comment (None when there is none, or it ends with `;`, `{` or `}`)."""
+    line_start = text.rfind("\n", 0, position)
+    while line_start > 0:
+        previous = text.rfind("\n", 0, line_start) + 1
+        content = text[previous:line_start]
+        comment = content.find("//")
+        if comment >= 0 and content.count('"', 0, comment) % 2 == 0:
+            content = content[:comment]
+        stripped = content.rstrip()
+        if stripped:
+            if stripped[-1] in ";{}":
+                return None
+            return previous + len(stripped) - 1
+        line_start = previous - 1
+    return None
+
+
+def _unclosed_brace(text: str) -> tuple[int, int] | None:
+    """(line, column) of the last `{` no `}` closes, strings and comments aside."""
+    openers: list[int] = []
+    k, n = 0, len(text)
+    while k < n:
+        c = text[k]
+        if c == '"':
+            k += 1
+            while k < n and text[k] not in '"\n':
+                k += 2 if text[k] == "\\" else 1
+        elif text.startswith("//", k):
+            k = text.find("\n", k) if text.find("\n", k) >= 0 else n
+        elif text.startswith("/*", k):
+            k = text.find("*/", k + 2) + 1 if text.find("*/", k + 2) >= 0 else n
+        elif c == "{":
+            openers.append(k)
+        elif c == "}" and openers:
+            openers.pop()
+        k += 1
+    return _line_column(text, openers[-1]) if openers else None
 
 
 def _line_column(text: str, position: int) -> tuple[int, int]:

@@ -365,7 +365,7 @@ GROUPS = {
 }
 
 REFLEXES = (
-    rt.ReflexSpec(name='emergencyStop', trigger='reply', source='us.watchObstacle', op='==', value='OBSTACLE', actions=(('request', 'loco.Stop'),)),
+    rt.ReflexSpec(name='emergencyStop', trigger='reply', source='us.watchObstacle', op='==', value='OK', actions=(('request', 'loco.Stop'),)),
 )
 
 PARAMETERS = {
