@@ -53,6 +53,27 @@ def report(loaded: Loaded) -> int:
 
 
 @app.command()
+def explain(code: Annotated[Optional[str], typer.Argument(help="A diagnostic's code, as it ends a message "
+                                                               "([unknown-unit]); none: every code.",
+                                                          show_default=False)] = None) -> None:
+    """Say what a diagnostic code means, with an example of a spec line that gets it.
+
+    Example: specc explain missing-semicolon
+    """
+    from specc.codes import CODES
+    from specc.diagnostics import did_you_mean
+
+    shown = code.strip("[]") if code is not None else None
+    if shown is not None and shown not in CODES:
+        err.print(f"error: no diagnostic code '{shown}'{did_you_mean(shown, CODES)}; `specc explain` lists them all",
+                  markup=False)
+        raise typer.Exit(2)
+    for name in [shown] if shown is not None else sorted(CODES):
+        entry = CODES[name]
+        out.print(f"{name}: {entry.summary}\n    e.g. {entry.example}", markup=False)
+
+
+@app.command()
 def check(paths: PathsArg,
           quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing when all is well.")] = False
           ) -> None:

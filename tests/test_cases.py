@@ -43,3 +43,22 @@ def test_case_reports_exactly_the_expected_codes(case: Path) -> None:
 def test_at_least_thirty_distinct_codes_are_covered() -> None:
     codes = {code for case in case_paths() for _, _, code in expectations(case)}
     assert len(codes) >= 30, sorted(codes)
+
+
+@pytest.mark.parametrize("case", case_paths(), ids=lambda p: p.name)
+def test_compile_reports_what_check_reports_and_nothing_more(case: Path, tmp_path: Path) -> None:
+    """`specc compile` on each case: the same diagnostics as `specc check`, no traceback, no
+    error of its own that check missed."""
+    import subprocess
+    import sys
+
+    def codes(*args: str) -> tuple[int, set[str], str]:
+        result = subprocess.run([sys.executable, "-m", "specc.cli", *args], capture_output=True, text=True,
+                                timeout=120)
+        shown = result.stdout + result.stderr
+        return result.returncode, set(re.findall(r": (?:error|warning): .*\[([a-z-]+)\]$", shown, re.M)), shown
+
+    checked, check_codes, _ = codes("check", str(case))
+    compiled, compile_codes, shown = codes("compile", str(case), "-o", str(tmp_path))
+    assert "Traceback" not in shown and "internal error" not in shown, shown
+    assert compiled == checked != 0 and compile_codes == check_codes, shown

@@ -1,0 +1,65 @@
+"""Every diagnostic code the passes report is registered (specc/codes.py) with a summary and an
+example, every registered code is still reported somewhere, and `specc explain` prints them."""
+
+from __future__ import annotations
+
+import ast
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+from specc.codes import CODES
+
+SPECC = Path(__file__).resolve().parents[1] / "specc"
+CODE = re.compile(r"^[a-z]+(-[a-z]+)+$")
+# The calls that take a diagnostic code as one of their arguments.
+CALLS = {"error", "report", "warn", "unknown", "Diagnostic", "resolve_member", "_reject", "Problem", "lookup"}
+
+
+def reported_codes() -> dict[str, str]:
+    """code -> a file reporting it, read from the source: the codes given to CALLS, those in the
+    check passes' (reference, kind, code) tables, and those written into a message (`[code]`)."""
+    found: dict[str, str] = {}
+    for path in sorted(SPECC.rglob("*.py")):
+        if path.name == "codes.py":
+            continue
+        text = path.read_text(encoding="utf-8")
+        for node in ast.walk(ast.parse(text)):
+            values: list[ast.expr] = []
+            if isinstance(node, ast.Call):
+                f = node.func
+                name = f.attr if isinstance(f, ast.Attribute) else f.id if isinstance(f, ast.Name) else ""
+                if name in CALLS:
+                    values = [*node.args, *(k.value for k in node.keywords)]
+            elif isinstance(node, ast.Tuple) and "check" in path.parts:
+                values = list(node.elts)
+            for value in values:
+                if isinstance(value, ast.Constant) and isinstance(value.value, str) and CODE.match(value.value):
+                    found.setdefault(value.value, str(path.relative_to(SPECC)))
+        for match in re.finditer(r"\[([a-z]+(?:-[a-z]+)+)\]\"", text):
+            found.setdefault(match.group(1), str(path.relative_to(SPECC)))
+    return found
+
+
+def test_every_code_reported_is_registered_and_every_registered_one_is_reported() -> None:
+    reported = reported_codes()
+    # Tuples of the check passes hold other words too (property names): only codes are compared.
+    unregistered = {c: where for c, where in reported.items() if c not in CODES and not where.startswith("check")}
+    assert not unregistered, f"register these in specc/codes.py: {unregistered}"
+    stale = sorted(set(CODES) - set(reported))
+    assert not stale, f"no pass reports these any more: {stale}"
+    assert all(entry.summary and entry.example for entry in CODES.values())
+
+
+def test_explain_prints_every_code_and_refuses_an_unknown_one() -> None:
+    every = subprocess.run([sys.executable, "-m", "specc.cli", "explain"], capture_output=True, text=True,
+                           timeout=60)
+    assert every.returncode == 0
+    assert {line.split(":")[0] for line in every.stdout.splitlines() if not line.startswith(" ")} == set(CODES)
+    one = subprocess.run([sys.executable, "-m", "specc.cli", "explain", "[unknown-unit]"], capture_output=True,
+                         text=True, timeout=60)
+    assert one.returncode == 0 and one.stdout.startswith("unknown-unit: ") and "e.g. " in one.stdout
+    typo = subprocess.run([sys.executable, "-m", "specc.cli", "explain", "unknwn-unit"], capture_output=True,
+                          text=True, timeout=60)
+    assert typo.returncode == 2 and "did you mean 'unknown-unit'" in typo.stderr
