@@ -8,7 +8,7 @@ from pathlib import Path
 from lark import Token
 
 from specc.check import check_program
-from specc.diagnostics import Diagnostic, sort_key
+from specc.diagnostics import Diagnostic, error, sort_key
 from specc.model import nodes as m
 from specc.syntax.parser import display_path, parse_text, read_source, spec_files
 
@@ -50,9 +50,25 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
     if check and parsed_all and loaded.program is not None:
         base_dirs = {shown: path.resolve().parent for shown, path in loaded.paths.items()}
         found = check_program(loaded.program, base_dirs)
+        if not any(d.severity == "error" for d in found):
+            found += _rule_bases_outside_kheops(loaded.program)
         loaded.diagnostics.extend(d for d in found if not _already_reported(d, loaded.diagnostics))
     loaded.diagnostics.sort(key=sort_key)
     return loaded
+
+
+def _rule_bases_outside_kheops(program: m.Program) -> list[Diagnostic]:
+    """What `specc compile` would refuse in a rule base, found by `specc check` too: a rule outside
+    the propositional subset Kheops compiles (normalising a base is cheap; compiling it is not)."""
+    from specc.analysis.kheops import KheopsError, normalise
+
+    found = []
+    for base in (item for item in program.items if isinstance(item, m.RuleBase)):
+        try:
+            normalise(base)
+        except KheopsError as exc:
+            found.append(error("not-propositional", str(exc), exc.node.span))
+    return found
 
 
 def _already_reported(diagnostic: Diagnostic, earlier: list[Diagnostic]) -> bool:
