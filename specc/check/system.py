@@ -140,8 +140,8 @@ def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
             continue
         try:
             load_world(path)
-        except WorldError as problem:
-            ctx.report("bad-world", f"{problem}", entry.value.span)
+        except WorldError as problem:  # named as the spec names it, not by this machine's folders
+            ctx.report("bad-world", str(problem).replace(str(path), entry.value.value), entry.value.span)
     return worlds
 
 
