@@ -29,8 +29,12 @@ def check(ctx: Context) -> None:
     files: dict[tuple[str, str], tuple[str, m.Node]] = {}  # (folder, file stem) -> (what, block)
     for kind, folder in FOLDERS.items():
         item: m.Node
+        seen: set[str] = set()
         for item in ctx.items(kind):
             name: str = item.name  # type: ignore[attr-defined]  # every block kind has one
+            if name in seen:  # a block written twice is reported as such, not as a clash of files
+                continue
+            seen.add(name)
             problem = python_name_problem(name)
             if problem is not None:
                 ctx.report("reserved-name", f"{KIND_WORDS[kind]} '{name}' names a file of the generated "

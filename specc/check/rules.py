@@ -9,6 +9,7 @@ declared symbolic attribute belong to its domain, and `foreach` variables are in
 from __future__ import annotations
 
 from specc.check.context import Context
+from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import Visitor
 
@@ -24,6 +25,7 @@ class RuleVisitor(Visitor):
         self.loop_vars: list[str] = []
         self.restricted: set[str] = set()
         self.tested: set[str] = set()
+        self.first_read: dict[str, m.AttrRef] = {}  # where each attribute is first tested
         self.in_action = False
 
     def visit_RuleForeach(self, node: m.RuleForeach) -> None:
@@ -98,6 +100,7 @@ class RuleVisitor(Visitor):
             self.check_not_input(attr.name, attr.span)
         else:
             self.tested.add(attr.name)
+            self.first_read.setdefault(attr.name, attr)
 
     def check_not_input(self, name: str, span: object) -> None:
         declared = self.declared.get(name)
@@ -132,6 +135,19 @@ class RuleVisitor(Visitor):
                             value.span)
 
 
+def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:
+    """An attribute a rule tests that is no input, has no init and that no rule sets never has a
+    value: the rule can never fire (a misspelt input or constant becomes such an attribute)."""
+    inputs = {a.name for a in base.attributes if a.role == "inputs"}
+    for name, ref in visitor.first_read.items():
+        if name in inputs or name in visitor.restricted or name in visitor.inits:
+            continue
+        known = inputs | visitor.restricted | visitor.constants
+        ctx.report("undefined-attribute", f"'{name}' is tested, but it is no input, has no init and no rule sets "
+                   f"it: the rule can never fire (a misspelt input or constant?){did_you_mean(name, known)}",
+                   ref.span)
+
+
 def check(ctx: Context) -> None:
     # An executive's own rules add to the controller generated from its conflicts, which
     # deduces the group states: only stand-alone bases must deduce every output themselves.
@@ -142,6 +158,8 @@ def check(ctx: Context) -> None:
         ctx.duplicates([r for r in base.rules if isinstance(r, m.Rule)], "rule")
         visitor = RuleVisitor(ctx, base)
         visitor.visit(base)
+        if base.name not in completed:  # an executive's own rules read the controller's attributes
+            check_never_set(ctx, base, visitor)
         for attr in base.attributes:
             domain = attr.domain
             if isinstance(domain, m.NumericDomain) and isinstance(domain.low, m.Number) \
