@@ -14,6 +14,11 @@ def python_name(base: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in base)
 
 
+def camel(name: str) -> str:
+    """A module's, request's or poster's name as the generated module capitalises it for a class."""
+    return name[:1].upper() + name[1:]
+
+
 def python_name_problem(name: str) -> str | None:
     """Why the spec name `name` cannot name something of the generated package (None when it can):
     a Python keyword, or a dunder (Python's own names: `__init__`, `__dict__`...)."""

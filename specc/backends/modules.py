@@ -14,6 +14,7 @@ from functools import cached_property
 from specc.backends.env import Code, ident, py, render
 from specc.backends.manifest import Output, describe_sources, header
 from specc.model import nodes as m
+from specc.pysource import camel
 
 BACKEND = "modules"
 
@@ -24,10 +25,6 @@ PRIMITIVES = {
     "bool": ("bool", "False", '"bool"'),
     "string": ("str", '""', '"str"'), "char": ("str", '""', '"str"'),
 }
-
-
-def camel(name: str) -> str:
-    return name[:1].upper() + name[1:]
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ import keyword
 
 from specc.check.context import Context
 from specc.model import nodes as m
-from specc.pysource import python_name_problem
+from specc.pysource import camel, python_name_problem
 
 BUILTIN_TYPES = frozenset({"double", "float", "int", "long", "bool", "string", "char"})
 STANDARD_STATES = ("start", "exec", "end", "inter")
@@ -41,11 +41,6 @@ ACTIVITY_ATTRIBUTES = frozenset({"id", "spec", "module", "input", "output", "sta
 MODULE_NAMES = frozenset({"annotations", "enum", "dataclass", "field", "Any", "rt", "SPEC", "create", "client"})
 # Names an Enum refuses, or keeps out of its members: `mro`, and the _sunder_ and __dunder__ ones.
 ENUM_REFUSED = frozenset({"mro"})
-
-
-def camel(name: str) -> str:
-    """As the generated module capitalises a module's, request's or poster's name for a class."""
-    return name[:1].upper() + name[1:]
 
 
 def check_names(ctx: Context, module: m.Module) -> None:

@@ -231,6 +231,7 @@ class MissionRun:
 class CheckedMission:
     world: Path  # the world file
     planning: Any = None  # specc.runtime.ftplan.MissionSetup when FTplan plans the mission
+    configuration: str | None = None  # FTplan's, the default one resolved (None: not planned)
 
 
 TIMINGS = ("model", "wall")  # FtPlan's: a deterministic planning charge, or the measured wall time
@@ -263,17 +264,18 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
         return CheckedMission(world_file)
     block = robot.part("ftplan").FTPLANS[robot.system.planning]
     try:
-        setup = mission_setup(block.CONFIGURATIONS, configuration or default_configuration(block), mission.plan,
+        chosen = configuration or default_configuration(block)
+        setup = mission_setup(block.CONFIGURATIONS, chosen, mission.plan,
                               robot.part("planner"))
     except UnknownName as error:
         raise RunError(str(error)) from None
     if domains:
         unused = sorted(set(domains) - setup.planned_in)
         if unused:
-            raise RunError(f"configuration {configuration or default_configuration(block)} plans in "
+            raise RunError(f"configuration {chosen} plans in "
                            f"{', '.join(sorted(setup.planned_in))}, not in {', '.join(unused)}")
         setup = dataclasses.replace(setup, domains={**setup.domains, **domains})
-    return CheckedMission(world_file, setup)
+    return CheckedMission(world_file, setup, chosen)
 
 
 def default_configuration(block: ModuleType) -> str:
@@ -324,12 +326,10 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         if supervisor is not None:
             recorder.watch_facts(supervisor.database)
         setup = checked.planning
-        planned = {"plan": mission.plan, "configuration": configuration or default_configuration(
-            robot.part("ftplan").FTPLANS[system.planning]), "timing": timing,
+        goals_planned = SystemState.from_problem(setup.problem).goals if setup else ()  # FTplan's to achieve
+        planned = {"plan": mission.plan, "configuration": checked.configuration, "timing": timing,
                    "planners": [f"{p.name} ({p.domain})" for p in setup.config.planners],
-                   # what FTplan is to achieve: attribute, arguments, value
-                   "planned_goals": [[g.attribute, list(g.args), g.value]
-                                     for g in SystemState.from_problem(setup.problem).goals]} if setup else {}
+                   "planned_goals": [[g.attribute, list(g.args), g.value] for g in goals_planned]} if setup else {}
         journal.emit(kernel.now, "mission-start", robot=robot.name, mission=mission.name, seed=seed,
                      goals=list(mission.goals), horizon=limit, body=dataclasses.asdict(system.body),
                      objects=[list(o) for o in sim.objects], **planned, **world_fields(ground))
@@ -369,8 +369,7 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         met = set(result.met)
         planned_figures = {"planned_goals_met": len(result.met), "planned_goals": len(result.met) + len(result.missed),
                            # mission-start's planned_goals, each as FTplan's ledger judged it at the end
-                           "planned_goals_met_each": [g.text() in met for g in SystemState.from_problem(
-                               checked.planning.problem).goals],
+                           "planned_goals_met_each": [g.text() in met for g in goals_planned],
                            "plannings": result.plannings, "replannings": result.replannings,
                            "planner_failures": result.planner_failures,
                            # the mission exception: no plan in time (not the horizon stopping the run)

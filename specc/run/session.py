@@ -252,7 +252,7 @@ class _Plan:
 
 def _plan_system(robot: Any, request: RunRequest) -> _Plan:
     """A mission of any robot, from its system block (`specc.run.mission`)."""
-    from specc.run.mission import check_mission, default_configuration, run_mission
+    from specc.run.mission import check_mission, run_mission
     from specc.runtime.system import MissionSpec
 
     if request.goals:
@@ -277,8 +277,7 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         raise RunError(f"timing '{request.timing}': FTplan's planning charge; mission {mission.name} is not planned")
     world = request.world or mission.world
     world_name = Path(world).stem if world.endswith(".toml") else world
-    configuration = (request.configuration or default_configuration(robot.part("ftplan").FTPLANS[
-        robot.system.planning])) if checked.planning is not None else None
+    configuration = checked.configuration
 
     def run(log: EventLog, progress: Progress | None) -> tuple[dict[str, Any], str]:
         def tell(step: Any) -> None:
