@@ -32,7 +32,7 @@ def reported_codes() -> dict[str, str]:
                 name = f.attr if isinstance(f, ast.Attribute) else f.id if isinstance(f, ast.Name) else ""
                 if name in CALLS:
                     values = [*node.args, *(k.value for k in node.keywords)]
-            elif isinstance(node, ast.Tuple) and "check" in path.parts:
+            elif isinstance(node, ast.Tuple) and "check" in path.relative_to(SPECC).parts:
                 values = list(node.elts)
             for value in values:
                 if isinstance(value, ast.Constant) and isinstance(value.value, str) and CODE.match(value.value):
