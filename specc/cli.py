@@ -550,7 +550,7 @@ def rules_report(paths: PathsArg,
     Example: specc rules examples/generic
     """
     from specc.analysis import kheops
-    from specc.backends.rules import describe
+    from specc.backends.rules import describe, tally, worst_first
 
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
@@ -576,19 +576,22 @@ def rules_report(paths: PathsArg,
         for attribute in normal.attributes.values():
             values = ", ".join(str(v) for v in attribute.values)
             out.print(f"  {attribute.role:12} {attribute.name}: {attribute.kind} {{{values}}}", markup=False)
-        findings = compiled.findings
+        findings = worst_first(compiled.findings)
         shown = findings if limit <= 0 else findings[:limit]
         for finding in shown:
             out.print(f"  {describe(finding)}", markup=False)
         if len(shown) < len(findings):
             out.print(f"  ... {len(findings) - len(shown)} more (--limit 0 shows all)", markup=False)
-        if not findings:
+        if findings:
+            out.print(f"  {len(findings)} input configuration(s) unsettled: {tally(findings)}", markup=False)
+        else:
             out.print("  complete and consistent for every input", markup=False)
 
 
 @app.command()
 def skeleton(paths: PathsArg) -> None:
-    """Write stubs for the codels a spec names but its codel modules lack; never rewrites code.
+    """Write stubs for the Python functions the specs name but their modules lack (module codels,
+    executive input/output functions, PRS actions and evaluable predicates); never rewrites code.
 
     Example: specc skeleton examples/tug
     """
@@ -600,13 +603,11 @@ def skeleton(paths: PathsArg) -> None:
     wrote = 0
     for source in loaded.program.files:
         spec_dir = loaded.paths[source.path].resolve().parent
-        for item in source.items:
-            if not isinstance(item, m.Module):
-                continue
+        for wanted in (needs for item in source.items for needs in stubs.needs(item)):
             try:
-                change = stubs.write_stubs(item, spec_dir)
+                change = stubs.write_stubs(wanted, spec_dir)
             except (OSError, SyntaxError) as exc:
-                err.print(f"{source.path}: error: module '{item.name}': {exc} [skeleton-failed]", markup=False)
+                err.print(f"{source.path}: error: {wanted.owner}: {exc} [skeleton-failed]", markup=False)
                 raise typer.Exit(1) from None
             if change is None or not change.functions:
                 continue
@@ -614,7 +615,7 @@ def skeleton(paths: PathsArg) -> None:
             verb = "created" if change.created else "added to"
             out.print(f"{verb} {change.path}: {', '.join(change.functions)}", markup=False)
     if not wrote:
-        out.print("every codel named by the specs already exists", markup=False)
+        out.print("every function named by the specs already exists", markup=False)
 
 
 TABLE_WIDTH = 140  # columns of `specc table` when it does not print to a terminal

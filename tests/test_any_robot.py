@@ -18,6 +18,7 @@ from specc.run.events import read_events
 SPEC = """\
 module drive {
   codels: "cart_codels.drive";
+  internal_data { x: double; y: double; }  // where the codels keep the pose they last read
   request Goto {
     type: exec;
     input: x: float, y: float;
@@ -166,7 +167,7 @@ PLANNED_SPEC = SPEC.replace("""  mission deliver { world: shop; horizon: 120 s; 
     codel start: start_drop;
     codel exec: drop;
   }
-  exec_task Motion""").replace("""module drive {""", """module drive {
+  exec_task Motion""").replace("""  internal_data { x: double; y: double; }""", """\
   internal_data { dropCycles: int; x: double; y: double; }
   poster Pose { update: auto; data: x, y; activity: step; }""").replace("""  ka Goto {""", """\
   ka GoDock { invocation: !(GO-PLACE DOCK); body { !(GO 1 1); } }

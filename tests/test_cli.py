@@ -247,7 +247,8 @@ def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> 
     assert proved.stdout.count(": holds - ") == 4 and "states" in proved.stdout
     from tests.test_verify import robot
 
-    spec = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";')
+    spec = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";',
+                 policy="interrupt")
     refuted = specc("verify", str(spec[0]))
     assert refuted.returncode == 1
     assert "exclusion: REFUTED" in refuted.stdout and "2. task: RQST EXEC BACK" in refuted.stdout
@@ -266,6 +267,26 @@ def test_compile_warns_about_rule_bases_that_leave_inputs_unsettled(tmp_path: Pa
     listed = specc("rules", str(EXAMPLES / "generic"))
     assert "executive generic: resource controller" in listed.stdout
     assert listed.stdout.count("complete and consistent for every input") == 2
+
+
+def test_unsettled_inputs_are_counted_per_kind_and_the_inconsistent_ones_shown_first(tmp_path: Path) -> None:
+    # Speed 'hot' leaves status undetermined whatever the load (one incomplete finding), and a
+    # heavy load at speed 'fast' is both OK and STOP (two inconsistent ones, loads 4 and 5).
+    spec = tmp_path / "base.spec"
+    spec.write_text("""rules base {
+  inputs speed: {"slow", "fast", "hot"}, load: {1, 2, 3, 4, 5};
+  outputs status: {"OK", "STOP"};
+  r1: speed == "slow" ==> restrict status == "OK";
+  r2: speed == "fast" ==> restrict status == "OK";
+  r3: speed == "fast", load oneof [4, 5] ==> restrict status == "STOP";
+}
+""")
+    compiled = specc("compile", str(spec), "-o", str(tmp_path / "out"))
+    warning = next(line for line in compiled.stderr.splitlines() if "[rules-unsettled]" in line)
+    assert "3 input configuration(s) unsettled (2 inconsistent, 1 incomplete), e.g. inconsistent:" in warning
+    listed = specc("rules", str(spec), "--limit", "1").stdout.splitlines()
+    assert listed[listed.index("  ... 2 more (--limit 0 shows all)") - 1].startswith("  inconsistent: ")
+    assert "  3 input configuration(s) unsettled: 2 inconsistent, 1 incomplete" in listed
 
 
 def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Path) -> None:

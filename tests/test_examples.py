@@ -23,10 +23,17 @@ def items(robot: str, kind: type) -> dict[str, m.Node]:
     return {i.name: i for i in loaded(robot).program.items if isinstance(i, kind)}  # type: ignore[union-attr]
 
 
+# Warnings an example keeps on purpose, with why. Hilare's procedures keep seed 000's Fig 4.4
+# fallback to a "peristaltic locomotion" service of another robot, which Hilare's executive does
+# not offer: the defect `specc check` and `specc verify --goal '!(FIND-SUBTRAJ $R)'` must find.
+KEPT_WARNINGS = {"hilare": [("procedures.spec", "undefined-service")]}
+
+
 @pytest.mark.parametrize("robot", EXAMPLE_ROBOTS)
 def test_example_checks_without_errors_or_warnings(robot: str) -> None:
     result = loaded(robot)
-    assert [d.headline() for d in result.diagnostics] == []
+    assert [(Path(d.span.file).name, d.code) for d in result.diagnostics] == KEPT_WARNINGS.get(robot, [])
+    assert all(d.severity == "warning" for d in result.diagnostics)
 
 
 @pytest.mark.parametrize("path", sorted(EXAMPLES.rglob("*.spec")), ids=lambda p: str(p.relative_to(EXAMPLES)))

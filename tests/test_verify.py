@@ -57,7 +57,7 @@ module base {
 executive shop {
   rules: policy;
   service GO { request: arm.Go; }
-  service BACK { request: arm.Back; %(back)s conflicts { GO: wait; } }
+  service BACK { request: arm.Back; %(back)s conflicts { GO: %(policy)s; } }
   service MOVE { request: base.Move; }
 }
 rules policy {
@@ -68,20 +68,29 @@ rules policy {
 """
 
 
-def robot(tmp_path: Path, rule: str, back: str = "") -> list[Path]:
+def robot(tmp_path: Path, rule: str, back: str = "", policy: str = "wait") -> list[Path]:
     (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
     spec = tmp_path / "shop.spec"
-    spec.write_text(ROBOT % {"rule": rule, "back": back})
+    spec.write_text(ROBOT % {"rule": rule, "back": back, "policy": policy})
     return [spec]
 
 
-def test_a_rule_letting_a_service_start_beside_the_one_it_waits_for_breaks_exclusion(tmp_path: Path) -> None:
+def test_a_rule_starting_a_service_before_the_one_it_interrupts_has_stopped_breaks_exclusion(
+        tmp_path: Path) -> None:
+    # GO and BACK are not incompatible in their module: interrupting GO takes an abort request,
+    # and the generated rules WAIT for it; this rule answers OK at once, so no abort is sent.
     rule = 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";'
-    result = run(robot(tmp_path, rule), "shop", 2)
+    result = run(robot(tmp_path, rule, policy="interrupt"), "shop", 2)
     assert set(result.violations) == {"exclusion"}
     trace = result.violations["exclusion"].trace
     # Shortest: GO starts and runs, then BACK is let in beside it.
     assert trace == ["task: RQST EXEC GO", "task: RQST EXEC BACK"]
+
+
+def test_a_rule_cannot_start_a_service_beside_the_one_it_is_declared_to_wait_for(tmp_path: Path) -> None:
+    # The same rule against `GO: wait`: where the declared wait applies the rule steps aside.
+    rule = 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";'
+    assert run(robot(tmp_path, rule), "shop", 2).ok
 
 
 def test_a_rule_keeping_a_service_waiting_starves_it_unless_it_has_a_start_timeout(tmp_path: Path) -> None:
@@ -199,7 +208,8 @@ def test_a_service_that_takes_inputs_is_explored_like_any_other(tmp_path: Path) 
     """`takes: x;` (inputs the task level gives with each request): the explorer's requests give
     one for each, so a rule that breaks exclusion between two such services is found, where a
     request without its inputs would be refused before it ever ran."""
-    paths = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";')
+    paths = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";',
+                  policy="interrupt")
     spec = paths[0]
     text = spec.read_text()
     spec.write_text(text.replace("request Go { type: exec;", "request Go { type: exec; input: x: double;")

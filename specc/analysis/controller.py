@@ -13,7 +13,9 @@ is interrupting; sendAbortRequest(service) asks another module to interrupt one.
 An executive's own rule bases (`executive { rules: ...; }`, e.g. Fig 5.6) join the generated
 ones (`executive_controller`): where a hand-written rule applies, it takes over the decisions it
 makes (the attributes it restricts, the calls it makes on a group), and the generated rules
-deciding the same thing step aside; everywhere else the generated rules decide. A hand-written
+deciding the same thing step aside; everywhere else the generated rules decide. The declared
+waits are the exception: where a service must WAIT for one it is declared to wait for, no
+hand-written rule applies to its start (`take_over`). A hand-written
 output whose values are a group's services plus IDLE names that group's state (Fig 5.6 calls
 the pilo group ExecTrajState).
 """
@@ -107,7 +109,7 @@ def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group],
     waited = [(g, members) for g, members in waited if members]
     rules: list[m.Rule] = []
     for group, members in waited:
-        rules.append(_rule(f"{service}_waits_{group.name}",
+        rules.append(_rule(declared_wait(service, group),
                            _and(*start, _one_of(state_attribute(group, names), members, previous=True)),
                            _restrict("status", "WAIT")))
     none_waited = tuple(_one_of(state_attribute(g, names), members, previous=True, negate=True)
@@ -138,6 +140,17 @@ def start_rules(service: str, graph: IncompatibilityGraph, groups: list[Group],
     free = tuple(m.KNot(operand=c) for c in must_wait_for_abort)
     rules.append(_rule(f"{service}_starts", _and(*start, *none_waited, *free), _restrict("status", "OK")))
     return rules
+
+
+def declared_wait(service: str, group: Group) -> str:
+    """The name of the generated rule making `service` WAIT while a member of `group` it is declared
+    to wait for runs: no hand-written rule takes that decision over."""
+    return f"{service}_waits_{group.name}"
+
+
+def declared_waits(graph: IncompatibilityGraph, groups: list[Group]) -> frozenset[str]:
+    return frozenset(declared_wait(a.source, g) for a in graph.arcs if a.policy == "wait"
+                     for g in groups if a.target in g.services)
 
 
 def physical(graph: IncompatibilityGraph, source: str, target: str) -> bool:
@@ -252,7 +265,7 @@ def executive_controller(program: m.Program, executive: m.Executive) -> Controll
     merged = k.normalise(controller_rules(controller_name(executive), graph, groups, names))
     if not named.problems:
         for base in named.hand:
-            merged = take_over(merged, k.normalise(base), groups, names)
+            merged = take_over(merged, k.normalise(base), groups, names, declared_waits(graph, groups))
     return Controller(executive, graph, groups, names, merged, named.problems)
 
 
@@ -315,15 +328,24 @@ def decisions(rule: k.Rule, groups: list[Group], names: Mapping[Group, str]) -> 
     return found
 
 
-def take_over(generated: k.Base, hand: k.Base, groups: list[Group], names: Mapping[Group, str]) -> k.Base:
+def take_over(generated: k.Base, hand: k.Base, groups: list[Group], names: Mapping[Group, str],
+              waits: frozenset[str] = frozenset()) -> k.Base:
     """Hand-written rules first; a generated rule deciding something a hand-written one decides
-    holds only where none of those hand-written rules applies."""
-    rules: list[k.Rule] = list(hand.rules)
-    when = [(rule, decisions(rule, groups, names)) for rule in hand.rules if rule.kind == "when"]
+    holds only where none of those hand-written rules applies. The generated rules named in
+    `waits` (a service WAITs while one it is declared to wait for runs) are not taken over: a
+    hand-written rule steps aside where one of them applies. Fig 5.6's rule starting CALC-TRAJ-OBJ
+    at once tests only the pilo group; taking over the wait for READ-MODEL too would let the
+    planner's module interrupt a READ-MODEL nobody decided to interrupt (§3.4.2's ERROR)."""
+    guards = tuple(rule.condition for rule in generated.rules if rule.name in waits and rule.condition is not None)
+    hand_rules = [k.Rule(rule.name, rule.kind, k.All((rule.condition, k.Not(k.Any_(guards)))), rule.actions)
+                  if guards and rule.kind == "when" and rule.condition is not None else rule
+                  for rule in hand.rules]
+    rules: list[k.Rule] = list(hand_rules)
+    when = [(rule, decisions(rule, groups, names)) for rule in hand_rules if rule.kind == "when"]
     for rule in generated.rules:
         mine = decisions(rule, groups, names)
         overriding = tuple(h.condition for h, theirs in when if theirs & mine and h.condition is not None)
-        if overriding and rule.condition is not None:
+        if overriding and rule.condition is not None and rule.name not in waits:
             rule = k.Rule(rule.name, rule.kind, k.All((rule.condition, k.Not(k.Any_(overriding)))), rule.actions)
         rules.append(rule)
     attributes = dict(generated.attributes)

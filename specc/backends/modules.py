@@ -52,6 +52,7 @@ class RecordView:
     fields: tuple[FieldView, ...]
     base: str = ""
     doc: str = ""
+    slots: bool = False  # a typo'd field assigned by a codel raises instead of adding a field
 
     @property
     def checks(self) -> Code:
@@ -138,7 +139,8 @@ class ModuleView:
     @property
     def sdi(self) -> RecordView:
         return RecordView(f"{self.prefix}Data", tuple(self.field(f.name, f.type) for f in self.module.internal_data),
-                          base=Code("rt.InternalData"), doc=f"The internal data (SDI) of module {self.name}.")
+                          base=Code("rt.InternalData"), doc=f"The internal data (SDI) of module {self.name}.",
+                          slots=True)
 
     @property
     def requests(self) -> list[RequestView]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -182,12 +183,24 @@ def describe(finding: k.Finding) -> str:
     return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
 
 
+def worst_first(findings: Sequence[k.Finding]) -> list[k.Finding]:
+    """Inconsistent configurations (no value left) before incomplete ones (no value deduced)."""
+    return sorted(findings, key=lambda finding: finding.kind != "inconsistent")
+
+
+def tally(findings: Sequence[k.Finding]) -> str:
+    """'48 inconsistent, 188 incomplete': the count of each kind found."""
+    counts = Counter(finding.kind for finding in findings)
+    return ", ".join(f"{counts[kind]} {kind}" for kind in ("inconsistent", "incomplete") if counts[kind])
+
+
 def warn_unsettled(output: Output, compiled: k.Compiled, what: str, node: m.Node) -> None:
     """A compiled base that leaves inputs unsettled deserves a word at compile time."""
     findings = compiled.findings
     if findings:
-        output.warn("rules-unsettled", f"{what} leaves {len(findings)} input configuration(s) unsettled, e.g. "
-                    f"{describe(findings[0])}; `specc rules` lists them", node.span)
+        output.warn("rules-unsettled", f"{what} leaves {len(findings)} input configuration(s) unsettled "
+                    f"({tally(findings)}), e.g. {describe(worst_first(findings)[0])}; `specc rules` lists them",
+                    node.span)
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> list[k.Compiled]:

@@ -1,4 +1,5 @@
-"""`specc skeleton`: stubs for the codels a spec names but its Python codel modules lack.
+"""`specc skeleton`: stubs for the Python functions a spec names but its modules lack: module
+codels, executive input/output functions, PRS actions and evaluable predicates.
 
 User code is never rewritten: a missing codel module is created, an existing one only gets
 the missing functions appended at its end.
@@ -6,6 +7,7 @@ the missing functions appended at its end.
 
 from __future__ import annotations
 
+import keyword
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,12 +23,12 @@ class Stub:
     function: str
     signature: str
     doc: str
-    result: str
+    returns: str  # a Python expression: what the stub returns
 
     @property
     def text(self) -> str:
         return (f"\n\ndef {self.function}({self.signature}):\n    \"\"\"{self.doc}\"\"\"\n"
-                f"    return \"{self.result}\"\n")
+                f"    return {self.returns}\n")
 
 
 @dataclass(frozen=True)
@@ -36,6 +38,67 @@ class Change:
     functions: tuple[str, ...]
 
 
+@dataclass(frozen=True)
+class Needs:
+    """The functions one Python module must define for one block of the specs."""
+
+    owner: str  # "module loco", "executive hilare", "procedures tasks": its file's docstring
+    dotted: str  # the Python module, as the spec names it
+    stubs: tuple[Stub, ...]
+
+
+def needs(item: m.Node) -> list[Needs]:
+    """What each block names in Python: module codels, executive input/output functions, PRS
+    actions and evaluable predicates."""
+    if isinstance(item, m.Module) and item.codel_module is not None:
+        return [Needs(f"module {item.name}", item.codel_module.value, tuple(needed(item)))]
+    if isinstance(item, m.Executive) and item.codel_module is not None:
+        return [Needs(f"executive {item.name}", item.codel_module.value, tuple(executive_functions(item)))]
+    if isinstance(item, m.Procedures):
+        by_module: dict[str, list[Stub]] = {}
+        for dotted, stub in procedure_functions(item):
+            by_module.setdefault(dotted, []).append(stub)
+        return [Needs(f"procedures {item.name}", dotted, tuple(stubs)) for dotted, stubs in by_module.items()]
+    return []
+
+
+def executive_functions(executive: m.Executive) -> Iterator[Stub]:
+    for service in executive.services:
+        request = service.request.text if service.request is not None else "its request"
+        if service.input is not None and len(service.input.parts) == 1:
+            yield Stub(service.input.text, "ctx",
+                       f"Input of service {service.name}: a dict of {request}'s inputs (or the value of its only "
+                       f"one), completing the service's args.", "{}")
+        if service.output is not None and len(service.output.parts) == 1:
+            yield Stub(service.output.text, "ctx, output",
+                       f"Output of service {service.name}: the result the task level hears from {request}'s "
+                       f"output.", '"OK"')
+
+
+def procedure_functions(procedures: m.Procedures) -> Iterator[tuple[str, Stub]]:
+    """(Python module, stub) for each action and evaluable predicate bound to a function, called
+    as function(ctx, *args)."""
+    for action in procedures.actions:
+        if isinstance(action.binding, m.String):
+            dotted, _, function = action.binding.value.rpartition(".")
+            value = "its value" if action.result is not None else "nothing"
+            yield dotted, Stub(function, ", ".join(["ctx", *(python_parameter(p.name) for p in action.params)]),
+                               f"Action {action.name} of procedures {procedures.name}: returns {value}.",
+                               "0" if action.result is not None else "None")
+    for predicate in procedures.predicates:
+        if predicate.binding is not None:
+            dotted, _, function = predicate.binding.value.rpartition(".")
+            yield dotted, Stub(function, ", ".join(["ctx", *(python_parameter(p.name) for p in predicate.params)]),
+                               f"Evaluable predicate {predicate.name} of procedures {procedures.name}: true or "
+                               "false now.", "False")
+
+
+def python_parameter(name: str) -> str:
+    """A PRS parameter as a Python parameter name (PRS names may hold '-' or be keywords)."""
+    text = "".join(c if c.isalnum() or c == "_" else "_" for c in name.lower()) or "arg"
+    return f"{text}_" if keyword.iskeyword(text) or text[0].isdigit() else text
+
+
 def needed(module: m.Module) -> Iterator[Stub]:
     """One stub per codel function the module names (a function used twice gets one stub)."""
     for request in module.requests:
@@ -43,18 +106,18 @@ def needed(module: m.Module) -> Iterator[Stub]:
         if request.validate is not None:
             yield Stub(request.validate.text, "sdi, request",
                        f"Validate request {request.name} of {module.name}: return \"end\" to accept, or a fail "
-                       f"message ({fail}).", "end")
+                       f"message ({fail}).", '"end"')
         for codel in request.codels:
             yield Stub(codel.function, "sdi, request",
                        f"Codel '{codel.state}' of request {request.name} ({module.name}): return the next state "
                        f"(a codel state, \"end\", \"ether\" when done, \"zombie\") or a fail message ({fail}).",
-                       next_state(codel))
+                       f'"{next_state(codel)}"')
     for task in module.exec_tasks:
         for codel in task.codels:
             yield Stub(codel.function, "sdi",
                        f"The {codel.state} codel of exec task {task.name} ({module.name}): runs "
                        f"{'once at start' if codel.state == 'init' else 'every period'} on the internal data.",
-                       "exec")
+                       '"exec"')
 
 
 def next_state(codel: m.Codel) -> str:
@@ -65,10 +128,10 @@ def next_state(codel: m.Codel) -> str:
     return "ether" if "ether" in codel.yields else codel.yields[0]
 
 
-def write_stubs(module: m.Module, spec_dir: Path) -> Change | None:
-    if module.codel_module is None:
+def write_stubs(wanted: Needs, spec_dir: Path) -> Change | None:
+    if not wanted.stubs or not wanted.dotted:
         return None
-    dotted = module.codel_module.value
+    dotted = wanted.dotted
     path = find_module(dotted, spec_dir)
     created = path is None
     if path is None:
@@ -81,14 +144,14 @@ def write_stubs(module: m.Module, spec_dir: Path) -> Change | None:
         package_init = path.parent / "__init__.py"
         if path.parent != spec_dir and not package_init.exists():
             package_init.write_text("")
-        path.write_text(f'"""Codels of module {module.name} (stubs written by `specc skeleton`)."""\n')
+        path.write_text(f'"""Functions of {wanted.owner} (stubs written by `specc skeleton`)."""\n')
         top_level_functions.cache_clear()
     existing = top_level_functions(path)
     if isinstance(existing, SyntaxError):
-        raise SyntaxError(f"{path}:{existing.lineno}: cannot add codels to a file with a syntax error: "
+        raise SyntaxError(f"{path}:{existing.lineno}: cannot add functions to a file with a syntax error: "
                           f"{existing.msg}")
     stubs: dict[str, Stub] = {}
-    for stub in needed(module):
+    for stub in wanted.stubs:
         if stub.function not in existing and stub.function not in stubs:
             stubs[stub.function] = stub
     if not stubs:

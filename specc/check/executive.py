@@ -104,7 +104,7 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
             elif io.text not in functions:
                 ctx.report("undefined-codel", f"function '{io.text}' is not defined in "
                            f"{executive.codel_module.value if executive.codel_module else ''}"
-                           f"{did_you_mean(io.text, functions)}", io.span)
+                           f"{did_you_mean(io.text, functions)}; `specc skeleton` can write a stub for it", io.span)
         timeout = service.timeout
         if timeout is not None:
             for value in (timeout.start, timeout.interm, timeout.final):

@@ -144,6 +144,11 @@ def check_ka(ctx: Context, ka: m.KA) -> None:
                        f"a KA may be {' or '.join(KA_PROPERTIES)}", span)
     if ka.invocation is None:
         ctx.report("missing-invocation", f"KA '{ka.name}' needs 'invocation: !(GOAL ...);' or a fact", ka.span)
+    if "executive" in ka.properties and not (isinstance(ka.invocation, m.Goal) and ka.invocation.op == "!"
+                                              and len(ka.invocation.body.args) >= 2):
+        span = ka.invocation.span if ka.invocation is not None else ka.span
+        ctx.report("bad-executive-ka", f"the executive KA '{ka.name}' must be invoked by a goal naming a service "
+                   "first and its result last, like !(EXEC-REQUEST $REQUEST $RESULT)", span)
     if ka.body is not None and ka.action is not None:
         ctx.report("conflicting-ka-kinds",
                    f"KA '{ka.name}' has both a body and a primitive 'action:'; keep one", ka.action.span)
@@ -179,5 +184,5 @@ def check_binding(ctx: Context, name: str, binding: m.String) -> None:
     functions = python_functions(ctx, m.String(value=module, span=binding.span))
     if functions is not None and function not in functions:
         ctx.report("undefined-codel",
-                   f"function '{function}' is not defined in {module}{did_you_mean(function, functions)}",
-                   binding.span)
+                   f"function '{function}' is not defined in {module}{did_you_mean(function, functions)}; "
+                   "`specc skeleton` can write a stub for it", binding.span)

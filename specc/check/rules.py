@@ -2,8 +2,9 @@
 
 Attributes that are neither inputs nor outputs are intermediate, declared or not (annex A:
 `diagn` and `difP` of Fig. 3.8 are never declared). What is checked: inputs are never
-restricted, outputs are all deduced by some rule, `@x` has an `init`, values compared with a
-declared symbolic attribute belong to its domain, and `foreach` variables are in scope.
+restricted, outputs are all deduced by some rule, inputs are all tested by some rule (a
+warning), `@x` has an `init`, values compared with a declared symbolic attribute belong to its
+domain, and `foreach` variables are in scope.
 """
 
 from __future__ import annotations
@@ -90,6 +91,7 @@ class RuleVisitor(Visitor):
         if attr.index is not None:
             self.check_index(attr.index, attr.span)
         if attr.previous:
+            self.tested.add(attr.name)
             if attr.name not in self.inits:
                 self.ctx.report("missing-init",
                                 f"'@{attr.name}' reads the previous cycle's value: add 'init @{attr.name} = ...;'",
@@ -148,6 +150,15 @@ def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> Non
                    ref.span)
 
 
+def check_never_read(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:
+    """An input no rule tests changes no decision: a warning, since a misspelt test elsewhere (an
+    undefined attribute) or a forgotten rule is the likely cause."""
+    for attr in base.attributes:
+        if attr.role == "inputs" and attr.name not in visitor.tested:
+            ctx.warn("input-never-read", f"no rule tests input '{attr.name}': it changes no decision; test it "
+                     f"in a rule or remove it", attr.span)
+
+
 def check(ctx: Context) -> None:
     # An executive's own rules add to the controller generated from its conflicts, which
     # deduces the group states: only stand-alone bases must deduce every output themselves.
@@ -160,6 +171,7 @@ def check(ctx: Context) -> None:
         visitor.visit(base)
         if base.name not in completed:  # an executive's own rules read the controller's attributes
             check_never_set(ctx, base, visitor)
+        check_never_read(ctx, base, visitor)
         for attr in base.attributes:
             domain = attr.domain
             if isinstance(domain, m.NumericDomain) and isinstance(domain.low, m.Number) \

@@ -39,14 +39,18 @@ def check(ctx: Context) -> None:
         supervisor = ctx.named(m.Procedures).get(system.supervisor.text) if system.supervisor else None
         check_planning(ctx, system, supervisor, executive)
         if supervisor is not None and (executive is not None or system.executive is None):
-            check_service_actions(ctx, supervisor, [executive] if executive is not None else [],
-                                  f"system '{system.name}' has no executive: give it 'executive: NAME;'")
+            without = f"system '{system.name}' has no executive: give it 'executive: NAME;'"
+            check_service_actions(ctx, supervisor, [executive] if executive is not None else [], without)
+            check_executive_goals(ctx, supervisor, [executive] if executive is not None else [], without,
+                                  system.missions)
     # Procedures no system runs: their services are looked for in every executive.
     supervised = {s.supervisor.text for s in systems if s.supervisor is not None}
     for procedures in ctx.items(m.Procedures):
         if procedures.name not in supervised:
-            check_service_actions(ctx, procedures, list(ctx.items(m.Executive)),
-                                  "no executive offers services: declare one")
+            executives = list(ctx.items(m.Executive))
+            check_service_actions(ctx, procedures, executives, "no executive offers services: declare one")
+            check_executive_goals(ctx, procedures, executives, "no system connects these procedures to an "
+                                  "executive: add 'supervisor:' and 'executive:' to a system block")
 
 
 def check_blocks(ctx: Context, system: m.System) -> None:
@@ -351,6 +355,32 @@ def check_service_actions(ctx: Context, procedures: m.Procedures, executives: li
             typed = inputs.get(taken_input.text)
             if typed is not None:
                 check_argument_type(ctx, procedures, param, typed, service.name)
+
+
+def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: list[m.Executive], without: str,
+                          missions: tuple[m.Node, ...] = ()) -> None:
+    """The goals of an executive KA (`property: executive`, the request protocol of Fig 4.3) name
+    a service first: a constant there must be one the executive offers, or the request is answered
+    BAD-SERVICE at run time and `specc verify --goal` stops at it."""
+    protocols = {ka.invocation.body.head: ka for ka in procedures.kas if "executive" in ka.properties
+                 and isinstance(ka.invocation, m.Goal) and ka.invocation.body.args}
+    if not protocols:
+        return
+    if not executives:
+        first = next(iter(protocols.values()))
+        ctx.warn("no-executive", f"KA '{first.name}' is the executive's request protocol, but {without}", first.span)
+        return
+    services = {s.name for e in executives for s in e.services}
+    for root in (procedures, *missions):
+        for node in walk(root):
+            if not (isinstance(node, m.Goal) and node.op == "!" and node.body.head in protocols):
+                continue
+            named = node.body.args[0]
+            if isinstance(named, m.Ref) and named.text not in services:
+                which = f"executive '{executives[0].name}' does not offer" if len(executives) == 1 \
+                    else "no executive offers"
+                ctx.warn("undefined-service", f"goal {node.body.head} asks for service '{named.text}', which "
+                         f"{which}{did_you_mean(named.text, services)}: it will be answered BAD-SERVICE", named.span)
 
 
 def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import difflib
 import enum
 import functools
 import itertools
@@ -326,15 +327,17 @@ def _single_field(poster_type: type) -> str | None:
 
 
 class InternalData:
-    """Base of each module's generated SDI: what codels reach besides their own data."""
+    """Base of each module's generated SDI: what codels reach besides their own data. The SDI
+    has slots: a codel assigning a field the spec does not declare (`sdi.maxSped = ...`) raises
+    AttributeError, reported as the codel's error, instead of silently adding a field."""
 
-    _module: Module | None = None
+    __slots__ = ("_module",)
 
     def read_poster(self, name: str) -> Any:
         """Another module's poster content (`"module.Poster"`), or None if it has none yet.
 
         A poster exporting a single field gives that field's value directly."""
-        module = self._module
+        module: Module | None = getattr(self, "_module", None)
         if module is None:
             return None
         snapshot = module.registry.read_poster(name)
@@ -347,7 +350,7 @@ class InternalData:
 
     def write_poster(self, name: str) -> None:
         """Update one of this module's `update: manual` posters from the SDI now."""
-        module = self._module
+        module: Module | None = getattr(self, "_module", None)
         assert module is not None
         if name not in module.posters:
             raise LookupError(f"module '{module.name}' has no poster '{name}' "
@@ -358,7 +361,7 @@ class InternalData:
     def hardware(self) -> Any:
         """The robot's devices when a simulator (`specc.runtime.sim.Simulation`) or a driver is
         attached to the registry, else None (codels then fall back on their own models)."""
-        module = self._module
+        module: Module | None = getattr(self, "_module", None)
         if module is None:
             return None
         registry = module.registry
@@ -366,8 +369,9 @@ class InternalData:
 
     def send_request(self, name: str, **inputs: Any) -> RequestHandle:
         """Send `"module.request"` from the running codel: the new activity is its child."""
-        assert self._module is not None
-        return self._module.registry.send_from_codel(name, inputs)
+        module: Module | None = getattr(self, "_module", None)
+        assert module is not None
+        return module.registry.send_from_codel(name, inputs)
 
 
 @dataclass
@@ -691,7 +695,7 @@ class Module:
         try:
             result = self.call_with_parent(activity, self.function(name), self.sdi, activity)
         except Exception as exc:  # a codel's bug is the activity's extrinsic error, not the runtime's
-            self.extrinsic(activity, "CODEL_ERROR", f"codel '{name}' raised {type(exc).__name__}: {exc}")
+            self.extrinsic(activity, "CODEL_ERROR", f"codel '{name}' raised {self.explain(exc)}")
             return None
         if not isinstance(result, str):
             self.extrinsic(activity, "UNDECLARED_STATE", f"codel '{name}' returned {result!r}, not a state name")
@@ -707,7 +711,7 @@ class Module:
         try:
             result = self.function(name)(self.sdi, record)
         except Exception as exc:
-            return Report("CODEL_ERROR", f"codel '{name}' raised {type(exc).__name__}: {exc}")
+            return Report("CODEL_ERROR", f"codel '{name}' raised {self.explain(exc)}")
         finally:
             if running is not None:
                 registry.current = running
@@ -717,6 +721,21 @@ class Module:
             return Report(result)
         return Report("UNDECLARED_STATE", f"validate codel '{name}' returned {result!r}: accept with 'end', "
                       f"refuse with a fail message ({', '.join(spec.fail) or 'none declared'})")
+
+    def explain(self, exc: Exception) -> str:
+        """A codel's exception as the activity's report gives it; a field the SDI does not declare
+        is named with the fields it has."""
+        missing = f"'{type(self.sdi).__name__}' object has no attribute '"
+        text = str(exc)
+        # Python names the attribute of a failed read (exc.name), not of a failed assignment.
+        if isinstance(exc, AttributeError) and text.startswith(missing) and text.endswith("'"):
+            name = text[len(missing):-1]
+            fields = [f.name for f in dataclasses.fields(self.sdi)]
+            close = difflib.get_close_matches(name, fields, n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
+            return (f"AttributeError: module {self.name}'s SDI has no field '{name}' ({hint}its fields: "
+                    f"{', '.join(fields) or 'none'}; declare it in the module's internal_data)")
+        return f"{type(exc).__name__}: {text}"
 
     def call_with_parent(self, activity: Activity, function: Callable[..., Any], *args: Any) -> Any:
         previous = self.registry.current
@@ -731,7 +750,7 @@ class Module:
             self.function(name)(self.sdi)
         except Exception as exc:
             self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: permanent codel '{name}' "
-                                           f"raised {type(exc).__name__}: {exc}")
+                                           f"raised {self.explain(exc)}")
 
     # -- endings
     def end(self, activity: Activity, report: Report) -> None:

@@ -234,6 +234,16 @@ def test_a_control_codel_writing_no_output_is_a_codel_error(robot: Robot) -> Non
     assert "no output 'valeu'" in reply.report.detail
 
 
+def test_a_codel_writing_a_field_the_sdi_does_not_declare_is_a_codel_error_naming_it(robot: Robot) -> None:
+    def get_value(sdi, request):  # type: ignore[no-untyped-def]
+        sdi.valeu = 3  # a typo: without the check, a new field nobody reads and the reply OK
+        return "end"
+
+    reply = with_codels(robot, get_value=get_value).client().call("Get")
+    assert (reply.status, reply.report.code) == (Status.FINAL_ERROR, "CODEL_ERROR")
+    assert "module alpha's SDI has no field 'valeu' (did you mean 'value'?" in reply.report.detail
+
+
 def test_a_request_sent_by_a_validate_codel_is_nobody_s_child(robot: Robot) -> None:
     def check_script(sdi, request):  # type: ignore[no-untyped-def]
         sdi.send_request("beta.Child", script="exec")

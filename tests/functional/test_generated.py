@@ -98,8 +98,31 @@ def test_skeleton_adds_only_missing_codels_and_keeps_user_code(tmp_path: Path) -
     assert text.startswith(user)
     assert text.count("def openGripper") == 1 and 'def closeGripper(sdi, request):' in text
     assert "return \"ether\"" in text.split("def closeGripper")[1].split("def ")[0]
-    assert skeleton().stdout.strip() == "every codel named by the specs already exists"
+    assert skeleton().stdout.strip() == "every function named by the specs already exists"
     assert (codels / "arm.py").read_text() == text
     check = subprocess.run([sys.executable, "-m", "specc.cli", "check", str(spec)], capture_output=True, text=True,
                            timeout=60)
     assert check.returncode == 0, check.stderr
+
+
+def test_skeleton_covers_executive_functions_prs_actions_and_evaluable_predicates(tmp_path: Path) -> None:
+    """Every function the specs name gets a stub, so a robot written from scratch checks at once."""
+    spec = tmp_path / "shop.spec"
+    spec.write_text('module arm {\n  codels: "arm_codels";\n  request Go { type: control; input: x: double;'
+                    ' validate: checkGo; }\n}\n'
+                    'executive shop {\n  codels: "shop_io";\n  service GO { request: arm.Go; input: where_to;'
+                    ' output: how_it_went; }\n}\n'
+                    'procedures tasks {\n  action SEND(service: {GO}) -> int = "task_codels.send";\n'
+                    '  predicate evaluable READY(lambda: {LEFT, RIGHT}) = "task_codels.ready";\n'
+                    '  ka Send { invocation: !(SEND-GO $ID); action: (SEND GO) -> $ID; }\n}\n')
+    check = [sys.executable, "-m", "specc.cli", "check", str(spec)]
+    before = subprocess.run(check, capture_output=True, text=True, timeout=60)
+    assert before.returncode == 1 and "[missing-python-module]" in before.stdout + before.stderr
+    wrote = subprocess.run([sys.executable, "-m", "specc.cli", "skeleton", str(spec)], capture_output=True,
+                           text=True, timeout=60)
+    assert wrote.returncode == 0, wrote.stderr
+    assert "shop_io.py: where_to, how_it_went" in wrote.stdout and "task_codels.py: send, ready" in wrote.stdout
+    tasks = (tmp_path / "task_codels.py").read_text()
+    assert "def send(ctx, service):" in tasks and "def ready(ctx, lambda_):" in tasks
+    after = subprocess.run(check, capture_output=True, text=True, timeout=60)
+    assert after.returncode == 0, after.stdout + after.stderr

@@ -17,7 +17,7 @@ class Link:
     end: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class AntennaData(rt.InternalData):
     """The internal data (SDI) of module antenna."""
 

@@ -16,7 +16,7 @@ class Photo:
     date: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class CameraData(rt.InternalData):
     """The internal data (SDI) of module camera."""
 

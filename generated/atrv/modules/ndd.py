@@ -54,7 +54,7 @@ class Arrival:
     distance: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class NddData(rt.InternalData):
     """The internal data (SDI) of module ndd."""
 

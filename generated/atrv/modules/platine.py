@@ -15,7 +15,7 @@ class PanTilt:
     tilt: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class PlatineData(rt.InternalData):
     """The internal data (SDI) of module platine."""
 

@@ -28,7 +28,7 @@ class WheelTravel:
     right: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class RflexData(rt.InternalData):
     """The internal data (SDI) of module rflex."""
 

@@ -20,7 +20,7 @@ class Scan:
     echo: bool = False
 
 
-@dataclass
+@dataclass(slots=True)
 class SickData(rt.InternalData):
     """The internal data (SDI) of module sick."""
 

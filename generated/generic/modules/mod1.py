@@ -9,7 +9,7 @@ from typing import Any
 from specc.runtime import functional as rt
 
 
-@dataclass
+@dataclass(slots=True)
 class Mod1Data(rt.InternalData):
     """The internal data (SDI) of module mod1."""
 

@@ -27,7 +27,7 @@ class ArmConfig:
     q: list[float] = field(default_factory=lambda: [0.0] * 6)
 
 
-@dataclass
+@dataclass(slots=True)
 class ArmData(rt.InternalData):
     """The internal data (SDI) of module arm."""
 

@@ -25,7 +25,7 @@ class FieldParams:
     influence: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class AvoidData(rt.InternalData):
     """The internal data (SDI) of module avoid."""
 

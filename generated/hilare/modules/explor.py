@@ -24,7 +24,7 @@ class Object:
     j: int = 0
 
 
-@dataclass
+@dataclass(slots=True)
 class ExplorData(rt.InternalData):
     """The internal data (SDI) of module explor."""
 

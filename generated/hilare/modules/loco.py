@@ -42,7 +42,7 @@ class Speed:
     w: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class LocoData(rt.InternalData):
     """The internal data (SDI) of module loco."""
 

@@ -44,7 +44,7 @@ class Trajectory:
     tolerance: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class PiloData(rt.InternalData):
     """The internal data (SDI) of module pilo."""
 

@@ -49,7 +49,7 @@ class Trajectory:
     tolerance: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class PlanData(rt.InternalData):
     """The internal data (SDI) of module plan."""
 

@@ -20,7 +20,7 @@ class UsConfig:
     maxRange: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class UsData(rt.InternalData):
     """The internal data (SDI) of module us."""
 

@@ -42,7 +42,7 @@ class Model:
     free: list[bool] = field(default_factory=lambda: [False] * 4096)
 
 
-@dataclass
+@dataclass(slots=True)
 class VisualData(rt.InternalData):
     """The internal data (SDI) of module visual."""
 
