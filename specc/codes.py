@@ -54,6 +54,10 @@ CODES: dict[str, Code] = {
     "undefined-exec-task": Code("no exec task of that name in the module", "task: Missing;"),
     "undefined-activity": Code("a poster's activity names no request of the module", "activity: nowhere;"),
     "undefined-codel": Code("a codel function the codel module does not define", "codel exec: stpe;"),
+    "bad-codel-signature": Code("a user function cannot be called with the arguments the runtime passes it",
+                                "def watch(sdi, request): ...   (an exec task's codel gets (sdi))"),
+    "undeclared-result": Code("a codel returns a string its request does not declare (no such state or fail)",
+                              'return "SLIPPED"   (fail: SLIP;)'),
     "undefined-codel-state": Code("a codel leads to a state the request has no codel for",
                                   "codel exec: go -> finished;"),
     "undefined-service": Code("no executive service of that name", "conflicts { GOTOO: wait; }"),
@@ -92,6 +96,7 @@ CODES: dict[str, Code] = {
                                      "request Set { type: control; codel exec: set; }"),
     "not-a-control-request": Code("a SET-PARAM parameter sets through an exec request", "set: loco.Track;"),
     "recursive-type": Code("a struct that contains itself", "struct Node { next: Node; }"),
+    "bad-python-module": Code("a Python module name that is not dotted identifiers", 'codels: "cart-codels";'),
     "missing-python-module": Code("the Python module a spec names is not next to it", 'codels: "cart_codles";'),
     "python-syntax-error": Code("a codel module has a syntax error", "cart_codels.py with `def go(sdi:`"),
     # ---------------------------------------------------------------- executive

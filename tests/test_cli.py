@@ -69,6 +69,19 @@ def test_binary_file_is_a_clear_error(tmp_path: Path) -> None:
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.parametrize("content", [b"def go(sdi, request):\n    return '\xe9t\xe9'\n",  # Latin-1
+                                     b"def go(sdi, request):\x00\n    return 'end'\n"])  # a NUL byte
+def test_a_codel_module_that_is_not_python_text_is_one_clear_error(tmp_path: Path, content: bytes) -> None:
+    (tmp_path / "m.spec").write_text('module m {\n  codels: "m_codels";\n  request Go { type: control; '
+                                     'validate: go; }\n}\n')
+    (tmp_path / "m_codels.py").write_bytes(content)
+    result = specc("check", str(tmp_path))
+    shown = result.stdout + result.stderr
+    assert result.returncode == 1 and "Traceback" not in shown
+    headline = next(line for line in shown.splitlines() if "[python-syntax-error]" in line)
+    assert headline.startswith(f"{tmp_path / 'm.spec'}:2:11: error: ") and "m_codels.py:1:" in headline
+
+
 def test_every_example_checks_from_another_directory(tmp_path: Path) -> None:
     result = specc("check", *(str(EXAMPLES / robot) for robot in ("hilare", "generic", "atrv")), cwd=tmp_path)
     assert result.returncode == 0, result.stderr

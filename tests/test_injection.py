@@ -191,7 +191,7 @@ def test_control_characters_of_a_spec_never_reach_the_terminal(tmp_path: Path) -
     result = subprocess.run([sys.executable, "-m", "specc.cli", "check", str(folder)], capture_output=True,
                             text=True, timeout=120)
     shown = result.stdout + result.stderr
-    assert result.returncode != 0 and "[missing-python-module]" in shown, shown
+    assert result.returncode != 0 and "[bad-python-module]" in shown, shown
     assert "\x1b" not in shown and "\x07" not in shown
-    headline = next(line for line in shown.splitlines() if "[missing-python-module]" in line)
+    headline = next(line for line in shown.splitlines() if "[bad-python-module]" in line)
     assert "\\x1b[2Jy\\x07" in headline

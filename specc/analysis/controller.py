@@ -328,6 +328,24 @@ def decisions(rule: k.Rule, groups: list[Group], names: Mapping[Group, str]) -> 
     return found
 
 
+def fixed_values(condition: k.Cond) -> dict[str, Any]:
+    """The attributes a condition requires to equal one value (its top-level `a == v` tests)."""
+    atoms = condition.operands if isinstance(condition, k.All) else (condition,)
+    return {a.attribute: a.value for a in atoms if isinstance(a, k.Atom) and a.op == "=="}
+
+
+def step_aside(rule: k.Rule, guards: list[k.Cond]) -> k.Rule:
+    """`rule`, holding only where none of `guards` applies. Guards that cannot hold with it (they
+    test another service or event) are left out: the decision graph stays as it was elsewhere."""
+    assert rule.condition is not None
+    mine = fixed_values(rule.condition)
+    relevant = tuple(g for g in guards
+                     if all(mine.get(attribute, value) == value for attribute, value in fixed_values(g).items()))
+    if not relevant:
+        return rule
+    return k.Rule(rule.name, rule.kind, k.All((rule.condition, k.Not(k.Any_(relevant)))), rule.actions)
+
+
 def take_over(generated: k.Base, hand: k.Base, groups: list[Group], names: Mapping[Group, str],
               waits: frozenset[str] = frozenset()) -> k.Base:
     """Hand-written rules first; a generated rule deciding something a hand-written one decides
@@ -336,9 +354,8 @@ def take_over(generated: k.Base, hand: k.Base, groups: list[Group], names: Mappi
     hand-written rule steps aside where one of them applies. Fig 5.6's rule starting CALC-TRAJ-OBJ
     at once tests only the pilo group; taking over the wait for READ-MODEL too would let the
     planner's module interrupt a READ-MODEL nobody decided to interrupt (§3.4.2's ERROR)."""
-    guards = tuple(rule.condition for rule in generated.rules if rule.name in waits and rule.condition is not None)
-    hand_rules = [k.Rule(rule.name, rule.kind, k.All((rule.condition, k.Not(k.Any_(guards)))), rule.actions)
-                  if guards and rule.kind == "when" and rule.condition is not None else rule
+    guards = [rule.condition for rule in generated.rules if rule.name in waits and rule.condition is not None]
+    hand_rules = [rule if rule.kind != "when" or rule.condition is None else step_aside(rule, guards)
                   for rule in hand.rules]
     rules: list[k.Rule] = list(hand_rules)
     when = [(rule, decisions(rule, groups, names)) for rule in hand_rules if rule.kind == "when"]

@@ -27,13 +27,18 @@ PRIMITIVES = {
 }
 
 
+# How the generated modules import dataclasses.field: a dunder name no spec field can take
+# (`reserved-name`), so that no field of a record hides it in the class body.
+FIELD = "__field__"
+
+
 @dataclass(frozen=True)
 class FieldView:
     """One field of a generated record, with what its dataclass line and type check need."""
 
     name: str
     annotation: str
-    default: str  # a dataclass default: `= 0.0` or `= field(default_factory=...)`
+    default: str  # a dataclass default: `0.0` or `__field__(default_factory=lambda: ...)`
     kind: str  # the runtime checker's kind: "float", ..., or a record class
     size: str  # "None" or the array length
 
@@ -88,23 +93,25 @@ class ModuleView:
         return camel(self.module.name)
 
     def field(self, name: str, type_ref: m.TypeRef) -> FieldView:
-        annotation, default, kind = self.scalar(type_ref.name)
+        annotation, value, kind = self.scalar(type_ref.name)
+        literal = type_ref.name in PRIMITIVES
         if type_ref.size is None:
+            # A default naming a type (or `field`) would be looked up in the class body, where an
+            # earlier field of that name hides it: a lambda looks names up in the module.
+            default = value if literal else f"{FIELD}(default_factory=lambda: {value})"
             return FieldView(name, annotation, default, kind, "None")
-        element = default.removeprefix("field(default_factory=").removesuffix(")")
-        if default.startswith("field("):
-            factory = f"lambda: [{element}() for _ in range({type_ref.size})]"
-        else:
-            factory = f"lambda: [{element}] * {type_ref.size}"
-        return FieldView(name, f"list[{annotation}]", f"field(default_factory={factory})", kind, str(type_ref.size))
+        elements = f"[{value}] * {type_ref.size}" if literal else f"[{value} for _ in range({type_ref.size})]"
+        return FieldView(name, f"list[{annotation}]", f"{FIELD}(default_factory=lambda: {elements})", kind,
+                         str(type_ref.size))
 
     def scalar(self, type_name: str) -> tuple[str, str, str]:
+        """The type's annotation, an expression giving its default value, its check kind."""
         if type_name in PRIMITIVES:
             return PRIMITIVES[type_name]
         if type_name in self.enums:
             first = self.enums[type_name].values[0]
             return type_name, f"{type_name}.{first}", type_name
-        return type_name, f"field(default_factory={type_name})", type_name
+        return type_name, f"{type_name}()", type_name
 
     @cached_property
     def sdi_types(self) -> dict[str, m.TypeRef]:

@@ -37,7 +37,9 @@ def _fields(record: Any) -> list[tuple[str, Any]]:
     shown = []
     for f in dataclasses.fields(record):
         value = getattr(record, f.name)
-        if f.default is not dataclasses.MISSING and value == f.default:
+        factory = f.default_factory
+        default = f.default if factory is dataclasses.MISSING else factory()
+        if default is not dataclasses.MISSING and value == default:
             continue
         shown.append((f.name, value))
     return shown

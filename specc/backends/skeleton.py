@@ -129,8 +129,8 @@ def next_state(codel: m.Codel) -> str:
 
 
 def write_stubs(wanted: Needs, spec_dir: Path) -> Change | None:
-    if not wanted.stubs or not wanted.dotted:
-        return None
+    if not wanted.stubs or not all(part.isidentifier() for part in wanted.dotted.split(".")):
+        return None  # no Python module can take that name: `specc check` says so
     dotted = wanted.dotted
     path = find_module(dotted, spec_dir)
     created = path is None

@@ -2,11 +2,21 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.span import Span
-from specc.pysource import find_module, top_level_functions
+from specc.pysource import FunctionShape, find_module, top_level_functions
+
+# How the runtime calls each kind of user function: the arguments it passes.
+REQUEST_CODEL = ("sdi", "request")
+TASK_CODEL = ("sdi",)
+# What any request codel may return besides its request's codel states and fail messages.
+CODEL_ENDINGS = frozenset({"ether", "zombie"})
+# What a validate codel may return to accept its request (or a fail message to refuse it).
+VALIDATE_ACCEPTS = frozenset({"end", "ok", "OK", "ether", "exec"})
 
 
 def check(ctx: Context) -> None:
@@ -32,10 +42,59 @@ def check(ctx: Context) -> None:
                 ctx.report("undefined-codel",
                            f"codel '{name}' is not defined in {module.codel_module.value}"
                            f"{did_you_mean(name, functions)}; `specc skeleton` can write a stub for it", span)
+        where = module.codel_module.value
+        for request in module.requests:
+            fail = {f.text for f in request.fail}
+            states = {c.state for c in request.codels} | {"end"}
+            for codel in request.codels:
+                shape = functions.get(codel.function)
+                check_call(ctx, codel.function, shape, REQUEST_CODEL, where, codel.span)
+                if codel.state != "inter":  # whatever an interruption codel returns but `inter` ends it
+                    allowed = CODEL_ENDINGS | fail | (set(codel.yields) if codel.yields else states)
+                    check_returns(ctx, codel.function, shape, allowed, where, codel.span,
+                                  f"codel '{codel.state}' of request {request.name}")
+            if request.validate is not None:
+                shape = functions.get(request.validate.text)
+                check_call(ctx, request.validate.text, shape, REQUEST_CODEL, where, request.validate.span)
+                check_returns(ctx, request.validate.text, shape, VALIDATE_ACCEPTS | fail, where,
+                              request.validate.span, f"the validate codel of request {request.name}")
+        for task in module.exec_tasks:
+            for codel in task.codels:
+                check_call(ctx, codel.function, functions.get(codel.function), TASK_CODEL, where, codel.span)
 
 
-def python_functions(ctx: Context, dotted: m.String) -> frozenset[str] | None:
+def check_call(ctx: Context, name: str, shape: FunctionShape | None, call: tuple[str, ...], where: str,
+               span: Span) -> None:
+    """The function can be called as the runtime calls it (read from its `def`, never run)."""
+    if shape is None or shape.accepts(len(call)):
+        return
+    if shape.most is not None and shape.most < 0:
+        takes = "a keyword-only argument without default"
+    elif shape.most is None:
+        takes = f"at least {shape.least} argument(s)"
+    else:
+        takes = f"{shape.least}" + (f" to {shape.most}" if shape.most != shape.least else "") + " argument(s)"
+    ctx.report("bad-codel-signature", f"'{name}' ({where}, line {shape.line}) takes {takes}, but it is called as "
+               f"{name}({', '.join(call)}): give it {len(call)} parameter(s)", span)
+
+
+def check_returns(ctx: Context, name: str, shape: FunctionShape | None, allowed: set[str] | frozenset[str],
+                  where: str, span: Span, what: str) -> None:
+    """Every string the function returns as it is written is one the runtime accepts there."""
+    for value, line in shape.returns if shape is not None else ():
+        if value not in allowed:
+            close = did_you_mean(value, allowed)
+            fix = close or f"; a new failure is declared with 'fail: {value};'"
+            ctx.report("undeclared-result", f"'{name}' returns {value!r} ({where}, line {line}), which {what} "
+                       f"does not declare (it may return {', '.join(sorted(allowed))}){fix}", span)
+
+
+def python_functions(ctx: Context, dotted: m.String) -> Mapping[str, FunctionShape | None] | None:
     """The functions of a user Python module named in the spec; None (reported) if unreadable."""
+    if not all(part.isidentifier() for part in dotted.value.split(".")):
+        ctx.report("bad-python-module", f"'{dotted.value}' is not a Python module name: give dotted identifiers, "
+                   "like \"cart_codels\" or \"cart_codels.drive\"", dotted.span)
+        return None
     path = find_module(dotted.value, ctx.base_dir(dotted.span))
     if path is None:
         ctx.report("missing-python-module",

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from specc.analysis.controller import naming
-from specc.check.codels import python_functions
+from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
@@ -61,6 +61,11 @@ def check(ctx: Context) -> None:
                                "activities share its internal data instead", ref.span)
 
 
+# How the executive calls its input and output functions (§3.3.1).
+INPUT_FUNCTION = ("ctx",)
+OUTPUT_FUNCTION = ("ctx", "output")
+
+
 def check_executive(ctx: Context, executive: m.Executive) -> None:
     ctx.duplicates(executive.services, "service")
     ctx.duplicates(executive.parameters, "parameter")
@@ -105,6 +110,9 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                 ctx.report("undefined-codel", f"function '{io.text}' is not defined in "
                            f"{executive.codel_module.value if executive.codel_module else ''}"
                            f"{did_you_mean(io.text, functions)}; `specc skeleton` can write a stub for it", io.span)
+            elif executive.codel_module is not None:
+                check_call(ctx, io.text, functions[io.text], INPUT_FUNCTION if io is service.input else OUTPUT_FUNCTION,
+                           executive.codel_module.value, io.span)
         timeout = service.timeout
         if timeout is not None:
             for value in (timeout.start, timeout.interm, timeout.final):

@@ -30,6 +30,8 @@ def check(ctx: Context) -> None:
 # The generated client already has these methods, and Python reserves its keywords.
 RESERVED = frozenset({"send", "reply", "interm", "final", "abort", "call", "poster", "module", "kernel", "create",
                       "client"}) | frozenset(keyword.kwlist)
+# The parameters the generated client's request methods have besides the request's inputs.
+CLIENT_PARAMETERS = frozenset({"self", "interm_timeout", "final_timeout"})
 # What a codel's `request` already carries at run time (specc.runtime.functional.Activity):
 # an input or output with one of these names would be hidden behind it.
 ACTIVITY_ATTRIBUTES = frozenset({"id", "spec", "module", "input", "output", "state", "codel_state", "sink", "parent",
@@ -63,6 +65,9 @@ def check_names(ctx: Context, module: m.Module) -> None:
         elif what == "request" and name in RESERVED:
             ctx.report("reserved-name", f"request '{name}' would clash with a method of the generated client; "
                        "rename it", span)
+        elif what == "input or output" and name in CLIENT_PARAMETERS:
+            ctx.report("reserved-name", f"{what} '{name}' would clash with the parameter '{name}' of the generated "
+                       "client's method; rename it", span)
         elif what == "input or output" and name in ACTIVITY_ATTRIBUTES:
             ctx.report("reserved-name", f"{what} '{name}' would be hidden by the activity's own '{name}' "
                        "when a codel reads request.{name}; rename it", span)

@@ -19,6 +19,10 @@ from specc.pysource import python_name, python_name_problem, shadowed_by_the_sta
 FOLDERS: dict[type, str] = {m.Module: "modules", m.Executive: "executive", m.RuleBase: "rules",
                             m.Procedures: "supervisor", m.Domain: "planner", m.FtPlan: "ftplan",
                             m.System: "systems"}
+# Names the generated folders' __init__ files bind themselves (templates/*/__init__.py.j2): a block
+# of that name would not be imported (`from . import rt` finds the runtime already bound there).
+INIT_NAMES = frozenset({"annotations", "rt", "Mapping", "Any", "create_all", "MODULES", "EXECUTIVES", "FTPLANS",
+                        "DOMAINS", "PROBLEMS", "RULE_BASES", "LIBRARIES", "SYSTEMS"})
 CONTROLLER_SUFFIX = "_resource_controller"  # specc.analysis.controller's name for an executive's controller
 
 
@@ -36,6 +40,8 @@ def check(ctx: Context) -> None:
                 continue
             seen.add(name)
             problem = python_name_problem(name)
+            if problem is None and python_name(name) in INIT_NAMES:
+                problem = f"'{python_name(name)}' is a name the generated {folder}/__init__.py uses itself"
             if problem is not None:
                 ctx.report("reserved-name", f"{KIND_WORDS[kind]} '{name}' names a file of the generated "
                            f"package, but {problem}; rename it", item.span)

@@ -4,7 +4,7 @@ predicates with the right arity, KA shape, and unreachable statements."""
 from __future__ import annotations
 
 from specc.analysis.procedures import Domains
-from specc.check.codels import python_functions
+from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
@@ -123,7 +123,7 @@ def check(ctx: Context) -> None:
             check_ka(ctx, ka)
         for action in procedures.actions:
             if isinstance(action.binding, m.String):  # a service binding is checked with the system
-                check_binding(ctx, action.name, action.binding)
+                check_binding(ctx, action.name, action.binding, action.params)
         for predicate in procedures.predicates:
             evaluable = "evaluable" in predicate.kinds
             if evaluable and predicate.binding is None:
@@ -133,7 +133,7 @@ def check(ctx: Context) -> None:
                 ctx.report("missing-binding", f"only an evaluable predicate is bound to Python; add 'evaluable' "
                            f"to '{predicate.name}' or remove the binding", predicate.binding.span)
             if predicate.binding is not None:
-                check_binding(ctx, predicate.name, predicate.binding)
+                check_binding(ctx, predicate.name, predicate.binding, predicate.params)
 
 
 def check_ka(ctx: Context, ka: m.KA) -> None:
@@ -176,13 +176,18 @@ def _variables(node: m.Node | None) -> list[m.LogicVar | m.ProgramVar]:
     return [n for n in walk(node) if isinstance(n, (m.LogicVar, m.ProgramVar))]
 
 
-def check_binding(ctx: Context, name: str, binding: m.String) -> None:
+def check_binding(ctx: Context, name: str, binding: m.String, params: tuple[m.PParam, ...]) -> None:
+    """A PRS action or evaluable predicate is bound to a function called as function(ctx, *args)."""
     module, _, function = binding.value.rpartition(".")
     if not module or not function:
         ctx.report("bad-binding", f"bind '{name}' to \"python.module.function\"", binding.span)
         return
     functions = python_functions(ctx, m.String(value=module, span=binding.span))
-    if functions is not None and function not in functions:
+    if functions is None:
+        return
+    if function not in functions:
         ctx.report("undefined-codel",
                    f"function '{function}' is not defined in {module}{did_you_mean(function, functions)}; "
                    "`specc skeleton` can write a stub for it", binding.span)
+        return
+    check_call(ctx, function, functions[function], ("ctx", *(p.name for p in params)), module, binding.span)

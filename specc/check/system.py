@@ -138,7 +138,11 @@ def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
                        "relative to this spec", entry.value.span)
             continue
         path = ctx.base_dir(entry.span) / entry.value.value
-        if not path.is_file():
+        try:
+            found = path.is_file()
+        except OSError:  # a name longer than the file system allows names no file
+            found = False
+        if not found:
             ctx.report("missing-world", f"world file '{entry.value.value}' not found (looked at {path})",
                        entry.value.span)
             continue

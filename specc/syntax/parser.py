@@ -105,7 +105,7 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
     line = getattr(exc, "line", 1) or 1
     column = getattr(exc, "column", 1) or 1
     if isinstance(exc, UnexpectedToken) and exc.token.type == "$END" or isinstance(exc, UnexpectedEOF):
-        last = text.rstrip().splitlines() or [""]
+        last = text.rstrip().split("\n")  # lines as the lexer counts them: a \x0b or \x0c ends none
         line, column = max(len(last), 1), len(last[-1]) + 1
         span = Span(path, line, column, line, column + 1)
         expected = describe_expected(getattr(exc, "expected", set()) or set(), keyword_texts())

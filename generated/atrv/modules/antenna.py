@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -21,7 +22,7 @@ class Link:
 class AntennaData(rt.InternalData):
     """The internal data (SDI) of module antenna."""
 
-    link: Link = field(default_factory=Link)
+    link: Link = __field__(default_factory=lambda: Link())
     elapsed: float = 0.0
 
 
@@ -43,7 +44,7 @@ class CommunicateOutput:
 class LinkPoster:
     """The content of poster antenna.Link."""
 
-    link: Link = field(default_factory=Link)
+    link: Link = __field__(default_factory=lambda: Link())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

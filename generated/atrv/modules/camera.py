@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -20,7 +21,7 @@ class Photo:
 class CameraData(rt.InternalData):
     """The internal data (SDI) of module camera."""
 
-    last: Photo = field(default_factory=Photo)
+    last: Photo = __field__(default_factory=lambda: Photo())
     exposure: float = 0.0
 
 
@@ -35,14 +36,14 @@ class TakePictureInput:
 class TakePictureOutput:
     """The output of request TakePicture."""
 
-    photo: Photo = field(default_factory=Photo)
+    photo: Photo = __field__(default_factory=lambda: Photo())
 
 
 @dataclass
 class ImagePoster:
     """The content of poster camera.Image."""
 
-    last: Photo = field(default_factory=Photo)
+    last: Photo = __field__(default_factory=lambda: Photo())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

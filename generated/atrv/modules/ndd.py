@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -42,8 +43,8 @@ class NavState:
 
 @dataclass
 class LocalMap:
-    x: list[float] = field(default_factory=lambda: [0.0] * 600)
-    y: list[float] = field(default_factory=lambda: [0.0] * 600)
+    x: list[float] = __field__(default_factory=lambda: [0.0] * 600)
+    y: list[float] = __field__(default_factory=lambda: [0.0] * 600)
     count: int = 0
 
 
@@ -58,11 +59,11 @@ class Arrival:
 class NddData(rt.InternalData):
     """The internal data (SDI) of module ndd."""
 
-    goal: Goal = field(default_factory=Goal)
-    params: NavParams = field(default_factory=NavParams)
-    speed: Speed = field(default_factory=Speed)
-    state: NavState = field(default_factory=NavState)
-    map: LocalMap = field(default_factory=LocalMap)
+    goal: Goal = __field__(default_factory=lambda: Goal())
+    params: NavParams = __field__(default_factory=lambda: NavParams())
+    speed: Speed = __field__(default_factory=lambda: Speed())
+    state: NavState = __field__(default_factory=lambda: NavState())
+    map: LocalMap = __field__(default_factory=lambda: LocalMap())
 
 
 @dataclass
@@ -78,36 +79,36 @@ class GotoTargetInput:
 class GotoTargetOutput:
     """The output of request GotoTarget."""
 
-    arrival: Arrival = field(default_factory=Arrival)
+    arrival: Arrival = __field__(default_factory=lambda: Arrival())
 
 
 @dataclass
 class SetParamsInput:
     """The input of request SetParams."""
 
-    params: NavParams = field(default_factory=NavParams)
+    params: NavParams = __field__(default_factory=lambda: NavParams())
 
 
 @dataclass
 class SpeedPoster:
     """The content of poster ndd.Speed."""
 
-    speed: Speed = field(default_factory=Speed)
+    speed: Speed = __field__(default_factory=lambda: Speed())
 
 
 @dataclass
 class NavigationPoster:
     """The content of poster ndd.Navigation."""
 
-    goal: Goal = field(default_factory=Goal)
-    state: NavState = field(default_factory=NavState)
+    goal: Goal = __field__(default_factory=lambda: Goal())
+    state: NavState = __field__(default_factory=lambda: NavState())
 
 
 @dataclass
 class MapPoster:
     """The content of poster ndd.Map."""
 
-    map: LocalMap = field(default_factory=LocalMap)
+    map: LocalMap = __field__(default_factory=lambda: LocalMap())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

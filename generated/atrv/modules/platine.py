@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -19,8 +20,8 @@ class PanTilt:
 class PlatineData(rt.InternalData):
     """The internal data (SDI) of module platine."""
 
-    position: PanTilt = field(default_factory=PanTilt)
-    target: PanTilt = field(default_factory=PanTilt)
+    position: PanTilt = __field__(default_factory=lambda: PanTilt())
+    target: PanTilt = __field__(default_factory=lambda: PanTilt())
     moving: bool = False
     elapsed: float = 0.0
 
@@ -37,7 +38,7 @@ class MoveToInput:
 class PositionPoster:
     """The content of poster platine.Position."""
 
-    position: PanTilt = field(default_factory=PanTilt)
+    position: PanTilt = __field__(default_factory=lambda: PanTilt())
     moving: bool = False
 
 

@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -32,11 +33,11 @@ class WheelTravel:
 class RflexData(rt.InternalData):
     """The internal data (SDI) of module rflex."""
 
-    pose: Pose = field(default_factory=Pose)
-    speed: Speed = field(default_factory=Speed)
+    pose: Pose = __field__(default_factory=lambda: Pose())
+    speed: Speed = __field__(default_factory=lambda: Speed())
     blocked: bool = False
     distance: float = 0.0
-    encoders: WheelTravel = field(default_factory=WheelTravel)
+    encoders: WheelTravel = __field__(default_factory=lambda: WheelTravel())
     speedPoster: str = ""
 
 
@@ -51,8 +52,8 @@ class TrackSpeedInput:
 class RobotPoster:
     """The content of poster rflex.Robot."""
 
-    pose: Pose = field(default_factory=Pose)
-    speed: Speed = field(default_factory=Speed)
+    pose: Pose = __field__(default_factory=lambda: Pose())
+    speed: Speed = __field__(default_factory=lambda: Speed())
     blocked: bool = False
     distance: float = 0.0
 

@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -11,7 +12,7 @@ from specc.runtime import functional as rt
 
 @dataclass
 class Scan:
-    ranges: list[float] = field(default_factory=lambda: [0.0] * 181)
+    ranges: list[float] = __field__(default_factory=lambda: [0.0] * 181)
     firstAngle: float = 0.0
     step: float = 0.0
     mount: float = 0.0
@@ -24,7 +25,7 @@ class Scan:
 class SickData(rt.InternalData):
     """The internal data (SDI) of module sick."""
 
-    scan: Scan = field(default_factory=Scan)
+    scan: Scan = __field__(default_factory=lambda: Scan())
 
 
 @dataclass
@@ -38,7 +39,7 @@ class ConfigureInput:
 class ScanPoster:
     """The content of poster sick.Scan."""
 
-    scan: Scan = field(default_factory=Scan)
+    scan: Scan = __field__(default_factory=lambda: Scan())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

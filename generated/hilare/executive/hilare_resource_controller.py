@@ -4418,63 +4418,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_0
-                                elif v == 'IDLE':
-                                    return _LEAF_2
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_987(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_1
-                                elif v == 'IDLE':
-                                    return _LEAF_3
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_988(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_4
-                                elif v == 'IDLE':
-                                    return _LEAF_6
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_989(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_5
-                                elif v == 'IDLE':
-                                    return _LEAF_7
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_990(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_8
-                                elif v == 'IDLE':
-                                    return _LEAF_10
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_991(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_9
-                                elif v == 'IDLE':
-                                    return _LEAF_11
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_992(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4485,63 +4449,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_36
-                                elif v == 'IDLE':
-                                    return _LEAF_38
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_993(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_37
-                                elif v == 'IDLE':
-                                    return _LEAF_39
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_994(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_40
-                                elif v == 'IDLE':
-                                    return _LEAF_42
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_995(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_41
-                                elif v == 'IDLE':
-                                    return _LEAF_43
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_996(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_44
-                                elif v == 'IDLE':
-                                    return _LEAF_46
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_997(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_45
-                                elif v == 'IDLE':
-                                    return _LEAF_47
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_998(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4552,63 +4480,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_72
-                                elif v == 'IDLE':
-                                    return _LEAF_74
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_999(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_73
-                                elif v == 'IDLE':
-                                    return _LEAF_75
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1000(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_76
-                                elif v == 'IDLE':
-                                    return _LEAF_78
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1001(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_77
-                                elif v == 'IDLE':
-                                    return _LEAF_79
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1002(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_80
-                                elif v == 'IDLE':
-                                    return _LEAF_82
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1003(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_81
-                                elif v == 'IDLE':
-                                    return _LEAF_83
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1004(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4633,63 +4525,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_24
-                                elif v == 'IDLE':
-                                    return _LEAF_26
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1005(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_25
-                                elif v == 'IDLE':
-                                    return _LEAF_27
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1006(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_28
-                                elif v == 'IDLE':
-                                    return _LEAF_30
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1007(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_29
-                                elif v == 'IDLE':
-                                    return _LEAF_31
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1008(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_32
-                                elif v == 'IDLE':
-                                    return _LEAF_34
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1009(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_33
-                                elif v == 'IDLE':
-                                    return _LEAF_35
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1010(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4700,63 +4556,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_60
-                                elif v == 'IDLE':
-                                    return _LEAF_62
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1011(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_61
-                                elif v == 'IDLE':
-                                    return _LEAF_63
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1012(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_64
-                                elif v == 'IDLE':
-                                    return _LEAF_66
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1013(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_65
-                                elif v == 'IDLE':
-                                    return _LEAF_67
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1014(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_68
-                                elif v == 'IDLE':
-                                    return _LEAF_70
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1015(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_69
-                                elif v == 'IDLE':
-                                    return _LEAF_71
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1016(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4767,63 +4587,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_96
-                                elif v == 'IDLE':
-                                    return _LEAF_98
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1017(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_97
-                                elif v == 'IDLE':
-                                    return _LEAF_99
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1018(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_100
-                                elif v == 'IDLE':
-                                    return _LEAF_102
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1019(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_101
-                                elif v == 'IDLE':
-                                    return _LEAF_103
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1020(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_104
-                                elif v == 'IDLE':
-                                    return _LEAF_106
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1021(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_105
-                                elif v == 'IDLE':
-                                    return _LEAF_107
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1022(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4842,63 +4626,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_108
-                                elif v == 'IDLE':
-                                    return _LEAF_110
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1023(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_109
-                                elif v == 'IDLE':
-                                    return _LEAF_111
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1024(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_112
-                                elif v == 'IDLE':
-                                    return _LEAF_114
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1025(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_113
-                                elif v == 'IDLE':
-                                    return _LEAF_115
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1026(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_116
-                                elif v == 'IDLE':
-                                    return _LEAF_118
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1027(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_117
-                                elif v == 'IDLE':
-                                    return _LEAF_119
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1028(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4909,63 +4657,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_144
-                                elif v == 'IDLE':
-                                    return _LEAF_146
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1029(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_145
-                                elif v == 'IDLE':
-                                    return _LEAF_147
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1030(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_148
-                                elif v == 'IDLE':
-                                    return _LEAF_150
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1031(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_149
-                                elif v == 'IDLE':
-                                    return _LEAF_151
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1032(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_152
-                                elif v == 'IDLE':
-                                    return _LEAF_154
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1033(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_153
-                                elif v == 'IDLE':
-                                    return _LEAF_155
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1034(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -4976,63 +4688,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_180
-                                elif v == 'IDLE':
-                                    return _LEAF_182
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1035(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_181
-                                elif v == 'IDLE':
-                                    return _LEAF_183
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1036(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_184
-                                elif v == 'IDLE':
-                                    return _LEAF_186
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1037(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_185
-                                elif v == 'IDLE':
-                                    return _LEAF_187
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1038(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_188
-                                elif v == 'IDLE':
-                                    return _LEAF_190
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1039(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_189
-                                elif v == 'IDLE':
-                                    return _LEAF_191
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1040(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5065,63 +4741,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_132
-                                elif v == 'IDLE':
-                                    return _LEAF_134
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1041(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_133
-                                elif v == 'IDLE':
-                                    return _LEAF_135
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1042(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_136
-                                elif v == 'IDLE':
-                                    return _LEAF_138
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1043(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_137
-                                elif v == 'IDLE':
-                                    return _LEAF_139
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1044(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_140
-                                elif v == 'IDLE':
-                                    return _LEAF_142
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1045(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_141
-                                elif v == 'IDLE':
-                                    return _LEAF_143
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1046(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5132,63 +4772,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_168
-                                elif v == 'IDLE':
-                                    return _LEAF_170
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1047(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_169
-                                elif v == 'IDLE':
-                                    return _LEAF_171
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1048(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_172
-                                elif v == 'IDLE':
-                                    return _LEAF_174
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1049(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_173
-                                elif v == 'IDLE':
-                                    return _LEAF_175
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1050(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_176
-                                elif v == 'IDLE':
-                                    return _LEAF_178
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1051(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_177
-                                elif v == 'IDLE':
-                                    return _LEAF_179
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1052(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5199,63 +4803,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_204
-                                elif v == 'IDLE':
-                                    return _LEAF_206
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1053(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_205
-                                elif v == 'IDLE':
-                                    return _LEAF_207
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1054(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_208
-                                elif v == 'IDLE':
-                                    return _LEAF_210
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1055(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_209
-                                elif v == 'IDLE':
-                                    return _LEAF_211
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1056(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_212
-                                elif v == 'IDLE':
-                                    return _LEAF_214
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1057(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_213
-                                elif v == 'IDLE':
-                                    return _LEAF_215
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1058(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5274,63 +4842,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_216
-                                elif v == 'IDLE':
-                                    return _LEAF_218
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1059(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_217
-                                elif v == 'IDLE':
-                                    return _LEAF_219
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1060(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_220
-                                elif v == 'IDLE':
-                                    return _LEAF_222
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1061(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_221
-                                elif v == 'IDLE':
-                                    return _LEAF_223
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1062(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_224
-                                elif v == 'IDLE':
-                                    return _LEAF_226
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1063(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_225
-                                elif v == 'IDLE':
-                                    return _LEAF_227
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1064(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5341,63 +4873,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_252
-                                elif v == 'IDLE':
-                                    return _LEAF_254
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1065(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_253
-                                elif v == 'IDLE':
-                                    return _LEAF_255
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1066(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_256
-                                elif v == 'IDLE':
-                                    return _LEAF_258
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1067(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_257
-                                elif v == 'IDLE':
-                                    return _LEAF_259
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1068(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_260
-                                elif v == 'IDLE':
-                                    return _LEAF_262
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1069(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_261
-                                elif v == 'IDLE':
-                                    return _LEAF_263
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1070(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5408,63 +4904,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_288
-                                elif v == 'IDLE':
-                                    return _LEAF_290
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1071(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_289
-                                elif v == 'IDLE':
-                                    return _LEAF_291
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1072(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_292
-                                elif v == 'IDLE':
-                                    return _LEAF_294
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1073(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_293
-                                elif v == 'IDLE':
-                                    return _LEAF_295
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1074(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_296
-                                elif v == 'IDLE':
-                                    return _LEAF_298
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1075(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_297
-                                elif v == 'IDLE':
-                                    return _LEAF_299
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1076(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5489,63 +4949,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_240
-                                elif v == 'IDLE':
-                                    return _LEAF_242
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1077(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_241
-                                elif v == 'IDLE':
-                                    return _LEAF_243
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1078(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_244
-                                elif v == 'IDLE':
-                                    return _LEAF_246
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1079(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_245
-                                elif v == 'IDLE':
-                                    return _LEAF_247
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1080(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_248
-                                elif v == 'IDLE':
-                                    return _LEAF_250
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1081(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_249
-                                elif v == 'IDLE':
-                                    return _LEAF_251
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1082(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5556,63 +4980,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_276
-                                elif v == 'IDLE':
-                                    return _LEAF_278
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1083(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_277
-                                elif v == 'IDLE':
-                                    return _LEAF_279
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1084(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_280
-                                elif v == 'IDLE':
-                                    return _LEAF_282
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1085(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_281
-                                elif v == 'IDLE':
-                                    return _LEAF_283
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1086(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_284
-                                elif v == 'IDLE':
-                                    return _LEAF_286
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1087(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_285
-                                elif v == 'IDLE':
-                                    return _LEAF_287
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1088(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5623,63 +5011,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_312
-                                elif v == 'IDLE':
-                                    return _LEAF_314
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1089(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_313
-                                elif v == 'IDLE':
-                                    return _LEAF_315
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1090(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_316
-                                elif v == 'IDLE':
-                                    return _LEAF_318
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1091(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_317
-                                elif v == 'IDLE':
-                                    return _LEAF_319
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1092(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_320
-                                elif v == 'IDLE':
-                                    return _LEAF_322
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1093(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_321
-                                elif v == 'IDLE':
-                                    return _LEAF_323
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1094(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5698,63 +5050,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_324
-                                elif v == 'IDLE':
-                                    return _LEAF_326
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1095(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_325
-                                elif v == 'IDLE':
-                                    return _LEAF_327
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1096(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_328
-                                elif v == 'IDLE':
-                                    return _LEAF_330
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1097(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_329
-                                elif v == 'IDLE':
-                                    return _LEAF_331
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1098(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_332
-                                elif v == 'IDLE':
-                                    return _LEAF_334
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1099(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_333
-                                elif v == 'IDLE':
-                                    return _LEAF_335
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1100(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5765,63 +5081,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_360
-                                elif v == 'IDLE':
-                                    return _LEAF_362
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1101(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_361
-                                elif v == 'IDLE':
-                                    return _LEAF_363
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1102(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_364
-                                elif v == 'IDLE':
-                                    return _LEAF_366
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1103(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_365
-                                elif v == 'IDLE':
-                                    return _LEAF_367
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1104(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_368
-                                elif v == 'IDLE':
-                                    return _LEAF_370
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1105(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_369
-                                elif v == 'IDLE':
-                                    return _LEAF_371
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1106(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5832,63 +5112,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_396
-                                elif v == 'IDLE':
-                                    return _LEAF_398
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1107(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_397
-                                elif v == 'IDLE':
-                                    return _LEAF_399
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1108(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_400
-                                elif v == 'IDLE':
-                                    return _LEAF_402
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1109(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_401
-                                elif v == 'IDLE':
-                                    return _LEAF_403
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1110(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_404
-                                elif v == 'IDLE':
-                                    return _LEAF_406
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1111(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_405
-                                elif v == 'IDLE':
-                                    return _LEAF_407
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1112(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5921,63 +5165,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_348
-                                elif v == 'IDLE':
-                                    return _LEAF_350
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1113(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_349
-                                elif v == 'IDLE':
-                                    return _LEAF_351
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1114(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_352
-                                elif v == 'IDLE':
-                                    return _LEAF_354
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1115(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_353
-                                elif v == 'IDLE':
-                                    return _LEAF_355
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1116(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_356
-                                elif v == 'IDLE':
-                                    return _LEAF_358
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1117(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_357
-                                elif v == 'IDLE':
-                                    return _LEAF_359
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1118(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -5988,63 +5196,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_384
-                                elif v == 'IDLE':
-                                    return _LEAF_386
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1119(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_385
-                                elif v == 'IDLE':
-                                    return _LEAF_387
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1120(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_388
-                                elif v == 'IDLE':
-                                    return _LEAF_390
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1121(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_389
-                                elif v == 'IDLE':
-                                    return _LEAF_391
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1122(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_392
-                                elif v == 'IDLE':
-                                    return _LEAF_394
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1123(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_393
-                                elif v == 'IDLE':
-                                    return _LEAF_395
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1124(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6055,63 +5227,27 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_420
-                                elif v == 'IDLE':
-                                    return _LEAF_422
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1125(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_421
-                                elif v == 'IDLE':
-                                    return _LEAF_423
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1126(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_424
-                                elif v == 'IDLE':
-                                    return _LEAF_426
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1127(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_425
-                                elif v == 'IDLE':
-                                    return _LEAF_427
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1128(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
                             v = a['@CALC_GOALstate']
                             if v == 'CALC-GOAL':
                                 calls('changeInterState', (a['@CALC_GOALstate'],))
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_428
-                                elif v == 'IDLE':
-                                    return _LEAF_430
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1129(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_OBJstate']
-                                if v == 'CALC-OBJ':
-                                    return _LEAF_429
-                                elif v == 'IDLE':
-                                    return _LEAF_431
-                                else:
-                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                return _node_1130(a, calls)
                             else:
                                 raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
@@ -6131,193 +5267,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_432
                                 elif v == 'IDLE':
-                                    return _LEAF_0
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_434
-                                elif v == 'IDLE':
-                                    return _LEAF_2
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_987(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_436
                                 elif v == 'IDLE':
-                                    return _LEAF_4
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_438
-                                elif v == 'IDLE':
-                                    return _LEAF_6
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_989(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_440
                                 elif v == 'IDLE':
-                                    return _LEAF_8
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_442
-                                elif v == 'IDLE':
-                                    return _LEAF_10
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_991(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_468
                                 elif v == 'IDLE':
-                                    return _LEAF_36
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_470
-                                elif v == 'IDLE':
-                                    return _LEAF_38
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_993(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_472
                                 elif v == 'IDLE':
-                                    return _LEAF_40
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_474
-                                elif v == 'IDLE':
-                                    return _LEAF_42
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_995(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_476
                                 elif v == 'IDLE':
-                                    return _LEAF_44
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_478
-                                elif v == 'IDLE':
-                                    return _LEAF_46
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_997(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_504
                                 elif v == 'IDLE':
-                                    return _LEAF_72
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_506
-                                elif v == 'IDLE':
-                                    return _LEAF_74
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_999(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_508
                                 elif v == 'IDLE':
-                                    return _LEAF_76
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_510
-                                elif v == 'IDLE':
-                                    return _LEAF_78
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1001(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_512
                                 elif v == 'IDLE':
-                                    return _LEAF_80
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_514
-                                elif v == 'IDLE':
-                                    return _LEAF_82
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1003(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -6327,193 +5409,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_444
                                 elif v == 'IDLE':
-                                    return _LEAF_12
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_446
-                                elif v == 'IDLE':
-                                    return _LEAF_14
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1131(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_448
                                 elif v == 'IDLE':
-                                    return _LEAF_16
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_450
-                                elif v == 'IDLE':
-                                    return _LEAF_18
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1132(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_452
                                 elif v == 'IDLE':
-                                    return _LEAF_20
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_454
-                                elif v == 'IDLE':
-                                    return _LEAF_22
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1133(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_480
                                 elif v == 'IDLE':
-                                    return _LEAF_48
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_482
-                                elif v == 'IDLE':
-                                    return _LEAF_50
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1134(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_484
                                 elif v == 'IDLE':
-                                    return _LEAF_52
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_486
-                                elif v == 'IDLE':
-                                    return _LEAF_54
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1135(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_488
                                 elif v == 'IDLE':
-                                    return _LEAF_56
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_490
-                                elif v == 'IDLE':
-                                    return _LEAF_58
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1136(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_516
                                 elif v == 'IDLE':
-                                    return _LEAF_84
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_518
-                                elif v == 'IDLE':
-                                    return _LEAF_86
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1137(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_520
                                 elif v == 'IDLE':
-                                    return _LEAF_88
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_522
-                                elif v == 'IDLE':
-                                    return _LEAF_90
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1138(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_524
                                 elif v == 'IDLE':
-                                    return _LEAF_92
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_526
-                                elif v == 'IDLE':
-                                    return _LEAF_94
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1139(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -6523,193 +5551,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_456
                                 elif v == 'IDLE':
-                                    return _LEAF_24
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_458
-                                elif v == 'IDLE':
-                                    return _LEAF_26
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1005(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_460
                                 elif v == 'IDLE':
-                                    return _LEAF_28
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_462
-                                elif v == 'IDLE':
-                                    return _LEAF_30
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1007(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_464
                                 elif v == 'IDLE':
-                                    return _LEAF_32
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_466
-                                elif v == 'IDLE':
-                                    return _LEAF_34
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1009(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_492
                                 elif v == 'IDLE':
-                                    return _LEAF_60
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_494
-                                elif v == 'IDLE':
-                                    return _LEAF_62
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1011(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_496
                                 elif v == 'IDLE':
-                                    return _LEAF_64
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_498
-                                elif v == 'IDLE':
-                                    return _LEAF_66
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1013(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_500
                                 elif v == 'IDLE':
-                                    return _LEAF_68
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_502
-                                elif v == 'IDLE':
-                                    return _LEAF_70
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1015(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_528
                                 elif v == 'IDLE':
-                                    return _LEAF_96
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_530
-                                elif v == 'IDLE':
-                                    return _LEAF_98
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1017(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_532
                                 elif v == 'IDLE':
-                                    return _LEAF_100
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_534
-                                elif v == 'IDLE':
-                                    return _LEAF_102
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1019(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_536
                                 elif v == 'IDLE':
-                                    return _LEAF_104
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_538
-                                elif v == 'IDLE':
-                                    return _LEAF_106
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1021(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -6723,193 +5697,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_540
                                 elif v == 'IDLE':
-                                    return _LEAF_108
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_542
-                                elif v == 'IDLE':
-                                    return _LEAF_110
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1023(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_544
                                 elif v == 'IDLE':
-                                    return _LEAF_112
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_546
-                                elif v == 'IDLE':
-                                    return _LEAF_114
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1025(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_548
                                 elif v == 'IDLE':
-                                    return _LEAF_116
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_550
-                                elif v == 'IDLE':
-                                    return _LEAF_118
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1027(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_576
                                 elif v == 'IDLE':
-                                    return _LEAF_144
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_578
-                                elif v == 'IDLE':
-                                    return _LEAF_146
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1029(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_580
                                 elif v == 'IDLE':
-                                    return _LEAF_148
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_582
-                                elif v == 'IDLE':
-                                    return _LEAF_150
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1031(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_584
                                 elif v == 'IDLE':
-                                    return _LEAF_152
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_586
-                                elif v == 'IDLE':
-                                    return _LEAF_154
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1033(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_612
                                 elif v == 'IDLE':
-                                    return _LEAF_180
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_614
-                                elif v == 'IDLE':
-                                    return _LEAF_182
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1035(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_616
                                 elif v == 'IDLE':
-                                    return _LEAF_184
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_618
-                                elif v == 'IDLE':
-                                    return _LEAF_186
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1037(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_620
                                 elif v == 'IDLE':
-                                    return _LEAF_188
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_622
-                                elif v == 'IDLE':
-                                    return _LEAF_190
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1039(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -6919,193 +5839,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_552
                                 elif v == 'IDLE':
-                                    return _LEAF_120
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_554
-                                elif v == 'IDLE':
-                                    return _LEAF_122
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1140(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_556
                                 elif v == 'IDLE':
-                                    return _LEAF_124
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_558
-                                elif v == 'IDLE':
-                                    return _LEAF_126
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1141(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_560
                                 elif v == 'IDLE':
-                                    return _LEAF_128
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_562
-                                elif v == 'IDLE':
-                                    return _LEAF_130
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1142(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_588
                                 elif v == 'IDLE':
-                                    return _LEAF_156
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_590
-                                elif v == 'IDLE':
-                                    return _LEAF_158
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1143(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_592
                                 elif v == 'IDLE':
-                                    return _LEAF_160
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_594
-                                elif v == 'IDLE':
-                                    return _LEAF_162
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1144(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_596
                                 elif v == 'IDLE':
-                                    return _LEAF_164
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_598
-                                elif v == 'IDLE':
-                                    return _LEAF_166
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1145(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_624
                                 elif v == 'IDLE':
-                                    return _LEAF_192
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_626
-                                elif v == 'IDLE':
-                                    return _LEAF_194
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1146(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_628
                                 elif v == 'IDLE':
-                                    return _LEAF_196
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_630
-                                elif v == 'IDLE':
-                                    return _LEAF_198
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1147(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_632
                                 elif v == 'IDLE':
-                                    return _LEAF_200
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_634
-                                elif v == 'IDLE':
-                                    return _LEAF_202
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1148(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -7115,193 +5981,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_564
                                 elif v == 'IDLE':
-                                    return _LEAF_132
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_566
-                                elif v == 'IDLE':
-                                    return _LEAF_134
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1041(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_568
                                 elif v == 'IDLE':
-                                    return _LEAF_136
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_570
-                                elif v == 'IDLE':
-                                    return _LEAF_138
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1043(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_572
                                 elif v == 'IDLE':
-                                    return _LEAF_140
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_574
-                                elif v == 'IDLE':
-                                    return _LEAF_142
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1045(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_600
                                 elif v == 'IDLE':
-                                    return _LEAF_168
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_602
-                                elif v == 'IDLE':
-                                    return _LEAF_170
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1047(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_604
                                 elif v == 'IDLE':
-                                    return _LEAF_172
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_606
-                                elif v == 'IDLE':
-                                    return _LEAF_174
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1049(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_608
                                 elif v == 'IDLE':
-                                    return _LEAF_176
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_610
-                                elif v == 'IDLE':
-                                    return _LEAF_178
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1051(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_636
                                 elif v == 'IDLE':
-                                    return _LEAF_204
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_638
-                                elif v == 'IDLE':
-                                    return _LEAF_206
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1053(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_640
                                 elif v == 'IDLE':
-                                    return _LEAF_208
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_642
-                                elif v == 'IDLE':
-                                    return _LEAF_210
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1055(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_644
                                 elif v == 'IDLE':
-                                    return _LEAF_212
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_646
-                                elif v == 'IDLE':
-                                    return _LEAF_214
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1057(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -7315,193 +6127,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_648
                                 elif v == 'IDLE':
-                                    return _LEAF_216
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_650
-                                elif v == 'IDLE':
-                                    return _LEAF_218
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1059(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_652
                                 elif v == 'IDLE':
-                                    return _LEAF_220
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_654
-                                elif v == 'IDLE':
-                                    return _LEAF_222
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1061(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_656
                                 elif v == 'IDLE':
-                                    return _LEAF_224
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_658
-                                elif v == 'IDLE':
-                                    return _LEAF_226
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1063(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_684
                                 elif v == 'IDLE':
-                                    return _LEAF_252
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_686
-                                elif v == 'IDLE':
-                                    return _LEAF_254
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1065(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_688
                                 elif v == 'IDLE':
-                                    return _LEAF_256
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_690
-                                elif v == 'IDLE':
-                                    return _LEAF_258
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1067(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_692
                                 elif v == 'IDLE':
-                                    return _LEAF_260
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_694
-                                elif v == 'IDLE':
-                                    return _LEAF_262
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1069(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_720
                                 elif v == 'IDLE':
-                                    return _LEAF_288
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_722
-                                elif v == 'IDLE':
-                                    return _LEAF_290
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1071(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_724
                                 elif v == 'IDLE':
-                                    return _LEAF_292
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_726
-                                elif v == 'IDLE':
-                                    return _LEAF_294
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1073(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_728
                                 elif v == 'IDLE':
-                                    return _LEAF_296
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_730
-                                elif v == 'IDLE':
-                                    return _LEAF_298
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1075(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -7511,193 +6269,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_660
                                 elif v == 'IDLE':
-                                    return _LEAF_228
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_662
-                                elif v == 'IDLE':
-                                    return _LEAF_230
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1149(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_664
                                 elif v == 'IDLE':
-                                    return _LEAF_232
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_666
-                                elif v == 'IDLE':
-                                    return _LEAF_234
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1150(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_668
                                 elif v == 'IDLE':
-                                    return _LEAF_236
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_670
-                                elif v == 'IDLE':
-                                    return _LEAF_238
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1151(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_696
                                 elif v == 'IDLE':
-                                    return _LEAF_264
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_698
-                                elif v == 'IDLE':
-                                    return _LEAF_266
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1152(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_700
                                 elif v == 'IDLE':
-                                    return _LEAF_268
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_702
-                                elif v == 'IDLE':
-                                    return _LEAF_270
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1153(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_704
                                 elif v == 'IDLE':
-                                    return _LEAF_272
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_706
-                                elif v == 'IDLE':
-                                    return _LEAF_274
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1154(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_732
                                 elif v == 'IDLE':
-                                    return _LEAF_300
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_734
-                                elif v == 'IDLE':
-                                    return _LEAF_302
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1155(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_736
                                 elif v == 'IDLE':
-                                    return _LEAF_304
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_738
-                                elif v == 'IDLE':
-                                    return _LEAF_306
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1156(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_740
                                 elif v == 'IDLE':
-                                    return _LEAF_308
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_742
-                                elif v == 'IDLE':
-                                    return _LEAF_310
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1157(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -7707,193 +6411,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_672
                                 elif v == 'IDLE':
-                                    return _LEAF_240
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_674
-                                elif v == 'IDLE':
-                                    return _LEAF_242
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1077(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_676
                                 elif v == 'IDLE':
-                                    return _LEAF_244
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_678
-                                elif v == 'IDLE':
-                                    return _LEAF_246
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1079(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_680
                                 elif v == 'IDLE':
-                                    return _LEAF_248
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_682
-                                elif v == 'IDLE':
-                                    return _LEAF_250
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1081(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_708
                                 elif v == 'IDLE':
-                                    return _LEAF_276
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_710
-                                elif v == 'IDLE':
-                                    return _LEAF_278
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1083(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_712
                                 elif v == 'IDLE':
-                                    return _LEAF_280
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_714
-                                elif v == 'IDLE':
-                                    return _LEAF_282
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1085(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_716
                                 elif v == 'IDLE':
-                                    return _LEAF_284
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_718
-                                elif v == 'IDLE':
-                                    return _LEAF_286
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1087(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_744
                                 elif v == 'IDLE':
-                                    return _LEAF_312
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_746
-                                elif v == 'IDLE':
-                                    return _LEAF_314
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1089(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_748
                                 elif v == 'IDLE':
-                                    return _LEAF_316
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_750
-                                elif v == 'IDLE':
-                                    return _LEAF_318
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1091(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_752
                                 elif v == 'IDLE':
-                                    return _LEAF_320
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_754
-                                elif v == 'IDLE':
-                                    return _LEAF_322
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1093(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -7907,193 +6557,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_756
                                 elif v == 'IDLE':
-                                    return _LEAF_324
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_758
-                                elif v == 'IDLE':
-                                    return _LEAF_326
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1095(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_760
                                 elif v == 'IDLE':
-                                    return _LEAF_328
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_762
-                                elif v == 'IDLE':
-                                    return _LEAF_330
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1097(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_764
                                 elif v == 'IDLE':
-                                    return _LEAF_332
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_766
-                                elif v == 'IDLE':
-                                    return _LEAF_334
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1099(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_792
                                 elif v == 'IDLE':
-                                    return _LEAF_360
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_794
-                                elif v == 'IDLE':
-                                    return _LEAF_362
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1101(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_796
                                 elif v == 'IDLE':
-                                    return _LEAF_364
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_798
-                                elif v == 'IDLE':
-                                    return _LEAF_366
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1103(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_800
                                 elif v == 'IDLE':
-                                    return _LEAF_368
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_802
-                                elif v == 'IDLE':
-                                    return _LEAF_370
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1105(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_828
                                 elif v == 'IDLE':
-                                    return _LEAF_396
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_830
-                                elif v == 'IDLE':
-                                    return _LEAF_398
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1107(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_832
                                 elif v == 'IDLE':
-                                    return _LEAF_400
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_834
-                                elif v == 'IDLE':
-                                    return _LEAF_402
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1109(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_836
                                 elif v == 'IDLE':
-                                    return _LEAF_404
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_838
-                                elif v == 'IDLE':
-                                    return _LEAF_406
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1111(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -8103,193 +6699,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_768
                                 elif v == 'IDLE':
-                                    return _LEAF_336
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_770
-                                elif v == 'IDLE':
-                                    return _LEAF_338
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1158(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_772
                                 elif v == 'IDLE':
-                                    return _LEAF_340
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_774
-                                elif v == 'IDLE':
-                                    return _LEAF_342
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1159(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_776
                                 elif v == 'IDLE':
-                                    return _LEAF_344
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_778
-                                elif v == 'IDLE':
-                                    return _LEAF_346
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1160(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_804
                                 elif v == 'IDLE':
-                                    return _LEAF_372
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_806
-                                elif v == 'IDLE':
-                                    return _LEAF_374
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1161(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_808
                                 elif v == 'IDLE':
-                                    return _LEAF_376
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_810
-                                elif v == 'IDLE':
-                                    return _LEAF_378
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1162(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_812
                                 elif v == 'IDLE':
-                                    return _LEAF_380
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_814
-                                elif v == 'IDLE':
-                                    return _LEAF_382
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1163(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_840
                                 elif v == 'IDLE':
-                                    return _LEAF_408
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_842
-                                elif v == 'IDLE':
-                                    return _LEAF_410
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1164(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_844
                                 elif v == 'IDLE':
-                                    return _LEAF_412
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_846
-                                elif v == 'IDLE':
-                                    return _LEAF_414
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1165(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_848
                                 elif v == 'IDLE':
-                                    return _LEAF_416
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_850
-                                elif v == 'IDLE':
-                                    return _LEAF_418
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1166(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -8299,193 +6841,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_780
                                 elif v == 'IDLE':
-                                    return _LEAF_348
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_782
-                                elif v == 'IDLE':
-                                    return _LEAF_350
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1113(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_784
                                 elif v == 'IDLE':
-                                    return _LEAF_352
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_786
-                                elif v == 'IDLE':
-                                    return _LEAF_354
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1115(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_788
                                 elif v == 'IDLE':
-                                    return _LEAF_356
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_790
-                                elif v == 'IDLE':
-                                    return _LEAF_358
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1117(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_816
                                 elif v == 'IDLE':
-                                    return _LEAF_384
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_818
-                                elif v == 'IDLE':
-                                    return _LEAF_386
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1119(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_820
                                 elif v == 'IDLE':
-                                    return _LEAF_388
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_822
-                                elif v == 'IDLE':
-                                    return _LEAF_390
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1121(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_824
                                 elif v == 'IDLE':
-                                    return _LEAF_392
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_826
-                                elif v == 'IDLE':
-                                    return _LEAF_394
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1123(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_852
                                 elif v == 'IDLE':
-                                    return _LEAF_420
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_854
-                                elif v == 'IDLE':
-                                    return _LEAF_422
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1125(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_856
                                 elif v == 'IDLE':
-                                    return _LEAF_424
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_858
-                                elif v == 'IDLE':
-                                    return _LEAF_426
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1127(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_860
                                 elif v == 'IDLE':
-                                    return _LEAF_428
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_862
-                                elif v == 'IDLE':
-                                    return _LEAF_430
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1129(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -8503,193 +6991,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_1
-                                elif v == 'IDLE':
-                                    return _LEAF_433
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_988(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_3
-                                elif v == 'IDLE':
-                                    return _LEAF_435
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1167(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_5
-                                elif v == 'IDLE':
-                                    return _LEAF_437
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_990(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_7
-                                elif v == 'IDLE':
-                                    return _LEAF_439
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1168(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_9
-                                elif v == 'IDLE':
-                                    return _LEAF_441
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_992(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_11
-                                elif v == 'IDLE':
-                                    return _LEAF_443
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1169(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_37
-                                elif v == 'IDLE':
-                                    return _LEAF_469
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_994(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_39
-                                elif v == 'IDLE':
-                                    return _LEAF_471
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1170(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_41
-                                elif v == 'IDLE':
-                                    return _LEAF_473
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_996(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_43
-                                elif v == 'IDLE':
-                                    return _LEAF_475
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1171(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_45
-                                elif v == 'IDLE':
-                                    return _LEAF_477
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_998(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_47
-                                elif v == 'IDLE':
-                                    return _LEAF_479
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1172(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_73
-                                elif v == 'IDLE':
-                                    return _LEAF_505
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1000(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_75
-                                elif v == 'IDLE':
-                                    return _LEAF_507
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1173(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_77
-                                elif v == 'IDLE':
-                                    return _LEAF_509
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1002(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_79
-                                elif v == 'IDLE':
-                                    return _LEAF_511
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1174(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_81
-                                elif v == 'IDLE':
-                                    return _LEAF_513
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1004(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_83
-                                elif v == 'IDLE':
-                                    return _LEAF_515
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1175(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -8699,193 +7079,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_13
                                 elif v == 'IDLE':
-                                    return _LEAF_445
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_15
-                                elif v == 'IDLE':
-                                    return _LEAF_447
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1176(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_17
                                 elif v == 'IDLE':
-                                    return _LEAF_449
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_19
-                                elif v == 'IDLE':
-                                    return _LEAF_451
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1177(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_21
                                 elif v == 'IDLE':
-                                    return _LEAF_453
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_23
-                                elif v == 'IDLE':
-                                    return _LEAF_455
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1178(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_49
                                 elif v == 'IDLE':
-                                    return _LEAF_481
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_51
-                                elif v == 'IDLE':
-                                    return _LEAF_483
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1179(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_53
                                 elif v == 'IDLE':
-                                    return _LEAF_485
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_55
-                                elif v == 'IDLE':
-                                    return _LEAF_487
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1180(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_57
                                 elif v == 'IDLE':
-                                    return _LEAF_489
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_59
-                                elif v == 'IDLE':
-                                    return _LEAF_491
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1181(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_85
                                 elif v == 'IDLE':
-                                    return _LEAF_517
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_87
-                                elif v == 'IDLE':
-                                    return _LEAF_519
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1182(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_89
                                 elif v == 'IDLE':
-                                    return _LEAF_521
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_91
-                                elif v == 'IDLE':
-                                    return _LEAF_523
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1183(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_93
                                 elif v == 'IDLE':
-                                    return _LEAF_525
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_95
-                                elif v == 'IDLE':
-                                    return _LEAF_527
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1184(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -8895,193 +7221,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_25
-                                elif v == 'IDLE':
-                                    return _LEAF_457
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1006(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_27
-                                elif v == 'IDLE':
-                                    return _LEAF_459
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1185(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_29
-                                elif v == 'IDLE':
-                                    return _LEAF_461
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1008(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_31
-                                elif v == 'IDLE':
-                                    return _LEAF_463
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1186(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_33
-                                elif v == 'IDLE':
-                                    return _LEAF_465
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1010(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_35
-                                elif v == 'IDLE':
-                                    return _LEAF_467
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1187(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_61
-                                elif v == 'IDLE':
-                                    return _LEAF_493
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1012(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_63
-                                elif v == 'IDLE':
-                                    return _LEAF_495
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1188(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_65
-                                elif v == 'IDLE':
-                                    return _LEAF_497
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1014(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_67
-                                elif v == 'IDLE':
-                                    return _LEAF_499
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1189(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_69
-                                elif v == 'IDLE':
-                                    return _LEAF_501
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1016(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_71
-                                elif v == 'IDLE':
-                                    return _LEAF_503
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1190(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_97
-                                elif v == 'IDLE':
-                                    return _LEAF_529
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1018(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_99
-                                elif v == 'IDLE':
-                                    return _LEAF_531
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1191(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_101
-                                elif v == 'IDLE':
-                                    return _LEAF_533
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1020(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_103
-                                elif v == 'IDLE':
-                                    return _LEAF_535
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1192(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_105
-                                elif v == 'IDLE':
-                                    return _LEAF_537
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1022(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_107
-                                elif v == 'IDLE':
-                                    return _LEAF_539
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1193(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -9095,193 +7313,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_109
-                                elif v == 'IDLE':
-                                    return _LEAF_541
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1024(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_111
-                                elif v == 'IDLE':
-                                    return _LEAF_543
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1194(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_113
-                                elif v == 'IDLE':
-                                    return _LEAF_545
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1026(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_115
-                                elif v == 'IDLE':
-                                    return _LEAF_547
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1195(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_117
-                                elif v == 'IDLE':
-                                    return _LEAF_549
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1028(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_119
-                                elif v == 'IDLE':
-                                    return _LEAF_551
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1196(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_145
-                                elif v == 'IDLE':
-                                    return _LEAF_577
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1030(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_147
-                                elif v == 'IDLE':
-                                    return _LEAF_579
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1197(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_149
-                                elif v == 'IDLE':
-                                    return _LEAF_581
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1032(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_151
-                                elif v == 'IDLE':
-                                    return _LEAF_583
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1198(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_153
-                                elif v == 'IDLE':
-                                    return _LEAF_585
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1034(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_155
-                                elif v == 'IDLE':
-                                    return _LEAF_587
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1199(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_181
-                                elif v == 'IDLE':
-                                    return _LEAF_613
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1036(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_183
-                                elif v == 'IDLE':
-                                    return _LEAF_615
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1200(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_185
-                                elif v == 'IDLE':
-                                    return _LEAF_617
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1038(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_187
-                                elif v == 'IDLE':
-                                    return _LEAF_619
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1201(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_189
-                                elif v == 'IDLE':
-                                    return _LEAF_621
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1040(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_191
-                                elif v == 'IDLE':
-                                    return _LEAF_623
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1202(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -9291,193 +7401,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_121
                                 elif v == 'IDLE':
-                                    return _LEAF_553
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_123
-                                elif v == 'IDLE':
-                                    return _LEAF_555
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1203(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_125
                                 elif v == 'IDLE':
-                                    return _LEAF_557
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_127
-                                elif v == 'IDLE':
-                                    return _LEAF_559
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1204(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_129
                                 elif v == 'IDLE':
-                                    return _LEAF_561
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_131
-                                elif v == 'IDLE':
-                                    return _LEAF_563
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1205(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_157
                                 elif v == 'IDLE':
-                                    return _LEAF_589
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_159
-                                elif v == 'IDLE':
-                                    return _LEAF_591
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1206(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_161
                                 elif v == 'IDLE':
-                                    return _LEAF_593
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_163
-                                elif v == 'IDLE':
-                                    return _LEAF_595
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1207(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_165
                                 elif v == 'IDLE':
-                                    return _LEAF_597
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_167
-                                elif v == 'IDLE':
-                                    return _LEAF_599
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1208(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_193
                                 elif v == 'IDLE':
-                                    return _LEAF_625
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_195
-                                elif v == 'IDLE':
-                                    return _LEAF_627
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1209(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_197
                                 elif v == 'IDLE':
-                                    return _LEAF_629
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_199
-                                elif v == 'IDLE':
-                                    return _LEAF_631
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1210(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_201
                                 elif v == 'IDLE':
-                                    return _LEAF_633
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_203
-                                elif v == 'IDLE':
-                                    return _LEAF_635
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1211(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -9487,193 +7543,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_133
-                                elif v == 'IDLE':
-                                    return _LEAF_565
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1042(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_135
-                                elif v == 'IDLE':
-                                    return _LEAF_567
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1212(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_137
-                                elif v == 'IDLE':
-                                    return _LEAF_569
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1044(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_139
-                                elif v == 'IDLE':
-                                    return _LEAF_571
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1213(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_141
-                                elif v == 'IDLE':
-                                    return _LEAF_573
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1046(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_143
-                                elif v == 'IDLE':
-                                    return _LEAF_575
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1214(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_169
-                                elif v == 'IDLE':
-                                    return _LEAF_601
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1048(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_171
-                                elif v == 'IDLE':
-                                    return _LEAF_603
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1215(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_173
-                                elif v == 'IDLE':
-                                    return _LEAF_605
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1050(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_175
-                                elif v == 'IDLE':
-                                    return _LEAF_607
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1216(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_177
-                                elif v == 'IDLE':
-                                    return _LEAF_609
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1052(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_179
-                                elif v == 'IDLE':
-                                    return _LEAF_611
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1217(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_205
-                                elif v == 'IDLE':
-                                    return _LEAF_637
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1054(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_207
-                                elif v == 'IDLE':
-                                    return _LEAF_639
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1218(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_209
-                                elif v == 'IDLE':
-                                    return _LEAF_641
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1056(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_211
-                                elif v == 'IDLE':
-                                    return _LEAF_643
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1219(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_213
-                                elif v == 'IDLE':
-                                    return _LEAF_645
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1058(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_215
-                                elif v == 'IDLE':
-                                    return _LEAF_647
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1220(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -9687,193 +7635,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_217
-                                elif v == 'IDLE':
-                                    return _LEAF_649
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1060(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_219
-                                elif v == 'IDLE':
-                                    return _LEAF_651
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1221(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_221
-                                elif v == 'IDLE':
-                                    return _LEAF_653
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1062(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_223
-                                elif v == 'IDLE':
-                                    return _LEAF_655
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1222(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_225
-                                elif v == 'IDLE':
-                                    return _LEAF_657
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1064(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_227
-                                elif v == 'IDLE':
-                                    return _LEAF_659
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1223(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_253
-                                elif v == 'IDLE':
-                                    return _LEAF_685
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1066(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_255
-                                elif v == 'IDLE':
-                                    return _LEAF_687
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1224(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_257
-                                elif v == 'IDLE':
-                                    return _LEAF_689
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1068(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_259
-                                elif v == 'IDLE':
-                                    return _LEAF_691
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1225(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_261
-                                elif v == 'IDLE':
-                                    return _LEAF_693
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1070(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_263
-                                elif v == 'IDLE':
-                                    return _LEAF_695
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1226(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_289
-                                elif v == 'IDLE':
-                                    return _LEAF_721
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1072(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_291
-                                elif v == 'IDLE':
-                                    return _LEAF_723
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1227(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_293
-                                elif v == 'IDLE':
-                                    return _LEAF_725
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1074(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_295
-                                elif v == 'IDLE':
-                                    return _LEAF_727
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1228(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_297
-                                elif v == 'IDLE':
-                                    return _LEAF_729
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1076(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_299
-                                elif v == 'IDLE':
-                                    return _LEAF_731
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1229(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -9883,193 +7723,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_229
                                 elif v == 'IDLE':
-                                    return _LEAF_661
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_231
-                                elif v == 'IDLE':
-                                    return _LEAF_663
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1230(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_233
                                 elif v == 'IDLE':
-                                    return _LEAF_665
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_235
-                                elif v == 'IDLE':
-                                    return _LEAF_667
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1231(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_237
                                 elif v == 'IDLE':
-                                    return _LEAF_669
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_239
-                                elif v == 'IDLE':
-                                    return _LEAF_671
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1232(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_265
                                 elif v == 'IDLE':
-                                    return _LEAF_697
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_267
-                                elif v == 'IDLE':
-                                    return _LEAF_699
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1233(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_269
                                 elif v == 'IDLE':
-                                    return _LEAF_701
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_271
-                                elif v == 'IDLE':
-                                    return _LEAF_703
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1234(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_273
                                 elif v == 'IDLE':
-                                    return _LEAF_705
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_275
-                                elif v == 'IDLE':
-                                    return _LEAF_707
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1235(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_301
                                 elif v == 'IDLE':
-                                    return _LEAF_733
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_303
-                                elif v == 'IDLE':
-                                    return _LEAF_735
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1236(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_305
                                 elif v == 'IDLE':
-                                    return _LEAF_737
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_307
-                                elif v == 'IDLE':
-                                    return _LEAF_739
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1237(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_309
                                 elif v == 'IDLE':
-                                    return _LEAF_741
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_311
-                                elif v == 'IDLE':
-                                    return _LEAF_743
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1238(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -10079,193 +7865,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_241
-                                elif v == 'IDLE':
-                                    return _LEAF_673
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1078(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_243
-                                elif v == 'IDLE':
-                                    return _LEAF_675
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1239(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_245
-                                elif v == 'IDLE':
-                                    return _LEAF_677
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1080(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_247
-                                elif v == 'IDLE':
-                                    return _LEAF_679
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1240(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_249
-                                elif v == 'IDLE':
-                                    return _LEAF_681
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1082(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_251
-                                elif v == 'IDLE':
-                                    return _LEAF_683
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1241(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_277
-                                elif v == 'IDLE':
-                                    return _LEAF_709
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1084(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_279
-                                elif v == 'IDLE':
-                                    return _LEAF_711
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1242(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_281
-                                elif v == 'IDLE':
-                                    return _LEAF_713
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1086(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_283
-                                elif v == 'IDLE':
-                                    return _LEAF_715
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1243(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_285
-                                elif v == 'IDLE':
-                                    return _LEAF_717
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1088(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_287
-                                elif v == 'IDLE':
-                                    return _LEAF_719
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1244(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_313
-                                elif v == 'IDLE':
-                                    return _LEAF_745
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1090(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_315
-                                elif v == 'IDLE':
-                                    return _LEAF_747
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1245(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_317
-                                elif v == 'IDLE':
-                                    return _LEAF_749
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1092(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_319
-                                elif v == 'IDLE':
-                                    return _LEAF_751
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1246(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_321
-                                elif v == 'IDLE':
-                                    return _LEAF_753
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1094(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_323
-                                elif v == 'IDLE':
-                                    return _LEAF_755
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1247(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -10279,193 +7957,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_325
-                                elif v == 'IDLE':
-                                    return _LEAF_757
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1096(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_327
-                                elif v == 'IDLE':
-                                    return _LEAF_759
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1248(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_329
-                                elif v == 'IDLE':
-                                    return _LEAF_761
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1098(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_331
-                                elif v == 'IDLE':
-                                    return _LEAF_763
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1249(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_333
-                                elif v == 'IDLE':
-                                    return _LEAF_765
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1100(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_335
-                                elif v == 'IDLE':
-                                    return _LEAF_767
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1250(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_361
-                                elif v == 'IDLE':
-                                    return _LEAF_793
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1102(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_363
-                                elif v == 'IDLE':
-                                    return _LEAF_795
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1251(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_365
-                                elif v == 'IDLE':
-                                    return _LEAF_797
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1104(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_367
-                                elif v == 'IDLE':
-                                    return _LEAF_799
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1252(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_369
-                                elif v == 'IDLE':
-                                    return _LEAF_801
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1106(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_371
-                                elif v == 'IDLE':
-                                    return _LEAF_803
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1253(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_397
-                                elif v == 'IDLE':
-                                    return _LEAF_829
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1108(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_399
-                                elif v == 'IDLE':
-                                    return _LEAF_831
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1254(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_401
-                                elif v == 'IDLE':
-                                    return _LEAF_833
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1110(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_403
-                                elif v == 'IDLE':
-                                    return _LEAF_835
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1255(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_405
-                                elif v == 'IDLE':
-                                    return _LEAF_837
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1112(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_407
-                                elif v == 'IDLE':
-                                    return _LEAF_839
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1256(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -10475,193 +8045,139 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_337
                                 elif v == 'IDLE':
-                                    return _LEAF_769
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_339
-                                elif v == 'IDLE':
-                                    return _LEAF_771
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1257(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_341
                                 elif v == 'IDLE':
-                                    return _LEAF_773
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_343
-                                elif v == 'IDLE':
-                                    return _LEAF_775
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1258(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_345
                                 elif v == 'IDLE':
-                                    return _LEAF_777
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_347
-                                elif v == 'IDLE':
-                                    return _LEAF_779
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1259(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_373
                                 elif v == 'IDLE':
-                                    return _LEAF_805
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_375
-                                elif v == 'IDLE':
-                                    return _LEAF_807
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1260(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_377
                                 elif v == 'IDLE':
-                                    return _LEAF_809
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_379
-                                elif v == 'IDLE':
-                                    return _LEAF_811
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1261(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_381
                                 elif v == 'IDLE':
-                                    return _LEAF_813
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_383
-                                elif v == 'IDLE':
-                                    return _LEAF_815
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1262(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_409
                                 elif v == 'IDLE':
-                                    return _LEAF_841
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_411
-                                elif v == 'IDLE':
-                                    return _LEAF_843
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1263(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_413
                                 elif v == 'IDLE':
-                                    return _LEAF_845
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_415
-                                elif v == 'IDLE':
-                                    return _LEAF_847
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1264(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                v = a['@CALC_OBJstate']
+                                if v == 'CALC-OBJ':
                                     return _LEAF_417
                                 elif v == 'IDLE':
-                                    return _LEAF_849
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-                            elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
                                     return _LEAF_419
-                                elif v == 'IDLE':
-                                    return _LEAF_851
                                 else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                            elif v == 'IDLE':
+                                return _node_1265(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -10671,193 +8187,85 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     if v == 'READ-OBST':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_349
-                                elif v == 'IDLE':
-                                    return _LEAF_781
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1114(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_351
-                                elif v == 'IDLE':
-                                    return _LEAF_783
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1266(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_353
-                                elif v == 'IDLE':
-                                    return _LEAF_785
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1116(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_355
-                                elif v == 'IDLE':
-                                    return _LEAF_787
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1267(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_357
-                                elif v == 'IDLE':
-                                    return _LEAF_789
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1118(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_359
-                                elif v == 'IDLE':
-                                    return _LEAF_791
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1268(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'SEARCH-OBJ':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_385
-                                elif v == 'IDLE':
-                                    return _LEAF_817
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1120(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_387
-                                elif v == 'IDLE':
-                                    return _LEAF_819
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1269(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_389
-                                elif v == 'IDLE':
-                                    return _LEAF_821
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1122(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_391
-                                elif v == 'IDLE':
-                                    return _LEAF_823
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1270(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_393
-                                elif v == 'IDLE':
-                                    return _LEAF_825
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1124(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_395
-                                elif v == 'IDLE':
-                                    return _LEAF_827
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1271(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     elif v == 'IDLE':
                         v = a['@ARM_OBJ_ARM_BACKstate']
                         if v == 'ARM-OBJ':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_421
-                                elif v == 'IDLE':
-                                    return _LEAF_853
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1126(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_423
-                                elif v == 'IDLE':
-                                    return _LEAF_855
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1272(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'ARM-BACK':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_425
-                                elif v == 'IDLE':
-                                    return _LEAF_857
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1128(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_427
-                                elif v == 'IDLE':
-                                    return _LEAF_859
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1273(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         elif v == 'IDLE':
-                            v = a['@CALC_OBJstate']
-                            if v == 'CALC-OBJ':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_429
-                                elif v == 'IDLE':
-                                    return _LEAF_861
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                            v = a['@CALC_GOALstate']
+                            if v == 'CALC-GOAL':
+                                return _node_1130(a, calls)
                             elif v == 'IDLE':
-                                v = a['@CALC_GOALstate']
-                                if v == 'CALC-GOAL':
-                                    return _LEAF_431
-                                elif v == 'IDLE':
-                                    return _LEAF_863
-                                else:
-                                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                                return _node_1274(a, calls)
                             else:
-                                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                         else:
                             raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
                     else:
@@ -10867,7 +8275,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_987(a, calls)
+            return _node_1275(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'CALC-OBJ':
@@ -13837,7 +11245,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             else:
                 raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_988(a, calls)
+            return _node_1276(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     else:
@@ -26096,6 +23504,2886 @@ def _node_986(a: Any, calls: Calls) -> Decision:
 
 
 def _node_987(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_0
+    elif v == 'IDLE':
+        return _LEAF_2
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_988(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_1
+    elif v == 'IDLE':
+        return _LEAF_3
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_989(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_4
+    elif v == 'IDLE':
+        return _LEAF_6
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_990(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_5
+    elif v == 'IDLE':
+        return _LEAF_7
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_991(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_8
+    elif v == 'IDLE':
+        return _LEAF_10
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_992(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_9
+    elif v == 'IDLE':
+        return _LEAF_11
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_993(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_36
+    elif v == 'IDLE':
+        return _LEAF_38
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_994(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_37
+    elif v == 'IDLE':
+        return _LEAF_39
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_995(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_40
+    elif v == 'IDLE':
+        return _LEAF_42
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_996(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_41
+    elif v == 'IDLE':
+        return _LEAF_43
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_997(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_44
+    elif v == 'IDLE':
+        return _LEAF_46
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_998(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_45
+    elif v == 'IDLE':
+        return _LEAF_47
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_999(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_72
+    elif v == 'IDLE':
+        return _LEAF_74
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1000(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_73
+    elif v == 'IDLE':
+        return _LEAF_75
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1001(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_76
+    elif v == 'IDLE':
+        return _LEAF_78
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1002(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_77
+    elif v == 'IDLE':
+        return _LEAF_79
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1003(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_80
+    elif v == 'IDLE':
+        return _LEAF_82
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1004(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_81
+    elif v == 'IDLE':
+        return _LEAF_83
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1005(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_24
+    elif v == 'IDLE':
+        return _LEAF_26
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1006(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_25
+    elif v == 'IDLE':
+        return _LEAF_27
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1007(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_28
+    elif v == 'IDLE':
+        return _LEAF_30
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1008(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_29
+    elif v == 'IDLE':
+        return _LEAF_31
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1009(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_32
+    elif v == 'IDLE':
+        return _LEAF_34
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1010(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_33
+    elif v == 'IDLE':
+        return _LEAF_35
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1011(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_60
+    elif v == 'IDLE':
+        return _LEAF_62
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1012(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_61
+    elif v == 'IDLE':
+        return _LEAF_63
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1013(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_64
+    elif v == 'IDLE':
+        return _LEAF_66
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1014(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_65
+    elif v == 'IDLE':
+        return _LEAF_67
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1015(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_68
+    elif v == 'IDLE':
+        return _LEAF_70
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1016(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_69
+    elif v == 'IDLE':
+        return _LEAF_71
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1017(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_96
+    elif v == 'IDLE':
+        return _LEAF_98
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1018(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_97
+    elif v == 'IDLE':
+        return _LEAF_99
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1019(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_100
+    elif v == 'IDLE':
+        return _LEAF_102
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1020(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_101
+    elif v == 'IDLE':
+        return _LEAF_103
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1021(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_104
+    elif v == 'IDLE':
+        return _LEAF_106
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1022(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_105
+    elif v == 'IDLE':
+        return _LEAF_107
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1023(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_108
+    elif v == 'IDLE':
+        return _LEAF_110
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1024(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_109
+    elif v == 'IDLE':
+        return _LEAF_111
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1025(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_112
+    elif v == 'IDLE':
+        return _LEAF_114
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1026(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_113
+    elif v == 'IDLE':
+        return _LEAF_115
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1027(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_116
+    elif v == 'IDLE':
+        return _LEAF_118
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1028(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_117
+    elif v == 'IDLE':
+        return _LEAF_119
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1029(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_144
+    elif v == 'IDLE':
+        return _LEAF_146
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1030(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_145
+    elif v == 'IDLE':
+        return _LEAF_147
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1031(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_148
+    elif v == 'IDLE':
+        return _LEAF_150
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1032(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_149
+    elif v == 'IDLE':
+        return _LEAF_151
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1033(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_152
+    elif v == 'IDLE':
+        return _LEAF_154
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1034(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_153
+    elif v == 'IDLE':
+        return _LEAF_155
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1035(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_180
+    elif v == 'IDLE':
+        return _LEAF_182
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1036(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_181
+    elif v == 'IDLE':
+        return _LEAF_183
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1037(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_184
+    elif v == 'IDLE':
+        return _LEAF_186
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1038(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_185
+    elif v == 'IDLE':
+        return _LEAF_187
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1039(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_188
+    elif v == 'IDLE':
+        return _LEAF_190
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1040(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_189
+    elif v == 'IDLE':
+        return _LEAF_191
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1041(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_132
+    elif v == 'IDLE':
+        return _LEAF_134
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1042(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_133
+    elif v == 'IDLE':
+        return _LEAF_135
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1043(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_136
+    elif v == 'IDLE':
+        return _LEAF_138
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1044(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_137
+    elif v == 'IDLE':
+        return _LEAF_139
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1045(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_140
+    elif v == 'IDLE':
+        return _LEAF_142
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1046(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_141
+    elif v == 'IDLE':
+        return _LEAF_143
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1047(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_168
+    elif v == 'IDLE':
+        return _LEAF_170
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1048(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_169
+    elif v == 'IDLE':
+        return _LEAF_171
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1049(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_172
+    elif v == 'IDLE':
+        return _LEAF_174
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1050(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_173
+    elif v == 'IDLE':
+        return _LEAF_175
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1051(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_176
+    elif v == 'IDLE':
+        return _LEAF_178
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1052(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_177
+    elif v == 'IDLE':
+        return _LEAF_179
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1053(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_204
+    elif v == 'IDLE':
+        return _LEAF_206
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1054(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_205
+    elif v == 'IDLE':
+        return _LEAF_207
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1055(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_208
+    elif v == 'IDLE':
+        return _LEAF_210
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1056(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_209
+    elif v == 'IDLE':
+        return _LEAF_211
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1057(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_212
+    elif v == 'IDLE':
+        return _LEAF_214
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1058(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_213
+    elif v == 'IDLE':
+        return _LEAF_215
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1059(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_216
+    elif v == 'IDLE':
+        return _LEAF_218
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1060(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_217
+    elif v == 'IDLE':
+        return _LEAF_219
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1061(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_220
+    elif v == 'IDLE':
+        return _LEAF_222
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1062(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_221
+    elif v == 'IDLE':
+        return _LEAF_223
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1063(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_224
+    elif v == 'IDLE':
+        return _LEAF_226
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1064(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_225
+    elif v == 'IDLE':
+        return _LEAF_227
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1065(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_252
+    elif v == 'IDLE':
+        return _LEAF_254
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1066(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_253
+    elif v == 'IDLE':
+        return _LEAF_255
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1067(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_256
+    elif v == 'IDLE':
+        return _LEAF_258
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1068(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_257
+    elif v == 'IDLE':
+        return _LEAF_259
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1069(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_260
+    elif v == 'IDLE':
+        return _LEAF_262
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1070(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_261
+    elif v == 'IDLE':
+        return _LEAF_263
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1071(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_288
+    elif v == 'IDLE':
+        return _LEAF_290
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1072(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_289
+    elif v == 'IDLE':
+        return _LEAF_291
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1073(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_292
+    elif v == 'IDLE':
+        return _LEAF_294
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1074(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_293
+    elif v == 'IDLE':
+        return _LEAF_295
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1075(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_296
+    elif v == 'IDLE':
+        return _LEAF_298
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1076(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_297
+    elif v == 'IDLE':
+        return _LEAF_299
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1077(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_240
+    elif v == 'IDLE':
+        return _LEAF_242
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1078(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_241
+    elif v == 'IDLE':
+        return _LEAF_243
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1079(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_244
+    elif v == 'IDLE':
+        return _LEAF_246
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1080(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_245
+    elif v == 'IDLE':
+        return _LEAF_247
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1081(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_248
+    elif v == 'IDLE':
+        return _LEAF_250
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1082(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_249
+    elif v == 'IDLE':
+        return _LEAF_251
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1083(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_276
+    elif v == 'IDLE':
+        return _LEAF_278
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1084(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_277
+    elif v == 'IDLE':
+        return _LEAF_279
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1085(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_280
+    elif v == 'IDLE':
+        return _LEAF_282
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1086(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_281
+    elif v == 'IDLE':
+        return _LEAF_283
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1087(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_284
+    elif v == 'IDLE':
+        return _LEAF_286
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1088(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_285
+    elif v == 'IDLE':
+        return _LEAF_287
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1089(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_312
+    elif v == 'IDLE':
+        return _LEAF_314
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1090(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_313
+    elif v == 'IDLE':
+        return _LEAF_315
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1091(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_316
+    elif v == 'IDLE':
+        return _LEAF_318
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1092(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_317
+    elif v == 'IDLE':
+        return _LEAF_319
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1093(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_320
+    elif v == 'IDLE':
+        return _LEAF_322
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1094(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_321
+    elif v == 'IDLE':
+        return _LEAF_323
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1095(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_324
+    elif v == 'IDLE':
+        return _LEAF_326
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1096(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_325
+    elif v == 'IDLE':
+        return _LEAF_327
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1097(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_328
+    elif v == 'IDLE':
+        return _LEAF_330
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1098(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_329
+    elif v == 'IDLE':
+        return _LEAF_331
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1099(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_332
+    elif v == 'IDLE':
+        return _LEAF_334
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1100(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_333
+    elif v == 'IDLE':
+        return _LEAF_335
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1101(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_360
+    elif v == 'IDLE':
+        return _LEAF_362
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1102(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_361
+    elif v == 'IDLE':
+        return _LEAF_363
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1103(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_364
+    elif v == 'IDLE':
+        return _LEAF_366
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1104(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_365
+    elif v == 'IDLE':
+        return _LEAF_367
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1105(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_368
+    elif v == 'IDLE':
+        return _LEAF_370
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1106(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_369
+    elif v == 'IDLE':
+        return _LEAF_371
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1107(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_396
+    elif v == 'IDLE':
+        return _LEAF_398
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1108(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_397
+    elif v == 'IDLE':
+        return _LEAF_399
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1109(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_400
+    elif v == 'IDLE':
+        return _LEAF_402
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1110(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_401
+    elif v == 'IDLE':
+        return _LEAF_403
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1111(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_404
+    elif v == 'IDLE':
+        return _LEAF_406
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1112(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_405
+    elif v == 'IDLE':
+        return _LEAF_407
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1113(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_348
+    elif v == 'IDLE':
+        return _LEAF_350
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1114(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_349
+    elif v == 'IDLE':
+        return _LEAF_351
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1115(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_352
+    elif v == 'IDLE':
+        return _LEAF_354
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1116(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_353
+    elif v == 'IDLE':
+        return _LEAF_355
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1117(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_356
+    elif v == 'IDLE':
+        return _LEAF_358
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1118(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_357
+    elif v == 'IDLE':
+        return _LEAF_359
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1119(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_384
+    elif v == 'IDLE':
+        return _LEAF_386
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1120(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_385
+    elif v == 'IDLE':
+        return _LEAF_387
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1121(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_388
+    elif v == 'IDLE':
+        return _LEAF_390
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1122(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_389
+    elif v == 'IDLE':
+        return _LEAF_391
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1123(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_392
+    elif v == 'IDLE':
+        return _LEAF_394
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1124(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_393
+    elif v == 'IDLE':
+        return _LEAF_395
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1125(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_420
+    elif v == 'IDLE':
+        return _LEAF_422
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1126(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_421
+    elif v == 'IDLE':
+        return _LEAF_423
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1127(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_424
+    elif v == 'IDLE':
+        return _LEAF_426
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1128(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_425
+    elif v == 'IDLE':
+        return _LEAF_427
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1129(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_428
+    elif v == 'IDLE':
+        return _LEAF_430
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1130(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_429
+    elif v == 'IDLE':
+        return _LEAF_431
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1131(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_12
+    elif v == 'IDLE':
+        return _LEAF_14
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1132(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_16
+    elif v == 'IDLE':
+        return _LEAF_18
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1133(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_20
+    elif v == 'IDLE':
+        return _LEAF_22
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1134(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_48
+    elif v == 'IDLE':
+        return _LEAF_50
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1135(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_52
+    elif v == 'IDLE':
+        return _LEAF_54
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1136(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_56
+    elif v == 'IDLE':
+        return _LEAF_58
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1137(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_84
+    elif v == 'IDLE':
+        return _LEAF_86
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1138(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_88
+    elif v == 'IDLE':
+        return _LEAF_90
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1139(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_92
+    elif v == 'IDLE':
+        return _LEAF_94
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1140(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_120
+    elif v == 'IDLE':
+        return _LEAF_122
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1141(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_124
+    elif v == 'IDLE':
+        return _LEAF_126
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1142(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_128
+    elif v == 'IDLE':
+        return _LEAF_130
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1143(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_156
+    elif v == 'IDLE':
+        return _LEAF_158
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1144(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_160
+    elif v == 'IDLE':
+        return _LEAF_162
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1145(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_164
+    elif v == 'IDLE':
+        return _LEAF_166
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1146(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_192
+    elif v == 'IDLE':
+        return _LEAF_194
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1147(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_196
+    elif v == 'IDLE':
+        return _LEAF_198
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1148(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_200
+    elif v == 'IDLE':
+        return _LEAF_202
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1149(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_228
+    elif v == 'IDLE':
+        return _LEAF_230
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1150(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_232
+    elif v == 'IDLE':
+        return _LEAF_234
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1151(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_236
+    elif v == 'IDLE':
+        return _LEAF_238
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1152(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_264
+    elif v == 'IDLE':
+        return _LEAF_266
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1153(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_268
+    elif v == 'IDLE':
+        return _LEAF_270
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1154(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_272
+    elif v == 'IDLE':
+        return _LEAF_274
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1155(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_300
+    elif v == 'IDLE':
+        return _LEAF_302
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1156(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_304
+    elif v == 'IDLE':
+        return _LEAF_306
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1157(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_308
+    elif v == 'IDLE':
+        return _LEAF_310
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1158(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_336
+    elif v == 'IDLE':
+        return _LEAF_338
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1159(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_340
+    elif v == 'IDLE':
+        return _LEAF_342
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1160(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_344
+    elif v == 'IDLE':
+        return _LEAF_346
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1161(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_372
+    elif v == 'IDLE':
+        return _LEAF_374
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1162(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_376
+    elif v == 'IDLE':
+        return _LEAF_378
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1163(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_380
+    elif v == 'IDLE':
+        return _LEAF_382
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1164(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_408
+    elif v == 'IDLE':
+        return _LEAF_410
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1165(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_412
+    elif v == 'IDLE':
+        return _LEAF_414
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1166(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_416
+    elif v == 'IDLE':
+        return _LEAF_418
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1167(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_433
+    elif v == 'IDLE':
+        return _LEAF_435
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1168(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_437
+    elif v == 'IDLE':
+        return _LEAF_439
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1169(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_441
+    elif v == 'IDLE':
+        return _LEAF_443
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1170(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_469
+    elif v == 'IDLE':
+        return _LEAF_471
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1171(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_473
+    elif v == 'IDLE':
+        return _LEAF_475
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1172(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_477
+    elif v == 'IDLE':
+        return _LEAF_479
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1173(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_505
+    elif v == 'IDLE':
+        return _LEAF_507
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1174(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_509
+    elif v == 'IDLE':
+        return _LEAF_511
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1175(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_513
+    elif v == 'IDLE':
+        return _LEAF_515
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1176(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_445
+    elif v == 'IDLE':
+        return _LEAF_447
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1177(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_449
+    elif v == 'IDLE':
+        return _LEAF_451
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1178(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_453
+    elif v == 'IDLE':
+        return _LEAF_455
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1179(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_481
+    elif v == 'IDLE':
+        return _LEAF_483
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1180(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_485
+    elif v == 'IDLE':
+        return _LEAF_487
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1181(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_489
+    elif v == 'IDLE':
+        return _LEAF_491
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1182(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_517
+    elif v == 'IDLE':
+        return _LEAF_519
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1183(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_521
+    elif v == 'IDLE':
+        return _LEAF_523
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1184(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_525
+    elif v == 'IDLE':
+        return _LEAF_527
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1185(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_457
+    elif v == 'IDLE':
+        return _LEAF_459
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1186(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_461
+    elif v == 'IDLE':
+        return _LEAF_463
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1187(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_465
+    elif v == 'IDLE':
+        return _LEAF_467
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1188(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_493
+    elif v == 'IDLE':
+        return _LEAF_495
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1189(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_497
+    elif v == 'IDLE':
+        return _LEAF_499
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1190(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_501
+    elif v == 'IDLE':
+        return _LEAF_503
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1191(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_529
+    elif v == 'IDLE':
+        return _LEAF_531
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1192(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_533
+    elif v == 'IDLE':
+        return _LEAF_535
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1193(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_537
+    elif v == 'IDLE':
+        return _LEAF_539
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1194(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_541
+    elif v == 'IDLE':
+        return _LEAF_543
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1195(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_545
+    elif v == 'IDLE':
+        return _LEAF_547
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1196(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_549
+    elif v == 'IDLE':
+        return _LEAF_551
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1197(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_577
+    elif v == 'IDLE':
+        return _LEAF_579
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1198(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_581
+    elif v == 'IDLE':
+        return _LEAF_583
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1199(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_585
+    elif v == 'IDLE':
+        return _LEAF_587
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1200(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_613
+    elif v == 'IDLE':
+        return _LEAF_615
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1201(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_617
+    elif v == 'IDLE':
+        return _LEAF_619
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1202(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_621
+    elif v == 'IDLE':
+        return _LEAF_623
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1203(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_553
+    elif v == 'IDLE':
+        return _LEAF_555
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1204(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_557
+    elif v == 'IDLE':
+        return _LEAF_559
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1205(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_561
+    elif v == 'IDLE':
+        return _LEAF_563
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1206(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_589
+    elif v == 'IDLE':
+        return _LEAF_591
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1207(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_593
+    elif v == 'IDLE':
+        return _LEAF_595
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1208(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_597
+    elif v == 'IDLE':
+        return _LEAF_599
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1209(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_625
+    elif v == 'IDLE':
+        return _LEAF_627
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1210(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_629
+    elif v == 'IDLE':
+        return _LEAF_631
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1211(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_633
+    elif v == 'IDLE':
+        return _LEAF_635
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1212(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_565
+    elif v == 'IDLE':
+        return _LEAF_567
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1213(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_569
+    elif v == 'IDLE':
+        return _LEAF_571
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1214(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_573
+    elif v == 'IDLE':
+        return _LEAF_575
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1215(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_601
+    elif v == 'IDLE':
+        return _LEAF_603
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1216(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_605
+    elif v == 'IDLE':
+        return _LEAF_607
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1217(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_609
+    elif v == 'IDLE':
+        return _LEAF_611
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1218(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_637
+    elif v == 'IDLE':
+        return _LEAF_639
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1219(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_641
+    elif v == 'IDLE':
+        return _LEAF_643
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1220(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_645
+    elif v == 'IDLE':
+        return _LEAF_647
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1221(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_649
+    elif v == 'IDLE':
+        return _LEAF_651
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1222(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_653
+    elif v == 'IDLE':
+        return _LEAF_655
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1223(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_657
+    elif v == 'IDLE':
+        return _LEAF_659
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1224(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_685
+    elif v == 'IDLE':
+        return _LEAF_687
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1225(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_689
+    elif v == 'IDLE':
+        return _LEAF_691
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1226(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_693
+    elif v == 'IDLE':
+        return _LEAF_695
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1227(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_721
+    elif v == 'IDLE':
+        return _LEAF_723
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1228(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_725
+    elif v == 'IDLE':
+        return _LEAF_727
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1229(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_729
+    elif v == 'IDLE':
+        return _LEAF_731
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1230(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_661
+    elif v == 'IDLE':
+        return _LEAF_663
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1231(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_665
+    elif v == 'IDLE':
+        return _LEAF_667
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1232(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_669
+    elif v == 'IDLE':
+        return _LEAF_671
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1233(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_697
+    elif v == 'IDLE':
+        return _LEAF_699
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1234(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_701
+    elif v == 'IDLE':
+        return _LEAF_703
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1235(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_705
+    elif v == 'IDLE':
+        return _LEAF_707
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1236(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_733
+    elif v == 'IDLE':
+        return _LEAF_735
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1237(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_737
+    elif v == 'IDLE':
+        return _LEAF_739
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1238(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_741
+    elif v == 'IDLE':
+        return _LEAF_743
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1239(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_673
+    elif v == 'IDLE':
+        return _LEAF_675
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1240(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_677
+    elif v == 'IDLE':
+        return _LEAF_679
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1241(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_681
+    elif v == 'IDLE':
+        return _LEAF_683
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1242(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_709
+    elif v == 'IDLE':
+        return _LEAF_711
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1243(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_713
+    elif v == 'IDLE':
+        return _LEAF_715
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1244(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_717
+    elif v == 'IDLE':
+        return _LEAF_719
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1245(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_745
+    elif v == 'IDLE':
+        return _LEAF_747
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1246(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_749
+    elif v == 'IDLE':
+        return _LEAF_751
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1247(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_753
+    elif v == 'IDLE':
+        return _LEAF_755
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1248(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_757
+    elif v == 'IDLE':
+        return _LEAF_759
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1249(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_761
+    elif v == 'IDLE':
+        return _LEAF_763
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1250(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_765
+    elif v == 'IDLE':
+        return _LEAF_767
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1251(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_793
+    elif v == 'IDLE':
+        return _LEAF_795
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1252(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_797
+    elif v == 'IDLE':
+        return _LEAF_799
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1253(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_801
+    elif v == 'IDLE':
+        return _LEAF_803
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1254(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_829
+    elif v == 'IDLE':
+        return _LEAF_831
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1255(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_833
+    elif v == 'IDLE':
+        return _LEAF_835
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1256(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_837
+    elif v == 'IDLE':
+        return _LEAF_839
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1257(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_769
+    elif v == 'IDLE':
+        return _LEAF_771
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1258(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_773
+    elif v == 'IDLE':
+        return _LEAF_775
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1259(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_777
+    elif v == 'IDLE':
+        return _LEAF_779
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1260(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_805
+    elif v == 'IDLE':
+        return _LEAF_807
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1261(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_809
+    elif v == 'IDLE':
+        return _LEAF_811
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1262(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_813
+    elif v == 'IDLE':
+        return _LEAF_815
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1263(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_841
+    elif v == 'IDLE':
+        return _LEAF_843
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1264(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_845
+    elif v == 'IDLE':
+        return _LEAF_847
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1265(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_849
+    elif v == 'IDLE':
+        return _LEAF_851
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1266(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_781
+    elif v == 'IDLE':
+        return _LEAF_783
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1267(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_785
+    elif v == 'IDLE':
+        return _LEAF_787
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1268(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_789
+    elif v == 'IDLE':
+        return _LEAF_791
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1269(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_817
+    elif v == 'IDLE':
+        return _LEAF_819
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1270(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_821
+    elif v == 'IDLE':
+        return _LEAF_823
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1271(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_825
+    elif v == 'IDLE':
+        return _LEAF_827
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1272(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_853
+    elif v == 'IDLE':
+        return _LEAF_855
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1273(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_857
+    elif v == 'IDLE':
+        return _LEAF_859
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1274(a: Any, calls: Calls) -> Decision:
+    v = a['@CALC_OBJstate']
+    if v == 'CALC-OBJ':
+        return _LEAF_861
+    elif v == 'IDLE':
+        return _LEAF_863
+    else:
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+
+
+def _node_1275(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']
@@ -26104,193 +26392,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_0
-                        elif v == 'IDLE':
-                            return _LEAF_433
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_987(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_2
-                        elif v == 'IDLE':
-                            return _LEAF_435
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1167(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_4
-                        elif v == 'IDLE':
-                            return _LEAF_437
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_989(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_6
-                        elif v == 'IDLE':
-                            return _LEAF_439
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1168(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_8
-                        elif v == 'IDLE':
-                            return _LEAF_441
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_991(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_10
-                        elif v == 'IDLE':
-                            return _LEAF_443
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1169(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_36
-                        elif v == 'IDLE':
-                            return _LEAF_469
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_993(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_38
-                        elif v == 'IDLE':
-                            return _LEAF_471
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1170(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_40
-                        elif v == 'IDLE':
-                            return _LEAF_473
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_995(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_42
-                        elif v == 'IDLE':
-                            return _LEAF_475
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1171(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_44
-                        elif v == 'IDLE':
-                            return _LEAF_477
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_997(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_46
-                        elif v == 'IDLE':
-                            return _LEAF_479
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1172(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_72
-                        elif v == 'IDLE':
-                            return _LEAF_505
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_999(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_74
-                        elif v == 'IDLE':
-                            return _LEAF_507
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1173(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_76
-                        elif v == 'IDLE':
-                            return _LEAF_509
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1001(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_78
-                        elif v == 'IDLE':
-                            return _LEAF_511
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1174(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_80
-                        elif v == 'IDLE':
-                            return _LEAF_513
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1003(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_82
-                        elif v == 'IDLE':
-                            return _LEAF_515
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1175(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -26300,193 +26480,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_12
-                        elif v == 'IDLE':
-                            return _LEAF_445
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1131(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_14
-                        elif v == 'IDLE':
-                            return _LEAF_447
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1176(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_16
-                        elif v == 'IDLE':
-                            return _LEAF_449
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1132(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_18
-                        elif v == 'IDLE':
-                            return _LEAF_451
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1177(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_20
-                        elif v == 'IDLE':
-                            return _LEAF_453
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1133(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_22
-                        elif v == 'IDLE':
-                            return _LEAF_455
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1178(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_48
-                        elif v == 'IDLE':
-                            return _LEAF_481
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1134(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_50
-                        elif v == 'IDLE':
-                            return _LEAF_483
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1179(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_52
-                        elif v == 'IDLE':
-                            return _LEAF_485
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1135(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_54
-                        elif v == 'IDLE':
-                            return _LEAF_487
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1180(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_56
-                        elif v == 'IDLE':
-                            return _LEAF_489
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1136(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_58
-                        elif v == 'IDLE':
-                            return _LEAF_491
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1181(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_84
-                        elif v == 'IDLE':
-                            return _LEAF_517
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1137(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_86
-                        elif v == 'IDLE':
-                            return _LEAF_519
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1182(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_88
-                        elif v == 'IDLE':
-                            return _LEAF_521
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1138(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_90
-                        elif v == 'IDLE':
-                            return _LEAF_523
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1183(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_92
-                        elif v == 'IDLE':
-                            return _LEAF_525
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1139(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_94
-                        elif v == 'IDLE':
-                            return _LEAF_527
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1184(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -26496,193 +26568,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_24
-                        elif v == 'IDLE':
-                            return _LEAF_457
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1005(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_26
-                        elif v == 'IDLE':
-                            return _LEAF_459
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1185(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_28
-                        elif v == 'IDLE':
-                            return _LEAF_461
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1007(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_30
-                        elif v == 'IDLE':
-                            return _LEAF_463
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1186(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_32
-                        elif v == 'IDLE':
-                            return _LEAF_465
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1009(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_34
-                        elif v == 'IDLE':
-                            return _LEAF_467
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1187(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_60
-                        elif v == 'IDLE':
-                            return _LEAF_493
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1011(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_62
-                        elif v == 'IDLE':
-                            return _LEAF_495
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1188(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_64
-                        elif v == 'IDLE':
-                            return _LEAF_497
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1013(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_66
-                        elif v == 'IDLE':
-                            return _LEAF_499
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1189(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_68
-                        elif v == 'IDLE':
-                            return _LEAF_501
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1015(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_70
-                        elif v == 'IDLE':
-                            return _LEAF_503
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1190(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_96
-                        elif v == 'IDLE':
-                            return _LEAF_529
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1017(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_98
-                        elif v == 'IDLE':
-                            return _LEAF_531
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1191(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_100
-                        elif v == 'IDLE':
-                            return _LEAF_533
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1019(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_102
-                        elif v == 'IDLE':
-                            return _LEAF_535
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1192(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_104
-                        elif v == 'IDLE':
-                            return _LEAF_537
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1021(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_106
-                        elif v == 'IDLE':
-                            return _LEAF_539
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1193(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -26696,193 +26660,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_108
-                        elif v == 'IDLE':
-                            return _LEAF_541
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1023(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_110
-                        elif v == 'IDLE':
-                            return _LEAF_543
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1194(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_112
-                        elif v == 'IDLE':
-                            return _LEAF_545
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1025(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_114
-                        elif v == 'IDLE':
-                            return _LEAF_547
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1195(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_116
-                        elif v == 'IDLE':
-                            return _LEAF_549
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1027(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_118
-                        elif v == 'IDLE':
-                            return _LEAF_551
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1196(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_144
-                        elif v == 'IDLE':
-                            return _LEAF_577
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1029(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_146
-                        elif v == 'IDLE':
-                            return _LEAF_579
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1197(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_148
-                        elif v == 'IDLE':
-                            return _LEAF_581
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1031(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_150
-                        elif v == 'IDLE':
-                            return _LEAF_583
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1198(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_152
-                        elif v == 'IDLE':
-                            return _LEAF_585
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1033(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_154
-                        elif v == 'IDLE':
-                            return _LEAF_587
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1199(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_180
-                        elif v == 'IDLE':
-                            return _LEAF_613
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1035(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_182
-                        elif v == 'IDLE':
-                            return _LEAF_615
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1200(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_184
-                        elif v == 'IDLE':
-                            return _LEAF_617
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1037(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_186
-                        elif v == 'IDLE':
-                            return _LEAF_619
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1201(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_188
-                        elif v == 'IDLE':
-                            return _LEAF_621
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1039(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_190
-                        elif v == 'IDLE':
-                            return _LEAF_623
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1202(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -26892,193 +26748,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_120
-                        elif v == 'IDLE':
-                            return _LEAF_553
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1140(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_122
-                        elif v == 'IDLE':
-                            return _LEAF_555
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1203(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_124
-                        elif v == 'IDLE':
-                            return _LEAF_557
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1141(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_126
-                        elif v == 'IDLE':
-                            return _LEAF_559
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1204(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_128
-                        elif v == 'IDLE':
-                            return _LEAF_561
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1142(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_130
-                        elif v == 'IDLE':
-                            return _LEAF_563
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1205(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_156
-                        elif v == 'IDLE':
-                            return _LEAF_589
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1143(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_158
-                        elif v == 'IDLE':
-                            return _LEAF_591
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1206(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_160
-                        elif v == 'IDLE':
-                            return _LEAF_593
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1144(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_162
-                        elif v == 'IDLE':
-                            return _LEAF_595
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1207(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_164
-                        elif v == 'IDLE':
-                            return _LEAF_597
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1145(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_166
-                        elif v == 'IDLE':
-                            return _LEAF_599
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1208(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_192
-                        elif v == 'IDLE':
-                            return _LEAF_625
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1146(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_194
-                        elif v == 'IDLE':
-                            return _LEAF_627
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1209(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_196
-                        elif v == 'IDLE':
-                            return _LEAF_629
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1147(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_198
-                        elif v == 'IDLE':
-                            return _LEAF_631
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1210(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_200
-                        elif v == 'IDLE':
-                            return _LEAF_633
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1148(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_202
-                        elif v == 'IDLE':
-                            return _LEAF_635
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1211(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -27088,193 +26836,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_132
-                        elif v == 'IDLE':
-                            return _LEAF_565
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1041(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_134
-                        elif v == 'IDLE':
-                            return _LEAF_567
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1212(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_136
-                        elif v == 'IDLE':
-                            return _LEAF_569
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1043(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_138
-                        elif v == 'IDLE':
-                            return _LEAF_571
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1213(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_140
-                        elif v == 'IDLE':
-                            return _LEAF_573
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1045(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_142
-                        elif v == 'IDLE':
-                            return _LEAF_575
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1214(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_168
-                        elif v == 'IDLE':
-                            return _LEAF_601
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1047(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_170
-                        elif v == 'IDLE':
-                            return _LEAF_603
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1215(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_172
-                        elif v == 'IDLE':
-                            return _LEAF_605
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1049(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_174
-                        elif v == 'IDLE':
-                            return _LEAF_607
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1216(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_176
-                        elif v == 'IDLE':
-                            return _LEAF_609
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1051(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_178
-                        elif v == 'IDLE':
-                            return _LEAF_611
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1217(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_204
-                        elif v == 'IDLE':
-                            return _LEAF_637
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1053(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_206
-                        elif v == 'IDLE':
-                            return _LEAF_639
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1218(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_208
-                        elif v == 'IDLE':
-                            return _LEAF_641
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1055(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_210
-                        elif v == 'IDLE':
-                            return _LEAF_643
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1219(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_212
-                        elif v == 'IDLE':
-                            return _LEAF_645
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1057(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_214
-                        elif v == 'IDLE':
-                            return _LEAF_647
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1220(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -27288,193 +26928,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_216
-                        elif v == 'IDLE':
-                            return _LEAF_649
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1059(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_218
-                        elif v == 'IDLE':
-                            return _LEAF_651
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1221(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_220
-                        elif v == 'IDLE':
-                            return _LEAF_653
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1061(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_222
-                        elif v == 'IDLE':
-                            return _LEAF_655
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1222(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_224
-                        elif v == 'IDLE':
-                            return _LEAF_657
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1063(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_226
-                        elif v == 'IDLE':
-                            return _LEAF_659
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1223(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_252
-                        elif v == 'IDLE':
-                            return _LEAF_685
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1065(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_254
-                        elif v == 'IDLE':
-                            return _LEAF_687
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1224(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_256
-                        elif v == 'IDLE':
-                            return _LEAF_689
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1067(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_258
-                        elif v == 'IDLE':
-                            return _LEAF_691
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1225(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_260
-                        elif v == 'IDLE':
-                            return _LEAF_693
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1069(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_262
-                        elif v == 'IDLE':
-                            return _LEAF_695
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1226(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_288
-                        elif v == 'IDLE':
-                            return _LEAF_721
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1071(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_290
-                        elif v == 'IDLE':
-                            return _LEAF_723
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1227(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_292
-                        elif v == 'IDLE':
-                            return _LEAF_725
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1073(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_294
-                        elif v == 'IDLE':
-                            return _LEAF_727
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1228(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_296
-                        elif v == 'IDLE':
-                            return _LEAF_729
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1075(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_298
-                        elif v == 'IDLE':
-                            return _LEAF_731
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1229(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -27484,193 +27016,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_228
-                        elif v == 'IDLE':
-                            return _LEAF_661
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1149(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_230
-                        elif v == 'IDLE':
-                            return _LEAF_663
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1230(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_232
-                        elif v == 'IDLE':
-                            return _LEAF_665
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1150(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_234
-                        elif v == 'IDLE':
-                            return _LEAF_667
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1231(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_236
-                        elif v == 'IDLE':
-                            return _LEAF_669
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1151(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_238
-                        elif v == 'IDLE':
-                            return _LEAF_671
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1232(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_264
-                        elif v == 'IDLE':
-                            return _LEAF_697
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1152(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_266
-                        elif v == 'IDLE':
-                            return _LEAF_699
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1233(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_268
-                        elif v == 'IDLE':
-                            return _LEAF_701
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1153(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_270
-                        elif v == 'IDLE':
-                            return _LEAF_703
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1234(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_272
-                        elif v == 'IDLE':
-                            return _LEAF_705
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1154(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_274
-                        elif v == 'IDLE':
-                            return _LEAF_707
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1235(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_300
-                        elif v == 'IDLE':
-                            return _LEAF_733
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1155(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_302
-                        elif v == 'IDLE':
-                            return _LEAF_735
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1236(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_304
-                        elif v == 'IDLE':
-                            return _LEAF_737
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1156(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_306
-                        elif v == 'IDLE':
-                            return _LEAF_739
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1237(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_308
-                        elif v == 'IDLE':
-                            return _LEAF_741
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1157(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_310
-                        elif v == 'IDLE':
-                            return _LEAF_743
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1238(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -27680,193 +27104,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_240
-                        elif v == 'IDLE':
-                            return _LEAF_673
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1077(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_242
-                        elif v == 'IDLE':
-                            return _LEAF_675
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1239(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_244
-                        elif v == 'IDLE':
-                            return _LEAF_677
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1079(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_246
-                        elif v == 'IDLE':
-                            return _LEAF_679
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1240(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_248
-                        elif v == 'IDLE':
-                            return _LEAF_681
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1081(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_250
-                        elif v == 'IDLE':
-                            return _LEAF_683
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1241(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_276
-                        elif v == 'IDLE':
-                            return _LEAF_709
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1083(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_278
-                        elif v == 'IDLE':
-                            return _LEAF_711
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1242(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_280
-                        elif v == 'IDLE':
-                            return _LEAF_713
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1085(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_282
-                        elif v == 'IDLE':
-                            return _LEAF_715
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1243(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_284
-                        elif v == 'IDLE':
-                            return _LEAF_717
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1087(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_286
-                        elif v == 'IDLE':
-                            return _LEAF_719
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1244(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_312
-                        elif v == 'IDLE':
-                            return _LEAF_745
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1089(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_314
-                        elif v == 'IDLE':
-                            return _LEAF_747
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1245(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_316
-                        elif v == 'IDLE':
-                            return _LEAF_749
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1091(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_318
-                        elif v == 'IDLE':
-                            return _LEAF_751
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1246(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_320
-                        elif v == 'IDLE':
-                            return _LEAF_753
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1093(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_322
-                        elif v == 'IDLE':
-                            return _LEAF_755
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1247(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -27880,193 +27196,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_324
-                        elif v == 'IDLE':
-                            return _LEAF_757
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1095(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_326
-                        elif v == 'IDLE':
-                            return _LEAF_759
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1248(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_328
-                        elif v == 'IDLE':
-                            return _LEAF_761
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1097(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_330
-                        elif v == 'IDLE':
-                            return _LEAF_763
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1249(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_332
-                        elif v == 'IDLE':
-                            return _LEAF_765
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1099(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_334
-                        elif v == 'IDLE':
-                            return _LEAF_767
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1250(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_360
-                        elif v == 'IDLE':
-                            return _LEAF_793
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1101(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_362
-                        elif v == 'IDLE':
-                            return _LEAF_795
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1251(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_364
-                        elif v == 'IDLE':
-                            return _LEAF_797
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1103(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_366
-                        elif v == 'IDLE':
-                            return _LEAF_799
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1252(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_368
-                        elif v == 'IDLE':
-                            return _LEAF_801
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1105(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_370
-                        elif v == 'IDLE':
-                            return _LEAF_803
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1253(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_396
-                        elif v == 'IDLE':
-                            return _LEAF_829
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1107(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_398
-                        elif v == 'IDLE':
-                            return _LEAF_831
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1254(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_400
-                        elif v == 'IDLE':
-                            return _LEAF_833
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1109(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_402
-                        elif v == 'IDLE':
-                            return _LEAF_835
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1255(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_404
-                        elif v == 'IDLE':
-                            return _LEAF_837
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1111(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_406
-                        elif v == 'IDLE':
-                            return _LEAF_839
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1256(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -28076,193 +27284,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_336
-                        elif v == 'IDLE':
-                            return _LEAF_769
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1158(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_338
-                        elif v == 'IDLE':
-                            return _LEAF_771
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1257(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_340
-                        elif v == 'IDLE':
-                            return _LEAF_773
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1159(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_342
-                        elif v == 'IDLE':
-                            return _LEAF_775
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1258(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_344
-                        elif v == 'IDLE':
-                            return _LEAF_777
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1160(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_346
-                        elif v == 'IDLE':
-                            return _LEAF_779
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1259(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_372
-                        elif v == 'IDLE':
-                            return _LEAF_805
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1161(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_374
-                        elif v == 'IDLE':
-                            return _LEAF_807
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1260(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_376
-                        elif v == 'IDLE':
-                            return _LEAF_809
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1162(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_378
-                        elif v == 'IDLE':
-                            return _LEAF_811
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1261(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_380
-                        elif v == 'IDLE':
-                            return _LEAF_813
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1163(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_382
-                        elif v == 'IDLE':
-                            return _LEAF_815
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1262(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_408
-                        elif v == 'IDLE':
-                            return _LEAF_841
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1164(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_410
-                        elif v == 'IDLE':
-                            return _LEAF_843
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1263(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_412
-                        elif v == 'IDLE':
-                            return _LEAF_845
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1165(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_414
-                        elif v == 'IDLE':
-                            return _LEAF_847
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1264(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_416
-                        elif v == 'IDLE':
-                            return _LEAF_849
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1166(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_418
-                        elif v == 'IDLE':
-                            return _LEAF_851
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1265(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -28272,193 +27372,85 @@ def _node_987(a: Any, calls: Calls) -> Decision:
             if v == 'READ-OBST':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_348
-                        elif v == 'IDLE':
-                            return _LEAF_781
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1113(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_350
-                        elif v == 'IDLE':
-                            return _LEAF_783
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1266(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_352
-                        elif v == 'IDLE':
-                            return _LEAF_785
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1115(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_354
-                        elif v == 'IDLE':
-                            return _LEAF_787
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1267(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_356
-                        elif v == 'IDLE':
-                            return _LEAF_789
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1117(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_358
-                        elif v == 'IDLE':
-                            return _LEAF_791
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1268(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'SEARCH-OBJ':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_384
-                        elif v == 'IDLE':
-                            return _LEAF_817
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1119(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_386
-                        elif v == 'IDLE':
-                            return _LEAF_819
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1269(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_388
-                        elif v == 'IDLE':
-                            return _LEAF_821
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1121(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_390
-                        elif v == 'IDLE':
-                            return _LEAF_823
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1270(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_392
-                        elif v == 'IDLE':
-                            return _LEAF_825
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1123(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_394
-                        elif v == 'IDLE':
-                            return _LEAF_827
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1271(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@ARM_OBJ_ARM_BACKstate']
                 if v == 'ARM-OBJ':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_420
-                        elif v == 'IDLE':
-                            return _LEAF_853
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1125(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_422
-                        elif v == 'IDLE':
-                            return _LEAF_855
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1272(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'ARM-BACK':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_424
-                        elif v == 'IDLE':
-                            return _LEAF_857
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1127(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_426
-                        elif v == 'IDLE':
-                            return _LEAF_859
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1273(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 elif v == 'IDLE':
-                    v = a['@CALC_OBJstate']
-                    if v == 'CALC-OBJ':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_428
-                        elif v == 'IDLE':
-                            return _LEAF_861
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    v = a['@CALC_GOALstate']
+                    if v == 'CALC-GOAL':
+                        return _node_1129(a, calls)
                     elif v == 'IDLE':
-                        v = a['@CALC_GOALstate']
-                        if v == 'CALC-GOAL':
-                            return _LEAF_430
-                        elif v == 'IDLE':
-                            return _LEAF_863
-                        else:
-                            raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                        return _node_1274(a, calls)
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
                 else:
                     raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             else:
@@ -28469,7 +27461,7 @@ def _node_987(a: Any, calls: Calls) -> Decision:
         raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
 
 
-def _node_988(a: Any, calls: Calls) -> Decision:
+def _node_1276(a: Any, calls: Calls) -> Decision:
     v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
     if v == 'READ-MODEL':
         v = a['@ExecTrajState']

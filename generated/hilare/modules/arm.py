@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -24,39 +25,39 @@ class Point:
 
 @dataclass
 class ArmConfig:
-    q: list[float] = field(default_factory=lambda: [0.0] * 6)
+    q: list[float] = __field__(default_factory=lambda: [0.0] * 6)
 
 
 @dataclass(slots=True)
 class ArmData(rt.InternalData):
     """The internal data (SDI) of module arm."""
 
-    config: ArmConfig = field(default_factory=ArmConfig)
-    target: ArmConfig = field(default_factory=ArmConfig)
-    object: Point = field(default_factory=Point)
-    grip: GripState = GripState.OPEN
+    config: ArmConfig = __field__(default_factory=lambda: ArmConfig())
+    target: ArmConfig = __field__(default_factory=lambda: ArmConfig())
+    object: Point = __field__(default_factory=lambda: Point())
+    grip: GripState = __field__(default_factory=lambda: GripState.OPEN)
 
 
 @dataclass
 class GoObjectInput:
     """The input of request goObject."""
 
-    object: Point = field(default_factory=Point)
+    object: Point = __field__(default_factory=lambda: Point())
 
 
 @dataclass
 class GripStateInput:
     """The input of request gripState."""
 
-    grip: GripState = GripState.OPEN
+    grip: GripState = __field__(default_factory=lambda: GripState.OPEN)
 
 
 @dataclass
 class StatePoster:
     """The content of poster arm.State."""
 
-    config: ArmConfig = field(default_factory=ArmConfig)
-    grip: GripState = GripState.OPEN
+    config: ArmConfig = __field__(default_factory=lambda: ArmConfig())
+    grip: GripState = __field__(default_factory=lambda: GripState.OPEN)
 
 
 # Checked by the runtime on every request: (field, kind, array length).

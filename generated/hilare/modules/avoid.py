@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -30,8 +31,8 @@ class AvoidData(rt.InternalData):
     """The internal data (SDI) of module avoid."""
 
     setpointPoster: str = ""
-    params: FieldParams = field(default_factory=FieldParams)
-    ref: Ref = field(default_factory=Ref)
+    params: FieldParams = __field__(default_factory=lambda: FieldParams())
+    ref: Ref = __field__(default_factory=lambda: Ref())
 
 
 @dataclass
@@ -45,7 +46,7 @@ class FilterInput:
 class SetpointPoster:
     """The content of poster avoid.Setpoint."""
 
-    ref: Ref = field(default_factory=Ref)
+    ref: Ref = __field__(default_factory=lambda: Ref())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

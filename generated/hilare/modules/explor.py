@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -28,9 +29,9 @@ class Object:
 class ExplorData(rt.InternalData):
     """The internal data (SDI) of module explor."""
 
-    goal: Posit = field(default_factory=Posit)
-    graspPos: Posit = field(default_factory=Posit)
-    object: Object = field(default_factory=Object)
+    goal: Posit = __field__(default_factory=lambda: Posit())
+    graspPos: Posit = __field__(default_factory=lambda: Posit())
+    object: Object = __field__(default_factory=lambda: Object())
     bestScore: float = 0.0
     candidate: int = 0
 
@@ -39,29 +40,29 @@ class ExplorData(rt.InternalData):
 class CalcGoalOutput:
     """The output of request calcGoal."""
 
-    goal: Posit = field(default_factory=Posit)
+    goal: Posit = __field__(default_factory=lambda: Posit())
 
 
 @dataclass
 class CalcObjInput:
     """The input of request calcObj."""
 
-    object: Object = field(default_factory=Object)
+    object: Object = __field__(default_factory=lambda: Object())
 
 
 @dataclass
 class CalcObjOutput:
     """The output of request calcObj."""
 
-    position: Posit = field(default_factory=Posit)
+    position: Posit = __field__(default_factory=lambda: Posit())
 
 
 @dataclass
 class GoalsPoster:
     """The content of poster explor.Goals."""
 
-    goal: Posit = field(default_factory=Posit)
-    graspPos: Posit = field(default_factory=Posit)
+    goal: Posit = __field__(default_factory=lambda: Posit())
+    graspPos: Posit = __field__(default_factory=lambda: Posit())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -18,7 +19,7 @@ class Posit:
 
 @dataclass
 class PosError:
-    cov: list[float] = field(default_factory=lambda: [0.0] * 9)
+    cov: list[float] = __field__(default_factory=lambda: [0.0] * 9)
 
 
 @dataclass
@@ -46,12 +47,12 @@ class Speed:
 class LocoData(rt.InternalData):
     """The internal data (SDI) of module loco."""
 
-    robot: Posit = field(default_factory=Posit)
-    odoError: PosError = field(default_factory=PosError)
-    ref: Ref = field(default_factory=Ref)
+    robot: Posit = __field__(default_factory=lambda: Posit())
+    odoError: PosError = __field__(default_factory=lambda: PosError())
+    ref: Ref = __field__(default_factory=lambda: Ref())
     trackedPoster: str = ""
-    encoders: WheelTravel = field(default_factory=WheelTravel)
-    speed: Speed = field(default_factory=Speed)
+    encoders: WheelTravel = __field__(default_factory=lambda: WheelTravel())
+    speed: Speed = __field__(default_factory=lambda: Speed())
     stopCycles: int = 0
     stillCycles: int = 0
 
@@ -60,7 +61,7 @@ class LocoData(rt.InternalData):
 class GoToInput:
     """The input of request GoTo."""
 
-    ref: Ref = field(default_factory=Ref)
+    ref: Ref = __field__(default_factory=lambda: Ref())
 
 
 @dataclass
@@ -74,9 +75,9 @@ class TrackInput:
 class RobotPoster:
     """The content of poster loco.Robot."""
 
-    robot: Posit = field(default_factory=Posit)
-    odoError: PosError = field(default_factory=PosError)
-    ref: Ref = field(default_factory=Ref)
+    robot: Posit = __field__(default_factory=lambda: Posit())
+    odoError: PosError = __field__(default_factory=lambda: PosError())
+    ref: Ref = __field__(default_factory=lambda: Ref())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

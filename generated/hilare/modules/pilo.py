@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -36,11 +37,11 @@ class Dynamic:
 
 @dataclass
 class Trajectory:
-    kind: TrajKind = TrajKind.SEGMENT
+    kind: TrajKind = __field__(default_factory=lambda: TrajKind.SEGMENT)
     nbPoints: int = 0
-    x: list[float] = field(default_factory=lambda: [0.0] * 64)
-    y: list[float] = field(default_factory=lambda: [0.0] * 64)
-    theta: list[float] = field(default_factory=lambda: [0.0] * 64)
+    x: list[float] = __field__(default_factory=lambda: [0.0] * 64)
+    y: list[float] = __field__(default_factory=lambda: [0.0] * 64)
+    theta: list[float] = __field__(default_factory=lambda: [0.0] * 64)
     tolerance: float = 0.0
 
 
@@ -49,12 +50,12 @@ class PiloData(rt.InternalData):
     """The internal data (SDI) of module pilo."""
 
     avoidOn: bool = False
-    dynamic: Dynamic = field(default_factory=Dynamic)
+    dynamic: Dynamic = __field__(default_factory=lambda: Dynamic())
     trajPoster: str = ""
-    traj: Trajectory = field(default_factory=Trajectory)
+    traj: Trajectory = __field__(default_factory=lambda: Trajectory())
     nextPoint: int = 0
-    setpoint: Ref = field(default_factory=Ref)
-    limits: Dynamic = field(default_factory=Dynamic)
+    setpoint: Ref = __field__(default_factory=lambda: Ref())
+    limits: Dynamic = __field__(default_factory=lambda: Dynamic())
     elapsed: float = 0.0
 
 
@@ -69,7 +70,7 @@ class AvoidOnOffInput:
 class SetDynamicInput:
     """The input of request setDynamic."""
 
-    dynamic: Dynamic = field(default_factory=Dynamic)
+    dynamic: Dynamic = __field__(default_factory=lambda: Dynamic())
 
 
 @dataclass
@@ -83,7 +84,7 @@ class ExecPosterTrajInput:
 class SetpointPoster:
     """The content of poster pilo.Setpoint."""
 
-    setpoint: Ref = field(default_factory=Ref)
+    setpoint: Ref = __field__(default_factory=lambda: Ref())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -27,8 +28,8 @@ class Posit:
 @dataclass
 class Polygon:
     n: int = 0
-    x: list[float] = field(default_factory=lambda: [0.0] * 16)
-    y: list[float] = field(default_factory=lambda: [0.0] * 16)
+    x: list[float] = __field__(default_factory=lambda: [0.0] * 16)
+    y: list[float] = __field__(default_factory=lambda: [0.0] * 16)
 
 
 @dataclass
@@ -41,11 +42,11 @@ class Box:
 
 @dataclass
 class Trajectory:
-    kind: TrajKind = TrajKind.SEGMENT
+    kind: TrajKind = __field__(default_factory=lambda: TrajKind.SEGMENT)
     nbPoints: int = 0
-    x: list[float] = field(default_factory=lambda: [0.0] * 64)
-    y: list[float] = field(default_factory=lambda: [0.0] * 64)
-    theta: list[float] = field(default_factory=lambda: [0.0] * 64)
+    x: list[float] = __field__(default_factory=lambda: [0.0] * 64)
+    y: list[float] = __field__(default_factory=lambda: [0.0] * 64)
+    theta: list[float] = __field__(default_factory=lambda: [0.0] * 64)
     tolerance: float = 0.0
 
 
@@ -54,13 +55,13 @@ class PlanData(rt.InternalData):
     """The internal data (SDI) of module plan."""
 
     autoBox: bool = False
-    box: Box = field(default_factory=Box)
+    box: Box = __field__(default_factory=lambda: Box())
     modelFile: str = ""
-    obstacles: list[Polygon] = field(default_factory=lambda: [Polygon() for _ in range(64)])
+    obstacles: list[Polygon] = __field__(default_factory=lambda: [Polygon() for _ in range(64)])
     nbObstacles: int = 0
-    start: Posit = field(default_factory=Posit)
-    goal: Posit = field(default_factory=Posit)
-    traj: Trajectory = field(default_factory=Trajectory)
+    start: Posit = __field__(default_factory=lambda: Posit())
+    goal: Posit = __field__(default_factory=lambda: Posit())
+    traj: Trajectory = __field__(default_factory=lambda: Trajectory())
 
 
 @dataclass
@@ -74,7 +75,7 @@ class AutoBoxInput:
 class SetPlannerEnvInput:
     """The input of request setPlannerEnv."""
 
-    box: Box = field(default_factory=Box)
+    box: Box = __field__(default_factory=lambda: Box())
 
 
 @dataclass
@@ -88,30 +89,30 @@ class ReadModelFileInput:
 class PlanInput:
     """The input of request plan."""
 
-    start: Posit = field(default_factory=Posit)
-    goal: Posit = field(default_factory=Posit)
+    start: Posit = __field__(default_factory=lambda: Posit())
+    goal: Posit = __field__(default_factory=lambda: Posit())
 
 
 @dataclass
 class ReplanInput:
     """The input of request replan."""
 
-    start: Posit = field(default_factory=Posit)
-    goal: Posit = field(default_factory=Posit)
+    start: Posit = __field__(default_factory=lambda: Posit())
+    goal: Posit = __field__(default_factory=lambda: Posit())
 
 
 @dataclass
 class TrajPoster:
     """The content of poster plan.Traj."""
 
-    traj: Trajectory = field(default_factory=Trajectory)
+    traj: Trajectory = __field__(default_factory=lambda: Trajectory())
 
 
 @dataclass
 class EnvPoster:
     """The content of poster plan.Env."""
 
-    box: Box = field(default_factory=Box)
+    box: Box = __field__(default_factory=lambda: Box())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -16,7 +17,7 @@ class WatchReport(enum.Enum):
 
 @dataclass
 class UsConfig:
-    enabled: list[bool] = field(default_factory=lambda: [False] * 32)
+    enabled: list[bool] = __field__(default_factory=lambda: [False] * 32)
     maxRange: float = 0.0
 
 
@@ -24,8 +25,8 @@ class UsConfig:
 class UsData(rt.InternalData):
     """The internal data (SDI) of module us."""
 
-    config: UsConfig = field(default_factory=UsConfig)
-    ranges: list[float] = field(default_factory=lambda: [0.0] * 32)
+    config: UsConfig = __field__(default_factory=lambda: UsConfig())
+    ranges: list[float] = __field__(default_factory=lambda: [0.0] * 32)
     threshold: float = 0.0
 
 
@@ -33,7 +34,7 @@ class UsData(rt.InternalData):
 class ConfigureInput:
     """The input of request configure."""
 
-    config: UsConfig = field(default_factory=UsConfig)
+    config: UsConfig = __field__(default_factory=lambda: UsConfig())
 
 
 @dataclass
@@ -47,14 +48,14 @@ class WatchObstacleInput:
 class WatchObstacleOutput:
     """The output of request watchObstacle."""
 
-    report: WatchReport = WatchReport.OBSTACLE
+    report: WatchReport = __field__(default_factory=lambda: WatchReport.OBSTACLE)
 
 
 @dataclass
 class ProximityPoster:
     """The content of poster us.Proximity."""
 
-    ranges: list[float] = field(default_factory=lambda: [0.0] * 32)
+    ranges: list[float] = __field__(default_factory=lambda: [0.0] * 32)
 
 
 # Checked by the runtime on every request: (field, kind, array length).

@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as __field__
 from typing import Any
 
 from specc.runtime import functional as rt
@@ -26,10 +27,10 @@ class Object:
 
 @dataclass
 class Image:
-    pose: Posit = field(default_factory=Posit)
+    pose: Posit = __field__(default_factory=lambda: Posit())
     pan: float = 0.0
     valid: bool = False
-    seen: list[Object] = field(default_factory=lambda: [Object() for _ in range(16)])
+    seen: list[Object] = __field__(default_factory=lambda: [Object() for _ in range(16)])
     nbSeen: int = 0
 
 
@@ -38,22 +39,22 @@ class Model:
     nx: int = 0
     ny: int = 0
     cellSize: float = 0.0
-    certainty: list[float] = field(default_factory=lambda: [0.0] * 4096)
-    free: list[bool] = field(default_factory=lambda: [False] * 4096)
+    certainty: list[float] = __field__(default_factory=lambda: [0.0] * 4096)
+    free: list[bool] = __field__(default_factory=lambda: [False] * 4096)
 
 
 @dataclass(slots=True)
 class VisualData(rt.InternalData):
     """The internal data (SDI) of module visual."""
 
-    model: Model = field(default_factory=Model)
+    model: Model = __field__(default_factory=lambda: Model())
     pan: float = 0.0
-    image: Image = field(default_factory=Image)
-    objects: list[Object] = field(default_factory=lambda: [Object() for _ in range(16)])
+    image: Image = __field__(default_factory=lambda: Image())
+    objects: list[Object] = __field__(default_factory=lambda: [Object() for _ in range(16)])
     nbObjects: int = 0
-    nearest: Object = field(default_factory=Object)
+    nearest: Object = __field__(default_factory=lambda: Object())
     modelFile: str = ""
-    worldObjects: list[Object] = field(default_factory=lambda: [Object() for _ in range(16)])
+    worldObjects: list[Object] = __field__(default_factory=lambda: [Object() for _ in range(16)])
     nbWorldObjects: int = 0
 
 
@@ -82,14 +83,14 @@ class SearchObjectOutput:
 class GetObjectOutput:
     """The output of request getObject."""
 
-    object: Object = field(default_factory=Object)
+    object: Object = __field__(default_factory=lambda: Object())
 
 
 @dataclass
 class ModelPoster:
     """The content of poster visual.Model."""
 
-    model: Model = field(default_factory=Model)
+    model: Model = __field__(default_factory=lambda: Model())
     pan: float = 0.0
 
 
@@ -97,9 +98,9 @@ class ModelPoster:
 class ObjectsPoster:
     """The content of poster visual.Objects."""
 
-    objects: list[Object] = field(default_factory=lambda: [Object() for _ in range(16)])
+    objects: list[Object] = __field__(default_factory=lambda: [Object() for _ in range(16)])
     nbObjects: int = 0
-    nearest: Object = field(default_factory=Object)
+    nearest: Object = __field__(default_factory=lambda: Object())
 
 
 # Checked by the runtime on every request: (field, kind, array length).

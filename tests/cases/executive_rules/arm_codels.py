@@ -1,9 +1,9 @@
 """Codels of the executive_rules case."""
 
 
-def go(record):
+def go(sdi, request):
     return "ether"
 
 
-def back(record):
+def back(sdi, request):
     return "ether"

@@ -1,0 +1,30 @@
+"""Codels of the test module `hand`: read by `specc check` for their signatures and the strings
+they return, never run."""
+
+raise RuntimeError("codel modules must never be executed by `specc check`")
+
+
+def check_grip(sdi):  # a validate codel is called with (sdi, request)
+    return "end"
+
+
+def squeeze(sdi, request, force=1.0):  # a default third argument is fine
+    if force > 2:
+        return "SLIPPED"  # no such fail message
+    if force > 1:
+        return "exce"  # a typo of a codel state
+    return "exec"
+
+
+def hold(sdi, request, *rest):
+    def inner():
+        return "anything"  # a nested function's returns are its own
+    return "SLIP" if inner() else "ether"
+
+
+def watch(sdi, request):  # an exec task's codel is called with (sdi)
+    return "exec"
+
+
+def release(sdi, request):
+    return "ether"
