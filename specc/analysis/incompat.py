@@ -1,9 +1,12 @@
 """The service incompatibility graph and its reduction to service groups (seed 000 §3.6.1).
 
 An arc A -> B says: to run A, B must first be interrupted (or, for a `wait` arc, have ended).
-Arcs come from the executive's `conflicts` (logical conflicts) and from the modules'
+Arcs come from the executive's `conflicts` (logical conflicts), from the modules'
 `incompatible_with` between the requests two services run (physical conflicts: the module
-itself interrupts). A control service takes no time, so nothing ever needs to interrupt it:
+itself interrupts), and from the requests a service's codels send to other modules (`sends:`)
+that are incompatible there with another service's request (logical: the executive aborts it
+before the sender starts, and holds it back while the sender runs, since the module would
+interrupt it without the executive's say). A control service takes no time, so nothing ever needs to interrupt it:
 no arc ends at one.
 
 Complete symmetric subgraphs (every pair both ways, every service looping on itself) are
@@ -76,6 +79,17 @@ def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGr
         if module_of[first] == module_of[second] and incompatible(requests[first], requests[second]):
             if second not in control:
                 arcs[(first, second)] = Arc(first, second, "interrupt", True)
+    # A request a service's codels send to another module (`sends:`, transitively) interrupts
+    # there what it is incompatible with, without the executive's say, at any time the sender
+    # runs: the controller stops that service (an abort) before the sender starts, and holds
+    # it back (a wait) while the sender runs. Both arcs are logical.
+    for first, request in requests.items():
+        for module_name, sent in sent_requests(modules, module_of[first], request):
+            for second, target in requests.items():
+                if module_of[second] == module_name and second not in control and incompatible(sent, target):
+                    arcs.setdefault((first, second), Arc(first, second, "interrupt", False))
+                    if first not in control and second != first:
+                        arcs.setdefault((second, first), Arc(second, first, "wait", False))
     declared = {s.name for s in executive.services}
     for service in executive.services:
         for conflict in service.conflicts:
@@ -86,6 +100,22 @@ def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGr
     names = tuple(dict.fromkeys(s.name for s in executive.services))
     ordered = tuple(sorted(arcs.values(), key=lambda a: (names.index(a.source), names.index(a.target))))
     return IncompatibilityGraph(names, ordered, module_of, control)
+
+
+def sent_requests(modules: dict[str, m.Module], module: str, request: m.Request) -> list[tuple[str, m.Request]]:
+    """(module, request) for each request `request`'s codels send, and those those send in turn."""
+    found: dict[tuple[str, str], m.Request] = {}
+    pending = [(module, request)]
+    while pending:
+        _, current = pending.pop()
+        for ref in current.sends:
+            if len(ref.parts) != 2 or ref.parts[0] not in modules or tuple(ref.parts) in found:
+                continue
+            target = {r.name: r for r in modules[ref.parts[0]].requests}.get(ref.parts[1])
+            if target is not None:
+                found[(ref.parts[0], ref.parts[1])] = target
+                pending.append((ref.parts[0], target))
+    return [(key[0], target) for key, target in found.items()]
 
 
 def incompatible(first: m.Request, second: m.Request) -> bool:

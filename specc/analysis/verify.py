@@ -4,8 +4,9 @@ The executive that runs is the real one (`specc.runtime.executive`) deciding wit
 controller; only its surroundings are abstract. Modules are models of the functional level
 (requests, physical incompatibilities, intermediate replies when an activity starts, final
 replies, ZOMBIE, aborts, as in `specc.runtime.functional`), whose activities may end, fail or
-freeze at any moment; any pending timeout may expire at any moment; the task level may ask for
-any service while fewer than `requests` are outstanding, and interrupt any of them. Time is
+freeze at any moment, and send once, at any moment, each request their codels send (`sends:`);
+any pending timeout may expire at any moment; the task level may ask for any service while
+fewer than `requests` are outstanding, and interrupt any of them. Time is
 abstracted away, so every interleaving is covered.
 
 The exploration is breadth-first over canonical states (activity ids renumbered by age), so
@@ -86,6 +87,8 @@ class ModelActivity:
     state: str = "INIT"  # INIT EXEC INTER ZOMBIE
     waiting_for: set[int] = field(default_factory=set)
     cause: str = "ABORT"
+    sent: frozenset[str] = frozenset()  # the requests (`sends:`) its codels have sent already
+    sent_by_codel: bool = False  # it is itself such a request: it counts as an outstanding one
 
 
 class ModelModule:
@@ -179,18 +182,34 @@ class ModelModule:
                 other.waiting_for.discard(activity.id)
                 self.try_start(other)
 
+    def send(self, activity: ModelActivity, target: str) -> None:
+        """A codel of the activity sends `target` (`module.request`) to another module, once."""
+        activity.sent = activity.sent | {target}
+        module, _, request = target.partition(".")
+        receiver = self.registry.modules.get(module)
+        if receiver is not None:
+            ident = receiver.submit(request, None, _ignore)
+            if ident in receiver.activities:
+                receiver.activities[ident].sent_by_codel = True
+
     def endings(self, activity: ModelActivity) -> list[tuple[str, Callable[[], None]]]:
         """What the activity itself may do next."""
         if activity.state == "EXEC":
             reported = [(f"ends with {code}", functools.partial(self.finish, activity, Status.END, code))
                         for code in self.codes]
-            return [("ends", functools.partial(self.finish, activity, Status.END, "OK")), *reported,
+            sends = [(f"sends {target}", functools.partial(self.send, activity, target))
+                     for target in activity.spec.sends if target not in activity.sent]
+            return [("ends", functools.partial(self.finish, activity, Status.END, "OK")), *reported, *sends,
                     ("fails", functools.partial(self.finish, activity, Status.FINAL_ERROR, "FAILED")),
                     ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         if activity.state == "INTER":
             return [("is interrupted", functools.partial(self.finish, activity, Status.INTERRUPTED, activity.cause)),
                     ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         return []
+
+
+def _ignore(reply: Reply) -> None:
+    """Where a sent request's replies go: its sender's codels, which the model leaves free."""
 
 
 class ModelRegistry:
@@ -292,7 +311,8 @@ class Explorer:
             entries = sorted(module.activities.values(), key=lambda a: (owners.get((name, a.id), len(ordered)), a.id))
             index = {a.id: i for i, a in enumerate(entries)}
             modules.append(tuple((owners.get((name, a.id), -1), a.spec.name, a.state, a.cause,
-                                  tuple(sorted(index[w] for w in a.waiting_for if w in index))) for a in entries))
+                                  tuple(sorted(index[w] for w in a.waiting_for if w in index)),
+                                  tuple(sorted(a.sent)), a.sent_by_codel) for a in entries))
         activities = tuple((a.service.name, str(a.state), a.holds_group, a.answered, a.abort_sent,
                             tuple(sorted(timers.get(rank, ()))))
                            for rank, a in enumerate(ordered))
@@ -316,18 +336,19 @@ class Explorer:
         for name, entries in zip(sorted(registry.modules), modules, strict=True):
             module = registry.modules[name]
             built = []
-            for owner, request, state, cause, _ in entries:
+            for owner, request, state, cause, _, sent, sent_by_codel in entries:
                 owned = made[owner] if owner >= 0 else None
                 sink = (functools.partial(executive._post, executive._on_reply, owned) if owned is not None
                         else executive.reflex_replies.append)
-                entry = ModelActivity(registry.new_id(), module.requests[request], sink, state, set(), cause)
+                entry = ModelActivity(registry.new_id(), module.requests[request], sink, state, set(), cause,
+                                      frozenset(sent), sent_by_codel)
                 module.activities[entry.id] = entry
                 if state == "ZOMBIE":
                     module.zombies.add(entry.id)
                 if owned is not None:
                     owned.module_id = entry.id
                 built.append(entry)
-            for entry, (_, _, _, _, waiting) in zip(built, entries, strict=True):
+            for entry, (_, _, _, _, waiting, _, _) in zip(built, entries, strict=True):
                 entry.waiting_for = {built[i].id for i in waiting}
         for activity in made:
             if activity.module_id is None and activity.state is not rx.Phase.WAIT:
@@ -342,7 +363,9 @@ class Explorer:
     def events(self, world: World) -> list[Event]:
         executive = world.executive
         found: list[Event] = []
-        if len(executive.activities) < self.requests:
+        # A request a codel sent is outstanding too: the bound keeps the state space finite.
+        sent = sum(a.sent_by_codel for module in world.registry.modules.values() for a in module.activities.values())
+        if len(executive.activities) + sent < self.requests:
             for service in self.spec.services:
                 found.append(Event(f"task: RQST EXEC {service}", True, functools.partial(_request, service)))
         for activity in executive.activities.values():
@@ -524,7 +547,8 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
     modules: dict[str, dict[str, RequestSpec]] = {}
     for module in (i for i in program.items if isinstance(i, m.Module)):
         modules[module.name] = {r.name: RequestSpec(r.name, r.kind or "exec",
-                                                    incompatible=tuple(x.text for x in r.incompatible_with))
+                                                    incompatible=tuple(x.text for x in r.incompatible_with),
+                                                    sends=tuple(x.text for x in r.sends))
                                 for r in module.requests}
     arcs = {(a.source, a.target) for a in controller.graph.arcs}
     return Explorer(spec, decision_function(compiled), modules, arcs, requests)
