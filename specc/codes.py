@@ -116,6 +116,8 @@ CODES: dict[str, Code] = {
     "output-never-set": Code("an output no rule deduces", "outputs status, never;"),
     "input-never-read": Code("an input no rule tests: it changes no decision (warning)", "inputs battery: [0, 100];"),
     "empty-domain": Code("a domain holding no value", "inputs load: [1, 0];"),
+    "rules-too-large": Code("a rule base or resource controller whose decision graph is too large to build",
+                            "8 numeric inputs tested against 50 thresholds each"),
     "not-propositional": Code("a rule base outside the propositional subset Kheops compiles (an attribute compared "
                               "with another, a constant that is not a literal...)", "r: speed > load ==> ..."),
     "rules-unsettled": Code("input configurations the rules do not settle (warning at compile)",

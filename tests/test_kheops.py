@@ -4,6 +4,10 @@ forward-chaining interpreter, and compilation reports inconsistent and incomplet
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -206,3 +210,48 @@ def test_generated_decision_functions_equal_the_interpreter(tmp_path_factory: py
             assert sorted(calls, key=repr) == sorted(expected.calls, key=repr)
 
         check()
+
+
+def threshold_base(inputs: int, rules: int) -> str:
+    """Numeric inputs tested against many thresholds, pairwise: the decision graph multiplies."""
+    lines = [f"rules big {{\n  inputs {', '.join(f'x{i}: [0, 100]' for i in range(inputs))};",
+             '  outputs level: {"LOW", "HIGH"};']
+    for r in range(rules):
+        a, b = r % inputs, (r * 3 + 1) % inputs
+        lines.append(f'  r{r}: x{a} > {(r * 37) % 97 + 1}, x{b} < {(r * 53) % 89 + 5} ==> restrict level == '
+                     f'"{"LOW" if r % 2 else "HIGH"}";')
+    return "\n".join(lines) + "\n}\n"
+
+
+def test_a_base_past_the_work_limit_is_refused_with_its_figures_not_built() -> None:
+    source = parse_text(threshold_base(5, 20), "big.spec").source
+    assert source is not None
+    base = k.normalise(next(i for i in source.items if isinstance(i, m.RuleBase)))
+    built = k.compile_base(base, limit=10**7)
+    with pytest.raises(k.TooLarge) as refused:
+        k.compile_base(base, limit=built.tree_nodes // 2)
+    assert refused.value.code == "rules-too-large" and refused.value.node.span.line == 1
+    message = str(refused.value)
+    bound, counts = k.paths_bound(base)
+    assert f"more than {built.tree_nodes // 2:,} decision-tree nodes" in message and f"{bound:,}" in message
+    assert bound >= built.tree_nodes // 2 and len(counts) == 5  # the estimate bounds what was built
+    assert "split it into bases" in message
+
+
+def test_compile_rules_and_verify_stop_at_the_limit_with_one_message(tmp_path: Path) -> None:
+    spec = tmp_path / "big.spec"
+    spec.write_text(threshold_base(5, 20))
+    small = {**os.environ, k.WORK_LIMIT_VARIABLE: "500"}
+    for args in (["compile", str(spec), "-o", str(tmp_path / "out")], ["rules", str(spec)],
+                 ["compile", str(EXAMPLES / "hilare"), "-o", str(tmp_path / "out")],
+                 ["verify", str(EXAMPLES / "hilare"), "--requests", "1"]):
+        result = subprocess.run([sys.executable, "-m", "specc.cli", *args], capture_output=True, text=True,
+                                timeout=120, env=small)
+        shown = result.stdout + result.stderr
+        assert result.returncode == 1 and "Traceback" not in shown, shown
+        headline = next(line for line in shown.splitlines() if line.endswith("[rules-too-large]"))
+        if "hilare" in args[1]:
+            assert "executive.spec:" in headline and "resource controller of executive 'hilare'" in headline
+            assert "service groups: 432 controller states x 21 services x 5 events" in headline
+        else:
+            assert headline.startswith(f"{spec}:1:1: error: rule base 'big' needs more than 500")

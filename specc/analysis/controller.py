@@ -22,6 +22,7 @@ the pilo group ExecTrajState).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -228,6 +229,19 @@ class Controller:
 
     def state_attribute(self, group: Group) -> str:
         return state_attribute(group, self.names)
+
+    def compile(self) -> k.Compiled:
+        """The decision graph; past Kheops' work limit, the reason told in the executive's terms."""
+        try:
+            return k.compile_base(self.base)
+        except k.TooLarge as exc:
+            states = math.prod(len(g.states) for g in self.groups)
+            raise k.TooLarge(
+                f"the resource controller of executive '{self.executive.name}' needs more than {exc.limit:,} "
+                f"decision-tree nodes to compile ({len(self.groups)} service groups: {states:,} controller states "
+                f"x {len(self.graph.services)} services x {len(EVENTS)} events): declare fewer conflicts between "
+                "services (every group multiplies the states), or give each independent part of the robot its "
+                f"own executive; {k.WORK_LIMIT_VARIABLE}=N raises the limit", self.executive, exc.limit) from None
 
 
 def controller_name(executive: m.Executive) -> str:

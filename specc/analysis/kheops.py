@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Union
@@ -34,9 +35,29 @@ NUMERIC_OPS = ("<", "<=", ">", ">=", "==", "!=")
 class KheopsError(Exception):
     """A rule base outside the propositional subset (carries the offending node's span)."""
 
+    code = "not-propositional"
+
     def __init__(self, message: str, node: m.Node):
         super().__init__(message)
         self.node = node
+
+
+class TooLarge(KheopsError):
+    """A rule base whose decision graph would take more work than its limit to build."""
+
+    code = "rules-too-large"
+
+    def __init__(self, message: str, node: m.Node, limit: int):
+        super().__init__(message, node)
+        self.limit = limit
+
+
+# Decision-tree nodes a compilation may visit (Hilare's resource controller: 85,000, ~3 s; a
+# million is ~30 s and ~1 GB): past it, a diagnostic with the figures and how to split the base,
+# never a run of many minutes and gigabytes (seed 000 §3.7 compiles every path of the base into
+# the decision graph). The environment variable raises it for a base that is worth the wait.
+WORK_LIMIT = 1_000_000
+WORK_LIMIT_VARIABLE = "SPECC_RULES_WORK_LIMIT"
 
 
 # ---------------------------------------------------------------- normalised rules
@@ -664,8 +685,9 @@ class Compiled:
 
 
 class Compiler:
-    def __init__(self, base: Base):
+    def __init__(self, base: Base, limit: int = WORK_LIMIT):
         self.base = base
+        self.limit = limit
         self.findings: list[Finding] = []
         self.tree_nodes = 0
         self.shared: dict[Node, Node] = {}
@@ -707,6 +729,8 @@ class Compiler:
         search explores the DAG rather than the whole tree; a shared state's findings carry
         the witness of the first path that reached it."""
         self.tree_nodes += 1
+        if self.tree_nodes > self.limit:
+            raise self.too_large()
         alive = tuple(r for r in alive if self.truth(r, memory) != FALSE)
         key = (tuple(memory[a] for a in self.order), tuple(r.name for r in alive), testable)
         found = self.explored.get(key)
@@ -771,6 +795,16 @@ class Compiler:
             branches.append((value, child))
         return self.wrap(procedural, self.intern(Test(chosen, tuple(branches))))
 
+    def too_large(self) -> TooLarge:
+        bound, counts = paths_bound(self.base)
+        largest = " x ".join(f"{name} {count}" for name, count in counts[:6]) + (" x ..." if len(counts) > 6 else "")
+        name = self.base.name
+        return TooLarge(f"rule base '{name}' needs more than {self.limit:,} decision-tree nodes to compile (its "
+                        f"tests split on up to {bound:,} input combinations: {largest} values): split it into "
+                        "bases that each decide from fewer inputs, or use fewer thresholds per numeric input "
+                        f"(each one adds a value); {WORK_LIMIT_VARIABLE}=N raises the limit",
+                        self.base.source or m.RuleBase(name=name), self.limit)
+
     def ordered(self, attribute: str, values: frozenset[Any]) -> list[Any]:
         domain = self.base.attributes[attribute].values
         return [v for v in domain if v in values]
@@ -790,8 +824,23 @@ class Compiler:
         return self.intern(Leaf(outputs, inconsistent, incomplete if not inconsistent else ()))
 
 
-def compile_base(base: Base) -> Compiled:
-    return Compiler(base).compile()
+def compile_base(base: Base, limit: int | None = None) -> Compiled:
+    if limit is None:
+        given = os.environ.get(WORK_LIMIT_VARIABLE, "")
+        limit = int(given) if given.isdigit() else WORK_LIMIT
+    return Compiler(base, limit).compile()
+
+
+def paths_bound(base: Base) -> tuple[int, list[tuple[str, int]]]:
+    """The most root-to-leaf paths the decision graph can have, estimated before building it:
+    the product of the number of values of every attribute a test can split on (the inputs, the
+    previous-cycle values and the assigned intermediates), and those counts, largest first."""
+    assigned = {action.target for rule in base.rules for action in rule.actions if isinstance(action, Assign)}
+    tested = {atom.attribute for rule in base.rules if rule.condition is not None for atom in atoms(rule.condition)}
+    counts = sorted(((name, len(attribute.values)) for name, attribute in base.attributes.items()
+                     if name in tested and (attribute.role in ("inputs", "previous") or name in assigned)),
+                    key=lambda item: -item[1])
+    return math.prod(count for _, count in counts), counts
 
 
 def depth(node: Node) -> int:

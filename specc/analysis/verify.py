@@ -542,7 +542,7 @@ def _check_exclusion(world: World, arcs: set[tuple[str, str]], activity: rx.Acti
 
 def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) -> Explorer:
     controller = executive_controller(program, executive)
-    compiled = k.compile_base(controller.base)
+    compiled = controller.compile()
     spec = executive_spec(program, controller)
     modules: dict[str, dict[str, RequestSpec]] = {}
     for module in (i for i in program.items if isinstance(i, m.Module)):

@@ -94,7 +94,7 @@ def generate(program: m.Program, output: Output, robot: str = "") -> None:
     executives = sorted((i for i in program.items if isinstance(i, m.Executive)), key=lambda e: e.name)
     for executive in executives:
         controller = executive_controller(program, executive)
-        compiled = k.compile_base(controller.base)
+        compiled = controller.compile()
         warn_unsettled(output, compiled, f"the resource controller of executive '{executive.name}'", executive)
         hand = {ref.text for ref in executive.rules}
         sources = ", ".join(sorted({executive.span.file} | {
