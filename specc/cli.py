@@ -464,6 +464,9 @@ def plan(paths: PathsArg,
              help="A replanning: the source line of a goal still to meet (repeatable; default: all).")] = None,
          picture: Annotated[Optional[Path], typer.Option("--picture", "-o", help="Draw the plan's timeline "
                                                          "(PNG, SVG, PDF).")] = None,
+         json_path: Annotated[Optional[Path], typer.Option("--json", help="Write the plan, its schedule, "
+                                                           "partial order and goals as JSON (format: "
+                                                           "docs/planning.md); '-' prints it.")] = None,
          nodes: Annotated[int, typer.Option(min=1, help="Partial plans each search may expand (one for every "
                                                         "goal at once, then one per goal added).")] = 300,
          exact: Annotated[bool, typer.Option(help="Durations and schedule by CasADi (else the interval "
@@ -474,7 +477,7 @@ def plan(paths: PathsArg,
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
     checked by the independent validator.
 
-    Example: specc plan examples/tug --problem shuttle -o build/shuttle.png"""
+    Example: specc plan examples/tug --problem shuttle -o build/shuttle.png --json build/shuttle.json"""
     from specc.plan_report import print_result, solve
 
     loaded = load(paths)
@@ -487,7 +490,24 @@ def plan(paths: PathsArg,
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None
-    print_result(outcome, out)
+    if json_path is not None:
+        import json
+
+        from specc.plan_report import plan_document
+
+        text = json.dumps(plan_document(outcome), indent=2, allow_nan=False) + "\n"
+        if str(json_path) == "-":
+            sys.stdout.write(text)
+        else:
+            try:
+                json_path.write_text(text, encoding="utf-8")
+            except OSError as exc:
+                err.print(f"error: cannot write '{json_path}': {exc} [unwritable-file]", markup=False)
+                raise typer.Exit(1) from None
+    if str(json_path) != "-":
+        print_result(outcome, out)
+        if json_path is not None:
+            out.print(f"wrote {json_path}", markup=False)
     if picture is not None and outcome.useful:
         from specc.pictures import draw_timeline
 

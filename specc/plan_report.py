@@ -3,7 +3,9 @@ validator and print it all."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 from rich.console import Console
 from rich.table import Table
@@ -116,3 +118,50 @@ def print_result(outcome: Outcome, out: Console) -> None:
             out.print(f"  {v}", markup=False)
     else:
         out.print("validator: the plan is valid for every duration and window instant nature may pick", markup=False)
+
+
+PLAN_FORMAT = "specc-plan/1"
+
+
+def _number(value: float) -> float | None:
+    """A date or bound as JSON has it: an unbounded one (infinite) is null."""
+    return value + 0.0 if math.isfinite(value) else None  # + 0.0: no -0.0 in the file
+
+
+def plan_document(outcome: Outcome) -> dict[str, Any]:
+    """The plan for other tools (`specc plan --json`; the format is docs/planning.md's "Plans for
+    other tools"): what `print_result` shows, as data, with the partial order that justifies it."""
+    result, plan = outcome.result, outcome.result.plan
+    document: dict[str, Any] = {
+        "format": PLAN_FORMAT,
+        "domain": outcome.domain.name,
+        "problem": outcome.problem.name,
+        "search": {"partial_plans": result.nodes, "seconds": round(result.seconds, 6)},
+        "goals": [{"description": g.description, "line": g.line, "priority": g.priority, "kept": g.kept,
+                   "reason": g.reason} for g in result.goals],
+        "plan": None,
+        "reason": result.reason if plan is None else "",
+        "notes": list(result.notes),
+        "validator": {"violations": list(outcome.violations)},
+    }
+    if plan is None:
+        return document
+    document["plan"] = {
+        "controllability": plan.controllability,
+        "now": plan.now,
+        "makespan": _number(plan.makespan),
+        "actions": [{
+            "id": a.id, "task": a.task, "args": list(a.args), "start": a.start, "end": a.end,
+            "dispatch": a.dispatch, "duration": [a.duration[0], _number(a.duration[1])],
+            "contingent": a.contingent, "preemptible": a.preemptible,
+            "window": [_number(a.window[0]), _number(a.window[1])], "ends_by": _number(plan.ends_by(a)),
+            "values": dict(a.values)} for a in plan.ordered()],
+        "orderings": [[before, after, _number(delay)] for before, after, delay in plan.orderings],
+        "links": [{"producer": link.producer, "consumer": link.consumer, "attribute": link.attribute,
+                   "value": link.value} for link in plan.links],
+        "timepoints": {name: _number(date) for name, date in plan.schedule.items()},
+        "uncontrolled": {name: [_number(low), _number(high)] for name, (low, high) in plan.uncontrolled.items()},
+        "assumed": dict(plan.assumed),
+        "bindings": dict(plan.bindings),
+    }
+    return document

@@ -19,7 +19,8 @@ CALLS = {"error", "report", "warn", "unknown", "Diagnostic", "resolve_member", "
 
 def reported_codes() -> dict[str, str]:
     """code -> a file reporting it, read from the source: the codes given to CALLS, those in the
-    check passes' (reference, kind, code) tables, and those written into a message (`[code]`)."""
+    check passes' (reference, kind, code) tables, those exception classes carry (`code = ...`),
+    and those written into a message (`[code]`)."""
     found: dict[str, str] = {}
     for path in sorted(SPECC.rglob("*.py")):
         if path.name == "codes.py":
@@ -34,6 +35,9 @@ def reported_codes() -> dict[str, str]:
                     values = [*node.args, *(k.value for k in node.keywords)]
             elif isinstance(node, ast.Tuple) and "check" in path.relative_to(SPECC).parts:
                 values = list(node.elts)
+            elif isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "code"
+                                                      for t in node.targets):
+                values = [node.value]  # an exception class's code (`code = "rules-too-large"`)
             for value in values:
                 if isinstance(value, ast.Constant) and isinstance(value.value, str) and CODE.match(value.value):
                     found.setdefault(value.value, str(path.relative_to(SPECC)))

@@ -20,7 +20,7 @@ from typing import Any, Protocol
 from specc.campaign.experiments import Experiment, Outcome, Setting, run_experiment
 from specc.run import RunError
 from specc.runtime.ftplan import planner_processes_kept
-from specc.runtime.ftplan.planners import exit_with_parent, stop_process
+from specc.runtime.ftplan.planners import exit_with_parent, start_forkserver_quietly, stop_process
 from specc.runtime.planner import model as pm
 
 # forkserver: the parent may run threads (the progress display, the local engine's own), which
@@ -33,6 +33,7 @@ Task = tuple[Experiment, pm.PlanningDomain | None]
 
 def _serve(connection: Connection, setting: Setting) -> None:
     """The experiment process: run what the parent sends until it sends None or goes away."""
+    start_forkserver_quietly()  # killed mid-way through a planner's start, we leave no traceback behind
     exit_with_parent()  # a killed campaign takes its experiment processes (and their planners) along
 
     # Planner processes go from one experiment to the next (each builds its planner anew from
@@ -123,6 +124,7 @@ class LocalEngine:
         return f"local pool of {self.workers} process(es)"
 
     def run(self, tasks: Iterable[Task]) -> Iterator[Outcome]:
+        start_forkserver_quietly()  # interrupted mid-way through an experiment process's start: no traceback
         idle: list[ExperimentProcess] = [ExperimentProcess(self.setting, self.timeout) for _ in range(self.workers)]
         everyone = list(idle)
         lock = threading.Lock()

@@ -575,6 +575,33 @@ def forkserver_preload() -> list[str]:
     return PRELOAD + [name for name in list(sys.modules) if name == "specc" or name.startswith("specc.")]
 
 
+_forkserver_quiet = False
+
+
+def start_forkserver_quietly() -> None:
+    """Start this program's forkserver (with the planner preloaded) with its stderr on /dev/null.
+    The forkserver prints a traceback when a client dies in the middle of asking it for a child,
+    as a campaign's experiment processes do when the campaign is interrupted; the children it
+    forks inherit that stderr too, so only programs whose children report through their pipes
+    call this (a campaign and its experiment processes)."""
+    global _forkserver_quiet
+    if _forkserver_quiet:
+        return
+    from multiprocessing import forkserver
+
+    multiprocessing.get_context(START_METHOD).set_forkserver_preload(forkserver_preload())
+    sys.stderr.flush()
+    saved, devnull = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 2)
+        forkserver.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+    _forkserver_quiet = True
+
+
 def _launch() -> tuple[multiprocessing.process.BaseProcess, Connection]:
     """A new planner process, waiting for its first `_Build`."""
     context = multiprocessing.get_context(START_METHOD)

@@ -1,0 +1,81 @@
+"""`specc plan --json`: the plan as data another tool reads (docs/planning.md, "Plans for other
+tools"). The test reads the file as such a tool would, and checks the plan against its own
+partial order and windows, without specc's code."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.conftest import EXAMPLES
+
+EPSILON = 1e-6
+
+
+def planned(tmp_path: Path, robot: str, *args: str) -> dict[str, Any]:
+    path = tmp_path / "plan.json"
+    result = subprocess.run([sys.executable, "-m", "specc.cli", "plan", str(EXAMPLES / robot), *args,
+                             "--json", str(path)], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert f"wrote {path}" in result.stdout
+    return json.loads(path.read_text(encoding="utf-8"))  # strict JSON: no NaN or Infinity
+
+
+def at_most(low: float | None, high: float | None) -> bool:
+    """low <= high, where null is unbounded (below for a low, above for a high)."""
+    return low is None or high is None or low <= high + EPSILON
+
+
+@pytest.mark.parametrize("robot, args", [("tug", ("--problem", "shuttle")),
+                                         ("atrv", ("--problem", "M1", "--domain", "model1"))])
+def test_the_json_plan_holds_by_its_own_partial_order_and_windows(tmp_path: Path, robot: str,
+                                                                  args: tuple[str, ...]) -> None:
+    document = planned(tmp_path, robot, *args)
+    assert document["format"] == "specc-plan/1" and document["validator"]["violations"] == []
+    plan = document["plan"]
+    assert plan is not None and plan["controllability"] == "strong"
+    actions = plan["actions"]
+    assert actions and [a["dispatch"] for a in actions] == sorted(a["dispatch"] for a in actions)
+    for action in actions:
+        low, high = action["duration"]
+        assert at_most(action["window"][0], action["dispatch"]) and at_most(action["dispatch"], action["window"][1])
+        assert at_most(action["dispatch"] + low, action["ends_by"])
+        assert high is None or at_most(action["ends_by"], action["dispatch"] + high)
+        assert plan["timepoints"][action["start"]] == action["dispatch"]
+    assert plan["makespan"] == max(a["ends_by"] for a in actions)
+    timepoints, uncontrolled = plan["timepoints"], plan["uncontrolled"]
+
+    def earliest(point: str) -> float:
+        return timepoints[point] if point in timepoints else uncontrolled[point][0]
+
+    def latest(point: str) -> float | None:
+        return timepoints[point] if point in timepoints else uncontrolled[point][1]
+
+    checked = 0
+    for before, after, delay in plan["orderings"]:
+        if delay is None or before not in timepoints | uncontrolled or after not in timepoints | uncontrolled:
+            continue
+        # Strong controllability: the ordering holds for the latest `before` and the earliest `after`.
+        last = latest(before)
+        assert last is None or earliest(after) >= last + delay - EPSILON, (before, after, delay)
+        checked += 1
+    assert checked >= len(actions)  # each action is at least ordered after its start
+    kept = [g for g in document["goals"] if g["kept"]]
+    assert kept and all(g["reason"] == "" for g in kept)
+    assert all(g["reason"] for g in document["goals"] if not g["kept"])
+
+
+def test_dropped_goals_say_why_and_printing_to_stdout_prints_json_only(tmp_path: Path) -> None:
+    # One second is too short to move the cart: its goal is dropped, the robot already is at DOCK.
+    result = subprocess.run([sys.executable, "-m", "specc.cli", "plan", str(EXAMPLES / "tug"), "--problem",
+                             "shuttle", "--horizon", "1", "--json", "-"], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    document = json.loads(result.stdout)  # nothing but the document on stdout
+    dropped = [g for g in document["goals"] if not g["kept"]]
+    assert [g["line"] for g in dropped] == [111] and "impossible even alone" in dropped[0]["reason"]
+    assert document["plan"]["actions"] == [] and document["plan"]["makespan"] == 0.0
