@@ -570,7 +570,7 @@ def rules_report(paths: PathsArg,
     Example: specc rules examples/generic
     """
     from specc.analysis import kheops
-    from specc.backends.rules import describe, tally, worst_first
+    from specc.analysis.kheops import describe, tally, worst_first
 
     loaded = load(paths)
     if report(loaded) or loaded.program is None:

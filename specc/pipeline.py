@@ -58,16 +58,22 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
 
 
 def _rule_bases_outside_kheops(program: m.Program) -> list[Diagnostic]:
-    """What `specc compile` would refuse in a rule base, found by `specc check` too: a rule outside
-    the propositional subset Kheops compiles (normalising a base is cheap; compiling it is not)."""
-    from specc.analysis.kheops import KheopsError, normalise
+    """What `specc compile` says of a stand-alone rule base, said by `specc check` too: a rule
+    outside the propositional subset Kheops compiles, a base past the compilation's work limit,
+    and the input configurations it leaves unsettled. (An executive's own bases are compiled
+    with its controller, by `compile`, `rules` and `verify`: seconds, not milliseconds.)"""
+    from specc.analysis.kheops import KheopsError, compile_base, normalise, unsettled_warning
 
+    joined = {ref.text for e in program.items if isinstance(e, m.Executive) for ref in e.rules}
     found = []
     for base in (item for item in program.items if isinstance(item, m.RuleBase)):
         try:
-            normalise(base)
+            normal = normalise(base)
+            if base.name not in joined:
+                warning = unsettled_warning(compile_base(normal), f"rule base '{base.name}'", base)
+                found += [warning] if warning is not None else []
         except KheopsError as exc:
-            found.append(error("not-propositional", str(exc), exc.node.span))
+            found.append(error(exc.code, str(exc), exc.node.span))
     return found
 
 

@@ -22,10 +22,12 @@ from __future__ import annotations
 import itertools
 import math
 import os
-from collections.abc import Iterable, Iterator, Mapping
+from collections import Counter
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Union
 
+from specc.diagnostics import Diagnostic
 from specc.model import nodes as m
 
 OTHER = "*other*"  # the values of an undeclared symbolic domain that no rule mentions
@@ -902,3 +904,34 @@ def sample_of(element: Any) -> Any:
     if element == OTHER:
         return "<unmentioned>"
     return element
+
+
+# ---------------------------------------------------------------- findings, as people read them
+
+
+def describe(finding: Finding) -> str:
+    witness = ", ".join(f"{a}={v}" for a, v in finding.witness) or "any input"
+    fired = ", ".join(finding.fired) or "none"
+    what = "no value left for" if finding.kind == "inconsistent" else "undetermined"
+    return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
+
+
+def worst_first(findings: Sequence[Finding]) -> list[Finding]:
+    """Inconsistent configurations (no value left) before incomplete ones (no value deduced)."""
+    return sorted(findings, key=lambda finding: finding.kind != "inconsistent")
+
+
+def tally(findings: Sequence[Finding]) -> str:
+    """'48 inconsistent, 188 incomplete': the count of each kind found."""
+    counts = Counter(finding.kind for finding in findings)
+    return ", ".join(f"{counts[kind]} {kind}" for kind in ("inconsistent", "incomplete") if counts[kind])
+
+
+def unsettled_warning(compiled: Compiled, what: str, node: m.Node) -> Diagnostic | None:
+    """A compiled base that leaves inputs unsettled deserves a word (check and compile alike)."""
+    findings = compiled.findings
+    if not findings:
+        return None
+    return Diagnostic("rules-unsettled", f"{what} leaves {len(findings)} input configuration(s) unsettled "
+                      f"({tally(findings)}), e.g. {describe(worst_first(findings)[0])}; `specc rules` lists them",
+                      node.span, "warning")

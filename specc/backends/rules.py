@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -94,7 +93,7 @@ class DecisionView:
 
     @property
     def findings(self) -> list[str]:
-        return [describe(f) for f in self.compiled.findings]
+        return [k.describe(f) for f in self.compiled.findings]
 
     def body(self, node: k.Node, depth: int, root: bool = False) -> list[str]:
         pad = INDENT * depth
@@ -176,43 +175,21 @@ def condition(attribute: k.Attribute, value: Any) -> str:
     return f"v == {value!r}"
 
 
-def describe(finding: k.Finding) -> str:
-    witness = ", ".join(f"{a}={v}" for a, v in finding.witness) or "any input"
-    fired = ", ".join(finding.fired) or "none"
-    what = "no value left for" if finding.kind == "inconsistent" else "undetermined"
-    return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
-
-
-def worst_first(findings: Sequence[k.Finding]) -> list[k.Finding]:
-    """Inconsistent configurations (no value left) before incomplete ones (no value deduced)."""
-    return sorted(findings, key=lambda finding: finding.kind != "inconsistent")
-
-
-def tally(findings: Sequence[k.Finding]) -> str:
-    """'48 inconsistent, 188 incomplete': the count of each kind found."""
-    counts = Counter(finding.kind for finding in findings)
-    return ", ".join(f"{counts[kind]} {kind}" for kind in ("inconsistent", "incomplete") if counts[kind])
-
-
 def warn_unsettled(output: Output, compiled: k.Compiled, what: str, node: m.Node) -> None:
     """A compiled base that leaves inputs unsettled deserves a word at compile time."""
-    findings = compiled.findings
-    if findings:
-        output.warn("rules-unsettled", f"{what} leaves {len(findings)} input configuration(s) unsettled "
-                    f"({tally(findings)}), e.g. {describe(worst_first(findings)[0])}; `specc rules` lists them",
-                    node.span)
+    warning = k.unsettled_warning(compiled, what, node)
+    if warning is not None:
+        output.warn(warning.code, warning.message, warning.span)
 
 
 def generate(program: m.Program, output: Output, robot: str = "") -> list[k.Compiled]:
     compiled_all = []
     bases = sorted((i for i in program.items if isinstance(i, m.RuleBase)), key=lambda b: b.name)
-    # An executive's own bases only decide where they apply: the generated controller completes them.
-    joined = {ref.text for e in program.items if isinstance(e, m.Executive) for ref in e.rules}
+    # What a stand-alone base leaves unsettled, `specc check` says (specc.pipeline); an executive's
+    # own bases only decide where they apply: the generated controller completes them.
     for base in bases:
         compiled = k.compile_base(k.normalise(base))
         compiled_all.append(compiled)
-        if base.name not in joined:
-            warn_unsettled(output, compiled, f"rule base '{base.name}'", base)
         view = DecisionView(compiled, base.span.file)
         output.add(BACKEND, f"rules/{python_name(base.name)}.py", render("rules/decision.py.j2", view=view))
     if bases:
