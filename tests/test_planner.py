@@ -378,3 +378,31 @@ def test_an_unknown_controllability_is_refused() -> None:
     domain, _ = radio()
     with pytest.raises(ValueError, match="choose strong or pseudo"):
         Planner(domain, controllability="weak")
+
+
+def test_the_least_room_first_heuristic_searches_otherwise_and_plans_validly() -> None:
+    """Seed 004 §5.3: two planners of one model made diverse by their heuristics. On the tug's
+    shuttle (orderings to choose between its moves and its hitching), least-room-first tries every
+    ordering the other way round: another search, a plan the validator accepts, the same goals."""
+    from specc.analysis.planning import domain_block
+    from specc.plan_report import choose_problem
+    from specc.runtime.ftplan.config import HEURISTICS, PlannerConfig
+    from specc.runtime.ftplan.planners import standard_planner
+    from tests.conftest import EXAMPLES
+
+    program = load([EXAMPLES / "tug"]).program
+    assert program is not None
+    chosen = choose_problem(program, "shuttle", None)
+    model, problem = domain_model(program, domain_block(program, chosen)), problem_model(program, chosen)
+    results = {h: Planner(model, heuristic=h).plan(problem) for h in ("most-room-first", "least-room-first")}
+    for result in results.values():
+        assert result.plan is not None
+        assert validate(model, problem, result.plan, dropped_lines={g.line for g in result.dropped}) == []
+    standard, other = results["most-room-first"], results["least-room-first"]
+    assert [g.kept for g in standard.goals] == [g.kept for g in other.goals] == [True, True]
+    assert standard.nodes != other.nodes  # the searches differ
+    assert set(HEURISTICS) == {"most-room-first", "least-room-first"}
+    built = standard_planner(PlannerConfig("p2", model.name, heuristic="least-room-first"), {model.name: model})
+    assert built.heuristic == "least-room-first"
+    with pytest.raises(ValueError, match="heuristic 'fastest'"):
+        Planner(model, heuristic="fastest")

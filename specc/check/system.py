@@ -6,7 +6,7 @@ service exactly the inputs it takes, with values of their types."""
 
 from __future__ import annotations
 
-from specc.check.codels import python_functions
+from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.check.executive import resolve_poster, resolve_request
 from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks
@@ -24,6 +24,10 @@ WHOLE_INPUTS = frozenset({"int", "long", "char"})
 TEXT_INPUTS = frozenset({"string"})
 NUMERIC_DOMAINS = frozenset({"int", "float", "number"})
 TEXT_DOMAINS = frozenset({"string", "symbol"})
+# The hooks a system's extension module may define, and how the runner calls them
+# (docs/reference.md, "A robot's extension module").
+EXTENSION_HOOKS = {"prepare": ("world", "setup"), "attach": ("run",), "measure": ("events",),
+                   "judge": ("events", "measures", "outcome", "why")}
 MISSION_GOAL_OPS = ("!", "?")  # achieve or test: what a mission can ask of the supervisor
 
 
@@ -64,7 +68,10 @@ def check_blocks(ctx: Context, system: m.System) -> None:
         if reference is not None:
             ctx.lookup(kind, reference, reference.span, code)
     if system.extension is not None:
-        python_functions(ctx, system.extension)  # reports a module that is not there
+        functions = python_functions(ctx, system.extension)  # reports a module that is not there
+        for hook, call in EXTENSION_HOOKS.items():
+            if functions is not None and hook in functions:
+                check_call(ctx, hook, functions[hook], call, system.extension.value, system.extension.span)
     if not system.modules:
         ctx.report("missing-property", f"system '{system.name}' needs 'modules: ...;'", system.span)
         return

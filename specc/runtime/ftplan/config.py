@@ -9,13 +9,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from specc.runtime.planner.model import Interval as Interval  # re-exported: the generated modules name it here
+from specc.runtime.planner.planner import HEURISTICS as PLANNER_HEURISTICS
 
 Value = float | str
 
-# Heuristics specc's planner can be configured with. It has a single search order so far: a
-# planner block naming any heuristic is refused (by `specc check` and by the planner's process)
+# Heuristics specc's planner can be configured with (specc.runtime.planner.planner.HEURISTICS):
+# a planner block naming another is refused (by `specc check` and by the planner's process)
 # rather than silently planned with another one.
-HEURISTICS: frozenset[str] = frozenset()
+HEURISTICS: frozenset[str] = frozenset(PLANNER_HEURISTICS)
 
 
 @dataclass(frozen=True)

@@ -76,6 +76,7 @@ from typing import Final, Literal, Protocol
 from specc.runtime.ftplan.config import HEURISTICS, PlannerConfig
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.planner import STANDARD
 
 START_METHOD: Final = "forkserver"
 # Imported once by the forkserver, so that a planner's process starts without importing them
@@ -110,7 +111,8 @@ def standard_planner(config: PlannerConfig, domains: Mapping[str, pm.PlanningDom
     if config.domain not in domains:
         raise ValueError(f"planner '{config.name}': no planning domain '{config.domain}' "
                          f"(given: {', '.join(sorted(domains)) or 'none'})")
-    return Planner(domains[config.domain], controllability=config.controllability, node_limit=config.node_limit)
+    return Planner(domains[config.domain], controllability=config.controllability, node_limit=config.node_limit,
+                   heuristic=config.heuristic or STANDARD)
 
 
 def planning_domains(generated: Mapping[str, ModuleType]) -> dict[str, pm.PlanningDomain]:

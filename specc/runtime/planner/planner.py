@@ -80,12 +80,26 @@ class Attempt:
     failures: Counter[str] = field(default_factory=Counter)
 
 
+# Resolver orders (`heuristic:` of an FTplan planner block; seed 004 §5.3: planners of one model
+# made diverse by their heuristics). STANDARD: the orderings that solve a threat tried by the room
+# they leave, most first (a resource conflict's: the task found first goes first). LEAST_ROOM:
+# every ordering choice the other way round, so that its search departs from STANDARD's wherever
+# it has an order to choose. Both link an open condition to a producer already in the plan
+# before they insert a new task.
+STANDARD = "most-room-first"
+LEAST_ROOM = "least-room-first"
+HEURISTICS = (STANDARD, LEAST_ROOM)
+
+
 class Planner:
     def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
                  exact: bool = True, limits: Limits | None = None, controllability: str = STRONG,
-                 node_limit: int | None = None) -> None:
+                 node_limit: int | None = None, heuristic: str = STANDARD) -> None:
         if controllability not in CONTROLLABILITIES:
             raise ValueError(f"controllability '{controllability}': choose {' or '.join(CONTROLLABILITIES)}")
+        if heuristic not in HEURISTICS:
+            raise ValueError(f"heuristic '{heuristic}': choose {' or '.join(sorted(HEURISTICS))}")
+        self.heuristic = heuristic  # the order of the orderings a choice offers (HEURISTICS)
         self.domain = domain
         self.controllability = controllability  # what the plans must hold against (search.py's doc)
         self.nodes = nodes  # budget of the search for every goal at once
@@ -101,7 +115,7 @@ class Planner:
     def plan(self, problem: pm.Problem, now: float = 0.0) -> PlanResult:
         started = time.perf_counter()
         try:
-            setup = Setup(self.domain, problem, now, self.limits, self.controllability)
+            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic)
         except PlanningInputError as error:
             return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
         try:
@@ -194,7 +208,8 @@ class Setup:
     """A problem made ready to plan: its goals, the contingent instants and the constraints."""
 
     def __init__(self, domain: pm.PlanningDomain, problem: pm.Problem, now: float, limits: Limits,
-                 controllability: str = STRONG) -> None:
+                 controllability: str = STRONG, heuristic: str = STANDARD) -> None:
+        self.heuristic = heuristic
         if problem.domain != domain.name:
             raise PlanningInputError(f"problem '{problem.name}' is written for domain '{problem.domain}', "
                                      f"not '{domain.name}'")
@@ -350,6 +365,9 @@ class Setup:
                     if resolver is not None:
                         resolver.apply(node)
                     choice = select(node)
+                    if choice is not None and self.heuristic == LEAST_ROOM and \
+                            all(r.kind == "order" for r in choice):
+                        choice = choice[::-1]
                 except DeadEnd as error:
                     failures[_generic(str(error))] += 1
                     continue

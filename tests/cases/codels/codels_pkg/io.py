@@ -18,3 +18,7 @@ def send(ctx, service, priority):  # the action gives one argument
 
 def ready(ctx, side=None):
     return True
+
+
+def judge(events, measures):  # the runner calls judge(events, measures, outcome, why)
+    return "failed", "never"
