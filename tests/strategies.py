@@ -136,7 +136,8 @@ statements = st.recursive(
         st.builds(m.ParallelStmt, branches=small(st.builds(m.Block, statements=small(inner)), 1)),
         st.builds(m.ChooseStmt, branches=small(st.builds(m.Block, statements=small(inner)), 1))),
     max_leaves=6)
-pdomains = st.one_of(st.builds(m.SymbolSet, values=small(hyphenated, 1)), st.builds(m.DomainRef, name=hyphenated))
+pdomains = st.one_of(st.builds(m.SymbolSet, values=small(hyphenated, 1)), st.builds(m.DomainRef, name=hyphenated),
+                     st.builds(m.IntRange, low=st.integers(-50, 50), high=st.integers(-50, 50)))
 pparams = st.builds(m.PParam, name=lower, domain=pdomains)
 kas = st.builds(
     m.KA, name=lower, invocation=st.none() | goals | sexps, context=st.none() | goals,

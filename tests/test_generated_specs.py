@@ -93,7 +93,7 @@ def robots(draw: st.DrawFn) -> str:
         procedures, predicate = draw(distinct(names, 2))
         text += textwrap.dedent(f"""\
             procedures {procedures} {{
-              predicate {predicate.upper()}(n: {abs(low)}..{abs(high)});
+              predicate {predicate.upper()}(n: {low}..{high});
               ka Count {{ invocation: !(COUNT $N); body {{ =>({predicate.upper()} $N); }} }}
             }}
             """)

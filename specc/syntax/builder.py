@@ -533,8 +533,16 @@ class Builder(Transformer[Token, Any]):
         return m.SymbolSet(values=tuple(str(c) for c in children), span=self.span(meta))
 
     def prange(self, meta: Meta, children: list[Token]) -> m.IntRange:
-        low, high = children
-        return m.IntRange(low=int(low), high=int(high), span=self.span(meta))
+        bounds: list[int] = []
+        sign = 1
+        for token in children:  # [SIGN] INT [SIGN] INT
+            if token.type == "SIGN":
+                sign = -1 if token == "-" else 1
+            else:
+                bounds.append(sign * int(token))
+                sign = 1
+        low, high = bounds
+        return m.IntRange(low=low, high=high, span=self.span(meta))
 
     def pdomain_ref(self, meta: Meta, children: list[Token]) -> m.DomainRef:
         return m.DomainRef(name=str(children[0]), span=self.span(meta))
