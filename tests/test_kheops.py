@@ -255,3 +255,18 @@ def test_compile_rules_and_verify_stop_at_the_limit_with_one_message(tmp_path: P
             assert "service groups: 432 controller states x 21 services x 5 events" in headline
         else:
             assert headline.startswith(f"{spec}:1:1: error: rule base 'big' needs more than 500")
+
+
+@pytest.mark.parametrize("given, limit", [("500", 500), ("5e2", 500), ("5_00", 500), ("0", 1), ("lots", k.WORK_LIMIT)])
+def test_the_work_limit_is_read_from_the_environment_in_any_number_form(
+        given: str, limit: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    source = parse_text(threshold_base(5, 20), "big.spec").source
+    assert source is not None
+    base = k.normalise(next(i for i in source.items if isinstance(i, m.RuleBase)))
+    monkeypatch.setenv(k.WORK_LIMIT_VARIABLE, given)
+    if limit < k.compile_base(base, limit=10**7).tree_nodes:
+        with pytest.raises(k.TooLarge) as refused:
+            k.compile_base(base)
+        assert refused.value.limit == limit
+    else:
+        assert k.compile_base(base).findings is not None

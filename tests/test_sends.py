@@ -147,3 +147,21 @@ rules eager {
     trace = result.violations["no-error"].trace
     assert "pilot: Go sends mapper.Pause" in trace and "task: RQST EXEC MAP" in trace, trace
     assert "MAP" in result.violations["no-error"].message
+
+
+def test_two_services_whose_requests_interrupt_each_other_get_the_same_arcs_in_any_order(tmp_path: Path) -> None:
+    # Each of GO and BACK sends the other's module a request incompatible with the other's: both
+    # interrupt (by an abort) whichever is declared first; no wait arc hides an interrupt one.
+    spec = """
+module a { number: 1; request Run { type: exec; task: T; codel exec: run; sends: b.Halt; } request Halt { type: exec; task: T; codel exec: run; incompatible_with: Run; } exec_task T { period: 10 ms; } }
+module b { number: 2; request Run { type: exec; task: T; codel exec: run; sends: a.Halt; } request Halt { type: exec; task: T; codel exec: run; incompatible_with: Run; } exec_task T { period: 10 ms; } }
+executive ex { %s }
+"""
+    services = ["service GO { request: a.Run; }", "service BACK { request: b.Run; }"]
+    found = []
+    for order in (services, services[::-1]):
+        (tmp_path / "x.spec").write_text(spec % " ".join(order))
+        loaded = load([tmp_path / "x.spec"], check=False)
+        assert loaded.program is not None
+        found.append(set(build_graph(loaded.program, executive_of(loaded.program)).arcs))
+    assert found[0] == found[1] == {Arc("GO", "BACK", "interrupt", False), Arc("BACK", "GO", "interrupt", False)}

@@ -83,19 +83,24 @@ def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGr
     # there what it is incompatible with, without the executive's say, at any time the sender
     # runs: the controller stops that service (an abort) before the sender starts, and holds
     # it back (a wait) while the sender runs. Both arcs are logical.
-    for first, request in requests.items():
-        for module_name, sent in sent_requests(modules, module_of[first], request):
-            for second, target in requests.items():
-                if module_of[second] == module_name and second not in control and incompatible(sent, target):
-                    arcs.setdefault((first, second), Arc(first, second, "interrupt", False))
-                    if first not in control and second != first:
-                        arcs.setdefault((second, first), Arc(second, first, "wait", False))
+    # Every interrupt arc first, then the waits where no arc is: which of two services sending to
+    # each other comes first in the spec changes nothing.
+    sent_over = [(first, second) for first, request in requests.items()
+                 for module_name, sent in sent_requests(modules, module_of[first], request)
+                 for second, target in requests.items()
+                 if module_of[second] == module_name and second not in control and incompatible(sent, target)]
+    for first, second in sent_over:
+        arcs.setdefault((first, second), Arc(first, second, "interrupt", False))
+    for first, second in sent_over:
+        if first not in control and second != first:
+            arcs.setdefault((second, first), Arc(second, first, "wait", False))
     declared = {s.name for s in executive.services}
     for service in executive.services:
         for conflict in service.conflicts:
             if conflict.service in control or conflict.service not in declared:  # unknown: reported by checks
                 continue
-            physical = (service.name, conflict.service) in arcs
+            existing = arcs.get((service.name, conflict.service))
+            physical = existing is not None and existing.physical  # a sent request's arc is logical
             arcs[(service.name, conflict.service)] = Arc(service.name, conflict.service, conflict.policy, physical)
     names = tuple(dict.fromkeys(s.name for s in executive.services))
     ordered = tuple(sorted(arcs.values(), key=lambda a: (names.index(a.source), names.index(a.target))))

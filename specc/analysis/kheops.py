@@ -828,8 +828,11 @@ class Compiler:
 
 def compile_base(base: Base, limit: int | None = None) -> Compiled:
     if limit is None:
-        given = os.environ.get(WORK_LIMIT_VARIABLE, "")
-        limit = int(given) if given.isdigit() else WORK_LIMIT
+        given = os.environ.get(WORK_LIMIT_VARIABLE, "").replace("_", "")
+        try:
+            limit = max(1, int(float(given))) if given else WORK_LIMIT  # 2000000, 2_000_000 or 2e6
+        except ValueError:
+            limit = WORK_LIMIT  # not a number: the default, as if unset
     return Compiler(base, limit).compile()
 
 

@@ -51,6 +51,8 @@ def check(ctx: Context) -> None:
                 check_call(ctx, codel.function, shape, REQUEST_CODEL, where, codel.span)
                 if codel.state != "inter":  # whatever an interruption codel returns but `inter` ends it
                     allowed = CODEL_ENDINGS | fail | (set(codel.yields) if codel.yields else states)
+                    if codel.state == "end":
+                        allowed |= {"end"}  # the end codel returning "end" ends the activity, declared or not
                     check_returns(ctx, codel.function, shape, allowed, where, codel.span,
                                   f"codel '{codel.state}' of request {request.name}")
             if request.validate is not None:

@@ -589,9 +589,10 @@ def start_forkserver_quietly() -> None:
     global _forkserver_quiet
     if _forkserver_quiet:
         return
-    from multiprocessing import forkserver
+    from multiprocessing import forkserver, resource_tracker
 
     multiprocessing.get_context(START_METHOD).set_forkserver_preload(forkserver_preload())
+    resource_tracker.ensure_running()  # before the redirection: its warnings keep the program's stderr
     sys.stderr.flush()
     saved, devnull = os.dup(2), os.open(os.devnull, os.O_WRONLY)
     try:
