@@ -54,7 +54,7 @@ class TooLarge(KheopsError):
         self.limit = limit
 
 
-# Decision-tree nodes a compilation may visit (Hilare's resource controller: 85,000, ~3 s; a
+# Decision-tree nodes a compilation may visit (a resource controller of 21 services and 6 groups: 85,000, ~3 s; a
 # million is ~30 s and ~1 GB): past it, a diagnostic with the figures and how to split the base,
 # never a run of many minutes and gigabytes (seed 000 §3.7 compiles every path of the base into
 # the decision graph). The environment variable raises it for a base that is worth the wait.

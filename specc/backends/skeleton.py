@@ -42,7 +42,7 @@ class Change:
 class Needs:
     """The functions one Python module must define for one block of the specs."""
 
-    owner: str  # "module loco", "executive hilare", "procedures tasks": its file's docstring
+    owner: str  # "module loco", "executive yard", "procedures tasks": its file's docstring
     dotted: str  # the Python module, as the spec names it
     stubs: tuple[Stub, ...]
 
