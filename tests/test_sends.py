@@ -152,11 +152,14 @@ rules eager {
 def test_two_services_whose_requests_interrupt_each_other_get_the_same_arcs_in_any_order(tmp_path: Path) -> None:
     # Each of GO and BACK sends the other's module a request incompatible with the other's: both
     # interrupt (by an abort) whichever is declared first; no wait arc hides an interrupt one.
-    spec = """
-module a { number: 1; request Run { type: exec; task: T; codel exec: run; sends: b.Halt; } request Halt { type: exec; task: T; codel exec: run; incompatible_with: Run; } exec_task T { period: 10 ms; } }
-module b { number: 2; request Run { type: exec; task: T; codel exec: run; sends: a.Halt; } request Halt { type: exec; task: T; codel exec: run; incompatible_with: Run; } exec_task T { period: 10 ms; } }
-executive ex { %s }
-"""
+    module = """
+module %s {
+  number: %d;
+  request Run { type: exec; task: T; codel exec: run; sends: %s.Halt; }
+  request Halt { type: exec; task: T; codel exec: run; incompatible_with: Run; }
+  exec_task T { period: 10 ms; }
+}"""
+    spec = (module % ("a", 1, "b") + module % ("b", 2, "a")).replace("%", "%%") + "\nexecutive ex { %s }\n"
     services = ["service GO { request: a.Run; }", "service BACK { request: b.Run; }"]
     found = []
     for order in (services, services[::-1]):
