@@ -594,6 +594,10 @@ def rules_report(paths: PathsArg,
             raise typer.Exit(1) from None
         out.print(f"{title}: {len(normal.rules)} rules, decision graph of depth {compiled.depth} "
                   f"({compiled.tree_nodes} tree nodes -> {compiled.dag_nodes} shared)", markup=False)
+        depths = compiled.part_depths()
+        if depths:
+            shown_depths = ", ".join(f"{service} {depth}" for service, depth in depths.items())
+            out.print(f"  one decision per service, tests after the one on the service: {shown_depths}", markup=False)
         for attribute in normal.attributes.values():
             values = ", ".join(str(v) for v in attribute.values)
             out.print(f"  {attribute.role:12} {attribute.name}: {attribute.kind} {{{values}}}", markup=False)
@@ -604,7 +608,7 @@ def rules_report(paths: PathsArg,
         if len(shown) < len(findings):
             out.print(f"  ... {len(findings) - len(shown)} more (--limit 0 shows all)", markup=False)
         if findings:
-            out.print(f"  {len(findings)} input configuration(s) unsettled: {tally(findings)}", markup=False)
+            out.print(f"  {len(findings)} case(s) of inputs unsettled: {tally(findings)}", markup=False)
         else:
             out.print("  complete and consistent for every input", markup=False)
 

@@ -283,8 +283,9 @@ def test_compile_warns_about_rule_bases_that_leave_inputs_unsettled(tmp_path: Pa
 
 
 def test_unsettled_inputs_are_counted_per_kind_and_the_inconsistent_ones_shown_first(tmp_path: Path) -> None:
-    # Speed 'hot' leaves status undetermined whatever the load (one incomplete finding), and a
-    # heavy load at speed 'fast' is both OK and STOP (two inconsistent ones, loads 4 and 5).
+    # Speed 'hot' leaves status undetermined whatever the load (one incomplete case), and a
+    # heavy load at speed 'fast' is both OK and STOP (one inconsistent case: loads 4 and 5), while
+    # 'slow' settles it (OK).
     spec = tmp_path / "base.spec"
     spec.write_text("""rules base {
   inputs speed: {"slow", "fast", "hot"}, load: {1, 2, 3, 4, 5};
@@ -296,10 +297,11 @@ def test_unsettled_inputs_are_counted_per_kind_and_the_inconsistent_ones_shown_f
 """)
     compiled = specc("compile", str(spec), "-o", str(tmp_path / "out"))
     warning = next(line for line in compiled.stderr.splitlines() if "[rules-unsettled]" in line)
-    assert "3 input configuration(s) unsettled (2 inconsistent, 1 incomplete), e.g. inconsistent:" in warning
+    assert "2 case(s) of inputs unsettled (1 inconsistent, 1 incomplete), e.g. inconsistent:" in warning
+    assert "when speed=fast, load=4 | 5 (rules fired: r2, r3)" in warning
     listed = specc("rules", str(spec), "--limit", "1").stdout.splitlines()
-    assert listed[listed.index("  ... 2 more (--limit 0 shows all)") - 1].startswith("  inconsistent: ")
-    assert "  3 input configuration(s) unsettled: 2 inconsistent, 1 incomplete" in listed
+    assert listed[listed.index("  ... 1 more (--limit 0 shows all)") - 1].startswith("  inconsistent: ")
+    assert "  2 case(s) of inputs unsettled: 1 inconsistent, 1 incomplete" in listed
 
 
 def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Path) -> None:

@@ -22,7 +22,7 @@ the pilo group ExecTrajState).
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -222,6 +222,9 @@ class Controller:
     names: dict[Group, str]
     base: k.Base
     problems: list[Problem] = field(default_factory=list)
+    # The generated frame rules (a group keeps its state), as objects of `base`: a rule a
+    # hand-written one took over is another object, and no longer a plain frame.
+    frames: tuple[k.Rule, ...] = ()
 
     @property
     def name(self) -> str:
@@ -230,18 +233,67 @@ class Controller:
     def state_attribute(self, group: Group) -> str:
         return state_attribute(group, self.names)
 
+    def parts(self) -> dict[str, tuple[k.Base, tuple[str, ...]]]:
+        """One decision per service, deciding only the group states its events may change: a group
+        the service is not in, whose state no rule that can apply to the service reads as it is
+        decided or restricts, keeps its previous state without a test (its frame rules are left
+        out). A decision then tests the groups its service is in conflict with (seed 000 §3.8.1's
+        rules for it), not the product of every group's states: the controller grows with the
+        conflicts (issue #24)."""
+        framed = {id(rule): output for rule in self.frames for output in restricted(rule)}
+        member_states = {service: {self.state_attribute(g) for g in self.groups if service in g.services}
+                         for service in self.graph.services}
+        service_attribute = self.base.attributes["service"]
+        parts: dict[str, tuple[k.Base, tuple[str, ...]]] = {}
+        for service in service_attribute.values:
+            memory = k.initial_memory(self.base)
+            memory["service"] = frozenset({service})
+            applicable = [rule for rule in self.base.rules
+                          if rule.condition is None or k.truth(rule.condition, memory) != k.FALSE]
+            read = set().union(*(mentioned(rule) for rule in applicable if id(rule) not in framed))
+            kept = tuple(output for output in self.base.outputs if output in framed.values()
+                         and output not in read and output not in member_states.get(service, ()))
+            rules = tuple(rule for rule in applicable if framed.get(id(rule)) not in kept)
+            attributes = {name: a for name, a in self.base.attributes.items() if name not in kept}
+            attributes["service"] = dataclasses.replace(service_attribute, values=(service,))
+            parts[service] = (k.Base(f"{self.base.name}[{service}]", attributes, rules, self.base.source), kept)
+        return parts
+
     def compile(self) -> k.Compiled:
-        """The decision graph; past Kheops' work limit, the reason told in the executive's terms."""
+        """The decision graph, one decision per service; past Kheops' work limit, the reason told
+        in the executive's terms."""
+        parts = self.parts()
         try:
-            return k.compile_base(self.base)
+            return k.compile_parts(self.base, "service", parts)
         except k.TooLarge as exc:
-            states = math.prod(len(g.states) for g in self.groups)
+            part, _ = parts[exc.part]
+            bound, counts = k.paths_bound(part)
+            largest = " x ".join(f"{name} {count}" for name, count in counts[:8])
+            largest += " x ..." if len(counts) > 8 else ""
             raise k.TooLarge(
                 f"the resource controller of executive '{self.executive.name}' needs more than {exc.limit:,} "
-                f"decision-tree nodes to compile ({len(self.groups)} service groups: {states:,} controller states "
-                f"x {len(self.graph.services)} services x {len(EVENTS)} events): declare fewer conflicts between "
-                "services (every group multiplies the states), or give each independent part of the robot its "
-                f"own executive; {k.WORK_LIMIT_VARIABLE}=N raises the limit", self.executive, exc.limit) from None
+                f"decision-tree nodes to compile (the decision for service {exc.part} alone tests up to {bound:,} "
+                f"combinations: {largest} values): declare fewer conflicts for that service (every group "
+                "it interrupts or waits for multiplies its decision), or give each independent part of the robot "
+                f"its own executive; {k.WORK_LIMIT_VARIABLE}=N raises the limit", self.executive, exc.limit,
+                exc.part) from None
+
+
+def restricted(rule: k.Rule) -> set[str]:
+    """The attributes a rule's actions restrict or assign."""
+    return {action.atom.attribute if isinstance(action, k.Restrict) else action.target
+            for action in rule.actions if not isinstance(action, k.Call)}
+
+
+def mentioned(rule: k.Rule) -> set[str]:
+    """Every attribute a rule tests, restricts, assigns or passes to a call."""
+    found = {atom.attribute for atom in k.atoms(rule.condition)} | restricted(rule)
+    for action in rule.actions:
+        if isinstance(action, k.Call):
+            found |= set().union(*(arg.attributes() for arg in action.args))
+        elif isinstance(action, k.Assign):
+            found |= action.expr.attributes()
+    return found
 
 
 def controller_name(executive: m.Executive) -> str:
@@ -277,10 +329,12 @@ def executive_controller(program: m.Program, executive: m.Executive) -> Controll
     named = naming(program, executive)
     graph, groups, names = named.graph, named.groups, named.names
     merged = k.normalise(controller_rules(controller_name(executive), graph, groups, names))
+    frame_names = {rule.name for group in groups for rule in frame_rules(group, names)}
+    frames = tuple(rule for rule in merged.rules if rule.name in frame_names)
     if not named.problems:
         for base in named.hand:
             merged = take_over(merged, k.normalise(base), groups, names, declared_waits(graph, groups))
-    return Controller(executive, graph, groups, names, merged, named.problems)
+    return Controller(executive, graph, groups, names, merged, named.problems, frames)
 
 
 def name_groups(base: m.RuleBase, graph: IncompatibilityGraph, groups: list[Group],

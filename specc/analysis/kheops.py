@@ -49,9 +49,10 @@ class TooLarge(KheopsError):
 
     code = "rules-too-large"
 
-    def __init__(self, message: str, node: m.Node, limit: int):
+    def __init__(self, message: str, node: m.Node, limit: int, part: Any = None):
         super().__init__(message, node)
         self.limit = limit
+        self.part = part  # the value of the input split on whose decision went past the limit (`compile_parts`)
 
 
 # Decision-tree nodes a compilation may visit (a resource controller of 21 services and 6 groups: 85,000, ~3 s; a
@@ -669,7 +670,7 @@ Node = Union[Leaf, Test, Do]
 class Finding:
     kind: str  # inconsistent | incomplete
     attributes: tuple[str, ...]
-    witness: tuple[tuple[str, Any], ...]  # the tests on the path: attribute, domain element
+    witness: tuple[tuple[str, Any], ...]  # the tests on the path: attribute, domain element (a tuple: any of them)
     fired: tuple[str, ...]
 
 
@@ -680,21 +681,33 @@ class Compiled:
     findings: list[Finding]
     tree_nodes: int
     dag_nodes: int
+    # Compiled in parts (`compile_parts`): the input the root tests, and for each of its values the
+    # outputs that value's decision leaves as they were (they keep their previous-cycle value `@name`).
+    split: str | None = None
+    kept: Mapping[Any, tuple[str, ...]] = field(default_factory=dict)
 
     @property
     def depth(self) -> int:
         return depth(self.root)
 
+    def part_depths(self) -> dict[Any, int]:
+        """Tests on the longest path of each part's decision, after the test on `split`."""
+        if self.split is None or not isinstance(self.root, Test):
+            return {}
+        return {value: depth(child) for value, child in self.root.branches}
+
 
 class Compiler:
-    def __init__(self, base: Base, limit: int = WORK_LIMIT):
+    def __init__(self, base: Base, limit: int = WORK_LIMIT, spent: int = 0, shared: dict[Any, Node] | None = None):
         self.base = base
         self.limit = limit
         self.findings: list[Finding] = []
-        self.tree_nodes = 0
-        self.shared: dict[Node, Node] = {}
+        self.tree_nodes = spent  # the work done before (the other parts of a base compiled in parts)
+        self.shared: dict[Any, Node] = {} if shared is None else shared
         self.explored: dict[tuple[Any, ...], Node] = {}
         self.reads: dict[str, tuple[str, ...]] = {}
+        self.rule_atoms: dict[str, tuple[Atom, ...]] = {}
+        self.holding: dict[tuple[Atom, frozenset[Any]], bool] = {}
         self.truths: dict[tuple[Any, ...], int] = {}
         self.order = list(base.attributes)
         self.observable = {n for n, a in base.attributes.items() if a.role in ("inputs", "previous")}
@@ -705,12 +718,54 @@ class Compiler:
         root = self.node(memory, alive, frozenset(self.observable), (), ())
         return Compiled(self.base, root, self.findings, self.tree_nodes, len(self.shared))
 
-    def truth(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> int:
-        """A rule condition's truth, cached on the values of the attributes it reads."""
+    def state(self, memory: Mapping[str, frozenset[Any]], alive: tuple[Rule, ...],
+              testable: frozenset[str]) -> tuple[Any, ...]:
+        """What the rest of the deduction depends on, so that states equal on it share one node
+        (the reduction that keeps the work near the DAG's size, not the tree's): the values still
+        possible of what the rules determine and of the inputs still to test; of an input tested
+        already (never tested again), only how the atoms of the rules still alive judge it; of
+        an input no rule still alive reads, nothing."""
+        read: dict[str, list[Atom]] = {}
+        for rule in alive:
+            for atom in self.atoms(rule):
+                read.setdefault(atom.attribute, []).append(atom)
+        return tuple(memory[a] if a not in self.observable or (a in testable and a in read)
+                     else tuple(atom_truth(atom, memory[a]) for atom in read[a]) if a in read else None
+                     for a in self.order)
+
+    def inert(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> bool:
+        """A rule whose firing would change nothing: it only restricts attributes to values they
+        are already restricted to (memory only shrinks, so it stays so). Dropping it lets the
+        states that differ only by it share one node."""
+        if rule.kind != "when" or not all(isinstance(action, Restrict) for action in rule.actions):
+            return False
+        return all(self.holds(action.atom, memory[action.atom.attribute])  # type: ignore[union-attr]
+                   for action in rule.actions)
+
+    def holds(self, atom: Atom, values: frozenset[Any]) -> bool:
+        """Whether `atom` holds for every value of `values` (cached: the same few sets recur)."""
+        key = (atom, values)
+        found = self.holding.get(key)
+        if found is None:
+            found = self.holding[key] = all(atom_holds(atom, v) for v in values)
+        return found
+
+    def atoms(self, rule: Rule) -> tuple[Atom, ...]:
+        found = self.rule_atoms.get(rule.name)
+        if found is None:
+            found = self.rule_atoms[rule.name] = tuple(atoms(rule.condition))
+        return found
+
+    def read(self, rule: Rule) -> tuple[str, ...]:
+        """The attributes a rule's condition reads."""
         attributes = self.reads.get(rule.name)
         if attributes is None:
             attributes = self.reads[rule.name] = tuple(sorted({a.attribute for a in atoms(rule.condition)}))
-        key = (rule.name, tuple(memory[a] for a in attributes))
+        return attributes
+
+    def truth(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> int:
+        """A rule condition's truth, cached on the values of the attributes it reads."""
+        key = (rule.name, tuple(memory[a] for a in self.read(rule)))
         cached = self.truths.get(key)
         if cached is None:
             cached = self.truths[key] = truth(rule.condition, memory)
@@ -721,28 +776,35 @@ class Compiler:
         the same place decides nothing and disappears."""
         if isinstance(node, Test) and len({id(child) for _, child in node.branches}) == 1:
             return node.branches[0][1]
-        return self.shared.setdefault(node, node)
+        # Children are interned already: a node is known by its own fields and its children's
+        # identity (hashing whole subgraphs again at every level would cost their size each time).
+        key: Any = node
+        if isinstance(node, Test):
+            key = (node.attribute, tuple((value, id(child)) for value, child in node.branches))
+        elif isinstance(node, Do):
+            key = (node.actions, id(node.next))
+        return self.shared.setdefault(key, node)
 
     def node(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
-             path: tuple[tuple[str, Any], ...], history: tuple[str, ...]) -> Node:
+             path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool = False) -> Node:
         """The subgraph for one state of the deduction: the values still possible, the rules
         that may still fire (not fired, condition not FALSE — monotony keeps a FALSE condition
         FALSE), the attributes still testable. Paths reaching the same state share it, so the
         search explores the DAG rather than the whole tree; a shared state's findings carry
-        the witness of the first path that reached it."""
+        the witness of the first path that reached it. `elsed`: the `else` rules have fired."""
         self.tree_nodes += 1
         if self.tree_nodes > self.limit:
             raise self.too_large()
-        alive = tuple(r for r in alive if self.truth(r, memory) != FALSE)
-        key = (tuple(memory[a] for a in self.order), tuple(r.name for r in alive), testable)
+        alive = tuple(r for r in alive if self.truth(r, memory) != FALSE and not self.inert(r, memory))
+        key = (self.state(memory, alive, testable), tuple(r.name for r in alive), elsed)
         found = self.explored.get(key)
         if found is None:
-            found = self.explore(memory, alive, testable, path, history)
+            found = self.explore(memory, alive, testable, path, history, elsed)
             self.explored[key] = found
         return found
 
     def explore(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
-                path: tuple[tuple[str, Any], ...], history: tuple[str, ...]) -> Node:
+                path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool) -> Node:
         memory = dict(memory)
         procedural: list[Assign | Call] = []
         fired_now: list[str] = []
@@ -766,9 +828,9 @@ class Compiler:
                         if isinstance(action, Assign):
                             testable = testable | {action.target}
         history = history + tuple(fired_now)
-        if any(not values for values in memory.values()):
-            return self.wrap(procedural, self.leaf(memory, path, history))
-        valid = [r for r in pending if self.truth(r, memory) == UNKNOWN]
+        # An attribute left with no value does not end the deduction: the other rules still fire,
+        # and an `impossible` rule still says so, as in the interpreter.
+        valid = [r for r in pending if self.truth(r, memory) == UNKNOWN and not self.inert(r, memory)]
         candidates: dict[str, int] = {}
         for rule in valid:
             for atom in atoms(rule.condition):
@@ -778,24 +840,40 @@ class Compiler:
         if not candidates:
             undetermined = [o for o in self.base.outputs if len(memory[o]) > 1]
             elses = [r for r in self.base.rules if r.kind == "else"]
-            if undetermined and elses:
-                for rule in elses:
-                    for action in rule.actions:
-                        if isinstance(action, Restrict):
-                            restrict(memory, action.atom)
-                        else:
-                            procedural.append(action)
-                history = history + tuple(r.name for r in elses)
-            return self.wrap(procedural, self.leaf(memory, path, history))
+            if not undetermined or not elses or elsed:
+                return self.wrap(procedural, self.leaf(memory, path, history))
+            # Nothing more fires and an output is undetermined: the `else` rules fire, once, and
+            # the deduction goes on from what they restrict (as in the interpreter).
+            for rule in elses:
+                for action in rule.actions:
+                    if isinstance(action, Restrict):
+                        restrict(memory, action.atom)
+                    else:
+                        procedural.append(action)
+                        if isinstance(action, Assign):
+                            testable = testable | {action.target}
+            history = history + tuple(r.name for r in elses)
+            return self.wrap(procedural, self.node(memory, tuple(pending), testable, path, history, elsed=True))
         # Heuristic: the attribute most valid rules wait for; then the fewest values; then declaration order.
         chosen = min(candidates, key=lambda a: (-candidates[a], len(memory[a]), self.order.index(a)))
         remaining = tuple(valid)
-        branches = []
+        # The values no remaining rule tells apart (every atom on the attribute holds for all of
+        # them or for none) lead to one subgraph, explored once: a numeric input cut by the
+        # thresholds of the whole base splits only where the rules still waiting compare it.
+        tests = [atom for rule in valid for atom in atoms(rule.condition) if atom.attribute == chosen]
+        classes: dict[tuple[bool, ...], list[Any]] = {}
         for value in self.ordered(chosen, memory[chosen]):
-            child_memory = {**memory, chosen: frozenset({value})}
-            child = self.node(child_memory, remaining, testable - {chosen}, path + ((chosen, value),), history)
-            branches.append((value, child))
-        return self.wrap(procedural, self.intern(Test(chosen, tuple(branches))))
+            single = frozenset((value,))
+            classes.setdefault(tuple(self.holds(atom, single) for atom in tests), []).append(value)
+        child_of: dict[Any, Node] = {}
+        for values in classes.values():
+            child_memory = {**memory, chosen: frozenset(values)}
+            tested = values[0] if len(values) == 1 else tuple(values)  # a witness names the whole class
+            child = self.node(child_memory, remaining, testable - {chosen}, path + ((chosen, tested),), history,
+                              elsed)
+            child_of.update(dict.fromkeys(values, child))
+        branches = tuple((value, child_of[value]) for value in self.ordered(chosen, memory[chosen]))
+        return self.wrap(procedural, self.intern(Test(chosen, branches)))
 
     def too_large(self) -> TooLarge:
         bound, counts = paths_bound(self.base)
@@ -823,17 +901,63 @@ class Compiler:
             self.findings.append(Finding("inconsistent", inconsistent, path, history))
         elif incomplete:
             self.findings.append(Finding("incomplete", incomplete, path, history))
-        return self.intern(Leaf(outputs, inconsistent, incomplete if not inconsistent else ()))
+        return self.intern(Leaf(outputs, inconsistent, incomplete))
+
+
+def work_limit() -> int:
+    given = os.environ.get(WORK_LIMIT_VARIABLE, "").replace("_", "")
+    try:
+        return max(1, int(float(given))) if given else WORK_LIMIT  # 2000000, 2_000_000 or 2e6
+    except ValueError:
+        return WORK_LIMIT  # not a number: the default, as if unset
+
+
+_COMPILED: dict[tuple[Any, ...], Compiled] = {}  # the last few bases compiled, by content
 
 
 def compile_base(base: Base, limit: int | None = None) -> Compiled:
-    if limit is None:
-        given = os.environ.get(WORK_LIMIT_VARIABLE, "").replace("_", "")
+    """The decision graph of `base`. `specc compile` checks a stand-alone base (what it leaves
+    unsettled) before its back end writes it: the second call finds the first one's graph."""
+    limit = work_limit() if limit is None else limit
+    key = (base.name, base.rules, limit, tuple((a.name, a.role, a.kind, a.values, a.init, a.assigned)
+                                               for a in base.attributes.values()))
+    compiled = _COMPILED.get(key)
+    if compiled is None:
+        compiled = Compiler(base, limit).compile()
+        if len(_COMPILED) >= 8:
+            _COMPILED.pop(next(iter(_COMPILED)))
+        _COMPILED[key] = compiled
+    return compiled
+
+
+def compile_parts(base: Base, split: str, parts: Mapping[Any, tuple[Base, tuple[str, ...]]],
+                  limit: int | None = None) -> Compiled:
+    """`base` compiled as one decision per value of its symbolic input `split`: `parts` gives, for
+    each value, the sub-base deciding it (the rules that can apply with that value, over the
+    attributes they need) and the outputs it leaves as they were (they keep their previous-cycle
+    value, copied without a test). The root tests `split`; each decision grows with what that
+    value's rules read, not with the product of every attribute of the base. The work limit is
+    shared by the parts, and equal subgraphs of different parts are one node."""
+    attribute = base.attributes[split]
+    if attribute.kind != "symbol" or OTHER in attribute.values or set(parts) != set(attribute.values):
+        raise ValueError(f"compile_parts splits on a declared symbolic input, one part per value: not {split!r}")
+    limit = work_limit() if limit is None else limit
+    shared: dict[Any, Node] = {}
+    branches: list[tuple[Any, Node]] = []
+    findings: list[Finding] = []
+    spent = 0
+    for value in attribute.values:
+        part, _ = parts[value]
+        compiler = Compiler(part, limit, spent, shared)
         try:
-            limit = max(1, int(float(given))) if given else WORK_LIMIT  # 2000000, 2_000_000 or 2e6
-        except ValueError:
-            limit = WORK_LIMIT  # not a number: the default, as if unset
-    return Compiler(base, limit).compile()
+            compiled = compiler.compile()
+        except TooLarge as exc:
+            raise TooLarge(str(exc), exc.node, exc.limit, value) from None
+        spent = compiler.tree_nodes
+        branches.append((value, compiled.root))
+        findings += [Finding(f.kind, f.attributes, ((split, value), *f.witness), f.fired) for f in compiled.findings]
+    return Compiled(base, Test(split, tuple(branches)), findings, spent, len(shared) + 1, split,
+                    {value: kept for value, (_, kept) in parts.items()})
 
 
 def paths_bound(base: Base) -> tuple[int, list[tuple[str, int]]]:
@@ -888,6 +1012,9 @@ def evaluate(compiled: Compiled, inputs: Mapping[str, Any]) -> Outcome:
                 outcome.impossible = node.impossible
                 return outcome
             outcome.outputs = {o: None for o in base.outputs} | dict(node.outputs)
+            if compiled.split is not None:
+                for output in compiled.kept[base.element(compiled.split, actual[compiled.split])]:
+                    outcome.outputs[output] = actual["@" + output]
             outcome.inconsistent = list(node.inconsistent)
             outcome.incomplete = list(node.incomplete)
             return outcome
@@ -913,7 +1040,8 @@ def sample_of(element: Any) -> Any:
 
 
 def describe(finding: Finding) -> str:
-    witness = ", ".join(f"{a}={v}" for a, v in finding.witness) or "any input"
+    witness = ", ".join(f"{a}={' | '.join(map(str, v)) if isinstance(v, tuple) else v}"
+                        for a, v in finding.witness) or "any input"
     fired = ", ".join(finding.fired) or "none"
     what = "no value left for" if finding.kind == "inconsistent" else "undetermined"
     return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
@@ -935,6 +1063,6 @@ def unsettled_warning(compiled: Compiled, what: str, node: m.Node) -> Diagnostic
     findings = compiled.findings
     if not findings:
         return None
-    return Diagnostic("rules-unsettled", f"{what} leaves {len(findings)} input configuration(s) unsettled "
+    return Diagnostic("rules-unsettled", f"{what} leaves {len(findings)} case(s) of inputs unsettled "
                       f"({tally(findings)}), e.g. {describe(worst_first(findings)[0])}; `specc rules` lists them",
                       node.span, "warning")

@@ -57,6 +57,8 @@ def py(value: Any) -> Code:
     if isinstance(value, tuple):
         items = [py(v) for v in value]
         return Code(f"({items[0]},)" if len(items) == 1 else f"({', '.join(items)})")
+    if isinstance(value, dict):
+        return Code(f"{{{', '.join(f'{py(k)}: {py(v)}' for k, v in value.items())}}}")
     if value is None or isinstance(value, bool | int | float):
         return Code(repr(value))
     raise UnescapedValue(f"no Python literal for a {type(value).__name__}")

@@ -64,6 +64,15 @@ class ExecutiveView:
         return self.compiled.depth
 
     @property
+    def decisions(self) -> str:
+        """The bound on the reaction time, per decision (seed 000 §3.7): tests after the one on the service."""
+        depths = self.compiled.part_depths()
+        if not depths:
+            return f"a decision graph of depth {self.depth}"
+        deepest = max(depths, key=lambda service: depths[service])
+        return f"at most {depths[deepest]} tests after the one on the service, for {deepest}"
+
+    @property
     def group_summary(self) -> str:
         return "; ".join(f"{name} = {' | '.join((*services, 'IDLE'))}"
                          for name, services in self.spec.groups.items()) or "none"

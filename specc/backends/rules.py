@@ -48,6 +48,29 @@ class DecisionView:
         for node in self.nodes.values():
             if isinstance(node, k.Leaf) and node not in self.leaves:
                 self.leaves[node] = f"_LEAF_{len(self.leaves)}"
+        self.undetermined = self.undetermined_outputs()
+
+    def undetermined_outputs(self) -> dict[k.Leaf, list[str]]:
+        """The outputs each leaf gives as None (undetermined). A base compiled in parts leaves out
+        the outputs a part keeps as they were (the decision copies them in): a leaf lists only the
+        outputs of the parts reaching it, so that a constant grows with its part, not the base."""
+        outputs = self.outputs
+        if self.compiled.split is None or not isinstance(self.compiled.root, k.Test):
+            return {leaf: [o for o in outputs if o not in dict(leaf.outputs)] for leaf in self.leaves}
+        found: dict[k.Leaf, set[str]] = {leaf: set() for leaf in self.leaves}
+        for value, part in self.compiled.root.branches:
+            decided = set(outputs) - set(self.compiled.kept[value])
+            seen: set[int] = set()
+            stack = [part]
+            while stack:
+                node = stack.pop()
+                if id(node) in seen:
+                    continue
+                seen.add(id(node))
+                if isinstance(node, k.Leaf):
+                    found[node] |= decided - {o for o, _ in node.outputs}
+                stack += children(node)
+        return {leaf: [o for o in outputs if o in names] for leaf, names in found.items()}
 
     @property
     def header(self) -> str:
@@ -66,6 +89,15 @@ class DecisionView:
         return self.base.outputs
 
     @property
+    def part_depths(self) -> dict[Any, int]:
+        return self.compiled.part_depths()
+
+    @property
+    def decides(self) -> dict[Any, tuple[str, ...]]:
+        """For each part of a base compiled in parts, the outputs it decides (it keeps the others)."""
+        return {value: tuple(o for o in self.outputs if o not in kept) for value, kept in self.compiled.kept.items()}
+
+    @property
     def copies_inputs(self) -> bool:
         return any(isinstance(n, k.Do) and any(isinstance(a, k.Assign) for a in n.actions)
                    for n in self.nodes.values())
@@ -74,7 +106,8 @@ class DecisionView:
     def leaf_constants(self) -> list[Code]:
         lines = []
         for leaf, name in self.leaves.items():
-            outputs = {o: None for o in self.outputs} | dict(leaf.outputs)
+            decided, undetermined = dict(leaf.outputs), self.undetermined[leaf]
+            outputs = {o: decided.get(o) for o in self.outputs if o in decided or o in undetermined}
             shown = ", ".join(f"{o!r}: {literal(v)}" for o, v in outputs.items())
             lines.append(Code(f"{name} = Decision(MappingProxyType({{{shown}}}), {leaf.inconsistent!r}, "
                               f"{leaf.incomplete!r}, {leaf.impossible!r})"))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import Any, NamedTuple
 
 
@@ -18,6 +19,13 @@ class Decision(NamedTuple):
     @property
     def ok(self) -> bool:
         return not (self.inconsistent or self.incomplete or self.impossible)
+
+    def keeping(self, kept: tuple[str, ...], inputs: Mapping[str, Any]) -> Decision:
+        """This decision with the outputs it left as they were at their previous-cycle value (`@name`)."""
+        outputs = dict(self.outputs)
+        for name in kept:
+            outputs[name] = inputs["@" + name]
+        return self._replace(outputs=MappingProxyType(outputs))
 
 
 Calls = Callable[[str, tuple[Any, ...]], object]

@@ -20,8 +20,8 @@ The ratio of the wall times is what the whole stack costs over the physics.
   again imports none of them anew.
 - The Hilare hunt (its mission `hunt` through the generic runner, `specc.run.mission`): the eight
   modules, the executive and the PRS supervisor collecting five objects; seed 1 is the longest hunt
-  of seeds 0-29. A one-second run before each robot's imports its compiled package (Hilare's 1.4 MB
-  resource controller takes most of a second to compile where no bytecode is cached).
+  of seeds 0-29. A one-second run before each robot's imports its compiled package (its generated code
+  is compiled to bytecode where none is cached).
 - The warehouse tug (examples/tug, the same runner): its procedures delivering a cart, and FTplan
   planning the same delivery with two planners (their processes' start counted in the wall time).
 No goal is asserted: the figures are printed."""

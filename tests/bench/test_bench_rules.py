@@ -51,7 +51,8 @@ def test_decision_function_against_the_interpreter(robot: str, kind: str, name: 
     sys.path.insert(0, str(tmp_path))
     try:
         module = f"{package}.rules.{name}" if kind == "rules" else f"{package}.executive.{name}_resource_controller"
-        decide = importlib.import_module(module).decide
+        generated = importlib.import_module(module)
+        decide = generated.decide
     finally:
         sys.path.remove(str(tmp_path))
     rng = random.Random(7)
@@ -68,7 +69,7 @@ def test_decision_function_against_the_interpreter(robot: str, kind: str, name: 
     cycles = [clips_kheops.call(base, values) for values in inputs[:500]]
     assert all(str(env.eval(c)) == clips_kheops.expected(base, v) for c, v in zip(cycles[:100], inputs, strict=False))
     clips_us = per_call_us(env.eval, cycles)
-    print(f"\n{kind} {name} ({len(base.rules)} rules, depth {k.compile_base(base).depth}):"
+    print(f"\n{kind} {name} ({len(base.rules)} rules, depth {generated.DEPTH}):"
           f"\n  CLIPS 6.4 (clipspy)    {clips_us:9.2f} us/evaluation"
           f"\n  reference interpreter  {interpreted_us:9.2f} us/evaluation"
           f"\n  compiled decision      {compiled_us:9.2f} us/evaluation  "

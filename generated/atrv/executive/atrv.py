@@ -2,7 +2,8 @@
 """Executive atrv: its service description list, groups and reflexes (seed 000 ch. 3).
 
 The resource controller is the decision function in atrv_resource_controller.py: 47 Kheops
-rules (generated from the conflicts), a decision graph of depth 6.
+rules (generated from the conflicts), one decision per service
+(at most 2 tests after the one on the service, for GOTO).
 Service groups: GOTOstate = GOTO | IDLE; PTU_MOVEstate = PTU-MOVE | IDLE; PICTUREstate = PICTURE | IDLE; COMMUNICATEstate = COMMUNICATE | IDLE.
 """
 

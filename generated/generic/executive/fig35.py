@@ -2,7 +2,8 @@
 """Executive fig35: its service description list, groups and reflexes (seed 000 ch. 3).
 
 The resource controller is the decision function in fig35_resource_controller.py: 85 Kheops
-rules (generated from the conflicts), a decision graph of depth 7.
+rules (generated from the conflicts), one decision per service
+(at most 3 tests after the one on the service, for G).
 Service groups: Bstate = B | IDLE; DEFstate = D | E | F | IDLE; Gstate = G | IDLE; HIstate = H | I | IDLE; Jstate = J | IDLE.
 """
 

@@ -2,7 +2,8 @@
 """Executive generic: its service description list, groups and reflexes (seed 000 ch. 3).
 
 The resource controller is the decision function in generic_resource_controller.py: 81 Kheops
-rules (generated from the conflicts, with generic_controller), a decision graph of depth 4.
+rules (generated from the conflicts, with generic_controller), one decision per service
+(at most 3 tests after the one on the service, for E).
 Service groups: ABCstate = A | B | C | IDLE; EFGstate = E | F | G | IDLE.
 """
 

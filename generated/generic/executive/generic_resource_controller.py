@@ -17,55 +17,66 @@ INPUTS = ["service", "event", "@ABCstate", "@EFGstate"]
 OUTPUTS = ["status", "ABCstate", "EFGstate"]
 DEPTH = 4
 FINDINGS = 0
+# One decision per value of service: the tests on its longest path, and the outputs it
+# decides; it leaves the others as they were (each keeps its previous-cycle value, copied without a test).
+SPLIT = "service"
+DEPTHS = {"A": 2, "B": 2, "C": 2, "D": 1, "E": 3, "F": 3, "G": 3, "H": 3, "I": 3, "J": 3}
+DECIDES = {"A": ("status", "ABCstate"), "B": ("status", "ABCstate"), "C": ("status", "ABCstate"), "D": ("status", "ABCstate"), "E": ("status", "ABCstate", "EFGstate"), "F": ("status", "ABCstate", "EFGstate"), "G": ("status", "ABCstate", "EFGstate"), "H": ("status", "ABCstate"), "I": ("status", "ABCstate"), "J": ("status", "ABCstate")}
+KEPT = {value: tuple(o for o in OUTPUTS if o not in decided) for value, decided in DECIDES.items()}
 
-_LEAF_0 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'E'}), (), (), None)
-_LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'F'}), (), (), None)
-_LEAF_2 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'G'}), (), (), None)
-_LEAF_3 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_4 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'E'}), (), (), None)
-_LEAF_5 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'F'}), (), (), None)
-_LEAF_6 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'G'}), (), (), None)
-_LEAF_7 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_8 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'E'}), (), (), None)
-_LEAF_9 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'F'}), (), (), None)
-_LEAF_10 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'G'}), (), (), None)
-_LEAF_11 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_12 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'E'}), (), (), None)
-_LEAF_13 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'F'}), (), (), None)
-_LEAF_14 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'G'}), (), (), None)
-_LEAF_15 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_16 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'E'}), (), (), None)
-_LEAF_17 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'F'}), (), (), None)
-_LEAF_18 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'G'}), (), (), None)
-_LEAF_19 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_20 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'E'}), (), (), None)
-_LEAF_21 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'F'}), (), (), None)
-_LEAF_22 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'G'}), (), (), None)
-_LEAF_23 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_24 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'E'}), (), (), None)
-_LEAF_25 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'F'}), (), (), None)
-_LEAF_26 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'G'}), (), (), None)
-_LEAF_27 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_28 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'E'}), (), (), None)
-_LEAF_29 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'F'}), (), (), None)
-_LEAF_30 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'G'}), (), (), None)
-_LEAF_31 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_32 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'A', 'EFGstate': 'E'}), (), (), None)
-_LEAF_33 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'A', 'EFGstate': 'F'}), (), (), None)
-_LEAF_34 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'A', 'EFGstate': 'G'}), (), (), None)
-_LEAF_35 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'A', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_36 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'B', 'EFGstate': 'E'}), (), (), None)
-_LEAF_37 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'B', 'EFGstate': 'F'}), (), (), None)
-_LEAF_38 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'B', 'EFGstate': 'G'}), (), (), None)
-_LEAF_39 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'B', 'EFGstate': 'IDLE'}), (), (), None)
-_LEAF_40 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'C', 'EFGstate': 'E'}), (), (), None)
-_LEAF_41 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'C', 'EFGstate': 'F'}), (), (), None)
-_LEAF_42 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'C', 'EFGstate': 'G'}), (), (), None)
-_LEAF_43 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'C', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_0 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A'}), (), (), None)
+_LEAF_1 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A'}), (), (), None)
+_LEAF_2 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE'}), (), (), None)
+_LEAF_3 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B'}), (), (), None)
+_LEAF_4 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B'}), (), (), None)
+_LEAF_5 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C'}), (), (), None)
+_LEAF_6 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C'}), (), (), None)
+_LEAF_7 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE'}), (), (), None)
+_LEAF_8 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'A'}), (), (), None)
+_LEAF_9 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'B'}), (), (), None)
+_LEAF_10 = Decision(MappingProxyType({'status': 'WAIT', 'ABCstate': 'C'}), (), (), None)
+_LEAF_11 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'E'}), (), (), None)
+_LEAF_12 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'F'}), (), (), None)
+_LEAF_13 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'G'}), (), (), None)
+_LEAF_14 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'A', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_15 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'E'}), (), (), None)
+_LEAF_16 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'F'}), (), (), None)
+_LEAF_17 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'G'}), (), (), None)
+_LEAF_18 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'B', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_19 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'E'}), (), (), None)
+_LEAF_20 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'F'}), (), (), None)
+_LEAF_21 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'G'}), (), (), None)
+_LEAF_22 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'C', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_23 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'E'}), (), (), None)
+_LEAF_24 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'F'}), (), (), None)
+_LEAF_25 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'G'}), (), (), None)
+_LEAF_26 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_27 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'E'}), (), (), None)
+_LEAF_28 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'F'}), (), (), None)
+_LEAF_29 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'G'}), (), (), None)
+_LEAF_30 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'E'}), (), (), None)
+_LEAF_31 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'F'}), (), (), None)
+_LEAF_32 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'G'}), (), (), None)
+_LEAF_33 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'E'}), (), (), None)
+_LEAF_34 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'F'}), (), (), None)
+_LEAF_35 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'G'}), (), (), None)
+_LEAF_36 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'E'}), (), (), None)
+_LEAF_37 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'F'}), (), (), None)
+_LEAF_38 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'G'}), (), (), None)
+_LEAF_39 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'A', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_40 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'B', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_41 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'C', 'EFGstate': 'IDLE'}), (), (), None)
+_LEAF_42 = Decision(MappingProxyType({'status': 'ERROR', 'ABCstate': 'IDLE', 'EFGstate': 'IDLE'}), (), (), None)
 
 
 def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 4 tests; `calls(name, args)` runs `do` calls."""
+    decision = _decide(inputs, calls)
+    kept = KEPT[inputs[SPLIT]]
+    return decision.keeping(kept, inputs) if kept and decision.impossible is None else decision
+
+
+def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
     v = a['service']
     if v == 'A':
@@ -75,31 +86,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'START':
                 return _node_0(a, calls)
             elif v == 'INTERM':
-                return _node_2(a, calls)
+                return _LEAF_1
             elif v == 'END':
-                return _node_3(a, calls)
+                return _LEAF_2
             elif v in ('ABORT', 'ZOMBIE'):
-                return _node_1(a, calls)
+                return _LEAF_0
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'B':
             v = a['event']
             if v == 'START':
-                return _node_4(a, calls)
+                return _node_1(a, calls)
             elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _node_6(a, calls)
+                return _LEAF_4
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'C':
-            return _node_7(a, calls)
+            return _node_2(a, calls)
         elif v == 'IDLE':
             v = a['event']
             if v == 'START':
-                return _node_3(a, calls)
+                return _LEAF_2
             elif v == 'INTERM':
-                return _node_1(a, calls)
+                return _LEAF_0
             elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _node_10(a, calls)
+                return _LEAF_7
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
@@ -111,31 +122,31 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'START':
                 return _node_0(a, calls)
             elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _node_2(a, calls)
+                return _LEAF_1
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'B':
             v = a['event']
             if v == 'START':
-                return _node_4(a, calls)
+                return _node_1(a, calls)
             elif v == 'INTERM':
-                return _node_6(a, calls)
+                return _LEAF_4
             elif v == 'END':
-                return _node_3(a, calls)
+                return _LEAF_2
             elif v in ('ABORT', 'ZOMBIE'):
-                return _node_5(a, calls)
+                return _LEAF_3
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'C':
-            return _node_7(a, calls)
+            return _node_2(a, calls)
         elif v == 'IDLE':
             v = a['event']
             if v == 'START':
-                return _node_3(a, calls)
+                return _LEAF_2
             elif v == 'INTERM':
-                return _node_5(a, calls)
+                return _LEAF_3
             elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _node_10(a, calls)
+                return _LEAF_7
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
@@ -145,83 +156,205 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
         if v == 'A':
             v = a['event']
             if v == 'START':
-                return _node_11(a, calls)
+                return _LEAF_8
             elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _node_2(a, calls)
+                return _LEAF_1
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'B':
             v = a['event']
             if v == 'START':
-                return _node_12(a, calls)
+                return _LEAF_9
             elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _node_6(a, calls)
+                return _LEAF_4
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'C':
             v = a['event']
             if v == 'START':
-                return _node_13(a, calls)
+                return _LEAF_10
             elif v == 'INTERM':
-                return _node_9(a, calls)
+                return _LEAF_6
             elif v == 'END':
-                return _node_3(a, calls)
+                return _LEAF_2
             elif v in ('ABORT', 'ZOMBIE'):
-                return _node_8(a, calls)
+                return _LEAF_5
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'IDLE':
             v = a['event']
             if v == 'START':
-                return _node_3(a, calls)
+                return _LEAF_2
             elif v == 'INTERM':
-                return _node_8(a, calls)
+                return _LEAF_5
             elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _node_10(a, calls)
+                return _LEAF_7
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
             raise ValueError(f"@ABCstate={v!r} is outside its domain")
     elif v == 'D':
-        return _node_14(a, calls)
+        v = a['@ABCstate']
+        if v == 'A':
+            return _LEAF_0
+        elif v == 'B':
+            return _LEAF_3
+        elif v == 'C':
+            return _LEAF_5
+        elif v == 'IDLE':
+            return _LEAF_2
+        else:
+            raise ValueError(f"@ABCstate={v!r} is outside its domain")
     elif v == 'E':
         v = a['event']
         if v == 'START':
-            return _node_15(a, calls)
+            return _node_3(a, calls)
         elif v == 'INTERM':
             v = a['@ABCstate']
             if v == 'A':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_4
+                    return _LEAF_27
                 elif v == 'F':
-                    return _LEAF_5
+                    return _LEAF_28
                 elif v == 'G':
-                    return _LEAF_6
+                    return _LEAF_29
                 elif v == 'IDLE':
-                    return _LEAF_0
+                    return _LEAF_11
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'B':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_16
+                    return _LEAF_30
                 elif v == 'F':
-                    return _LEAF_17
+                    return _LEAF_31
                 elif v == 'G':
-                    return _LEAF_18
+                    return _LEAF_32
                 elif v == 'IDLE':
-                    return _LEAF_12
+                    return _LEAF_15
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'C':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_24
+                    return _LEAF_33
                 elif v == 'F':
-                    return _LEAF_25
+                    return _LEAF_34
                 elif v == 'G':
+                    return _LEAF_35
+                elif v == 'IDLE':
+                    return _LEAF_19
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_36
+                elif v == 'F':
+                    return _LEAF_37
+                elif v == 'G':
+                    return _LEAF_38
+                elif v == 'IDLE':
+                    return _LEAF_23
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'END':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_14
+                elif v == 'F':
+                    return _LEAF_28
+                elif v == 'G':
+                    return _LEAF_29
+                elif v == 'IDLE':
+                    return _LEAF_39
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_18
+                elif v == 'F':
+                    return _LEAF_31
+                elif v == 'G':
+                    return _LEAF_32
+                elif v == 'IDLE':
+                    return _LEAF_40
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            elif v == 'C':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_22
+                elif v == 'F':
+                    return _LEAF_34
+                elif v == 'G':
+                    return _LEAF_35
+                elif v == 'IDLE':
+                    return _LEAF_41
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['@EFGstate']
+                if v == 'E':
                     return _LEAF_26
+                elif v == 'F':
+                    return _LEAF_37
+                elif v == 'G':
+                    return _LEAF_38
+                elif v == 'IDLE':
+                    return _LEAF_42
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v in ('ABORT', 'ZOMBIE'):
+            return _node_4(a, calls)
+        else:
+            raise ValueError(f"event={v!r} is outside its domain")
+    elif v == 'F':
+        v = a['event']
+        if v == 'START':
+            return _node_3(a, calls)
+        elif v == 'INTERM':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_27
+                elif v == 'F':
+                    return _LEAF_28
+                elif v == 'G':
+                    return _LEAF_29
+                elif v == 'IDLE':
+                    return _LEAF_12
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_30
+                elif v == 'F':
+                    return _LEAF_31
+                elif v == 'G':
+                    return _LEAF_32
+                elif v == 'IDLE':
+                    return _LEAF_16
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            elif v == 'C':
+                v = a['@EFGstate']
+                if v == 'E':
+                    return _LEAF_33
+                elif v == 'F':
+                    return _LEAF_34
+                elif v == 'G':
+                    return _LEAF_35
                 elif v == 'IDLE':
                     return _LEAF_20
                 else:
@@ -229,13 +362,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif v == 'IDLE':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_28
+                    return _LEAF_36
                 elif v == 'F':
-                    return _LEAF_29
+                    return _LEAF_37
                 elif v == 'G':
-                    return _LEAF_30
+                    return _LEAF_38
                 elif v == 'IDLE':
-                    return _LEAF_8
+                    return _LEAF_24
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             else:
@@ -245,95 +378,95 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'A':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_3
+                    return _LEAF_27
                 elif v == 'F':
-                    return _LEAF_5
+                    return _LEAF_14
                 elif v == 'G':
-                    return _LEAF_6
+                    return _LEAF_29
                 elif v == 'IDLE':
-                    return _LEAF_7
+                    return _LEAF_39
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'B':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_15
+                    return _LEAF_30
                 elif v == 'F':
-                    return _LEAF_17
-                elif v == 'G':
                     return _LEAF_18
+                elif v == 'G':
+                    return _LEAF_32
                 elif v == 'IDLE':
-                    return _LEAF_19
+                    return _LEAF_40
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'C':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_23
+                    return _LEAF_33
                 elif v == 'F':
-                    return _LEAF_25
+                    return _LEAF_22
                 elif v == 'G':
-                    return _LEAF_26
+                    return _LEAF_35
                 elif v == 'IDLE':
-                    return _LEAF_27
+                    return _LEAF_41
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_11
+                    return _LEAF_36
                 elif v == 'F':
-                    return _LEAF_29
+                    return _LEAF_26
                 elif v == 'G':
-                    return _LEAF_30
+                    return _LEAF_38
                 elif v == 'IDLE':
-                    return _LEAF_31
+                    return _LEAF_42
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             else:
                 raise ValueError(f"@ABCstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_17(a, calls)
+            return _node_5(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'F':
+    elif v == 'G':
         v = a['event']
         if v == 'START':
-            return _node_15(a, calls)
+            return _node_3(a, calls)
         elif v == 'INTERM':
             v = a['@ABCstate']
             if v == 'A':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_4
+                    return _LEAF_27
                 elif v == 'F':
-                    return _LEAF_5
+                    return _LEAF_28
                 elif v == 'G':
-                    return _LEAF_6
+                    return _LEAF_29
                 elif v == 'IDLE':
-                    return _LEAF_1
+                    return _LEAF_13
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'B':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_16
+                    return _LEAF_30
                 elif v == 'F':
-                    return _LEAF_17
+                    return _LEAF_31
                 elif v == 'G':
-                    return _LEAF_18
+                    return _LEAF_32
                 elif v == 'IDLE':
-                    return _LEAF_13
+                    return _LEAF_17
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'C':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_24
+                    return _LEAF_33
                 elif v == 'F':
-                    return _LEAF_25
+                    return _LEAF_34
                 elif v == 'G':
-                    return _LEAF_26
+                    return _LEAF_35
                 elif v == 'IDLE':
                     return _LEAF_21
                 else:
@@ -341,13 +474,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif v == 'IDLE':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_28
+                    return _LEAF_36
                 elif v == 'F':
-                    return _LEAF_29
+                    return _LEAF_37
                 elif v == 'G':
-                    return _LEAF_30
+                    return _LEAF_38
                 elif v == 'IDLE':
-                    return _LEAF_9
+                    return _LEAF_25
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             else:
@@ -357,683 +490,475 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             if v == 'A':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_4
-                elif v == 'F':
-                    return _LEAF_3
-                elif v == 'G':
-                    return _LEAF_6
-                elif v == 'IDLE':
-                    return _LEAF_7
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_16
-                elif v == 'F':
-                    return _LEAF_15
-                elif v == 'G':
-                    return _LEAF_18
-                elif v == 'IDLE':
-                    return _LEAF_19
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_24
-                elif v == 'F':
-                    return _LEAF_23
-                elif v == 'G':
-                    return _LEAF_26
-                elif v == 'IDLE':
                     return _LEAF_27
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
+                elif v == 'F':
                     return _LEAF_28
-                elif v == 'F':
-                    return _LEAF_11
                 elif v == 'G':
-                    return _LEAF_30
-                elif v == 'IDLE':
-                    return _LEAF_31
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_18(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'G':
-        v = a['event']
-        if v == 'START':
-            return _node_15(a, calls)
-        elif v == 'INTERM':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_4
-                elif v == 'F':
-                    return _LEAF_5
-                elif v == 'G':
-                    return _LEAF_6
-                elif v == 'IDLE':
-                    return _LEAF_2
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_16
-                elif v == 'F':
-                    return _LEAF_17
-                elif v == 'G':
-                    return _LEAF_18
-                elif v == 'IDLE':
                     return _LEAF_14
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_24
-                elif v == 'F':
-                    return _LEAF_25
-                elif v == 'G':
-                    return _LEAF_26
                 elif v == 'IDLE':
-                    return _LEAF_22
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_28
-                elif v == 'F':
-                    return _LEAF_29
-                elif v == 'G':
-                    return _LEAF_30
-                elif v == 'IDLE':
-                    return _LEAF_10
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_4
-                elif v == 'F':
-                    return _LEAF_5
-                elif v == 'G':
-                    return _LEAF_3
-                elif v == 'IDLE':
-                    return _LEAF_7
+                    return _LEAF_39
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'B':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_16
+                    return _LEAF_30
                 elif v == 'F':
-                    return _LEAF_17
+                    return _LEAF_31
                 elif v == 'G':
-                    return _LEAF_15
+                    return _LEAF_18
                 elif v == 'IDLE':
-                    return _LEAF_19
+                    return _LEAF_40
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'C':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_24
+                    return _LEAF_33
                 elif v == 'F':
-                    return _LEAF_25
+                    return _LEAF_34
                 elif v == 'G':
-                    return _LEAF_23
+                    return _LEAF_22
                 elif v == 'IDLE':
-                    return _LEAF_27
+                    return _LEAF_41
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v == 'IDLE':
                 v = a['@EFGstate']
                 if v == 'E':
-                    return _LEAF_28
+                    return _LEAF_36
                 elif v == 'F':
-                    return _LEAF_29
+                    return _LEAF_37
                 elif v == 'G':
-                    return _LEAF_11
+                    return _LEAF_26
                 elif v == 'IDLE':
-                    return _LEAF_31
+                    return _LEAF_42
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
             else:
                 raise ValueError(f"@ABCstate={v!r} is outside its domain")
         elif v in ('ABORT', 'ZOMBIE'):
-            return _node_19(a, calls)
+            return _node_6(a, calls)
         else:
             raise ValueError(f"event={v!r} is outside its domain")
     elif v == 'H':
-        v = a['event']
-        if v == 'START':
-            return _node_15(a, calls)
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _node_20(a, calls)
-        elif v == 'END':
-            return _node_14(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'I':
         v = a['@ABCstate']
         if v == 'A':
             v = a['event']
             if v == 'START':
-                return _node_11(a, calls)
+                v = a['@EFGstate']
+                if v in ('E', 'F', 'G'):
+                    return _node_7(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _node_2(a, calls)
+                return _LEAF_1
             elif v == 'END':
-                return _node_1(a, calls)
+                return _LEAF_0
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'B':
             v = a['event']
             if v == 'START':
-                return _node_12(a, calls)
+                v = a['@EFGstate']
+                if v in ('E', 'F', 'G'):
+                    return _node_8(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_3
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _node_6(a, calls)
+                return _LEAF_4
             elif v == 'END':
-                return _node_5(a, calls)
+                return _LEAF_3
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'C':
             v = a['event']
             if v == 'START':
-                return _node_13(a, calls)
+                v = a['@EFGstate']
+                if v in ('E', 'F', 'G'):
+                    return _node_9(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_5
+                else:
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _node_9(a, calls)
+                return _LEAF_6
             elif v == 'END':
-                return _node_8(a, calls)
+                return _LEAF_5
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'IDLE':
+            return _node_10(a, calls)
+        else:
+            raise ValueError(f"@ABCstate={v!r} is outside its domain")
+    elif v == 'I':
+        v = a['@ABCstate']
+        if v == 'A':
             v = a['event']
             if v == 'START':
-                return _node_16(a, calls)
+                return _LEAF_8
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _node_10(a, calls)
+                return _LEAF_1
             elif v == 'END':
-                return _node_3(a, calls)
+                return _LEAF_0
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'B':
+            v = a['event']
+            if v == 'START':
+                return _LEAF_9
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_4
+            elif v == 'END':
+                return _LEAF_3
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'C':
+            v = a['event']
+            if v == 'START':
+                return _LEAF_10
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_6
+            elif v == 'END':
+                return _LEAF_5
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'IDLE':
+            return _node_10(a, calls)
         else:
             raise ValueError(f"@ABCstate={v!r} is outside its domain")
     elif v == 'J':
-        v = a['event']
-        if v == 'START':
-            v = a['@ABCstate']
-            if v == 'A':
+        v = a['@ABCstate']
+        if v == 'A':
+            v = a['event']
+            if v == 'START':
                 calls('changeInterState', (a['@ABCstate'],))
                 calls('sendAbortRequest', (a['@ABCstate'],))
-                return _node_11(a, calls)
-            elif v == 'B':
-                calls('changeInterState', (a['@ABCstate'],))
-                calls('sendAbortRequest', (a['@ABCstate'],))
-                return _node_12(a, calls)
-            elif v == 'C':
-                calls('changeInterState', (a['@ABCstate'],))
-                calls('sendAbortRequest', (a['@ABCstate'],))
-                return _node_13(a, calls)
-            elif v == 'IDLE':
-                return _node_16(a, calls)
+                return _LEAF_8
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_1
+            elif v == 'END':
+                return _LEAF_0
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _node_20(a, calls)
-        elif v == 'END':
-            return _node_14(a, calls)
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'B':
+            v = a['event']
+            if v == 'START':
+                calls('changeInterState', (a['@ABCstate'],))
+                calls('sendAbortRequest', (a['@ABCstate'],))
+                return _LEAF_9
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_4
+            elif v == 'END':
+                return _LEAF_3
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'C':
+            v = a['event']
+            if v == 'START':
+                calls('changeInterState', (a['@ABCstate'],))
+                calls('sendAbortRequest', (a['@ABCstate'],))
+                return _LEAF_10
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_6
+            elif v == 'END':
+                return _LEAF_5
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'IDLE':
+            return _node_10(a, calls)
         else:
-            raise ValueError(f"event={v!r} is outside its domain")
+            raise ValueError(f"@ABCstate={v!r} is outside its domain")
     else:
         raise ValueError(f"service={v!r} is outside its domain")
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@ABCstate'],))
-    return _node_1(a, calls)
+    return _LEAF_0
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_0
-    elif v == 'F':
-        return _LEAF_1
-    elif v == 'G':
-        return _LEAF_2
-    elif v == 'IDLE':
-        return _LEAF_3
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    calls('changeInterState', (a['@ABCstate'],))
+    return _LEAF_3
 
 
 def _node_2(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_4
-    elif v == 'F':
-        return _LEAF_5
-    elif v == 'G':
-        return _LEAF_6
-    elif v == 'IDLE':
-        return _LEAF_7
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_3(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_8
-    elif v == 'F':
-        return _LEAF_9
-    elif v == 'G':
-        return _LEAF_10
-    elif v == 'IDLE':
-        return _LEAF_11
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_4(a: Any, calls: Calls) -> Decision:
-    calls('changeInterState', (a['@ABCstate'],))
-    return _node_5(a, calls)
-
-
-def _node_5(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_12
-    elif v == 'F':
-        return _LEAF_13
-    elif v == 'G':
-        return _LEAF_14
-    elif v == 'IDLE':
-        return _LEAF_15
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_6(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_16
-    elif v == 'F':
-        return _LEAF_17
-    elif v == 'G':
-        return _LEAF_18
-    elif v == 'IDLE':
-        return _LEAF_19
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_7(a: Any, calls: Calls) -> Decision:
     v = a['event']
     if v == 'START':
         calls('changeInterState', (a['@ABCstate'],))
-        return _node_8(a, calls)
+        return _LEAF_5
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-        return _node_9(a, calls)
+        return _LEAF_6
     else:
         raise ValueError(f"event={v!r} is outside its domain")
 
 
-def _node_8(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_20
-    elif v == 'F':
-        return _LEAF_21
-    elif v == 'G':
-        return _LEAF_22
+def _node_3(a: Any, calls: Calls) -> Decision:
+    v = a['@ABCstate']
+    if v == 'A':
+        v = a['@EFGstate']
+        if v == 'E':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_11
+        elif v == 'F':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_12
+        elif v == 'G':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_13
+        elif v == 'IDLE':
+            return _LEAF_14
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'B':
+        v = a['@EFGstate']
+        if v == 'E':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_15
+        elif v == 'F':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_16
+        elif v == 'G':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_17
+        elif v == 'IDLE':
+            return _LEAF_18
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'C':
+        v = a['@EFGstate']
+        if v == 'E':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_19
+        elif v == 'F':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_20
+        elif v == 'G':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_21
+        elif v == 'IDLE':
+            return _LEAF_22
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
     elif v == 'IDLE':
-        return _LEAF_23
+        v = a['@EFGstate']
+        if v == 'E':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_23
+        elif v == 'F':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_24
+        elif v == 'G':
+            calls('changeInterState', (a['@EFGstate'],))
+            return _LEAF_25
+        elif v == 'IDLE':
+            return _LEAF_26
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
     else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+
+
+def _node_4(a: Any, calls: Calls) -> Decision:
+    v = a['@ABCstate']
+    if v == 'A':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_11
+        elif v == 'F':
+            return _LEAF_28
+        elif v == 'G':
+            return _LEAF_29
+        elif v == 'IDLE':
+            return _LEAF_39
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'B':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_15
+        elif v == 'F':
+            return _LEAF_31
+        elif v == 'G':
+            return _LEAF_32
+        elif v == 'IDLE':
+            return _LEAF_40
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'C':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_19
+        elif v == 'F':
+            return _LEAF_34
+        elif v == 'G':
+            return _LEAF_35
+        elif v == 'IDLE':
+            return _LEAF_41
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_23
+        elif v == 'F':
+            return _LEAF_37
+        elif v == 'G':
+            return _LEAF_38
+        elif v == 'IDLE':
+            return _LEAF_42
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+
+
+def _node_5(a: Any, calls: Calls) -> Decision:
+    v = a['@ABCstate']
+    if v == 'A':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_27
+        elif v == 'F':
+            return _LEAF_12
+        elif v == 'G':
+            return _LEAF_29
+        elif v == 'IDLE':
+            return _LEAF_39
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'B':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_30
+        elif v == 'F':
+            return _LEAF_16
+        elif v == 'G':
+            return _LEAF_32
+        elif v == 'IDLE':
+            return _LEAF_40
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'C':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_33
+        elif v == 'F':
+            return _LEAF_20
+        elif v == 'G':
+            return _LEAF_35
+        elif v == 'IDLE':
+            return _LEAF_41
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_36
+        elif v == 'F':
+            return _LEAF_24
+        elif v == 'G':
+            return _LEAF_38
+        elif v == 'IDLE':
+            return _LEAF_42
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+
+
+def _node_6(a: Any, calls: Calls) -> Decision:
+    v = a['@ABCstate']
+    if v == 'A':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_27
+        elif v == 'F':
+            return _LEAF_28
+        elif v == 'G':
+            return _LEAF_13
+        elif v == 'IDLE':
+            return _LEAF_39
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'B':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_30
+        elif v == 'F':
+            return _LEAF_31
+        elif v == 'G':
+            return _LEAF_17
+        elif v == 'IDLE':
+            return _LEAF_40
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'C':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_33
+        elif v == 'F':
+            return _LEAF_34
+        elif v == 'G':
+            return _LEAF_21
+        elif v == 'IDLE':
+            return _LEAF_41
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v == 'IDLE':
+        v = a['@EFGstate']
+        if v == 'E':
+            return _LEAF_36
+        elif v == 'F':
+            return _LEAF_37
+        elif v == 'G':
+            return _LEAF_25
+        elif v == 'IDLE':
+            return _LEAF_42
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    else:
+        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+
+
+def _node_7(a: Any, calls: Calls) -> Decision:
+    calls('changeInterState', (a['@EFGstate'],))
+    return _LEAF_0
+
+
+def _node_8(a: Any, calls: Calls) -> Decision:
+    calls('changeInterState', (a['@EFGstate'],))
+    return _LEAF_3
 
 
 def _node_9(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_24
-    elif v == 'F':
-        return _LEAF_25
-    elif v == 'G':
-        return _LEAF_26
-    elif v == 'IDLE':
-        return _LEAF_27
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    calls('changeInterState', (a['@EFGstate'],))
+    return _LEAF_5
 
 
 def _node_10(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_28
-    elif v == 'F':
-        return _LEAF_29
-    elif v == 'G':
-        return _LEAF_30
-    elif v == 'IDLE':
-        return _LEAF_31
+    v = a['event']
+    if v == 'START':
+        v = a['@EFGstate']
+        if v in ('E', 'F', 'G'):
+            return _node_11(a, calls)
+        elif v == 'IDLE':
+            return _LEAF_2
+        else:
+            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+    elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+        return _LEAF_7
+    elif v == 'END':
+        return _LEAF_2
     else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain")
 
 
 def _node_11(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_32
-    elif v == 'F':
-        return _LEAF_33
-    elif v == 'G':
-        return _LEAF_34
-    elif v == 'IDLE':
-        return _LEAF_35
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_12(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_36
-    elif v == 'F':
-        return _LEAF_37
-    elif v == 'G':
-        return _LEAF_38
-    elif v == 'IDLE':
-        return _LEAF_39
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_13(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        return _LEAF_40
-    elif v == 'F':
-        return _LEAF_41
-    elif v == 'G':
-        return _LEAF_42
-    elif v == 'IDLE':
-        return _LEAF_43
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_14(a: Any, calls: Calls) -> Decision:
-    v = a['@ABCstate']
-    if v == 'A':
-        return _node_1(a, calls)
-    elif v == 'B':
-        return _node_5(a, calls)
-    elif v == 'C':
-        return _node_8(a, calls)
-    elif v == 'IDLE':
-        return _node_3(a, calls)
-    else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
-
-
-def _node_15(a: Any, calls: Calls) -> Decision:
-    v = a['@ABCstate']
-    if v == 'A':
-        v = a['@EFGstate']
-        if v == 'E':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_0
-        elif v == 'F':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_1
-        elif v == 'G':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_2
-        elif v == 'IDLE':
-            return _LEAF_3
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'B':
-        v = a['@EFGstate']
-        if v == 'E':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_12
-        elif v == 'F':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_13
-        elif v == 'G':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_14
-        elif v == 'IDLE':
-            return _LEAF_15
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['@EFGstate']
-        if v == 'E':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_20
-        elif v == 'F':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_21
-        elif v == 'G':
-            calls('changeInterState', (a['@EFGstate'],))
-            return _LEAF_22
-        elif v == 'IDLE':
-            return _LEAF_23
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'IDLE':
-        return _node_16(a, calls)
-    else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
-
-
-def _node_16(a: Any, calls: Calls) -> Decision:
-    v = a['@EFGstate']
-    if v == 'E':
-        calls('changeInterState', (a['@EFGstate'],))
-        return _LEAF_8
-    elif v == 'F':
-        calls('changeInterState', (a['@EFGstate'],))
-        return _LEAF_9
-    elif v == 'G':
-        calls('changeInterState', (a['@EFGstate'],))
-        return _LEAF_10
-    elif v == 'IDLE':
-        return _LEAF_11
-    else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
-
-
-def _node_17(a: Any, calls: Calls) -> Decision:
-    v = a['@ABCstate']
-    if v == 'A':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_0
-        elif v == 'F':
-            return _LEAF_5
-        elif v == 'G':
-            return _LEAF_6
-        elif v == 'IDLE':
-            return _LEAF_7
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'B':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_12
-        elif v == 'F':
-            return _LEAF_17
-        elif v == 'G':
-            return _LEAF_18
-        elif v == 'IDLE':
-            return _LEAF_19
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_20
-        elif v == 'F':
-            return _LEAF_25
-        elif v == 'G':
-            return _LEAF_26
-        elif v == 'IDLE':
-            return _LEAF_27
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'IDLE':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_8
-        elif v == 'F':
-            return _LEAF_29
-        elif v == 'G':
-            return _LEAF_30
-        elif v == 'IDLE':
-            return _LEAF_31
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
-
-
-def _node_18(a: Any, calls: Calls) -> Decision:
-    v = a['@ABCstate']
-    if v == 'A':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_4
-        elif v == 'F':
-            return _LEAF_1
-        elif v == 'G':
-            return _LEAF_6
-        elif v == 'IDLE':
-            return _LEAF_7
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'B':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_16
-        elif v == 'F':
-            return _LEAF_13
-        elif v == 'G':
-            return _LEAF_18
-        elif v == 'IDLE':
-            return _LEAF_19
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_24
-        elif v == 'F':
-            return _LEAF_21
-        elif v == 'G':
-            return _LEAF_26
-        elif v == 'IDLE':
-            return _LEAF_27
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'IDLE':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_28
-        elif v == 'F':
-            return _LEAF_9
-        elif v == 'G':
-            return _LEAF_30
-        elif v == 'IDLE':
-            return _LEAF_31
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
-
-
-def _node_19(a: Any, calls: Calls) -> Decision:
-    v = a['@ABCstate']
-    if v == 'A':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_4
-        elif v == 'F':
-            return _LEAF_5
-        elif v == 'G':
-            return _LEAF_2
-        elif v == 'IDLE':
-            return _LEAF_7
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'B':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_16
-        elif v == 'F':
-            return _LEAF_17
-        elif v == 'G':
-            return _LEAF_14
-        elif v == 'IDLE':
-            return _LEAF_19
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_24
-        elif v == 'F':
-            return _LEAF_25
-        elif v == 'G':
-            return _LEAF_22
-        elif v == 'IDLE':
-            return _LEAF_27
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    elif v == 'IDLE':
-        v = a['@EFGstate']
-        if v == 'E':
-            return _LEAF_28
-        elif v == 'F':
-            return _LEAF_29
-        elif v == 'G':
-            return _LEAF_10
-        elif v == 'IDLE':
-            return _LEAF_31
-        else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
-
-
-def _node_20(a: Any, calls: Calls) -> Decision:
-    v = a['@ABCstate']
-    if v == 'A':
-        return _node_2(a, calls)
-    elif v == 'B':
-        return _node_6(a, calls)
-    elif v == 'C':
-        return _node_9(a, calls)
-    elif v == 'IDLE':
-        return _node_10(a, calls)
-    else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+    calls('changeInterState', (a['@EFGstate'],))
+    return _LEAF_2

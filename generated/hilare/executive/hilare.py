@@ -2,7 +2,8 @@
 """Executive hilare: its service description list, groups and reflexes (seed 000 ch. 3).
 
 The resource controller is the decision function in hilare_resource_controller.py: 143 Kheops
-rules (generated from the conflicts, with hilare_controller), a decision graph of depth 8.
+rules (generated from the conflicts, with hilare_controller), one decision per service
+(at most 5 tests after the one on the service, for EXEC-TRAJ-GOAL).
 Service groups: READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate = READ-MODEL | CALC-TRAJ-GOAL | CALC-TRAJ-OBJ | IDLE; READ_OBST_SEARCH_OBJstate = READ-OBST | SEARCH-OBJ | IDLE; ExecTrajState = EXEC-TRAJ-GOAL | EXEC-TRAJ-OBJ | IDLE; ARM_OBJ_ARM_BACKstate = ARM-OBJ | ARM-BACK | IDLE; CALC_GOALstate = CALC-GOAL | IDLE; CALC_OBJstate = CALC-OBJ | IDLE.
 """
 

@@ -2,28 +2,11 @@
 """Rule base hilare_controller, compiled into a decision graph of depth 3.
 
 Inputs: service, event, @ExecTrajState. Outputs: status, ExecTrajState.
-The compiler found 27 input configuration(s) the rules do not settle:
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-OBJ (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=AVOID-ON (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=SET-DYNAMIC (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=AUTOBOX-OFF (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=SET-BOX (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=READ-MODEL (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=INIT-MODEL (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=READ-OBST (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=EXEC-TRAJ-GOAL (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=EXEC-TRAJ-OBJ (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=CALC-TRAJ-GOAL (rules fired: none)
+The compiler found 3 case(s) of inputs the rules do not settle (a value
+listed as `a | b` stands for any of them):
+- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-OBJ | IDLE (rules fired: none)
 - incomplete: undetermined ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=CALC-TRAJ-OBJ (rules fired: CalcTrajObjWhenExecTrajGoal)
 - incomplete: undetermined ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=ARM-OBJ (rules fired: ArmGoWhenExecTrajGoal)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=ARM-BACK (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=OPEN-GRIP (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=CLOSE-GRIP (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=TURN-CAMERA (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=TAKE-IMAGE (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=SEARCH-OBJ (rules fired: none)
-- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=GET-NEAR-OBJ (rules fired: none)
-- ... and 7 more (`specc rules` lists them all).
 """
 
 from __future__ import annotations
@@ -38,7 +21,7 @@ from specc.runtime.rules import divide as _divide
 INPUTS = ["service", "event", "@ExecTrajState"]
 OUTPUTS = ["status", "ExecTrajState"]
 DEPTH = 3
-FINDINGS = 27
+FINDINGS = 3
 
 _LEAF_0 = Decision(MappingProxyType({'status': None, 'ExecTrajState': None}), (), ('status', 'ExecTrajState'), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ExecTrajState': None}), (), ('ExecTrajState',), None)

@@ -2,7 +2,8 @@
 """Executive tug: its service description list, groups and reflexes (seed 000 ch. 3).
 
 The resource controller is the decision function in tug_resource_controller.py: 31 Kheops
-rules (generated from the conflicts), a decision graph of depth 3.
+rules (generated from the conflicts), one decision per service
+(at most 2 tests after the one on the service, for GOTO).
 Service groups: GOTO_HITCH_UNHITCHstate = GOTO | HITCH | UNHITCH | IDLE.
 """
 

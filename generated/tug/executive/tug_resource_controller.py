@@ -17,26 +17,40 @@ INPUTS = ["service", "event", "@GOTO_HITCH_UNHITCHstate"]
 OUTPUTS = ["status", "GOTO_HITCH_UNHITCHstate"]
 DEPTH = 3
 FINDINGS = 0
+# One decision per value of service: the tests on its longest path, and the outputs it
+# decides; it leaves the others as they were (each keeps its previous-cycle value, copied without a test).
+SPLIT = "service"
+DEPTHS = {"GOTO": 2, "HITCH": 2, "UNHITCH": 2, "SET-LOAD": 1}
+DECIDES = {"GOTO": ("status", "GOTO_HITCH_UNHITCHstate"), "HITCH": ("status", "GOTO_HITCH_UNHITCHstate"), "UNHITCH": ("status", "GOTO_HITCH_UNHITCHstate"), "SET-LOAD": ("status",)}
+KEPT = {value: tuple(o for o in OUTPUTS if o not in decided) for value, decided in DECIDES.items()}
 
 _LEAF_0 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'GOTO'}), (), (), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'GOTO'}), (), (), None)
 _LEAF_2 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'IDLE'}), (), (), None)
-_LEAF_3 = Decision(MappingProxyType({'status': 'WAIT', 'GOTO_HITCH_UNHITCHstate': 'GOTO'}), (), (), None)
-_LEAF_4 = Decision(MappingProxyType({'status': 'WAIT', 'GOTO_HITCH_UNHITCHstate': 'HITCH'}), (), (), None)
-_LEAF_5 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'HITCH'}), (), (), None)
-_LEAF_6 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'HITCH'}), (), (), None)
-_LEAF_7 = Decision(MappingProxyType({'status': 'WAIT', 'GOTO_HITCH_UNHITCHstate': 'UNHITCH'}), (), (), None)
-_LEAF_8 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'UNHITCH'}), (), (), None)
-_LEAF_9 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'UNHITCH'}), (), (), None)
-_LEAF_10 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'IDLE'}), (), (), None)
+_LEAF_3 = Decision(MappingProxyType({'status': 'WAIT', 'GOTO_HITCH_UNHITCHstate': 'HITCH'}), (), (), None)
+_LEAF_4 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'HITCH'}), (), (), None)
+_LEAF_5 = Decision(MappingProxyType({'status': 'WAIT', 'GOTO_HITCH_UNHITCHstate': 'UNHITCH'}), (), (), None)
+_LEAF_6 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'UNHITCH'}), (), (), None)
+_LEAF_7 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'IDLE'}), (), (), None)
+_LEAF_8 = Decision(MappingProxyType({'status': 'WAIT', 'GOTO_HITCH_UNHITCHstate': 'GOTO'}), (), (), None)
+_LEAF_9 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'HITCH'}), (), (), None)
+_LEAF_10 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'UNHITCH'}), (), (), None)
+_LEAF_11 = Decision(MappingProxyType({'status': 'OK'}), (), (), None)
+_LEAF_12 = Decision(MappingProxyType({'status': 'ERROR'}), (), (), None)
 
 
 def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 3 tests; `calls(name, args)` runs `do` calls."""
+    decision = _decide(inputs, calls)
+    kept = KEPT[inputs[SPLIT]]
+    return decision.keeping(kept, inputs) if kept and decision.impossible is None else decision
+
+
+def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
-    v = a['@GOTO_HITCH_UNHITCHstate']
+    v = a['service']
     if v == 'GOTO':
-        v = a['service']
+        v = a['@GOTO_HITCH_UNHITCHstate']
         if v == 'GOTO':
             v = a['event']
             if v == 'START':
@@ -50,148 +64,122 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 return _LEAF_0
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        elif v in ('HITCH', 'UNHITCH'):
-            return _node_0(a, calls)
-        elif v == 'SET-LOAD':
-            v = a['event']
-            if v in ('START', 'END'):
-                return _LEAF_0
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_1
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"service={v!r} is outside its domain")
-    elif v == 'HITCH':
-        v = a['service']
-        if v == 'GOTO':
+        elif v == 'HITCH':
             v = a['event']
             if v == 'START':
+                return _LEAF_3
+            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_4
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_5
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'HITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_1(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_5
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_6
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'UNHITCH':
             v = a['event']
             if v == 'START':
-                return _node_1(a, calls)
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_5
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'SET-LOAD':
-            v = a['event']
-            if v in ('START', 'END'):
+            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_6
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_5
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"service={v!r} is outside its domain")
-    elif v == 'UNHITCH':
-        v = a['service']
-        if v == 'GOTO':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_7
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_8
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'HITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_2(a, calls)
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_8
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'UNHITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_2(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_8
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_9
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'SET-LOAD':
-            v = a['event']
-            if v in ('START', 'END'):
-                return _LEAF_9
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_8
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"service={v!r} is outside its domain")
-    elif v == 'IDLE':
-        v = a['service']
-        if v == 'GOTO':
+        elif v == 'IDLE':
             v = a['event']
             if v == 'START':
                 return _LEAF_2
             elif v == 'INTERM':
                 return _LEAF_0
             elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_10
+                return _LEAF_7
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+    elif v == 'HITCH':
+        v = a['@GOTO_HITCH_UNHITCHstate']
+        if v == 'GOTO':
+            return _node_0(a, calls)
         elif v == 'HITCH':
             v = a['event']
             if v == 'START':
-                return _LEAF_2
+                return _node_1(a, calls)
             elif v == 'INTERM':
-                return _LEAF_6
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_10
+                return _LEAF_4
+            elif v == 'END':
+                return _LEAF_2
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _LEAF_9
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'UNHITCH':
+            v = a['event']
+            if v == 'START':
+                return _node_2(a, calls)
+            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_6
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'IDLE':
             v = a['event']
             if v == 'START':
                 return _LEAF_2
             elif v == 'INTERM':
                 return _LEAF_9
             elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_10
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'SET-LOAD':
-            v = a['event']
-            if v in ('START', 'END'):
-                return _LEAF_2
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_10
+                return _LEAF_7
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+    elif v == 'UNHITCH':
+        v = a['@GOTO_HITCH_UNHITCHstate']
+        if v == 'GOTO':
+            return _node_0(a, calls)
+        elif v == 'HITCH':
+            v = a['event']
+            if v == 'START':
+                return _node_1(a, calls)
+            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_4
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'UNHITCH':
+            v = a['event']
+            if v == 'START':
+                return _node_2(a, calls)
+            elif v == 'INTERM':
+                return _LEAF_6
+            elif v == 'END':
+                return _LEAF_2
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _LEAF_10
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'IDLE':
+            v = a['event']
+            if v == 'START':
+                return _LEAF_2
+            elif v == 'INTERM':
+                return _LEAF_10
+            elif v in ('END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_7
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        else:
+            raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+    elif v == 'SET-LOAD':
+        v = a['event']
+        if v in ('START', 'END'):
+            return _LEAF_11
+        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+            return _LEAF_12
+        else:
+            raise ValueError(f"event={v!r} is outside its domain")
     else:
-        raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+        raise ValueError(f"service={v!r} is outside its domain")
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:
     v = a['event']
     if v == 'START':
-        return _LEAF_3
+        return _LEAF_8
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
         return _LEAF_1
     else:
@@ -200,9 +188,9 @@ def _node_0(a: Any, calls: Calls) -> Decision:
 
 def _node_1(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@GOTO_HITCH_UNHITCHstate'],))
-    return _LEAF_6
+    return _LEAF_9
 
 
 def _node_2(a: Any, calls: Calls) -> Decision:
     calls('changeInterState', (a['@GOTO_HITCH_UNHITCHstate'],))
-    return _LEAF_9
+    return _LEAF_10
