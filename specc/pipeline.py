@@ -58,10 +58,11 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
 
 
 def _rule_bases_outside_kheops(program: m.Program) -> list[Diagnostic]:
-    """What `specc compile` says of a stand-alone rule base, said by `specc check` too: a rule
-    outside the propositional subset Kheops compiles, a base past the compilation's work limit,
-    and the input configurations it leaves unsettled. (An executive's own bases are compiled
-    with its controller, by `compile`, `rules` and `verify`: seconds, not milliseconds.)"""
+    """What `specc compile` says of the rule bases, said by `specc check` too: a rule outside the
+    propositional subset Kheops compiles, a base past the compilation's work limit, and the inputs
+    it leaves unsettled; for each executive, the same of its resource controller (its generated
+    rules joined by its own bases, compiled one decision per service: milliseconds for Hilare's)."""
+    from specc.analysis.controller import executive_controller
     from specc.analysis.kheops import KheopsError, compile_base, normalise, unsettled_warning
 
     joined = {ref.text for e in program.items if isinstance(e, m.Executive) for ref in e.rules}
@@ -72,6 +73,18 @@ def _rule_bases_outside_kheops(program: m.Program) -> list[Diagnostic]:
             if base.name not in joined:
                 warning = unsettled_warning(compile_base(normal), f"rule base '{base.name}'", base)
                 found += [warning] if warning is not None else []
+        except KheopsError as exc:
+            found.append(error(exc.code, str(exc), exc.node.span))
+    if any(d.severity == "error" for d in found):
+        return found
+    for executive in (item for item in program.items if isinstance(item, m.Executive)):
+        try:
+            controller = executive_controller(program, executive)
+            if controller.problems:
+                continue  # the executive's check reported them
+            warning = unsettled_warning(controller.compile(), f"the resource controller of executive "
+                                        f"'{executive.name}'", executive)
+            found += [warning] if warning is not None else []
         except KheopsError as exc:
             found.append(error(exc.code, str(exc), exc.node.span))
     return found

@@ -208,13 +208,6 @@ def condition(attribute: k.Attribute, value: Any) -> str:
     return f"v == {value!r}"
 
 
-def warn_unsettled(output: Output, compiled: k.Compiled, what: str, node: m.Node) -> None:
-    """A compiled base that leaves inputs unsettled deserves a word at compile time."""
-    warning = k.unsettled_warning(compiled, what, node)
-    if warning is not None:
-        output.warn(warning.code, warning.message, warning.span)
-
-
 def generate(program: m.Program, output: Output, robot: str = "") -> list[k.Compiled]:
     compiled_all = []
     bases = sorted((i for i in program.items if isinstance(i, m.RuleBase)), key=lambda b: b.name)
