@@ -285,11 +285,12 @@ class Explorer:
         self.modules = modules
         self.arcs = arcs
         self.requests = requests
+        # The report codes reflexes look for: module activities may end with them too.
+        self.codes = tuple(sorted({str(r.value) for r in self.spec.reflexes if r.op is not None} - {"OK"}))
 
     # -- states: a world is rebuilt from its canonical key before each step (cheaper than copying it)
     def initial(self) -> World:
-        codes = tuple(sorted({str(r.value) for r in self.spec.reflexes if r.op is not None} - {"OK"}))
-        registry = ModelRegistry(self.modules, codes)
+        registry = ModelRegistry(self.modules, self.codes)
         executive = rx.Executive(self.spec, self.decide, registry)  # type: ignore[arg-type]
         world = World(executive, registry)
         executive.observers.append(functools.partial(_check_exclusion, world, self.arcs))
@@ -381,10 +382,10 @@ class Explorer:
             found.append(Event(f"timer: {_timer_label(timer)}", False, functools.partial(_fire, index)))
         return found
 
-    def step(self, key: Key, index: int) -> tuple[World, Event]:
-        """Rebuild the world of `key`, run its `index`th event, note what went wrong."""
-        world = self.world(key)
-        event = self.events(world)[index]
+    def step(self, world: World, event: Event) -> World:
+        """Run one event in a world just rebuilt from its key, note what went wrong. An event names
+        activities, module entries and timers by id or position, which every rebuild of one key
+        gives alike: the events listed once for a state serve each of its transitions."""
         executive = world.executive
         before = {a.id: a.answered for a in executive.activities.values()}
         fresh = world.next_id
@@ -392,7 +393,7 @@ class Explorer:
             event.run(world)
         except Exception as exc:  # the runtime itself failed: a finding, not a crash of the verifier
             world.problems.append(("no-error", f"the executive raised {type(exc).__name__}: {exc}"))
-            return world, event
+            return world
         replied: set[int] = set()
         for message in executive.messages:
             if message.kind == "WARNING" and message.result == "ERROR":
@@ -406,7 +407,7 @@ class Explorer:
         for ident, answered in before.items():
             if ident not in executive.activities and not answered and ident not in replied:
                 world.problems.append(("one-reply", f"request {ident} left the activity list without a reply"))
-        return world, event
+        return world
 
     # -- the search
     def explore(self, limit: int = 200_000, progress: Callable[[int], None] | None = None) -> Verification:
@@ -422,8 +423,9 @@ class Explorer:
         while queue:
             index = queue.popleft()
             key = states[index]
-            for number in range(len(self.events(self.world(key)))):
-                after, event = self.step(key, number)
+            listed = self.world(key)
+            for number, event in enumerate(self.events(listed)):
+                after = self.step(listed if number == 0 else self.world(key), event)
                 transitions += 1
                 for prop, message in after.problems:
                     if prop not in violations:
