@@ -55,8 +55,9 @@ class TooLarge(KheopsError):
         self.part = part  # the value of the input split on whose decision went past the limit (`compile_parts`)
 
 
-# Decision-tree nodes a compilation may visit (a resource controller of 21 services and 6 groups: 85,000, ~3 s; a
-# million is ~30 s and ~1 GB): past it, a diagnostic with the figures and how to split the base,
+# Decision-tree nodes a compilation may visit (Hilare's resource controller, one decision per service: about 300;
+# 8 numeric inputs x 50 threshold rules: 575,000, ~30 s and 250 MB): past it, a diagnostic with the figures and how
+# to split the base,
 # never a run of many minutes and gigabytes (seed 000 §3.7 compiles every path of the base into
 # the decision graph). The environment variable raises it for a base that is worth the wait.
 WORK_LIMIT = 1_000_000
@@ -708,6 +709,7 @@ class Compiler:
         self.reads: dict[str, tuple[str, ...]] = {}
         self.rule_atoms: dict[str, tuple[Atom, ...]] = {}
         self.holding: dict[tuple[Atom, frozenset[Any]], bool] = {}
+        self.restricting: dict[str, frozenset[str]] = {}
         self.truths: dict[tuple[Any, ...], int] = {}
         self.order = list(base.attributes)
         self.observable = {n for n, a in base.attributes.items() if a.role in ("inputs", "previous")}
@@ -756,6 +758,14 @@ class Compiler:
             found = self.rule_atoms[rule.name] = tuple(atoms(rule.condition))
         return found
 
+    def restricts(self, rule: Rule) -> frozenset[str]:
+        """The attributes a rule's actions restrict."""
+        found = self.restricting.get(rule.name)
+        if found is None:
+            found = self.restricting[rule.name] = frozenset(
+                a.atom.attribute for a in rule.actions if isinstance(a, Restrict))
+        return found
+
     def read(self, rule: Rule) -> tuple[str, ...]:
         """The attributes a rule's condition reads."""
         attributes = self.reads.get(rule.name)
@@ -786,33 +796,48 @@ class Compiler:
         return self.shared.setdefault(key, node)
 
     def node(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
-             path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool = False) -> Node:
+             path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool = False,
+             tested: str | None = None) -> Node:
         """The subgraph for one state of the deduction: the values still possible, the rules
         that may still fire (not fired, condition not FALSE — monotony keeps a FALSE condition
         FALSE), the attributes still testable. Paths reaching the same state share it, so the
         search explores the DAG rather than the whole tree; a shared state's findings carry
-        the witness of the first path that reached it. `elsed`: the `else` rules have fired."""
+        the witness of the first path that reached it. `elsed`: the `else` rules have fired.
+        `tested`: the only attribute whose values differ from those `alive` was last filtered on
+        (a test's branch): only the rules reading it may have become FALSE, and none inert."""
         self.tree_nodes += 1
         if self.tree_nodes > self.limit:
             raise self.too_large()
-        alive = tuple(r for r in alive if self.truth(r, memory) != FALSE and not self.inert(r, memory))
+        if tested is None:
+            alive = tuple(r for r in alive if self.truth(r, memory) != FALSE and not self.inert(r, memory))
+        else:
+            alive = tuple(r for r in alive if tested not in self.read(r) or self.truth(r, memory) != FALSE)
         key = (self.state(memory, alive, testable), tuple(r.name for r in alive), elsed)
         found = self.explored.get(key)
         if found is None:
-            found = self.explore(memory, alive, testable, path, history, elsed)
+            found = self.explore(memory, alive, testable, path, history, elsed, tested)
             self.explored[key] = found
         return found
 
     def explore(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
-                path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool) -> Node:
+                path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool,
+                tested: str | None = None) -> Node:
         memory = dict(memory)
         procedural: list[Assign | Call] = []
         fired_now: list[str] = []
         pending = list(alive)
+        # With `tested`, the rules that read nothing else were UNKNOWN and not inert in the state
+        # this one branches from: only those reading what changed since (the tested attribute,
+        # then what firing restricts) are looked at again.
+        dirty: set[str] | None = None if tested is None else {tested}
+        changed: set[str] = set(dirty or ())
         progress = True
         while progress:
             progress = False
+            restricted_now: set[str] = set()
             for rule in list(pending):
+                if dirty is not None and dirty.isdisjoint(self.read(rule)):
+                    continue
                 if self.truth(rule, memory) != TRUE:
                     continue
                 if rule.kind == "impossible":
@@ -823,17 +848,27 @@ class Compiler:
                 for action in rule.actions:
                     if isinstance(action, Restrict):
                         restrict(memory, action.atom)
+                        restricted_now.add(action.atom.attribute)
+                        if dirty is not None:
+                            dirty.add(action.atom.attribute)  # later rules of this pass see it too
                     else:
                         procedural.append(action)
                         if isinstance(action, Assign):
                             testable = testable | {action.target}
+            changed |= restricted_now
+            if dirty is not None:
+                dirty = restricted_now
         history = history + tuple(fired_now)
         # An attribute left with no value does not end the deduction: the other rules still fire,
         # and an `impossible` rule still says so, as in the interpreter.
-        valid = [r for r in pending if self.truth(r, memory) == UNKNOWN and not self.inert(r, memory)]
+        if tested is None:
+            valid = [r for r in pending if self.truth(r, memory) == UNKNOWN and not self.inert(r, memory)]
+        else:
+            valid = [r for r in pending if (changed.isdisjoint(self.read(r)) or self.truth(r, memory) == UNKNOWN)
+                     and (changed.isdisjoint(self.restricts(r)) or not self.inert(r, memory))]
         candidates: dict[str, int] = {}
         for rule in valid:
-            for atom in atoms(rule.condition):
+            for atom in self.atoms(rule):
                 if atom.attribute in testable and len(memory[atom.attribute]) > 1 \
                         and atom_truth(atom, memory[atom.attribute]) == UNKNOWN:
                     candidates[atom.attribute] = candidates.get(atom.attribute, 0) + 1
@@ -860,7 +895,7 @@ class Compiler:
         # The values no remaining rule tells apart (every atom on the attribute holds for all of
         # them or for none) lead to one subgraph, explored once: a numeric input cut by the
         # thresholds of the whole base splits only where the rules still waiting compare it.
-        tests = [atom for rule in valid for atom in atoms(rule.condition) if atom.attribute == chosen]
+        tests = [atom for rule in valid for atom in self.atoms(rule) if atom.attribute == chosen]
         classes: dict[tuple[bool, ...], list[Any]] = {}
         for value in self.ordered(chosen, memory[chosen]):
             single = frozenset((value,))
@@ -868,9 +903,9 @@ class Compiler:
         child_of: dict[Any, Node] = {}
         for values in classes.values():
             child_memory = {**memory, chosen: frozenset(values)}
-            tested = values[0] if len(values) == 1 else tuple(values)  # a witness names the whole class
-            child = self.node(child_memory, remaining, testable - {chosen}, path + ((chosen, tested),), history,
-                              elsed)
+            witness = values[0] if len(values) == 1 else tuple(values)  # a witness names the whole class
+            child = self.node(child_memory, remaining, testable - {chosen}, path + ((chosen, witness),), history,
+                              elsed, chosen)
             child_of.update(dict.fromkeys(values, child))
         branches = tuple((value, child_of[value]) for value in self.ordered(chosen, memory[chosen]))
         return self.wrap(procedural, self.intern(Test(chosen, branches)))
