@@ -706,10 +706,10 @@ class Compiler:
         self.tree_nodes = spent  # the work done before (the other parts of a base compiled in parts)
         self.shared: dict[Any, Node] = {} if shared is None else shared
         self.explored: dict[tuple[Any, ...], Node] = {}
-        self.reads: dict[str, tuple[str, ...]] = {}
-        self.rule_atoms: dict[str, tuple[Atom, ...]] = {}
+        self.reads: dict[int, tuple[str, ...]] = {}
+        self.rule_atoms: dict[int, tuple[Atom, ...]] = {}
         self.holding: dict[tuple[Atom, frozenset[Any]], bool] = {}
-        self.restricting: dict[str, frozenset[str]] = {}
+        self.restricting: dict[int, frozenset[str]] = {}
         self.truths: dict[tuple[Any, ...], int] = {}
         self.order = list(base.attributes)
         self.observable = {n for n, a in base.attributes.items() if a.role in ("inputs", "previous")}
@@ -731,9 +731,11 @@ class Compiler:
         for rule in alive:
             for atom in self.atoms(rule):
                 read.setdefault(atom.attribute, []).append(atom)
-        return tuple(memory[a] if a not in self.observable or (a in testable and a in read)
-                     else tuple(atom_truth(atom, memory[a]) for atom in read[a]) if a in read else None
-                     for a in self.order)
+        # An intermediate becomes testable once an assignment gives it its value (its values
+        # still possible do not say so): whether it has is part of the state.
+        return (*(memory[a] if a not in self.observable or (a in testable and a in read)
+                  else tuple(atom_truth(atom, memory[a]) for atom in read[a]) if a in read else None
+                  for a in self.order), testable - self.observable)
 
     def inert(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> bool:
         """A rule whose firing would change nothing: it only restricts attributes to values they
@@ -741,10 +743,10 @@ class Compiler:
         states that differ only by it share one node."""
         if rule.kind != "when" or not all(isinstance(action, Restrict) for action in rule.actions):
             return False
-        return all(self.holds(action.atom, memory[action.atom.attribute])  # type: ignore[union-attr]
+        return all(self.holds_for_all(action.atom, memory[action.atom.attribute])  # type: ignore[union-attr]
                    for action in rule.actions)
 
-    def holds(self, atom: Atom, values: frozenset[Any]) -> bool:
+    def holds_for_all(self, atom: Atom, values: frozenset[Any]) -> bool:
         """Whether `atom` holds for every value of `values` (cached: the same few sets recur)."""
         key = (atom, values)
         found = self.holding.get(key)
@@ -753,29 +755,29 @@ class Compiler:
         return found
 
     def atoms(self, rule: Rule) -> tuple[Atom, ...]:
-        found = self.rule_atoms.get(rule.name)
+        found = self.rule_atoms.get(id(rule))
         if found is None:
-            found = self.rule_atoms[rule.name] = tuple(atoms(rule.condition))
+            found = self.rule_atoms[id(rule)] = tuple(atoms(rule.condition))
         return found
 
     def restricts(self, rule: Rule) -> frozenset[str]:
         """The attributes a rule's actions restrict."""
-        found = self.restricting.get(rule.name)
+        found = self.restricting.get(id(rule))
         if found is None:
-            found = self.restricting[rule.name] = frozenset(
+            found = self.restricting[id(rule)] = frozenset(
                 a.atom.attribute for a in rule.actions if isinstance(a, Restrict))
         return found
 
     def read(self, rule: Rule) -> tuple[str, ...]:
         """The attributes a rule's condition reads."""
-        attributes = self.reads.get(rule.name)
+        attributes = self.reads.get(id(rule))
         if attributes is None:
-            attributes = self.reads[rule.name] = tuple(sorted({a.attribute for a in atoms(rule.condition)}))
+            attributes = self.reads[id(rule)] = tuple(sorted({a.attribute for a in atoms(rule.condition)}))
         return attributes
 
     def truth(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> int:
         """A rule condition's truth, cached on the values of the attributes it reads."""
-        key = (rule.name, tuple(memory[a] for a in self.read(rule)))
+        key = (id(rule), tuple(memory[a] for a in self.read(rule)))
         cached = self.truths.get(key)
         if cached is None:
             cached = self.truths[key] = truth(rule.condition, memory)
@@ -796,13 +798,13 @@ class Compiler:
         return self.shared.setdefault(key, node)
 
     def node(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
-             path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool = False,
+             path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elses_fired: bool = False,
              tested: str | None = None) -> Node:
         """The subgraph for one state of the deduction: the values still possible, the rules
         that may still fire (not fired, condition not FALSE — monotony keeps a FALSE condition
         FALSE), the attributes still testable. Paths reaching the same state share it, so the
         search explores the DAG rather than the whole tree; a shared state's findings carry
-        the witness of the first path that reached it. `elsed`: the `else` rules have fired.
+        the witness of the first path that reached it. `elses_fired`: the `else` rules have fired.
         `tested`: the only attribute whose values differ from those `alive` was last filtered on
         (a test's branch): only the rules reading it may have become FALSE, and none inert."""
         self.tree_nodes += 1
@@ -812,15 +814,16 @@ class Compiler:
             alive = tuple(r for r in alive if self.truth(r, memory) != FALSE and not self.inert(r, memory))
         else:
             alive = tuple(r for r in alive if tested not in self.read(r) or self.truth(r, memory) != FALSE)
-        key = (self.state(memory, alive, testable), tuple(r.name for r in alive), elsed)
+        # Rules by identity: two joined bases may each have a rule of the same name.
+        key = (self.state(memory, alive, testable), tuple(id(r) for r in alive), elses_fired)
         found = self.explored.get(key)
         if found is None:
-            found = self.explore(memory, alive, testable, path, history, elsed, tested)
+            found = self.explore(memory, alive, testable, path, history, elses_fired, tested)
             self.explored[key] = found
         return found
 
     def explore(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
-                path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elsed: bool,
+                path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elses_fired: bool,
                 tested: str | None = None) -> Node:
         memory = dict(memory)
         procedural: list[Assign | Call] = []
@@ -860,7 +863,9 @@ class Compiler:
                 dirty = restricted_now
         history = history + tuple(fired_now)
         # An attribute left with no value does not end the deduction: the other rules still fire,
-        # and an `impossible` rule still says so, as in the interpreter.
+        # and an `impossible` rule may still apply. What fires then can differ from the interpreter
+        # (an atom on the empty attribute reads FALSE, so a negation of it turns TRUE after its rule
+        # was dropped as FALSE): such a decision is only "inconsistent" (docs/reference.md).
         if tested is None:
             valid = [r for r in pending if self.truth(r, memory) == UNKNOWN and not self.inert(r, memory)]
         else:
@@ -875,10 +880,10 @@ class Compiler:
         if not candidates:
             undetermined = [o for o in self.base.outputs if len(memory[o]) > 1]
             elses = [r for r in self.base.rules if r.kind == "else"]
-            if not undetermined or not elses or elsed:
+            if not undetermined or not elses or elses_fired:
                 return self.wrap(procedural, self.leaf(memory, path, history))
             # Nothing more fires and an output is undetermined: the `else` rules fire, once, and
-            # the deduction goes on from what they restrict (as in the interpreter).
+            # the deduction goes on from what they restrict, as the interpreter's does.
             for rule in elses:
                 for action in rule.actions:
                     if isinstance(action, Restrict):
@@ -888,7 +893,7 @@ class Compiler:
                         if isinstance(action, Assign):
                             testable = testable | {action.target}
             history = history + tuple(r.name for r in elses)
-            return self.wrap(procedural, self.node(memory, tuple(pending), testable, path, history, elsed=True))
+            return self.wrap(procedural, self.node(memory, tuple(pending), testable, path, history, elses_fired=True))
         # Heuristic: the attribute most valid rules wait for; then the fewest values; then declaration order.
         chosen = min(candidates, key=lambda a: (-candidates[a], len(memory[a]), self.order.index(a)))
         remaining = tuple(valid)
@@ -899,13 +904,13 @@ class Compiler:
         classes: dict[tuple[bool, ...], list[Any]] = {}
         for value in self.ordered(chosen, memory[chosen]):
             single = frozenset((value,))
-            classes.setdefault(tuple(self.holds(atom, single) for atom in tests), []).append(value)
+            classes.setdefault(tuple(self.holds_for_all(atom, single) for atom in tests), []).append(value)
         child_of: dict[Any, Node] = {}
         for values in classes.values():
             child_memory = {**memory, chosen: frozenset(values)}
             witness = values[0] if len(values) == 1 else tuple(values)  # a witness names the whole class
             child = self.node(child_memory, remaining, testable - {chosen}, path + ((chosen, witness),), history,
-                              elsed, chosen)
+                              elses_fired, chosen)
             child_of.update(dict.fromkeys(values, child))
         branches = tuple((value, child_of[value]) for value in self.ordered(chosen, memory[chosen]))
         return self.wrap(procedural, self.intern(Test(chosen, branches)))
@@ -968,8 +973,8 @@ def compile_base(base: Base, limit: int | None = None) -> Compiled:
 def compile_parts(base: Base, split: str, parts: Mapping[Any, tuple[Base, tuple[str, ...]]],
                   limit: int | None = None) -> Compiled:
     """`base` compiled as one decision per value of its symbolic input `split`: `parts` gives, for
-    each value, the sub-base deciding it (the rules that can apply with that value, over the
-    attributes they need) and the outputs it leaves as they were (they keep their previous-cycle
+    each value, the sub-base deciding it (the rules that can apply with that value) and the
+    outputs it leaves as they were (they keep their previous-cycle
     value, copied without a test). The root tests `split`; each decision grows with what that
     value's rules read, not with the product of every attribute of the base. The work limit is
     shared by the parts, and equal subgraphs of different parts are one node."""

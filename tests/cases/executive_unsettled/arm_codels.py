@@ -1,4 +1,4 @@
-"""Codels of the executive_rules case."""
+"""Codels of the executive_unsettled case."""
 
 
 def go(sdi, request):
