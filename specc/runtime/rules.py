@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from types import MappingProxyType
 from typing import Any, NamedTuple
 
 
@@ -22,10 +21,10 @@ class Decision(NamedTuple):
 
     def keeping(self, kept: tuple[str, ...], inputs: Mapping[str, Any]) -> Decision:
         """This decision with the outputs it left as they were at their previous-cycle value (`@name`)."""
-        outputs = dict(self.outputs)
+        outputs = dict(self.outputs)  # a fresh mapping for each call: the leaf's own stays shared and read-only
         for name in kept:
             outputs[name] = inputs["@" + name]
-        return self._replace(outputs=MappingProxyType(outputs))
+        return Decision(outputs, self.inconsistent, self.incomplete, self.impossible)
 
 
 Calls = Callable[[str, tuple[Any, ...]], object]
