@@ -61,7 +61,7 @@ def _rule_bases_outside_kheops(program: m.Program) -> list[Diagnostic]:
     """What `specc compile` says of the rule bases, said by `specc check` too: a rule outside the
     propositional subset Kheops compiles, a base past the compilation's work limit, and the inputs
     it leaves unsettled; for each executive, the same of its resource controller (its generated
-    rules joined by its own bases, compiled one decision per service: milliseconds for Hilare's)."""
+    rules joined by its own bases, compiled one decision per service: milliseconds for 21 services)."""
     from specc.analysis.controller import executive_controller
     from specc.analysis.kheops import KheopsError, compile_base, normalise, unsettled_warning
 
