@@ -57,7 +57,7 @@ class TooLarge(KheopsError):
 
 # Decision-tree nodes a compilation may visit (a resource controller of 21 services and 6 groups,
 # one decision per service: about 300; 8 numeric inputs x 50 threshold rules: 575,000, ~30 s and
-# 250 MB): past it, a diagnostic with the figures and how to split the base, never a run of many
+# 400 MB): past it, a diagnostic with the figures and how to split the base, never a run of many
 # minutes and gigabytes (seed 000 §3.7 compiles every path of the base into the decision graph).
 # The environment variable raises it for a base that is worth the wait.
 WORK_LIMIT = 1_000_000
