@@ -117,7 +117,7 @@ def compile(paths: PathsArg,
     try:
         result = generate_all(loaded.program, name)
     except KheopsError as exc:
-        err.print(f"{exc.node.span}: error: {exc} [{exc.code}]", markup=False)
+        err.print(exc.headline(), markup=False)
         raise typer.Exit(1) from None
     folder = output / name
     try:
@@ -303,7 +303,7 @@ def verify(paths: PathsArg,
             result = explore(loaded.program, chosen, requests, max_states,
                              lambda states: status.update(f"exploring: {states} states"))
         except kheops.KheopsError as exc:
-            err.print(f"{exc.node.span}: error: {exc} [{exc.code}]", markup=False)
+            err.print(exc.headline(), markup=False)
             raise typer.Exit(1) from None
     for line in describe(result):
         out.print(line, markup=False)
@@ -590,7 +590,7 @@ def rules_report(paths: PathsArg,
                 controller = executive_controller(loaded.program, item)
                 normal, compiled = controller.base, controller.compile()
         except kheops.KheopsError as exc:
-            err.print(f"{exc.node.span}: error: {exc} [{exc.code}]", markup=False)
+            err.print(exc.headline(), markup=False)
             raise typer.Exit(1) from None
         out.print(f"{title}: {len(normal.rules)} rules, decision graph of depth {compiled.depth} "
                   f"({compiled.tree_nodes} tree nodes -> {compiled.dag_nodes} shared)", markup=False)

@@ -51,13 +51,13 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
         base_dirs = {shown: path.resolve().parent for shown, path in loaded.paths.items()}
         found = check_program(loaded.program, base_dirs)
         if not any(d.severity == "error" for d in found):
-            found += _rule_bases_outside_kheops(loaded.program)
+            found += _rule_base_diagnostics(loaded.program)
         loaded.diagnostics.extend(d for d in found if not _already_reported(d, loaded.diagnostics))
     loaded.diagnostics.sort(key=sort_key)
     return loaded
 
 
-def _rule_bases_outside_kheops(program: m.Program) -> list[Diagnostic]:
+def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
     """What `specc compile` says of the rule bases, said by `specc check` too: a rule outside the
     propositional subset Kheops compiles, a base past the compilation's work limit, and the inputs
     it leaves unsettled; for each executive, the same of its resource controller (its generated

@@ -240,18 +240,19 @@ class Controller:
         out). A decision then tests the groups its service is in conflict with (seed 000 §3.8.1's
         rules for it), not the product of every group's states: the controller grows with the
         conflicts (issue #24)."""
-        framed = {id(rule): output for rule in self.frames for output in restricted(rule)}
+        framed = {id(rule): output for rule in self.frames for output in k.targets(rule)}
+        framed_states = set(framed.values())
         member_states = {service: {self.state_attribute(g) for g in self.groups if service in g.services}
                          for service in self.graph.services}
         service_attribute = self.base.attributes["service"]
+        memory = k.initial_memory(self.base)
         parts: dict[str, tuple[k.Base, tuple[str, ...]]] = {}
         for service in service_attribute.values:
-            memory = k.initial_memory(self.base)
             memory["service"] = frozenset({service})
             applicable = [rule for rule in self.base.rules
                           if rule.condition is None or k.truth(rule.condition, memory) != k.FALSE]
             read = set().union(*(mentioned(rule) for rule in applicable if id(rule) not in framed))
-            kept = tuple(output for output in self.base.outputs if output in framed.values()
+            kept = tuple(output for output in self.base.outputs if output in framed_states
                          and output not in read and output not in member_states.get(service, ()))
             rules = tuple(rule for rule in applicable if framed.get(id(rule)) not in kept)
             attributes = {name: a for name, a in self.base.attributes.items() if name not in kept}
@@ -266,10 +267,7 @@ class Controller:
         try:
             return k.compile_parts(self.base, "service", parts)
         except k.TooLarge as exc:
-            part, _ = parts[exc.part]
-            bound, counts = k.paths_bound(part)
-            largest = " x ".join(f"{name} {count}" for name, count in counts[:8])
-            largest += " x ..." if len(counts) > 8 else ""
+            bound, largest = k.paths_bound_text(parts[exc.part][0], shown=8)
             raise k.TooLarge(
                 f"the resource controller of executive '{self.executive.name}' needs more than {exc.limit:,} "
                 f"decision-tree nodes to compile (the decision for service {exc.part} alone tests up to {bound:,} "
@@ -279,15 +277,9 @@ class Controller:
                 exc.part) from None
 
 
-def restricted(rule: k.Rule) -> set[str]:
-    """The attributes a rule's actions restrict or assign."""
-    return {action.atom.attribute if isinstance(action, k.Restrict) else action.target
-            for action in rule.actions if not isinstance(action, k.Call)}
-
-
 def mentioned(rule: k.Rule) -> set[str]:
     """Every attribute a rule tests, restricts, assigns or passes to a call."""
-    found = {atom.attribute for atom in k.atoms(rule.condition)} | restricted(rule)
+    found = {atom.attribute for atom in k.atoms(rule.condition)} | k.targets(rule)
     for action in rule.actions:
         if isinstance(action, k.Call):
             found |= set().union(*(arg.attributes() for arg in action.args))

@@ -43,6 +43,10 @@ class KheopsError(Exception):
         super().__init__(message)
         self.node = node
 
+    def headline(self) -> str:
+        """`file:line:col: error: message [code]`, as the command line prints it."""
+        return f"{self.node.span}: error: {self} [{self.code}]"
+
 
 class TooLarge(KheopsError):
     """A rule base whose decision graph would take more work than its limit to build."""
@@ -394,6 +398,12 @@ def convert_rule(rule: m.Rule, constants: Mapping[str, Any], loop: Mapping[str, 
     return Rule(name, rule.kind, condition, tuple(actions))
 
 
+def targets(rule: Rule) -> frozenset[str]:
+    """The attributes a rule's actions restrict or assign."""
+    return frozenset(action.atom.attribute if isinstance(action, Restrict) else action.target
+                     for action in rule.actions if not isinstance(action, Call))
+
+
 def atoms(cond: Cond | None) -> Iterator[Atom]:
     if cond is None:
         return
@@ -644,7 +654,7 @@ def finish(base: Base, memory: Mapping[str, frozenset[Any]], outcome: Outcome) -
 
 @dataclass(frozen=True)
 class Leaf:
-    outputs: tuple[tuple[str, Any], ...]
+    outputs: tuple[tuple[str, Any], ...]  # every output of the base compiled: (name, value or None)
     inconsistent: tuple[str, ...] = ()
     incomplete: tuple[str, ...] = ()
     impossible: str | None = None
@@ -708,7 +718,6 @@ class Compiler:
         self.explored: dict[tuple[Any, ...], Node] = {}
         self.reads: dict[int, tuple[str, ...]] = {}
         self.rule_atoms: dict[int, tuple[Atom, ...]] = {}
-        self.holding: dict[tuple[Atom, frozenset[Any]], bool] = {}
         self.restricting: dict[int, frozenset[str]] = {}
         self.truths: dict[tuple[Any, ...], int] = {}
         self.order = list(base.attributes)
@@ -743,16 +752,10 @@ class Compiler:
         states that differ only by it share one node."""
         if rule.kind != "when" or not all(isinstance(action, Restrict) for action in rule.actions):
             return False
-        return all(self.holds_for_all(action.atom, memory[action.atom.attribute])  # type: ignore[union-attr]
-                   for action in rule.actions)
-
-    def holds_for_all(self, atom: Atom, values: frozenset[Any]) -> bool:
-        """Whether `atom` holds for every value of `values` (cached: the same few sets recur)."""
-        key = (atom, values)
-        found = self.holding.get(key)
-        if found is None:
-            found = self.holding[key] = all(atom_holds(atom, v) for v in values)
-        return found
+        # Already restricted so: the atom holds for every value left (an attribute left with no
+        # value counts too: restricting it changes nothing).
+        return all(not memory[a.attribute] or atom_truth(a, memory[a.attribute]) == TRUE
+                   for a in (action.atom for action in rule.actions if isinstance(action, Restrict)))
 
     def atoms(self, rule: Rule) -> tuple[Atom, ...]:
         found = self.rule_atoms.get(id(rule))
@@ -761,18 +764,16 @@ class Compiler:
         return found
 
     def restricts(self, rule: Rule) -> frozenset[str]:
-        """The attributes a rule's actions restrict."""
         found = self.restricting.get(id(rule))
         if found is None:
-            found = self.restricting[id(rule)] = frozenset(
-                a.atom.attribute for a in rule.actions if isinstance(a, Restrict))
+            found = self.restricting[id(rule)] = targets(rule)
         return found
 
     def read(self, rule: Rule) -> tuple[str, ...]:
         """The attributes a rule's condition reads."""
         attributes = self.reads.get(id(rule))
         if attributes is None:
-            attributes = self.reads[id(rule)] = tuple(sorted({a.attribute for a in atoms(rule.condition)}))
+            attributes = self.reads[id(rule)] = tuple(sorted({a.attribute for a in self.atoms(rule)}))
         return attributes
 
     def truth(self, rule: Rule, memory: Mapping[str, frozenset[Any]]) -> int:
@@ -903,8 +904,7 @@ class Compiler:
         tests = [atom for rule in valid for atom in self.atoms(rule) if atom.attribute == chosen]
         classes: dict[tuple[bool, ...], list[Any]] = {}
         for value in self.ordered(chosen, memory[chosen]):
-            single = frozenset((value,))
-            classes.setdefault(tuple(self.holds_for_all(atom, single) for atom in tests), []).append(value)
+            classes.setdefault(tuple(atom_holds(atom, value) for atom in tests), []).append(value)
         child_of: dict[Any, Node] = {}
         for values in classes.values():
             child_memory = {**memory, chosen: frozenset(values)}
@@ -916,8 +916,7 @@ class Compiler:
         return self.wrap(procedural, self.intern(Test(chosen, branches)))
 
     def too_large(self) -> TooLarge:
-        bound, counts = paths_bound(self.base)
-        largest = " x ".join(f"{name} {count}" for name, count in counts[:6]) + (" x ..." if len(counts) > 6 else "")
+        bound, largest = paths_bound_text(self.base)
         name = self.base.name
         return TooLarge(f"rule base '{name}' needs more than {self.limit:,} decision-tree nodes to compile (its "
                         f"tests split on up to {bound:,} input combinations: {largest} values): split it into "
@@ -936,7 +935,9 @@ class Compiler:
              history: tuple[str, ...]) -> Node:
         inconsistent = tuple(sorted(n for n, v in memory.items() if not v))
         incomplete = tuple(o for o in self.base.outputs if len(memory[o]) > 1)
-        outputs = tuple((o, next(iter(memory[o]))) for o in self.base.outputs if len(memory[o]) == 1)
+        # Every output of the base compiled, None when undetermined: a part of a base compiled in
+        # parts lists its own outputs, the others being those it keeps as they were.
+        outputs = tuple((o, next(iter(memory[o])) if len(memory[o]) == 1 else None) for o in self.base.outputs)
         if inconsistent:
             self.findings.append(Finding("inconsistent", inconsistent, path, history))
         elif incomplete:
@@ -974,10 +975,10 @@ def compile_parts(base: Base, split: str, parts: Mapping[Any, tuple[Base, tuple[
                   limit: int | None = None) -> Compiled:
     """`base` compiled as one decision per value of its symbolic input `split`: `parts` gives, for
     each value, the sub-base deciding it (the rules that can apply with that value) and the
-    outputs it leaves as they were (they keep their previous-cycle
-    value, copied without a test). The root tests `split`; each decision grows with what that
-    value's rules read, not with the product of every attribute of the base. The work limit is
-    shared by the parts, and equal subgraphs of different parts are one node."""
+    outputs it leaves as they were (they keep their previous-cycle value, copied without a test).
+    The root tests `split`; each decision grows with what that value's rules read, not with the
+    product of every attribute of the base. The work limit is shared by the parts, and equal
+    subgraphs of different parts are one node."""
     attribute = base.attributes[split]
     if attribute.kind != "symbol" or OTHER in attribute.values or set(parts) != set(attribute.values):
         raise ValueError(f"compile_parts splits on a declared symbolic input, one part per value: not {split!r}")
@@ -1010,6 +1011,13 @@ def paths_bound(base: Base) -> tuple[int, list[tuple[str, int]]]:
                      if name in tested and (attribute.role in ("inputs", "previous") or name in assigned)),
                     key=lambda item: -item[1])
     return math.prod(count for _, count in counts), counts
+
+
+def paths_bound_text(base: Base, shown: int = 6) -> tuple[int, str]:
+    """`paths_bound` and its largest counts as a message says them ("x1 15 x x0 14 x ...")."""
+    bound, counts = paths_bound(base)
+    return bound, " x ".join(f"{name} {count}" for name, count in counts[:shown]) + (
+        " x ..." if len(counts) > shown else "")
 
 
 def depth(node: Node) -> int:

@@ -48,29 +48,6 @@ class DecisionView:
         for node in self.nodes.values():
             if isinstance(node, k.Leaf) and node not in self.leaves:
                 self.leaves[node] = f"_LEAF_{len(self.leaves)}"
-        self.undetermined = self.undetermined_outputs()
-
-    def undetermined_outputs(self) -> dict[k.Leaf, list[str]]:
-        """The outputs each leaf gives as None (undetermined). A base compiled in parts leaves out
-        the outputs a part keeps as they were (the decision copies them in): a leaf lists only the
-        outputs of the parts reaching it, so that a constant grows with its part, not the base."""
-        outputs = self.outputs
-        if self.compiled.split is None or not isinstance(self.compiled.root, k.Test):
-            return {leaf: [o for o in outputs if o not in dict(leaf.outputs)] for leaf in self.leaves}
-        found: dict[k.Leaf, set[str]] = {leaf: set() for leaf in self.leaves}
-        for value, part in self.compiled.root.branches:
-            decided = set(outputs) - set(self.compiled.kept[value])
-            seen: set[int] = set()
-            stack = [part]
-            while stack:
-                node = stack.pop()
-                if id(node) in seen:
-                    continue
-                seen.add(id(node))
-                if isinstance(node, k.Leaf):
-                    found[node] |= decided - {o for o, _ in node.outputs}
-                stack += children(node)
-        return {leaf: [o for o in outputs if o in names] for leaf, names in found.items()}
 
     @property
     def header(self) -> str:
@@ -106,9 +83,9 @@ class DecisionView:
     def leaf_constants(self) -> list[Code]:
         lines = []
         for leaf, name in self.leaves.items():
-            decided, undetermined = dict(leaf.outputs), self.undetermined[leaf]
-            outputs = {o: decided.get(o) for o in self.outputs if o in decided or o in undetermined}
-            shown = ", ".join(f"{o!r}: {literal(v)}" for o, v in outputs.items())
+            # Every output of the base (or of its part) the leaf was compiled from; a decision
+            # compiled in parts copies in the outputs its part keeps as they were.
+            shown = ", ".join(f"{o!r}: {literal(v)}" for o, v in leaf.outputs)
             lines.append(Code(f"{name} = Decision(MappingProxyType({{{shown}}}), {leaf.inconsistent!r}, "
                               f"{leaf.incomplete!r}, {leaf.impossible!r})"))
         return lines

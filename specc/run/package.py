@@ -57,7 +57,7 @@ def ensure_compiled(specs: Path, output: Path) -> Compiled:
     try:
         result = generate_all(loaded.program, robot)
     except KheopsError as exc:
-        raise RunError(f"{exc.node.span}: error: {exc} [{exc.code}]") from None
+        raise RunError(exc.headline()) from None
     folder = output / robot
     up_to_date = all(_reads(folder / relative) == text for relative, text in result.files.items())
     if not up_to_date:
