@@ -661,7 +661,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
                                                           "the mission's).")] = None,
         config: Annotated[Optional[str], typer.Option(help="FTplan's configuration for a planned mission: Robot1, "
                                                            "Robot2 (one planner), Robot1/2 (successive), Robot1/2c "
-                                                           "(concurrent); default: the ftplan block's own.")] = None,
+                                                           "(concurrent), any with -repair, -norepair or "
+                                                           "-noanalyzer; default: the ftplan block's own.")] = None,
         seed: Annotated[int, typer.Option(min=0, help="Draws the run's randomness: one seed, one event log.")] = 0,
         generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to (compiled "
                                                 "first when stale).")] = Path("generated"),
@@ -955,8 +956,10 @@ def campaign(
         runs: Annotated[int, typer.Option(min=1, help="Runs (seeds 0..N-1) of every activity.")] = 3,
         configs: Annotated[Optional[str], typer.Option(help="Comma-separated configurations; the first one judges "
                                                             "the mutants (add -noanalyzer to one for it without the "
-                                                            "plan analyzer). Default: Robot1 (the first planner "
-                                                            "alone), then every planner (Robot1/2...).")] = None,
+                                                            "plan analyzer, -repair or -norepair for every planner "
+                                                            "repairing its plans or none). Default: Robot1 (the "
+                                                            "first planner alone), then every planner "
+                                                            "(Robot1/2...).")] = None,
         domain: Annotated[Optional[str], typer.Option(help="The planning model faults are injected into (default: "
                                                            "the first planner's).")] = None,
         seed: Annotated[int, typer.Option(help="Draws the mutants.")] = 0,

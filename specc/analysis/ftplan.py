@@ -141,5 +141,5 @@ def ftplan_config(ftplan: m.FtPlan, program: m.Program | None = None) -> fc.FtPl
 def planner_config(planner: m.Planner) -> fc.PlannerConfig:
     return fc.PlannerConfig(planner.name, planner.domain.text if planner.domain is not None else "",
                             planner.heuristic.text if planner.heuristic is not None else None,
-                            controllability=planner.controllability or "strong",
+                            controllability=planner.controllability or "strong", repair=planner.repair == "on",
                             view=tuple(correspondence(c) for c in planner.view))

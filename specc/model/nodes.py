@@ -845,6 +845,8 @@ class Planner(Node):
     heuristic: Ref | None = prop("heuristic", "ref", doc="flaw/resolver ordering heuristic")
     controllability: str | None = prop("controllability", "symbol", choices=("strong", "pseudo"),
                                        doc="what plans must hold against nature (specc.runtime.planner.search)")
+    repair: str | None = prop("repair", "symbol", choices=("on", "off"),
+                              doc="repair its plan after an action failure before FTplan recovers (IxTeT's)")
     doc: String | None = prop("doc", "string")
     view: tuple[Correspondence, ...] = ()
 

@@ -13,7 +13,9 @@ A robot's extension measures one run from its log (its `measure(events)` returns
   invalid plan and was recovered from is counted apart (`planner_failures`);
 - R, the replannings: planning rounds after the first (with FTplan, model switches too). A round
   is one request in successive planning (Fig 3.1 line 9), one request to every planner at once in
-  concurrent planning (Fig 3.2 line 5);
+  concurrent planning (Fig 3.2 line 5). A plan repair (`repair: on` planners, IxTeT's) is not one,
+  as the thesis counts R (§4.2.1.2: R-bar 0.3 for Robot1 with repair, 8.3 for Robot1* without):
+  `repairs` and `repaired` count them apart;
 - T, the physical activity time: how long at least one action ran (the planner's time is not
   counted, nor waiting for a window);
 - D, the distance the robot travelled.
@@ -84,6 +86,8 @@ class Measures:
     mission_time: float  # s, when the mission ended
     planner_failures: int  # FTplan's detections: watchdog, crash, no plan, invalid plan
     believed: GoalCount  # every goal, as FTplan's ledger counted them
+    repairs: int = 0  # plan repairs asked after an action failure (not replannings: seed 004 §4.2.1.2)
+    repaired: int = 0  # of them, those whose plan was carried out
 
     def count(self, kind: str) -> GoalCount:
         """The goals of `kind` (none asked when the run had none)."""
@@ -131,7 +135,8 @@ class Measures:
                        world=str(data["world"]), seed=int(data["seed"]), goals=goals, kappa=int(data["kappa"]),
                        replannings=int(data["replannings"]), activity_time=float(data["activity_time"]),
                        distance=float(data["distance"]), mission_time=float(data["mission_time"]),
-                       planner_failures=int(data["planner_failures"]), believed=believed)
+                       planner_failures=int(data["planner_failures"]), believed=believed,
+                       repairs=int(data.get("repairs", 0)), repaired=int(data.get("repaired", 0)))
         except (KeyError, TypeError, ValueError, AttributeError) as error:
             raise RunError(f"not the measures of seed 004 §4.1.4 ({type(error).__name__}: {error})") from None
 
@@ -144,7 +149,8 @@ class Measures:
             f"(nu = {self.nu}, mu = {self.mu})",
             f"  goals met: {counts}",
             f"  planner failure kappa = {self.kappa} ({self.planner_failures} failure(s) detected), "
-            f"replannings R = {self.replannings}",
+            f"replannings R = {self.replannings}"
+            + (f", plan repairs {self.repairs} ({self.repaired} carried out)" if self.repairs else ""),
             f"  physical activity T = {self.activity_time:.1f} s of {self.mission_time:.1f} s, "
             f"distance D = {self.distance:.1f} m",
             f"  FTplan counted {self.believed.text()} goals met",
@@ -208,7 +214,8 @@ def planned_measures(events: Sequence[Mapping[str, Any]], judge: Judgement = bel
         replannings=int(figures.get("replannings", 0)), activity_time=activity_time(events),
         distance=float(figures.get("distance", 0.0)), mission_time=float(figures["t"]),
         planner_failures=int(figures.get("planner_failures", 0)),
-        believed=GoalCount(len(goals), sum(g.believed for g in goals)))
+        believed=GoalCount(len(goals), sum(g.believed for g in goals)),
+        repairs=int(figures.get("repairs", 0)), repaired=int(figures.get("repaired", 0)))
 
 
 def _rank(kind: str, kinds: Sequence[str]) -> int:

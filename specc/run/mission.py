@@ -371,6 +371,7 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
                            # mission-start's planned_goals, each as FTplan's ledger judged it at the end
                            "planned_goals_met_each": [g.text() in met for g in goals_planned],
                            "plannings": result.plannings, "replannings": result.replannings,
+                           "repairs": result.repairs, "repaired": result.repaired,
                            "planner_failures": result.planner_failures,
                            # the mission exception: no plan in time (not the horizon stopping the run)
                            "planning_failure": "" if stopped else result.failure}

@@ -48,7 +48,7 @@ from specc.runtime.ftplan.planners import Answer, Watchdog
 from specc.runtime.ftplan.state import SystemState, fact_list
 from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.plan import Plan, format_value
+from specc.runtime.planner.plan import Plan, Repair, format_value
 from specc.runtime.planner.replan import replanning_problem
 
 MISSION_FAILED_IN_TIME = "mission failure: no valid plan found in time"  # Fig 3.1 line 24, Fig 3.2 line 24
@@ -67,8 +67,9 @@ class PlannerPool(Protocol):
 
     names: tuple[str, ...]
 
-    def request(self, name: str, problem: pm.Problem, now: float) -> None:
-        """Send a planning request (envoyer(demande_plan) à k); returns at once."""
+    def request(self, name: str, problem: pm.Problem, now: float, repair: Repair | None = None) -> None:
+        """Send a planning request (envoyer(demande_plan) à k); returns at once. With `repair`, a
+        request to repair the plan under way (`Planner.repair`)."""
         ...
 
     def next_answer(self, names: Collection[str], wall_timeout: float) -> Answer | None:
@@ -142,11 +143,13 @@ class MissionResult:
     missed: dict[str, str]  # goal -> why
     failure: str  # the mission exception's message, "" when none was raised
     now: float  # mission time at the end
-    plannings: int  # planning requests sent
+    plannings: int  # planning requests sent (repairs apart)
     rounds: int  # planning rounds: a request (Fig 3.1 line 9), or one to every planner at once (Fig 3.2 line 5)
     planner_failures: int  # watchdog expiries, crashes, plan-less answers, invalid plans
     events: list[Event]
     trace: list[tuple[int, str]]  # (line of Fig 3.1 / 3.2, what happened)
+    repairs: int = 0  # plan repairs asked after an action failure (`repair: on` planners)
+    repaired: int = 0  # of them, those that gave a plan carried out
 
     @property
     def replannings(self) -> int:
@@ -199,6 +202,8 @@ class FtPlan:
         self.plannings = 0
         self.rounds = 0
         self.planner_failures = 0
+        self.repairs = 0
+        self.repaired = 0
 
     # ------------------------------------------------------------ entry point
     def run(self) -> MissionResult:
@@ -224,7 +229,7 @@ class FtPlan:
             missed={by_line[line]: why for line, why in sorted(self.state.missed.items())},
             failure=failure, now=self.now, plannings=self.plannings, rounds=self.rounds,
             planner_failures=self.planner_failures,
-            events=self.events, trace=self.trace)
+            events=self.events, trace=self.trace, repairs=self.repairs, repaired=self.repaired)
 
     # ------------------------------------------------------------ Fig 3.1
     def successive(self) -> None:
@@ -469,31 +474,79 @@ class FtPlan:
     def execute(self, k: str, plan: Plan) -> str:
         """k.executer(plan): blocking; FTplan's state follows the reports, the goals are checked
         after each. `failed` (an action failed), `met` (it ended and met some goal) or
-        `idle` (it ended, meeting none)."""
+        `idle` (it ended, meeting none). A planner with `repair: on` repairs its plan after an
+        action failure, and the repaired plan is carried out in its stead (`repair`): FTplan's
+        recovery starts only when the repair fails, as IxTeT-eXeC tells FTplan of a failure only
+        after its own repair failed (seed 004 §3.2.2.3)."""
         met_before = len(self.state.met)
         self.log("execute", f"{k}'s plan of {len(plan.actions)} actions starts", k)
+        ended: set[str] = set()  # ids of the current plan's actions that ended
 
         def report(r: Report) -> None:
             self.state.report(self.config.state_rules, r.kind, r.name, r.args, self.views.get(k))
             self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
                      + (f": {r.why}" if r.why else ""), k, r.time)
+            if r.kind == "ended":
+                ended.add(r.action)
             # After every report that may change a fact (a failure too): a goal is met when it
             # comes true, by its deadline (`SystemState.check_goals`).
             for goal in self.state.check_goals(r.time):
                 self.log("goal-met", goal.text(), k, r.time)
 
-        outcome: Execution = self.executor.execute(plan, self.now, report)
-        self.now = outcome.now
-        if not outcome.completed:
+        while True:
+            outcome: Execution = self.executor.execute(plan, self.now, report)
+            self.now = outcome.now
+            if outcome.completed:
+                break
             self.log("action-failed", f"{outcome.why} (action {outcome.failed_action})", k)
             self.now = self.executor.safe_state(self.now)
             self.log("safe-state", "running activities stopped before recovery", k)
-            return "failed"
+            repaired = self.repair(k, plan, ended, outcome.failed_action)
+            if repaired is None:
+                return "failed"
+            plan = repaired
+            ended = set()
+            self.log("execute", f"{k}'s repaired plan of {len(plan.actions)} actions starts", k)
         self.state.check_goals(self.now)
         left = ", ".join(g.text() for g in self.state.pending())
         if left:
             self.log("goals-open", f"{k}'s plan ended with goals open: {left}", k)
         return "met" if len(self.state.met) > met_before else "idle"
+
+    def repair(self, k: str, plan: Plan, ended: Collection[str], failed: str) -> Plan | None:
+        """Plan repair (seed 004 §3.2.1, IxTeT-eXeC's): k, if its block says `repair: on`, is sent
+        the present (the replanning problem FTplan would send) and its plan's actions still to
+        carry out, the failed one left out; it keeps what still fits and plans only what the
+        failure broke. The repaired plan, once the analyzer accepts it, is carried out; None (a
+        repair refused, found wanting, late or invalid) leaves the recovery to the policy.
+
+        A repair is charged to mission time as a planning is, and judged by the same watchdog; it
+        is neither a replanning nor a planning round (seed 004 §4.2.1.2 counts R without them).
+        One departure: the system is brought to a safe state first, as for a replanning, where
+        IxTeT-eXeC kept the rest of the plan running while it repaired."""
+        if not next((p.repair for p in self.config.planners if p.name == k), False):
+            return None
+        kept = tuple(a.id for a in plan.ordered() if a.id not in ended and a.id != failed)
+        self.repairs += 1
+        self.log("repair-request", f"{k} asked to repair its plan at {self.now:g} s ({len(kept)} action(s) still "
+                 "to carry out)", k)
+        self.pool.request(k, self.planning_problem(k, False), self.now, Repair(plan, kept))
+        arrivals = self.arrivals([k])
+        answer = next(arrivals, None)
+        arrivals.close()
+        self.now += self.config.watchdog if answer is None else self.charge(answer)
+        if answer is None:
+            return None  # the watchdog judged it (`arrivals`)
+        if answer.result is not None and answer.result.plan is None:
+            self.log("repair-failed", f"{k}: {answer.result.reason}", k)
+            return None
+        repaired = self.plan_of(answer)
+        if repaired is None or self.analyse(k, repaired):
+            return None
+        self.repaired += 1
+        said = answer.result.notes if answer.result is not None else ()
+        self.log("repaired", f"{k}: {'; '.join(n for n in said if n.startswith('repaired')) or 'plan repaired'}", k)
+        return repaired
 
     def give_up(self, why: str) -> None:
         for goal in self.state.open_goals():

@@ -5,7 +5,7 @@ as data in the generated package; the runtime reads nothing else."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
 from specc.runtime.planner.model import Interval as Interval  # re-exported: the generated modules name it here
@@ -65,6 +65,8 @@ class PlannerConfig:
     # Partial plans a planning may expand before it gives up (None: no limit); FTplan sets it
     # (component.planners_as_run), the spec does not.
     node_limit: int | None = None
+    # IxTeT's plan repair after an action failure, before FTplan's recovery (`repair: on`).
+    repair: bool = False
 
 
 @dataclass(frozen=True)
@@ -171,17 +173,33 @@ class FtPlanConfig:
 
 
 WITHOUT_ANALYZER = "-noanalyzer"  # a configuration's name with this suffix: the same, plan analyzer off
+WITH_REPAIR = "-repair"  # ... every planner repairing its plans after an action failure (IxTeT's)
+WITHOUT_REPAIR = "-norepair"  # ... no planner repairing (seed 004 §4.2.1.2's Robot1*, Robot1/1*)
+VARIANTS: dict[str, Callable[[FtPlanConfig], FtPlanConfig]] = {
+    WITHOUT_ANALYZER: lambda c: replace(c, analyzer=()),
+    WITH_REPAIR: lambda c: replace(c, planners=tuple(replace(p, repair=True) for p in c.planners)),
+    WITHOUT_REPAIR: lambda c: replace(c, planners=tuple(replace(p, repair=False) for p in c.planners)),
+}
+VARIANTS_HELP = (f"add {WITHOUT_ANALYZER} to one for it without the plan analyzer, {WITH_REPAIR} or "
+                 f"{WITHOUT_REPAIR} for every planner repairing its plans or none")
 
 
 def configuration_named(configurations: Mapping[str, FtPlanConfig], name: str) -> FtPlanConfig:
-    """The configuration `name` of `configurations`; `<name>-noanalyzer` is it without the plan
-    analyzer (the thesis' own FTplan, which never had one). KeyError when unknown."""
-    if name in configurations:
-        return configurations[name]
-    base = name.removesuffix(WITHOUT_ANALYZER)
-    if base != name and base in configurations:
-        return replace(configurations[base], analyzer=())
-    raise KeyError(name)
+    """The configuration `name` of `configurations`, or one of them with variant suffixes
+    (VARIANTS, in any order): `<name>-noanalyzer` is it without the plan analyzer (the thesis'
+    own FTplan, which never had one), `<name>-repair` / `<name>-norepair` with every planner
+    repairing its plans after an action failure or none. KeyError when unknown."""
+    base, applied = name, []
+    while base not in configurations:
+        suffix = next((v for v in VARIANTS if base.endswith(v)), None)
+        if suffix is None:
+            raise KeyError(name)
+        base = base.removesuffix(suffix)
+        applied.append(suffix)
+    config = configurations[base]
+    for suffix in reversed(applied):
+        config = VARIANTS[suffix](config)
+    return config
 
 
 def configurations(config: FtPlanConfig) -> dict[str, FtPlanConfig]:

@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import ModuleType
 
-from specc.runtime.ftplan.config import WITHOUT_ANALYZER, FtPlanConfig, configuration_named
+from specc.runtime.ftplan.config import VARIANTS_HELP, FtPlanConfig, configuration_named
 from specc.runtime.planner import model as pm
 
 
@@ -41,7 +41,7 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
         base = configuration_named(configurations, configuration)
     except KeyError:
         raise UnknownName(f"no robot configuration '{configuration}' (known: {', '.join(configurations)}; "
-                          f"add {WITHOUT_ANALYZER} to one for it without the plan analyzer)") from None
+                          f"{VARIANTS_HELP})") from None
     try:
         config = base.for_mission(mission)
         statement = base.mission(mission)

@@ -76,6 +76,7 @@ from typing import Final, Literal, Protocol
 from specc.runtime.ftplan.config import HEURISTICS, PlannerConfig
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import Repair
 from specc.runtime.planner.planner import STANDARD
 
 START_METHOD: Final = "forkserver"
@@ -206,6 +207,7 @@ class _Request:
     id: int
     problem: pm.Problem
     now: float
+    repair: Repair | None = None  # a repair request: the plan and its actions still to carry out
 
 
 @dataclass(frozen=True)
@@ -261,6 +263,19 @@ class Answer:
     @property
     def failed(self) -> bool:
         return self.status != "answered"
+
+
+def answer_request(planner: SupportsPlan, problem: pm.Problem, now: float,
+                   repair: Repair | None) -> PlanResult:
+    """A planning request's answer; with `repair`, a repair request's, which a planner without
+    a `repair` method (a factory's own) refuses with a result that says so."""
+    if repair is None:
+        return planner.plan(problem, now)
+    repairing = getattr(planner, "repair", None)
+    if repairing is None:
+        return PlanResult(None, reason=f"{type(planner).__name__} does not repair plans (it has no `repair` method)")
+    result: PlanResult = repairing(problem, now, repair)
+    return result
 
 
 def _exit_description(exitcode: int | None) -> str:
@@ -329,7 +344,7 @@ def _serve(connection: Connection) -> None:
         try:
             if planner is None:
                 raise PlannerStartError(startup_error)
-            result = planner.plan(request.problem, request.now)
+            result = answer_request(planner, request.problem, request.now, request.repair)
             if not isinstance(result, PlanResult):
                 raise TypeError(f"the planner returned a {type(result).__name__}, not a PlanResult")
             reply = _Reply(request.id, result, "", "", time.perf_counter() - started)
@@ -481,13 +496,14 @@ class PlannerProcess:
         self.close()
 
     # ------------------------------------------------------------ planning
-    def request(self, problem: pm.Problem, now: float = 0.0) -> int:
-        """Send a planning request and return its id, without waiting for the answer."""
+    def request(self, problem: pm.Problem, now: float = 0.0, repair: Repair | None = None) -> int:
+        """Send a planning request (with `repair`, a repair request) and return its id, without
+        waiting for the answer."""
         _, connection = self._require_started()
         if self._pending is not None:
             raise RuntimeError(f"planner '{self.name}' is still planning request {self._pending.id}: "
                                f"poll() its answer or abandon() it first")
-        request = _Request(next(self._ids), problem, now)
+        request = _Request(next(self._ids), problem, now, repair)
         self._pending, self._sent_at = request, time.perf_counter()
         try:
             connection.send(request)

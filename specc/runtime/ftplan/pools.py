@@ -16,8 +16,16 @@ from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 
 from specc.runtime.ftplan.config import PlannerConfig
-from specc.runtime.ftplan.planners import Answer, PlannerProcess, PlannerStartError, SupportsPlan, first_answer
+from specc.runtime.ftplan.planners import (
+    Answer,
+    PlannerProcess,
+    PlannerStartError,
+    SupportsPlan,
+    answer_request,
+    first_answer,
+)
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.plan import Repair
 
 READY_TIMEOUT = 60.0  # wall seconds a planner may take to start
 
@@ -37,8 +45,8 @@ class ProcessPool:
             with contextlib.suppress(PlannerStartError, TimeoutError):
                 process.wait_ready(ready_timeout)
 
-    def request(self, name: str, problem: pm.Problem, now: float) -> None:
-        self.processes[name].request(problem, now)
+    def request(self, name: str, problem: pm.Problem, now: float, repair: Repair | None = None) -> None:
+        self.processes[name].request(problem, now, repair)
 
     def next_answer(self, names: Collection[str], wall_timeout: float) -> Answer | None:
         waiting = [self.processes[n] for n in names if self.processes[n].busy]
@@ -73,11 +81,11 @@ class LocalPool:
         self._answers: dict[str, Answer] = {}
         self._requests = 0
 
-    def request(self, name: str, problem: pm.Problem, now: float) -> None:
+    def request(self, name: str, problem: pm.Problem, now: float, repair: Repair | None = None) -> None:
         self._requests += 1
         started = time.perf_counter()
         try:
-            result = self.planners[name].plan(problem, now)
+            result = answer_request(self.planners[name], problem, now, repair)
         except Exception as error:  # a planner's fault is an answer, as in its own process
             self._answers[name] = Answer(name, self._requests, "raised", None, time.perf_counter() - started,
                                          error=f"{type(error).__name__}: {error}",

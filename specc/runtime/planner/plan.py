@@ -65,6 +65,7 @@ class Plan:
     controllability: str = "strong"
     now: float = 0.0  # mission time the plan was made for (a replanning starts later)
     assumed: dict[str, float] = field(default_factory=dict)
+    goals: tuple[int, ...] = ()  # source lines of the problem's goals the plan meets
 
     def ends_by(self, action: Action) -> float:
         """The latest date the action may end, whatever nature does."""
@@ -76,6 +77,25 @@ class Plan:
 
     def ordered(self) -> list[Action]:
         return sorted(self.actions, key=lambda a: (a.dispatch, a.id))
+
+
+@dataclass(frozen=True)
+class Repair:
+    """What a planner is asked to repair (seed 004 §3.2.1): its `plan` under way, and the ids of
+    the actions `kept`, still to carry out (the failed one and those that ended are not)."""
+
+    plan: Plan
+    kept: tuple[str, ...]
+
+    @property
+    def actions(self) -> tuple[Action, ...]:
+        return tuple(a for a in self.plan.ordered() if a.id in self.kept)
+
+    @property
+    def orderings(self) -> tuple[tuple[str, str, float], ...]:
+        """The plan's precedences between two of the kept actions."""
+        points = {p for a in self.actions for p in (a.start, a.end)}
+        return tuple(o for o in self.plan.orderings if o[0] in points and o[1] in points)
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.numeric import domain_of, exact_duration
-from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult
+from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult, Repair
 from specc.runtime.planner.search import (
     CONTROLLABILITIES,
     EPS,
@@ -174,8 +174,47 @@ class Planner:
             outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, True)
         assert best.node is not None
         plan, notes = setup.extract(best.node, self.exact)
+        plan = replace(plan, goals=tuple(g.hold.line for g in kept))
         ordered = tuple(outcomes[g.index] for g in goals)
         return PlanResult(plan, ordered, nodes=total, seconds=time.perf_counter() - started, notes=notes)
+
+
+    # ------------------------------------------------------------ plan repair
+    def repair(self, problem: pm.Problem, now: float, repair: Repair) -> PlanResult:
+        """IxTeT's plan repair (seed 004 §3.2.1, after Lemai-Chenevier 2004: "il essaie de réparer
+        le plan en ne replanifiant que les objectifs ou les contraintes mis en échec"). The plan
+        under way failed; `problem` is the replanning problem of the present (its facts, the goals
+        still open, `now`) and `repair` the plan with its actions still to carry out. The search starts
+        from those actions, each put back with its arguments (one that no longer fits the present is
+        left out, as IxTeT backtracks over the actions that became impossible), and resolves only
+        the flaws the failure left: the conditions a failed action no longer gives, the present's
+        facts, the threats and conflicts they bring; the kept actions keep the order and the causal
+        links the plan gave them. A repair meets every goal the plan met that is still open; when
+        none is found within the planner's budget, the result has no plan and the caller replans
+        from scratch (FTplan, `component.FtPlan.execute`)."""
+        started = time.perf_counter()
+        try:
+            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic)
+        except PlanningInputError as error:
+            return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
+        # The goals the plan met (all, when it does not say): one it left aside stays so.
+        active = [g for g in setup.goals if g.hold.line in repair.plan.goals or not repair.plan.goals]
+        aside = "left aside by the plan repaired"
+        attempt = setup.search(active, self.nodes, True, self.node_limit, repair)
+        if attempt.node is None:
+            why = f"no repair of the plan: {explain(attempt)}"
+            dropped = tuple(GoalOutcome(g.text, g.priority, g.hold.line, False, why if g in active else aside)
+                            for g in setup.goals)
+            return PlanResult(None, dropped, reason=why, nodes=attempt.nodes, seconds=time.perf_counter() - started)
+        plan, notes = setup.extract(attempt.node, self.exact)
+        plan = replace(plan, goals=tuple(g.hold.line for g in active))
+        still = sum(1 for a in plan.actions if a.id in setup.kept_ids)
+        note = (f"repaired: {still} of the {len(repair.kept)} action(s) still to carry out kept, "
+                f"{len(plan.actions) - still} inserted")
+        outcomes = tuple(GoalOutcome(g.text, g.priority, g.hold.line, g in active, "" if g in active else aside)
+                         for g in setup.goals)
+        return PlanResult(plan, outcomes, nodes=attempt.nodes, seconds=time.perf_counter() - started,
+                          notes=(*notes, note))
 
 
 def explain(attempt: Attempt) -> str:
@@ -293,10 +332,58 @@ class Setup:
         goal_indexes = {g.index for g in self.goals}
         self.owned = {point: owners for point, owners in used_by.items()
                       if owners <= goal_indexes and point not in (self.origin, problem.end)}
+        self.kept_ids: set[str] = set()  # a repair's instances put back from the plan it repairs
         self.context = Context(problem.end, self.origin, now, limits, {r.name: r.capacity for r in domain.resources},
                                producers_of(domain), self.nature_before, controllability)
 
-    def root(self, active: list[Goal]) -> Node:
+    def root(self, active: list[Goal], repair: Repair | None = None) -> Node:
+        node = self.problem_root(active)
+        if repair is None:
+            return node
+        # A repair's actions still to carry out, each with the arguments it had; an action that
+        # no longer fits (its arguments, duration or window refused by the present) is left out,
+        # and so is an order between two of them that no longer can hold.
+        points: dict[str, str] = {}  # the repaired plan's timepoints -> the new instances'
+        for action in repair.actions:
+            task = self.domain.task(action.task)
+            if task is None:
+                continue
+            trial = node.copy()
+            try:
+                instance = trial.insert(task)
+                changed: list[str] = []
+                for local, value in zip(task.params, action.args, strict=True):
+                    changed += trial.bindings.unify(instance.var(local), value)
+                trial.bound(changed)
+            except DeadEnd:
+                continue
+            self.kept_ids.add(instance.id)
+            points |= {action.start: instance.start, action.end: instance.end}
+            node = trial
+        for first, second, low in repair.orderings:
+            if first in points and second in points and node.allows(points[first], points[second], low):
+                node.require(points[first], points[second], low)
+        # The causal links between two kept actions hold again: only the needs the failure (or the
+        # present's facts) left without a producer are open. Links are read back by their
+        # descriptions (`_where`), which the same assertion of the same action gives again.
+        renamed = {action.id: new_id for action in repair.actions
+                   if (new_id := points.get(action.start, "").rsplit(".", 1)[0])}
+        renamed["problem"] = "problem"  # its goals, and the facts that still hold
+        described = {f"{old}: {a.text(node.bindings)}": a for old, new in renamed.items()
+                     for a in node.assertions if a.owner == new}
+        for link in repair.plan.links:
+            producer, consumer = described.get(link.producer), described.get(link.consumer)
+            if producer is None or consumer is None or consumer.id not in node.open:
+                continue
+            trial = node.copy()
+            try:
+                trial.link(trial.assertions[producer.id], trial.assertions[consumer.id])
+            except DeadEnd:
+                continue
+            node = trial
+        return node
+
+    def problem_root(self, active: list[Goal]) -> Node:
         node = Node(self.context)
         problem = self.problem
         active_indexes = {g.index for g in active}
@@ -329,12 +416,13 @@ class Setup:
 
     # ------------------------------------------------------------ search
     def search(self, active: list[Goal], budget: int, discrepancies: bool = True,
-               allowance: int | None = None) -> Attempt:
+               allowance: int | None = None, repair: Repair | None = None) -> Attempt:
         """A plan for the `active` goals within `budget` partial plans, or none; the search stops
-        as soon as it has expanded more than `allowance` (the planning's node limit)."""
+        as soon as it has expanded more than `allowance` (the planning's node limit). A repair
+        starts from the actions of the plan it repairs."""
         failures: Counter[str] = Counter()
         try:
-            root = self.root(active)
+            root = self.root(active, repair)
         except DeadEnd as error:
             failures[_generic(str(error))] += 1
             return Attempt(None, 1, True, failures)
