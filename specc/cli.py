@@ -473,7 +473,10 @@ def plan(paths: PathsArg,
                                                   "enclosures and the temporal network alone).")] = True,
          controllability: Annotated[Controllability, typer.Option(
              help="strong: the plan holds whatever nature does; pseudo (IxTeT's): the problem's contingent "
-                  "instants one at a time, each anywhere in its bounds.")] = Controllability.strong) -> None:
+                  "instants one at a time, each anywhere in its bounds.")] = Controllability.strong,
+         improve: Annotated[int, typer.Option(min=0, help="Partial plans spent improving the first plan (goals "
+                                                          "it dropped, then its worst-case makespan); 0: the "
+                                                          "first plan.")] = 300) -> None:
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
     checked by the independent validator.
 
@@ -486,7 +489,7 @@ def plan(paths: PathsArg,
     assert loaded.program is not None
     try:
         outcome = solve(loaded.program, problem, domain, horizon, now, fact or [], goal, nodes, exact,
-                        controllability.value)
+                        controllability.value, improve)
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None

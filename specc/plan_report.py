@@ -51,7 +51,7 @@ def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Probl
 
 def solve(program: m.Program, name: str, domain_name: str | None, horizon: float | None, now: float,
           facts: list[str], goals: list[int] | None, nodes: int, exact: bool,
-          controllability: str = "strong") -> Outcome:
+          controllability: str = "strong", improve: int = 0) -> Outcome:
     chosen = choose_problem(program, name, domain_name)
     model = domain_model(program, domain_block(program, chosen))
     problem = problem_model(program, chosen)
@@ -66,8 +66,8 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
             raise ValueError(f"no goal on line(s) {', '.join(map(str, unknown))} of {problem.source} "
                              f"(goal lines: {', '.join(map(str, sorted(lines)))})")
         problem = replanning_problem(problem, [Fact.parse(f) for f in facts], lines if goals is None else goals, now)
-    result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability).plan(
-        problem, now=now)
+    result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability,
+                     improve=improve).plan(problem, now=now)
     violations = []
     if result.plan is not None:
         violations = validate(model, problem, result.plan, dropped_lines={g.line for g in result.dropped})

@@ -142,4 +142,5 @@ def planner_config(planner: m.Planner) -> fc.PlannerConfig:
     return fc.PlannerConfig(planner.name, planner.domain.text if planner.domain is not None else "",
                             planner.heuristic.text if planner.heuristic is not None else None,
                             controllability=planner.controllability or "strong", repair=planner.repair == "on",
+                            improve=int(planner.improve.value) if planner.improve is not None else 0,
                             view=tuple(correspondence(c) for c in planner.view))

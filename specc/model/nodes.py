@@ -847,6 +847,7 @@ class Planner(Node):
                                        doc="what plans must hold against nature (specc.runtime.planner.search)")
     repair: str | None = prop("repair", "symbol", choices=("on", "off"),
                               doc="repair its plan after an action failure before FTplan recovers (IxTeT's)")
+    improve: Number | None = prop("improve", "int", doc="partial plans spent improving each first plan (anytime)")
     doc: String | None = prop("doc", "string")
     view: tuple[Correspondence, ...] = ()
 

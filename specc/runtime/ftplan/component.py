@@ -451,7 +451,9 @@ class FtPlan:
             self.planner_failed(k, f"{k} found no plan: {result.reason}")
             return None
         dropped = "; ".join(f"{g.description}: {g.reason}" for g in result.dropped)
-        self.log("plan", f"{k}: {len(result.plan.actions)} actions" + (f", dropped {dropped}" if dropped else ""), k)
+        improved = "".join(f"; {note}" for note in result.notes if note.startswith("improvement"))
+        self.log("plan", f"{k}: {len(result.plan.actions)} actions" + (f", dropped {dropped}" if dropped else "")
+                 + improved, k)
         return result.plan
 
     def planner_failed(self, k: str, why: str, at: float | None = None) -> None:

@@ -67,6 +67,9 @@ class PlannerConfig:
     node_limit: int | None = None
     # IxTeT's plan repair after an action failure, before FTplan's recovery (`repair: on`).
     repair: bool = False
+    # Partial plans spent improving each first plan (`improve: N`, anytime); under the cost model
+    # the node limit caps them, so an improving planner is never late for it.
+    improve: int = 0
 
 
 @dataclass(frozen=True)

@@ -113,7 +113,7 @@ def standard_planner(config: PlannerConfig, domains: Mapping[str, pm.PlanningDom
         raise ValueError(f"planner '{config.name}': no planning domain '{config.domain}' "
                          f"(given: {', '.join(sorted(domains)) or 'none'})")
     return Planner(domains[config.domain], controllability=config.controllability, node_limit=config.node_limit,
-                   heuristic=config.heuristic or STANDARD)
+                   heuristic=config.heuristic or STANDARD, improve=config.improve)
 
 
 def planning_domains(generated: Mapping[str, ModuleType]) -> dict[str, pm.PlanningDomain]:

@@ -43,6 +43,7 @@ from specc.runtime.planner.search import (
 from specc.runtime.stn import STN, Inconsistent
 
 INF = math.inf
+IMPROVEMENT = 0.5  # s: a plan must end this much earlier to count as better (not a rounding's worth)
 
 
 class NodeLimitReached(Exception):
@@ -94,7 +95,7 @@ HEURISTICS = (STANDARD, LEAST_ROOM)
 class Planner:
     def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
                  exact: bool = True, limits: Limits | None = None, controllability: str = STRONG,
-                 node_limit: int | None = None, heuristic: str = STANDARD) -> None:
+                 node_limit: int | None = None, heuristic: str = STANDARD, improve: int = 0) -> None:
         if controllability not in CONTROLLABILITIES:
             raise ValueError(f"controllability '{controllability}': choose {' or '.join(CONTROLLABILITIES)}")
         if heuristic not in HEURISTICS:
@@ -110,6 +111,8 @@ class Planner:
         # its watchdog pays for, so that a planning stops where its answer would be late anyway,
         # at the same count on any machine. Below it, the search is the same as without.
         self.node_limit = node_limit
+        # Partial plans spent improving the first plan (anytime, `_improve`); 0: the first plan.
+        self.improve = improve
 
     # ------------------------------------------------------------ entry point
     def plan(self, problem: pm.Problem, now: float = 0.0) -> PlanResult:
@@ -170,13 +173,52 @@ class Planner:
                     outcomes[goal.index] = GoalOutcome(
                         goal.text, goal.priority, goal.hold.line, False,
                         f"cannot be met together with the goals kept before it ({higher}): {explain(tried)}")
-        for goal in kept:
-            outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, True)
         assert best.node is not None
         plan, notes = setup.extract(best.node, self.exact)
+        if self.improve:
+            budget = self.improve if self.node_limit is None else min(self.improve, self.node_limit - total)
+            plan, notes, kept, spent = self._improve(setup, best.node, plan, notes, kept, candidates, budget)
+            total += spent
+        for goal in kept:
+            outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, True)
         plan = replace(plan, goals=tuple(g.hold.line for g in kept))
         ordered = tuple(outcomes[g.index] for g in goals)
         return PlanResult(plan, ordered, nodes=total, seconds=time.perf_counter() - started, notes=notes)
+
+    def _improve(self, setup: Setup, node: Node, plan: Plan, notes: tuple[str, ...], kept: list[Goal],
+                 candidates: list[Goal], budget: int) -> tuple[Plan, tuple[str, ...], list[Goal], int]:
+        """Anytime improvement of a first plan within `budget` partial plans (#25: the time the
+        watchdog leaves, under FTplan's cost model): first the goals it dropped that are not
+        impossible alone, highest priority first, each tried again with the budget left (more
+        priority-weighted goals kept is the better plan); then the worst-case makespan, by branch
+        and bound (`Setup.improve`). A plan replaces the first only when it keeps every goal it
+        kept and ends earlier at worst (`Plan.makespan`, the measure the plans are compared by),
+        so the result is never worse. Returns the plan, its notes, the goals kept and the partial
+        plans spent."""
+        spent = 0
+        gained: list[str] = []
+        for goal in sorted((g for g in candidates if g not in kept), key=lambda g: (-g.priority, g.index)):
+            if spent >= budget:
+                break
+            tried = setup.search(kept + [goal], budget - spent)
+            spent += tried.nodes
+            if tried.node is not None:
+                kept, node = kept + [goal], tried.node
+                plan, notes = setup.extract(node, self.exact)
+                gained.append(goal.text)
+        first = plan.makespan
+        found, used = setup.improve(kept, node.worst_end(), budget - spent) if spent < budget else ([], 0)
+        spent += used
+        for better in reversed(found):  # the best by the search's measure first
+            candidate, candidate_notes = setup.extract(better, self.exact)
+            if candidate.makespan < plan.makespan - 1e-6:
+                plan, notes = candidate, candidate_notes
+                break
+        said = ([f"goal(s) kept by the improvement: {'; '.join(gained)}"] if gained else []) + (
+            [f"worst-case makespan improved from {first:.1f} s to {plan.makespan:.1f} s"]
+            if plan.makespan < first - 1e-6 else [])
+        note = f"improvement: {spent} partial plan(s); " + ("; ".join(said) or "no better plan found")
+        return plan, (*notes, note), kept, spent
 
 
     # ------------------------------------------------------------ plan repair
@@ -470,6 +512,52 @@ class Setup:
                     stack.append((node, choice[rank], cost))  # a pass revisits the last one's: never holds the tree
             if not cut:
                 return Attempt(None, nodes, True, failures)
+        raise AssertionError("unreachable")
+
+    def improve(self, active: list[Goal], bound: float, budget: int) -> tuple[list[Node], int]:
+        """Plans for the `active` goals whose worst-case makespan (`Node.worst_end`) beats `bound`,
+        each better than the one before, within `budget` partial plans; and the partial plans
+        expanded. Branch and bound over limited discrepancy search: the passes depart from the
+        heuristic at no choice, then one, then two..., so the plans nearest the heuristic's come
+        first; a partial plan that can no longer beat the best so far is cut."""
+        found: list[Node] = []
+        nodes = 0
+        try:
+            root = self.root(active)
+        except DeadEnd:
+            return found, 1
+        for allowed in itertools.count(0):
+            stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
+            cut = False
+            while stack:
+                node, resolver, used = stack.pop()
+                if resolver is not None:
+                    node = node.copy()
+                nodes += 1
+                if nodes > budget:
+                    return found, nodes - 1
+                try:
+                    if resolver is not None:
+                        resolver.apply(node)
+                    if node.worst_end() >= bound - IMPROVEMENT:
+                        continue
+                    choice = select(node)
+                except DeadEnd:
+                    continue
+                if choice is None:
+                    found.append(node)
+                    bound = node.worst_end()
+                    continue
+                if self.heuristic == LEAST_ROOM and all(r.kind == "order" for r in choice):
+                    choice = choice[::-1]
+                for rank in range(len(choice) - 1, -1, -1):
+                    cost = used + (1 if rank else 0)
+                    if cost > allowed:
+                        cut = True
+                        continue
+                    stack.append((node, choice[rank], cost))
+            if not cut:
+                return found, nodes
         raise AssertionError("unreachable")
 
     # ------------------------------------------------------------ output

@@ -515,6 +515,23 @@ class Node:
         surely = (a, b) in self.ctx.nature_before or low >= gap - SURELY
         return surely, -(gap - (lb - ha) - TOLERANCE) + ahead >= 0
 
+    def worst_end(self) -> float:
+        """The worst-case makespan of the partial plan's earliest schedule: the latest any of its
+        actions may end, whatever nature does (`Plan.makespan`'s measure, with the durations the
+        search knows). No plan made from this one ends earlier: constraints only tighten and
+        actions only add."""
+        d = self.stn.distances
+        worst = 0.0
+        for instance in self.instances.values():
+            spec = self.durations.get(instance.id)
+            if spec is not None and not spec.contingent:  # the plan dispatches it, nature ends it by its longest
+                base, _, _ = self._place(instance.start)
+                worst = max(worst, -d.item(base, 0) + spec.high)
+            else:
+                base, _, high = self._place(instance.end)
+                worst = max(worst, -d.item(base, 0) + high)
+        return worst
+
     def make_contingent(self, point: str, start: str, low: float, high: float, instant: bool = False) -> None:
         """Nature now places `point` within [low, high] after `start`: every requirement already
         written on it is rewritten for its worst case, unless the point is one of the problem's
