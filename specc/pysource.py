@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import dataclasses
 import functools
 import keyword
 import sys
@@ -63,6 +64,7 @@ class FunctionShape:
     least: int  # positional arguments it needs
     most: int | None  # positional arguments it accepts (None: *args)
     returns: tuple[tuple[str, int], ...] = ()  # the string constants it returns, with their lines
+    defined_in: str = ""  # where a re-exported function is written (its package's folder / file)
 
     def accepts(self, count: int) -> bool:
         return self.least <= count and (self.most is None or count <= self.most)
@@ -92,10 +94,19 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
     return FunctionShape(node.lineno, least, most, tuple(sorted(returns, key=lambda r: r[1])))
 
 
+@dataclass(frozen=True)
+class _Imported:
+    """`from module import name` at a module's top level (level: the leading dots)."""
+
+    module: str
+    level: int
+    name: str
+
+
 @functools.lru_cache(maxsize=256)
-def top_level_functions(path: Path) -> Mapping[str, FunctionShape | None] | SyntaxError:
-    """The names a module defines at top level, each with its shape when it is a plain function
-    (None for an import, an assignment or a decorated function), or why it cannot be read."""
+def _top_level(path: Path) -> Mapping[str, FunctionShape | _Imported | None] | SyntaxError:
+    """The names a module defines at top level: a plain function's shape, where a `from ... import`
+    takes a name from, or None (an assignment, a decorated function); or why it cannot be read."""
     try:
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     except SyntaxError as exc:
@@ -105,12 +116,69 @@ def top_level_functions(path: Path) -> Mapping[str, FunctionShape | None] | Synt
         unreadable = SyntaxError(f"cannot read it as Python source: {exc}")
         unreadable.lineno = 1
         return unreadable
-    names: dict[str, FunctionShape | None] = {}
+    names: dict[str, FunctionShape | _Imported | None] = {}
     for node in tree.body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             names[node.name] = shape_of(node)
         elif isinstance(node, ast.ImportFrom):
-            names.update((alias.asname or alias.name, None) for alias in node.names)
+            names.update((alias.asname or alias.name, _Imported(node.module or "", node.level, alias.name))
+                         for alias in node.names if alias.name != "*")
+        elif isinstance(node, ast.Import):
+            names.update(((alias.asname or alias.name).split(".")[0], None) for alias in node.names)
         elif isinstance(node, ast.Assign):
             names.update((t.id, None) for t in node.targets if isinstance(t, ast.Name))
     return names
+
+
+def _source_of(imported: _Imported, path: Path) -> Path | None:
+    """The file an import reads from: relative to the importing module's package, or looked up
+    from its folder as the spec's modules are (`find_module`); None outside the robot's folders
+    (the standard library, an installed package: not checked)."""
+    if imported.level:
+        package = path.parent
+        for _ in range(imported.level - 1):
+            package = package.parent
+        parts = [p for p in imported.module.split(".") if p]
+        if not all(part.isidentifier() for part in parts):
+            return None
+        base = package.joinpath(*parts) if parts else package
+        for candidate in (base.with_suffix(".py") if parts else base / "__init__.py", base / "__init__.py"):
+            if candidate.is_file():
+                return candidate
+        return None
+    return find_module(imported.module, path.parent) if imported.module else None
+
+
+def top_level_functions(path: Path) -> Mapping[str, FunctionShape | None] | SyntaxError:
+    """The names a module defines at top level, each with its shape when it is a plain function
+    (None for an assignment, a decorated function or an import from outside the robot's
+    folders), or why it cannot be read. A name a `from ... import` re-exports from a module of
+    the robot (`from .drive import stop`, `from tug_codels.drive import stop`) has the shape of
+    the function it names there."""
+    found = _top_level(path)
+    if isinstance(found, SyntaxError):
+        return found
+    return {name: _follow(entry, path, 0) for name, entry in found.items()}
+
+
+IMPORT_DEPTH = 8  # re-exports followed before giving up (an import circle ends there)
+
+
+def _follow(entry: FunctionShape | _Imported | None, path: Path, depth: int) -> FunctionShape | None:
+    if not isinstance(entry, _Imported) or depth >= IMPORT_DEPTH:
+        return entry if isinstance(entry, FunctionShape) else None
+    source = _source_of(entry, path)
+    if source is None:
+        return None
+    names = _top_level(source)
+    if isinstance(names, SyntaxError):
+        return None
+    found = _follow(names.get(entry.name), source, depth + 1)
+    if found is None or found.defined_in:
+        return found
+    return dataclasses.replace(found, defined_in=f"{source.parent.name}/{source.name}")
+
+
+def clear_caches() -> None:
+    """Forget what was read (a file just written, e.g. by `specc skeleton`)."""
+    _top_level.cache_clear()

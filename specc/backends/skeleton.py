@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from specc.model import nodes as m
-from specc.pysource import find_module, top_level_functions
+from specc.pysource import clear_caches, find_module, top_level_functions
 
 FIRST_NEXT_STATE = {"start": "exec", "exec": "ether", "end": "ether", "inter": "ether"}
 
@@ -145,7 +145,7 @@ def write_stubs(wanted: Needs, spec_dir: Path) -> Change | None:
         if path.parent != spec_dir and not package_init.exists():
             package_init.write_text("")
         path.write_text(f'"""Functions of {wanted.owner} (stubs written by `specc skeleton`)."""\n')
-        top_level_functions.cache_clear()
+        clear_caches()
     existing = top_level_functions(path)
     if isinstance(existing, SyntaxError):
         raise SyntaxError(f"{path}:{existing.lineno}: cannot add functions to a file with a syntax error: "
@@ -159,5 +159,5 @@ def write_stubs(wanted: Needs, spec_dir: Path) -> Change | None:
     with path.open("a", encoding="utf-8") as handle:
         for stub in stubs.values():
             handle.write(stub.text)
-    top_level_functions.cache_clear()
+    clear_caches()
     return Change(path, created, tuple(stubs))

@@ -76,8 +76,16 @@ def check_call(ctx: Context, name: str, shape: FunctionShape | None, call: tuple
         takes = f"at least {shape.least} argument(s)"
     else:
         takes = f"{shape.least}" + (f" to {shape.most}" if shape.most != shape.least else "") + " argument(s)"
-    ctx.report("bad-codel-signature", f"'{name}' ({where}, line {shape.line}) takes {takes}, but it is called as "
-               f"{name}({', '.join(call)}): give it {len(call)} parameter(s)", span)
+    ctx.report("bad-codel-signature", f"'{name}' ({place(shape, where, shape.line)}) takes {takes}, but it is "
+               f"called as {name}({', '.join(call)}): give it {len(call)} parameter(s)", span)
+
+
+def place(shape: FunctionShape, where: str, line: int) -> str:
+    """Where a line of the function is: in the module the spec names, or, for a function that
+    module re-exports, in the file it is written in."""
+    if shape.defined_in:
+        return f"{shape.defined_in}, line {line}, re-exported by {where}"
+    return f"{where}, line {line}"
 
 
 def check_returns(ctx: Context, name: str, shape: FunctionShape | None, allowed: set[str] | frozenset[str],
@@ -87,7 +95,8 @@ def check_returns(ctx: Context, name: str, shape: FunctionShape | None, allowed:
         if value not in allowed:
             close = did_you_mean(value, allowed)
             fix = close or f"; a new failure is declared with 'fail: {value};'"
-            ctx.report("undeclared-result", f"'{name}' returns {value!r} ({where}, line {line}), which {what} "
+            assert shape is not None
+            ctx.report("undeclared-result", f"'{name}' returns {value!r} ({place(shape, where, line)}), which {what} "
                        f"does not declare (it may return {', '.join(sorted(allowed))}){fix}", span)
 
 
