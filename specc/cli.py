@@ -6,7 +6,7 @@ import difflib
 import os
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Optional
@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Optional
 import typer
 from rich.console import Console
 
+from specc.check.symbols import symbols_of
 from specc.diagnostics import error, render
 from specc.model import nodes as m
 from specc.model.span import Span
@@ -229,7 +230,7 @@ def graph(paths: PathsArg,
 
 def choose_executive(program: m.Program, name: str | None) -> m.Executive:
     """The executive the user means: the only one, or the one named by --executive."""
-    executives = {e.name: e for e in program.items if isinstance(e, m.Executive)}
+    executives: Mapping[str, m.Executive] = symbols_of(program).blocks[m.Executive]
     if not executives:
         err.print("error: no executive block in these specs", markup=False)
         raise typer.Exit(1)
@@ -344,7 +345,7 @@ def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], fac
     from specc.runtime import procedures as rp
 
     assert loaded.program is not None
-    blocks = {p.name: p for p in loaded.program.items if isinstance(p, m.Procedures)}
+    blocks: Mapping[str, m.Procedures] = symbols_of(loaded.program).blocks[m.Procedures]
     chosen = blocks.get(name) if name else next(iter(blocks.values()), None)
     if chosen is None or (name is None and len(blocks) > 1):
         what = f"no procedures '{name}'" if name else "no procedures block" if not blocks else \

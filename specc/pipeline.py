@@ -49,12 +49,22 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
         loaded.program = m.Program(files=tuple(sources))
     if check and parsed_all and loaded.program is not None:
         base_dirs = {shown: path.resolve().parent for shown, path in loaded.paths.items()}
-        found = check_program(loaded.program, base_dirs)
+        found = check_program(loaded.program, base_dirs) + _controller_naming_diagnostics(loaded.program)
         if not any(d.severity == "error" for d in found):
             found += _rule_base_diagnostics(loaded.program)
         loaded.diagnostics.extend(d for d in found if not _already_reported(d, loaded.diagnostics))
     loaded.diagnostics.sort(key=sort_key)
     return loaded
+
+
+def _controller_naming_diagnostics(program: m.Program) -> list[Diagnostic]:
+    """How each executive's own rule bases name its service groups (seed 000 Fig 5.6 calls the
+    pilo group ExecTrajState): what they get wrong, from the incompatibility graph (an analysis,
+    so reported here, after the check passes, and before anything is compiled)."""
+    from specc.analysis.controller import naming
+
+    return [error(p.code, p.message, p.node.span) for e in program.items if isinstance(e, m.Executive)
+            for p in naming(program, e).problems]
 
 
 def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:

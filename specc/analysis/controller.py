@@ -29,6 +29,7 @@ from typing import Any
 
 from specc.analysis import kheops as k
 from specc.analysis.incompat import Group, IncompatibilityGraph, build_graph, service_groups
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 
 EVENTS = ("START", "INTERM", "END", "ABORT", "ZOMBIE")
@@ -307,7 +308,7 @@ def naming(program: m.Program, executive: m.Executive) -> Naming:
     """Cheap (no rules normalised or compiled): the executive check reports its problems."""
     graph = build_graph(program, executive)
     groups = service_groups(graph)
-    bases = {b.name: b for b in program.items if isinstance(b, m.RuleBase)}
+    bases = symbols_of(program).blocks[m.RuleBase]
     hand = [bases[ref.text] for ref in executive.rules if ref.text in bases]
     names: dict[Group, str] = {}
     problems: list[Problem] = []

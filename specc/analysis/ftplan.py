@@ -3,41 +3,13 @@ back end `ftplan` writes into the generated package."""
 
 from __future__ import annotations
 
-import math
-
-from specc.analysis.planning import Lowering, PlanningError, Scope
+from specc.check.expressions import NotConstant, bound, term
+from specc.check.ftplan import viewed_planners
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 from specc.runtime.ftplan import config as fc
-from specc.runtime.planner import model as pm
 
 DEFAULT_WATCHDOG = 10.0  # seconds, when the block names none
-
-# A rule argument names no constant set, macro or timepoint: lowered as a planning model's
-# expression is (the same folding of constant arithmetic, `-3` and `0 -. 3.0` alike), with no scope.
-_LOWERING = Lowering(m.Program(), ())
-
-
-class NotConstant(ValueError):
-    """An argument of an analyzer or state rule that is neither a ?variable nor a constant."""
-
-
-def _lowered(e: m.IxExpr) -> pm.Expr | None:
-    try:
-        return _LOWERING.expr(e, Scope({}, {}))
-    except PlanningError:  # an unknown function
-        return None
-
-
-def term(e: m.IxExpr) -> fc.Term:
-    """A rule argument: a ?variable, a symbol, or a number."""
-    lowered = _lowered(e)
-    if isinstance(lowered, pm.Var):
-        return fc.Var(lowered.name)
-    if isinstance(lowered, pm.Sym):
-        return lowered.name
-    if isinstance(lowered, pm.Num) and math.isfinite(lowered.value):
-        return lowered.value
-    raise NotConstant("a rule argument is a ?variable, a symbol or a number")
 
 
 def terms(exprs: tuple[m.IxExpr, ...]) -> tuple[fc.Term, ...]:
@@ -64,14 +36,6 @@ def state_rule(update: m.StateUpdate) -> fc.StateRule:
                         update.span.line)
 
 
-def bound(e: m.IxExpr) -> float:
-    """An interval's bound: a number, `-oo` or `+oo`."""
-    lowered = _lowered(e)
-    if isinstance(lowered, pm.Num):
-        return float(lowered.value)
-    raise NotConstant("an interval's bounds are numbers")
-
-
 def view_value(e: m.IxExpr | m.Interval) -> fc.Term | fc.Interval:
     if isinstance(e, m.Interval):
         return fc.Interval(bound(e.low), bound(e.high))
@@ -93,13 +57,6 @@ def planner_order(ftplan: m.FtPlan) -> list[m.Planner]:
     order = [ref.text for ref in ftplan.order if ref.text in planners] or list(planners)
     order += [name for name in planners if name not in order]
     return [planners[name] for name in order]
-
-
-def viewed_planners(ftplan: m.FtPlan) -> set[str]:
-    """The planners speaking another vocabulary than FTplan's state: those with a view, in their
-    block or in a mission."""
-    return {p.name for p in ftplan.planners if p.view} | {
-        v.planner.text for mission in ftplan.missions for v in mission.views}
 
 
 def state_planner(ftplan: m.FtPlan) -> m.Planner | None:
@@ -124,7 +81,7 @@ def mission_config(mission: m.Mission, problems: dict[str, m.Problem], state_pla
 
 def ftplan_config(ftplan: m.FtPlan, program: m.Program | None = None) -> fc.FtPlanConfig:
     """The block's configuration; `program` (for the missions' problems) defaults to the block alone."""
-    problems = {p.name: p for p in (program or m.Program()).items if isinstance(p, m.Problem)}
+    problems: dict[str, m.Problem] = dict(symbols_of(program).blocks[m.Problem]) if program is not None else {}
     own = state_planner(ftplan)
     return fc.FtPlanConfig(
         name=ftplan.name,

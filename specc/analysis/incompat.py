@@ -22,6 +22,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import combinations
 
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 
 
@@ -62,17 +63,14 @@ class Group:
 
 
 def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGraph:
-    modules = {module.name: module for module in program.items if isinstance(module, m.Module)}
+    symbols = symbols_of(program)
     requests: dict[str, m.Request] = {}
     module_of: dict[str, str] = {}
     for service in executive.services:
-        ref = service.request
-        if ref is None or len(ref.parts) != 2 or ref.parts[0] not in modules:
-            continue
-        found = {r.name: r for r in modules[ref.parts[0]].requests}.get(ref.parts[1])
-        if found is not None:
+        found = symbols.service_request(service)
+        if found is not None and service.request is not None:
             requests[service.name] = found
-            module_of[service.name] = ref.parts[0]
+            module_of[service.name] = service.request.parts[0]
     control = frozenset(name for name, request in requests.items() if request.kind == "control")
     arcs: dict[tuple[str, str], Arc] = {}
     for first, second in ((a, b) for a in requests for b in requests):
@@ -86,7 +84,7 @@ def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGr
     # Every interrupt arc first, then the waits where no arc is: which of two services sending to
     # each other comes first in the spec changes nothing.
     sent_over = [(first, second) for first, request in requests.items()
-                 for module_name, sent in sent_requests(modules, module_of[first], request)
+                 for module_name, sent in symbols.sent(request)
                  for second, target in requests.items()
                  if module_of[second] == module_name and second not in control and incompatible(sent, target)]
     for first, second in sent_over:
@@ -105,22 +103,6 @@ def build_graph(program: m.Program, executive: m.Executive) -> IncompatibilityGr
     names = tuple(dict.fromkeys(s.name for s in executive.services))
     ordered = tuple(sorted(arcs.values(), key=lambda a: (names.index(a.source), names.index(a.target))))
     return IncompatibilityGraph(names, ordered, module_of, control)
-
-
-def sent_requests(modules: dict[str, m.Module], module: str, request: m.Request) -> list[tuple[str, m.Request]]:
-    """(module, request) for each request `request`'s codels send, and those those send in turn."""
-    found: dict[tuple[str, str], m.Request] = {}
-    pending = [(module, request)]
-    while pending:
-        _, current = pending.pop()
-        for ref in current.sends:
-            if len(ref.parts) != 2 or ref.parts[0] not in modules or tuple(ref.parts) in found:
-                continue
-            target = {r.name: r for r in modules[ref.parts[0]].requests}.get(ref.parts[1])
-            if target is not None:
-                found[(ref.parts[0], ref.parts[1])] = target
-                pending.append((ref.parts[0], target))
-    return [(key[0], target) for key, target in found.items()]
 
 
 def incompatible(first: m.Request, second: m.Request) -> bool:

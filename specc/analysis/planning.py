@@ -16,6 +16,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
+from specc.check.expressions import UnknownFunction, lowered
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 from specc.runtime.planner import model as pm
 
@@ -29,7 +31,7 @@ class PlanningError(ValueError):
 
 def members(program: m.Program, items: Iterable[Any], chain: tuple[str, ...] = ()) -> Iterator[Any]:
     """`items` with every include replaced by the included fragment's members, each once."""
-    fragments = {i.name: i for i in program.items if isinstance(i, m.Fragment)}
+    fragments = symbols_of(program).blocks[m.Fragment]
     seen: set[int] = set()
 
     def expand(items: Iterable[Any], chain: tuple[str, ...]) -> Iterator[Any]:
@@ -80,32 +82,10 @@ class Lowering:
         return tuple(sorted(values))
 
     def expr(self, e: m.IxExpr, scope: Scope) -> pm.Expr:
-        if isinstance(e, m.Number):
-            return pm.Num(float(e.value))
-        if isinstance(e, m.Infinity):
-            return pm.Num(pm.INF)
-        if isinstance(e, m.IxVar):
-            return pm.Var(scope.renames.get(e.name, e.name))
-        if isinstance(e, m.IxName):
-            if e.name in scope.arguments:
-                return scope.arguments[e.name]
-            return pm.Time(e.name) if e.name in scope.timepoints else pm.Sym(e.name)
-        if isinstance(e, m.IxCall):
-            if e.function not in pm.FUNCTIONS:
-                raise PlanningError(f"unknown function '{e.function}'")
-            return pm.Op(e.function, tuple(self.expr(a, scope) for a in e.args))
-        if isinstance(e, m.IxUnary):
-            inner = self.expr(e.operand, scope)
-            if e.op == "+":
-                return inner
-            return pm.Num(-inner.value) if isinstance(inner, pm.Num) else pm.Op("neg", (inner,))
-        left, right = self.expr(e.left, scope), self.expr(e.right, scope)
-        op = e.op.rstrip(".")
-        if isinstance(left, pm.Num) and isinstance(right, pm.Num):
-            folded = pm.fold(op, left.value, right.value)
-            if folded is not None:
-                return pm.Num(folded)
-        return pm.Op(op, (left, right))
+        try:
+            return lowered(e, scope.timepoints, scope.arguments, scope.renames)
+        except UnknownFunction as error:
+            raise PlanningError(str(error)) from None
 
     def domain(self, d: m.DomainValue, scope: Scope) -> pm.Values | tuple[pm.Expr, pm.Expr]:
         """A constant domain, or the two bound expressions of a non-constant interval."""
@@ -264,7 +244,7 @@ def domain_model(program: m.Program, domain: m.Domain) -> pm.PlanningDomain:
 
 def domain_block(program: m.Program, problem: m.Problem) -> m.Domain:
     """The `domain` block a problem is written for."""
-    domain = next((d for d in program.items if isinstance(d, m.Domain) and d.name == problem.domain.text), None)
+    domain: m.Domain | None = symbols_of(program).blocks[m.Domain].get(problem.domain.text)
     if domain is None:
         raise PlanningError(f"unknown domain '{problem.domain.text}'")
     return domain

@@ -94,28 +94,3 @@ def library(node: m.Procedures) -> rp.Library:
         kas=tuple(ka(k) for k in node.kas),
         source=node.span.file,
     )
-
-
-class Domains:
-    """The values each predicate argument may take: a tuple when finite, None when unbounded
-    (`int`, `string`, ... — fine for the interpreter, not for a Petri net)."""
-
-    def __init__(self, node: m.Procedures):
-        self.types = {t.name: t.domain for t in node.types}
-        self.params = {p.name: p.params for p in node.predicates}
-
-    def values(self, domain: m.PDomain, seen: frozenset[str] = frozenset()) -> tuple[str | int, ...] | None:
-        if isinstance(domain, m.SymbolSet):
-            return tuple(int(v) if v.isdigit() else v for v in domain.values)
-        if isinstance(domain, m.IntRange):
-            return tuple(range(domain.low, domain.high + 1))
-        declared = self.types.get(domain.name)
-        if declared is None or domain.name in seen:
-            return None
-        return self.values(declared, seen | {domain.name})
-
-    def argument(self, predicate: str, index: int) -> tuple[str | int, ...] | None:
-        params = self.params.get(predicate)
-        if params is None or index >= len(params):
-            return None
-        return self.values(params[index].domain)

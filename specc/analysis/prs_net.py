@@ -37,7 +37,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from specc.analysis import petri
-from specc.analysis.procedures import Domains, library
+from specc.analysis.procedures import library
+from specc.check.procedures import Domains
 from specc.diagnostics import Diagnostic
 from specc.model import nodes as m
 from specc.model.visitor import walk

@@ -26,6 +26,7 @@ from specc.analysis import petri
 from specc.analysis.controller import executive_controller
 from specc.analysis.prs_net import ExecutiveModel, Reading, Service, Translation, Translator
 from specc.analysis.service_list import executive_spec
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 from specc.runtime import procedures as rp
 
@@ -113,7 +114,7 @@ def executive_model(program: m.Program, procedures: m.Procedures, failing: Seque
         return None
     assert systems[0].executive is not None
     name = systems[0].executive.text
-    executive = next((i for i in program.items if isinstance(i, m.Executive) and i.name == name), None)
+    executive: m.Executive | None = symbols_of(program).blocks[m.Executive].get(name)
     if executive is None:
         return None
     spec = executive_spec(program, executive_controller(program, executive))

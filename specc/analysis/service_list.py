@@ -7,6 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 from specc.analysis.controller import Controller
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 from specc.runtime import executive as rx
 
@@ -28,12 +29,13 @@ def seconds(duration: m.Duration | None) -> float | None:
 
 def executive_spec(program: m.Program, controller: Controller) -> rx.ExecutiveSpec:
     executive, graph = controller.executive, controller.graph
-    modules = {i.name: i for i in program.items if isinstance(i, m.Module)}
+    symbols = symbols_of(program)
     services = {}
     for service in executive.services:
-        assert service.request is not None  # the checks guarantee a resolved module.request
+        found = symbols.service_request(service)
+        assert found is not None and service.request is not None  # the checks resolved it
         module, request = service.request.parts
-        kind = next(r for r in modules[module].requests if r.name == request).kind or "exec"
+        kind = found.kind or "exec"
         timeout = service.timeout or m.Timeouts()
         targets = {a.target for a in graph.arcs if a.source == service.name}
         linked = targets | {a.source for a in graph.arcs if a.target == service.name}

@@ -37,6 +37,7 @@ from typing import Any
 from specc.analysis import kheops as k
 from specc.analysis.controller import executive_controller
 from specc.analysis.service_list import executive_spec
+from specc.check.symbols import symbols_of
 from specc.model import nodes as m
 from specc.runtime import executive as rx
 from specc.runtime.functional import Reply, Report, RequestSpec, Status
@@ -546,12 +547,11 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
     controller = executive_controller(program, executive)
     compiled = controller.compile()
     spec = executive_spec(program, controller)
-    modules: dict[str, dict[str, RequestSpec]] = {}
-    for module in (i for i in program.items if isinstance(i, m.Module)):
-        modules[module.name] = {r.name: RequestSpec(r.name, r.kind or "exec",
-                                                    incompatible=tuple(x.text for x in r.incompatible_with),
-                                                    sends=tuple(x.text for x in r.sends))
-                                for r in module.requests}
+    modules = {name: {r.name: RequestSpec(r.name, r.kind or "exec",
+                                          incompatible=tuple(x.text for x in r.incompatible_with),
+                                          sends=tuple(x.text for x in r.sends))
+                      for r in declared.values()}
+               for name, declared in symbols_of(program).requests.items()}
     arcs = {(a.source, a.target) for a in controller.graph.arcs}
     return Explorer(spec, decision_function(compiled), modules, arcs, requests)
 

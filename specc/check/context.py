@@ -2,23 +2,17 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
+from specc.check.symbols import KIND_WORDS, symbols_of
 from specc.diagnostics import Diagnostic, did_you_mean, error
 from specc.model import nodes as m
 from specc.model.span import Span
 
 T = TypeVar("T")
-
-KIND_WORDS: dict[type, str] = {
-    m.Module: "module", m.Executive: "executive", m.RuleBase: "rules", m.Procedures: "procedures",
-    m.Domain: "domain", m.Problem: "problem", m.Fragment: "fragment", m.FtPlan: "ftplan",
-    m.System: "system",
-}
-
 
 @dataclass
 class Context:
@@ -27,15 +21,15 @@ class Context:
     diagnostics: list[Diagnostic] = field(default_factory=list)
 
     def __post_init__(self) -> None:
-        self.by_kind: dict[type, dict[str, Any]] = {kind: {} for kind in KIND_WORDS}
-        for item in self.program.items:
-            self.by_kind[type(item)].setdefault(item.name, item)
+        # The semantic analysis, first: every later pass reads these tables (check/symbols.py).
+        self.symbols = symbols_of(self.program)
+        self.by_kind = self.symbols.blocks
 
     # ------------------------------------------------------------ lookups
     def items(self, kind: type[T]) -> Iterator[T]:
         return (item for item in self.program.items if isinstance(item, kind))
 
-    def named(self, kind: type[T]) -> dict[str, T]:
+    def named(self, kind: type[T]) -> Mapping[str, T]:
         return self.by_kind[kind]
 
     def lookup(self, kind: type[T], ref: m.Ref | str, span: Span, code: str) -> T | None:

@@ -3,9 +3,9 @@ existing services, reflexes and parameters point at real requests and posters.""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
-from specc.analysis.controller import naming
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
@@ -20,7 +20,7 @@ def resolve_member(ctx: Context, ref: m.Ref, collection: str, word: str, code: s
     module = ctx.lookup(m.Module, ref.parts[0], ref.span, "undefined-module")
     if module is None:
         return None
-    members = {member.name: member for member in getattr(module, collection)}
+    members = getattr(ctx.symbols, collection)[module.name]
     member = members.get(ref.parts[1])
     if member is None:
         ctx.unknown(code, word, ref.parts[1], members, ref.span, f" in module '{module.name}'")
@@ -69,7 +69,7 @@ OUTPUT_FUNCTION = ("ctx", "output")
 def check_executive(ctx: Context, executive: m.Executive) -> None:
     ctx.duplicates(executive.services, "service")
     ctx.duplicates(executive.parameters, "parameter")
-    services = {s.name: s for s in executive.services}
+    services = ctx.symbols.services_of(executive)
     functions = python_functions(ctx, executive.codel_module) if executive.codel_module else None
     for ref in executive.rules:
         ctx.lookup(m.RuleBase, ref, ref.span, "undefined-rules")
@@ -137,8 +137,8 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                            parameter.set.span)
     for reflex in executive.reflexes:
         check_reflex(ctx, reflex, services)
-    for problem in naming(ctx.program, executive).problems:
-        ctx.report(problem.code, problem.message, problem.node.span)
+    # How its own rule bases name its service groups is checked from the incompatibility graph,
+    # an analysis: `specc.pipeline` reports it after these passes.
 
 
 # The report codes a module's final reply may carry beside OK and the request's declared fail
@@ -148,7 +148,7 @@ RUNTIME_CODES = frozenset({"ABORT", "INTERRUPTED", "BAD_INPUT", "CODEL_ERROR", "
                            "MODULE_FROZEN"})
 
 
-def check_reflex(ctx: Context, reflex: m.Reflex, services: dict[str, m.Service]) -> None:
+def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Service]) -> None:
     source = reflex.source
     request: m.Request | None = None
     if len(source.parts) == 1:
@@ -162,9 +162,9 @@ def check_reflex(ctx: Context, reflex: m.Reflex, services: dict[str, m.Service])
     comparison = reflex.comparison
     if reflex.trigger == "reply" and comparison is not None and comparison.op == "==" and request is not None:
         value = comparison.value.text if isinstance(comparison.value, m.Ref) else None
-        module = next((mod for mod in ctx.items(m.Module) if request in mod.requests), None)
-        replies = {"OK"} | {f.text for f in request.fail} | RUNTIME_CODES | {
-            r.name for r in (module.requests if module is not None else ())}
+        module = ctx.symbols.module_of(request)
+        replies = {"OK"} | {f.text for f in request.fail} | RUNTIME_CODES | set(
+            ctx.symbols.requests_of(module) if module is not None else ())
         if value is not None and value not in replies:
             ctx.warn("reflex-never-fires", f"'{source.text}' never replies '{value}' (its fail messages: "
                      f"{', '.join(f.text for f in request.fail) or 'none'}): this reflex cannot fire; declare the "

@@ -3,8 +3,8 @@ updates speak of tasks and attributes that some planner's domain defines."""
 
 from __future__ import annotations
 
-from specc.analysis.ftplan import NotConstant, bound, term, viewed_planners
 from specc.check.context import Context
+from specc.check.expressions import NotConstant, bound, term
 from specc.check.planning import DomainTables, tables
 from specc.model import nodes as m
 from specc.runtime.ftplan.config import HEURISTICS
@@ -212,3 +212,10 @@ def check_attribute(ctx: Context, known: DomainTables, name: str, arity: int, sp
         ctx.unknown("undefined-attribute", "attribute", name, known.attributes, span, " in the planners' domains")
     elif len(attribute.params) != arity:
         ctx.report("arity-mismatch", f"'{name}' takes {len(attribute.params)} argument(s), {arity} given", span)
+
+
+def viewed_planners(ftplan: m.FtPlan) -> set[str]:
+    """The planners speaking another vocabulary than FTplan's state: those with a view, in their
+    block or in a mission."""
+    return {p.name for p in ftplan.planners if p.view} | {
+        v.planner.text for mission in ftplan.missions for v in mission.views}

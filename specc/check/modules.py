@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import keyword
+from collections.abc import Mapping
 
 from specc.check.context import Context
 from specc.model import nodes as m
@@ -134,7 +135,7 @@ def check_module(ctx: Context, module: m.Module) -> None:
             check_type(f.type)
     for f in module.internal_data:
         check_type(f.type)
-    requests = {r.name: r for r in module.requests}
+    requests = ctx.symbols.requests_of(module)
     tasks = {t.name: t for t in module.exec_tasks}
     for request in module.requests:
         check_request(ctx, module, request, requests, tasks, check_type)
@@ -157,7 +158,7 @@ def check_module(ctx: Context, module: m.Module) -> None:
                        poster.span)
 
 
-def check_request(ctx: Context, module: m.Module, request: m.Request, requests: dict[str, m.Request],
+def check_request(ctx: Context, module: m.Module, request: m.Request, requests: Mapping[str, m.Request],
                   tasks: dict[str, m.ExecTask], check_type: object) -> None:
     assert callable(check_type)
     ctx.duplicates(request.inputs, "input")

@@ -3,7 +3,6 @@ predicates with the right arity, KA shape, and unreachable statements."""
 
 from __future__ import annotations
 
-from specc.analysis.procedures import Domains
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
@@ -191,3 +190,28 @@ def check_binding(ctx: Context, name: str, binding: m.String, params: tuple[m.PP
                    "`specc skeleton` can write a stub for it", binding.span)
         return
     check_call(ctx, function, functions[function], ("ctx", *(p.name for p in params)), module, binding.span)
+
+
+class Domains:
+    """The values each predicate argument may take: a tuple when finite, None when unbounded
+    (`int`, `string`, ... — fine for the interpreter, not for a Petri net)."""
+
+    def __init__(self, node: m.Procedures):
+        self.types = {t.name: t.domain for t in node.types}
+        self.params = {p.name: p.params for p in node.predicates}
+
+    def values(self, domain: m.PDomain, seen: frozenset[str] = frozenset()) -> tuple[str | int, ...] | None:
+        if isinstance(domain, m.SymbolSet):
+            return tuple(int(v) if v.isdigit() else v for v in domain.values)
+        if isinstance(domain, m.IntRange):
+            return tuple(range(domain.low, domain.high + 1))
+        declared = self.types.get(domain.name)
+        if declared is None or domain.name in seen:
+            return None
+        return self.values(declared, seen | {domain.name})
+
+    def argument(self, predicate: str, index: int) -> tuple[str | int, ...] | None:
+        params = self.params.get(predicate)
+        if params is None or index >= len(params):
+            return None
+        return self.values(params[index].domain)

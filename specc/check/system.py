@@ -6,6 +6,8 @@ service exactly the inputs it takes, with values of their types."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.check.executive import resolve_poster, resolve_request
@@ -217,7 +219,7 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
                        f"is carried out in system '{system.name}''s 'bindings {{ {task.name}(...) => goal "
                        "G(...); }'", (system.bindings or system).span)
     goals = achievable_goals(supervisor) if supervisor is not None else {}
-    services = {s.name: s for s in executive.services} if executive is not None else {}
+    services = ctx.symbols.services_of(executive) if executive is not None else {}
     reports = {u.task: len(u.args) for u in ftplan.state_updates if u.report == "report"}
     for binding in bindings:
         check_task(ctx, tasks, binding.task, binding.span, binding.args)
@@ -243,7 +245,7 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
 
 
 def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goals: dict[str, int],
-                         services: dict[str, m.Service]) -> None:
+                         services: Mapping[str, m.Service]) -> None:
     target, given = binding.target, len(binding.target_args)
     if binding.kind == "goal":
         if system.supervisor is None:
@@ -350,7 +352,7 @@ def check_service_actions(ctx: Context, procedures: m.Procedures, executives: li
             ctx.report("undefined-service", f"action '{action.name}' requests service '{binding.service}', but "
                        f"{without}", binding.span)
             continue
-        services = {s.name: s for e in executives for s in e.services}
+        services = ctx.symbols.offered
         service = services.get(binding.service)
         if service is None:
             ctx.unknown("undefined-service", "service", binding.service, services, binding.span,
@@ -381,7 +383,7 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
         first = next(iter(protocols.values()))
         ctx.warn("no-executive", f"KA '{first.name}' is the executive's request protocol, but {without}", first.span)
         return
-    services = {s.name for e in executives for s in e.services}
+    services = ctx.symbols.offered
     for root in (procedures, *missions):
         for node in walk(root):
             if not (isinstance(node, m.Goal) and node.op == "!" and node.body.head in protocols):
@@ -395,10 +397,7 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
 
 
 def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:
-    if service.request is None or len(service.request.parts) != 2:
-        return {}
-    module = ctx.named(m.Module).get(service.request.parts[0])
-    request = next((r for r in module.requests if r.name == service.request.parts[1]), None) if module else None
+    request = ctx.symbols.service_request(service)
     return {i.name: i for i in request.inputs} if request is not None else {}
 
 
