@@ -15,8 +15,7 @@ from specc.check.ftplan import check_attribute, check_bound, check_task, check_t
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
-from specc.runtime.body import BODY_KEYS, body_problem
-from specc.runtime.sim.simulation import DEVICES
+from specc.runtime.body import BODY_KEYS, DEVICES, body_problem
 from specc.runtime.sim.world import WorldError, load_world
 
 # The PRS domains a request input of each type accepts (seed 000 §4.2: the task level passes

@@ -23,6 +23,8 @@ from dataclasses import dataclass, field, fields
 from typing import Any, NamedTuple
 
 COUNT, LENGTH, MASS, SPEED, ACCEL, RATIO, ANGLE, TURN_RATE = "", "m", "kg", "m/s", "m/s²", "ratio", "deg", "deg/s"
+# The devices of the simulated body (`specc.runtime.sim.simulation`) a module's codels may own.
+DEVICES = ("wheels", "encoders", "sonars", "laser", "camera", "pan_tilt", "arm", "antenna", "pose", "objects")
 
 
 def _key(default: float | int, unit: str, doc: str) -> Any:

@@ -14,19 +14,49 @@ next inside `with planner_processes_kept():` (see `planners`).
 
 from __future__ import annotations
 
-from specc.runtime.ftplan.component import (
-    HUNG_PLANNER_SECONDS,
-    CostModel,
-    FtPlan,
-    MissionFailure,
-    MissionResult,
-    planners_as_run,
-)
-from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig, configurations
-from specc.runtime.ftplan.execution import Executor, Outcome, Report, ScriptedExecutor
-from specc.runtime.ftplan.missions import MissionSetup, UnknownName, mission_setup
-from specc.runtime.ftplan.planners import planner_processes_kept
-from specc.runtime.ftplan.pools import LocalPool, ProcessPool
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from specc.runtime.ftplan.component import (
+        HUNG_PLANNER_SECONDS,
+        CostModel,
+        FtPlan,
+        MissionFailure,
+        MissionResult,
+        planners_as_run,
+    )
+    from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig, configurations
+    from specc.runtime.ftplan.execution import Executor, Outcome, Report, ScriptedExecutor
+    from specc.runtime.ftplan.missions import MissionSetup, UnknownName, mission_setup
+    from specc.runtime.ftplan.planners import planner_processes_kept
+    from specc.runtime.ftplan.pools import LocalPool, ProcessPool
+
+# What the package offers, each imported where it is defined on first use (PEP 562): a program
+# that needs one module of the package (a generated configuration reads `specc.runtime.ftplan.config`) does
+# not import the rest (the planners' processes, the search).
+_OFFERS = {
+    "HUNG_PLANNER_SECONDS": "specc.runtime.ftplan.component", "CostModel": "specc.runtime.ftplan.component",
+    "FtPlan": "specc.runtime.ftplan.component", "MissionFailure": "specc.runtime.ftplan.component",
+    "MissionResult": "specc.runtime.ftplan.component", "planners_as_run": "specc.runtime.ftplan.component",
+    "FtPlanConfig": "specc.runtime.ftplan.config", "PlannerConfig": "specc.runtime.ftplan.config",
+    "configurations": "specc.runtime.ftplan.config", "Executor": "specc.runtime.ftplan.execution",
+    "Outcome": "specc.runtime.ftplan.execution", "Report": "specc.runtime.ftplan.execution",
+    "ScriptedExecutor": "specc.runtime.ftplan.execution", "MissionSetup": "specc.runtime.ftplan.missions",
+    "UnknownName": "specc.runtime.ftplan.missions", "mission_setup": "specc.runtime.ftplan.missions",
+    "planner_processes_kept": "specc.runtime.ftplan.planners", "LocalPool": "specc.runtime.ftplan.pools",
+    "ProcessPool": "specc.runtime.ftplan.pools",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _OFFERS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = ["HUNG_PLANNER_SECONDS", "CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure",
            "MissionResult", "MissionSetup", "Outcome", "PlannerConfig", "ProcessPool", "Report", "ScriptedExecutor",

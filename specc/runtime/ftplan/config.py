@@ -8,12 +8,12 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
+from specc.runtime.planner.heuristics import HEURISTICS as PLANNER_HEURISTICS
 from specc.runtime.planner.model import Interval as Interval  # re-exported: the generated modules name it here
-from specc.runtime.planner.planner import HEURISTICS as PLANNER_HEURISTICS
 
 Value = float | str
 
-# Heuristics specc's planner can be configured with (specc.runtime.planner.planner.HEURISTICS):
+# Heuristics specc's planner can be configured with (specc.runtime.planner.heuristics):
 # a planner block naming another is refused (by `specc check` and by the planner's process)
 # rather than silently planned with another one.
 HEURISTICS: frozenset[str] = frozenset(PLANNER_HEURISTICS)

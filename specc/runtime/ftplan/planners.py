@@ -76,8 +76,8 @@ from typing import Final, Literal, Protocol
 from specc.runtime.ftplan.config import HEURISTICS, PlannerConfig
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.heuristics import STANDARD
 from specc.runtime.planner.plan import Repair
-from specc.runtime.planner.planner import STANDARD
 
 START_METHOD: Final = "forkserver"
 # Imported once by the forkserver, so that a planner's process starts without importing them

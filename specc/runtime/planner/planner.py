@@ -18,6 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.heuristics import HEURISTICS, LEAST_ROOM, STANDARD
 from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult, Repair
 from specc.runtime.planner.search import (
@@ -81,15 +82,6 @@ class Attempt:
     failures: Counter[str] = field(default_factory=Counter)
 
 
-# Resolver orders (`heuristic:` of an FTplan planner block; seed 004 §5.3: planners of one model
-# made diverse by their heuristics). STANDARD: the orderings that solve a threat tried by the room
-# they leave, most first (a resource conflict's: the task found first goes first). LEAST_ROOM:
-# every ordering choice the other way round, so that its search departs from STANDARD's wherever
-# it has an order to choose. Both link an open condition to a producer already in the plan
-# before they insert a new task.
-STANDARD = "most-room-first"
-LEAST_ROOM = "least-room-first"
-HEURISTICS = (STANDARD, LEAST_ROOM)
 
 
 class Planner:

@@ -7,20 +7,47 @@ mission runs as fast as the computer allows (seed 004 §4.2.2 could only run Gaz
 
 from __future__ import annotations
 
-from specc.runtime.sim.devices import reliability
-from specc.runtime.sim.rover import RobotConfig, Rover
-from specc.runtime.sim.simulation import Simulation, Trace
-from specc.runtime.sim.world import (
-    Circle,
-    Polygon,
-    Target,
-    Window,
-    World,
-    WorldError,
-    load_world,
-    parse_world,
-    world_data,
-)
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from specc.runtime.sim.devices import reliability
+    from specc.runtime.sim.rover import RobotConfig, Rover
+    from specc.runtime.sim.simulation import Simulation, Trace
+    from specc.runtime.sim.world import (
+        Circle,
+        Polygon,
+        Target,
+        Window,
+        World,
+        WorldError,
+        load_world,
+        parse_world,
+        world_data,
+    )
+
+# What the package offers, each imported where it is defined on first use (PEP 562): a program
+# that needs one module of the package (`specc check` reads world files with `specc.runtime.sim.world`) does
+# not import the rest (numpy, pymunk).
+_OFFERS = {
+    "reliability": "specc.runtime.sim.devices", "RobotConfig": "specc.runtime.sim.rover",
+    "Rover": "specc.runtime.sim.rover", "Simulation": "specc.runtime.sim.simulation",
+    "Trace": "specc.runtime.sim.simulation", "Circle": "specc.runtime.sim.world",
+    "Polygon": "specc.runtime.sim.world", "Target": "specc.runtime.sim.world",
+    "Window": "specc.runtime.sim.world", "World": "specc.runtime.sim.world",
+    "WorldError": "specc.runtime.sim.world", "load_world": "specc.runtime.sim.world",
+    "parse_world": "specc.runtime.sim.world", "world_data": "specc.runtime.sim.world",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _OFFERS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = ["Circle", "Polygon", "RobotConfig", "Rover", "Simulation", "Target",
            "Trace", "Window", "World", "WorldError", "load_world", "parse_world", "reliability", "world_data"]

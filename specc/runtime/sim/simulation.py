@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from specc.runtime.body import DEVICES as DEVICES  # re-exported: the devices a body has
 from specc.runtime.kernel import Kernel
 from specc.runtime.sim.devices import Antenna, Arm, Camera, Encoders, PanTilt, RangeSensor, Wheels
 from specc.runtime.sim.rays import RayCaster
@@ -34,7 +35,6 @@ SCATTER_TRIES = 1000  # random places tried in a row for one object before givin
 # What a system's `devices { module: device, ...; }` may give a module's codels (`sdi.hardware`):
 # actuators and sensors, the robot's true pose (a localisation), the world's objects. Whatever a
 # module is given, it also sees the world, the body, the trace and the clock (COMMON).
-DEVICES = ("wheels", "encoders", "sonars", "laser", "camera", "pan_tilt", "arm", "antenna", "pose", "objects")
 COMMON = ("world", "robot", "trace", "now", "physics_period", "kernel", "seed")
 
 
