@@ -38,7 +38,7 @@ import itertools
 import math
 from collections import OrderedDict
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any, Union
@@ -72,6 +72,7 @@ from specc.model import nodes as m
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.model import describe
 from specc.runtime.planner.numeric import div, evaluate, mul
+from specc.runtime.planner.replan import replanning_problem
 
 VALUE = -1  # the position of an attribute's value, next to its argument positions 0, 1, ...
 ROOT_TYPE = "symbol"
@@ -97,8 +98,28 @@ def export(domain: pm.PlanningDomain, problem: pm.Problem,
            set_names: Mapping[frozenset[str], str] | None = None) -> Exported:
     """The unified_planning problem of `problem` in `domain`. `set_names` names the user types made
     from symbol sets (see `constant_set_names`); unnamed sets get a name from their members or
-    from their first user."""
-    return _Exporter(domain, problem, dict(set_names or {})).run()
+    from their first user. A goal impossible even alone (specc's planner exhausts every partial
+    plan for it: a window too short for the task, a horizon too near), which `specc plan` drops,
+    is left out and said so: PDDL 2.1 has no oversubscription, and a problem keeping it would have
+    no plan at all."""
+    impossible = impossible_goals(domain, problem)
+    if impossible:
+        kept = [a.line for a in problem.assertions if a.goal is not None and a.line not in impossible]
+        # The problem without them (their own timepoints and constraints go too), from its origin.
+        problem = replace(replanning_problem(problem, (), kept, 0.0), name=problem.name)
+    exported = _Exporter(domain, problem, dict(set_names or {})).run()
+    for line, why in sorted(impossible.items()):
+        exported.unsupported.insert(0, f"the goal of line {line} is left out: it is {why}, as `specc plan` finds "
+                                       "(PDDL 2.1 has no oversubscription: a problem keeping it has no plan).")
+    return exported
+
+
+def impossible_goals(domain: pm.PlanningDomain, problem: pm.Problem) -> dict[int, str]:
+    """The source lines of the goals specc's planner finds impossible even alone, with why."""
+    from specc.runtime.planner.planner import Planner
+
+    result = Planner(domain, exact=False).plan(problem)
+    return {g.line: g.reason for g in result.goals if not g.kept and g.reason.startswith("impossible even alone")}
 
 
 def write_pddl(exported: Exported, folder: Path) -> tuple[Path, Path]:
