@@ -100,4 +100,5 @@ def planner_config(planner: m.Planner) -> fc.PlannerConfig:
                             planner.heuristic.text if planner.heuristic is not None else None,
                             controllability=planner.controllability or "strong", repair=planner.repair == "on",
                             improve=int(planner.improve.value) if planner.improve is not None else 0,
+                            flaws=planner.flaws.text if planner.flaws is not None else None,
                             view=tuple(correspondence(c) for c in planner.view))

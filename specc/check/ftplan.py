@@ -7,7 +7,7 @@ from specc.check.context import Context
 from specc.check.expressions import NotConstant, bound, term
 from specc.check.planning import DomainTables, tables
 from specc.model import nodes as m
-from specc.runtime.ftplan.config import HEURISTICS
+from specc.runtime.ftplan.config import FLAW_ORDERS, HEURISTICS
 
 
 def check(ctx: Context) -> None:
@@ -29,6 +29,9 @@ def check(ctx: Context) -> None:
                 choices = ", ".join(sorted(HEURISTICS)) or "none yet: leave 'heuristic' out"
                 ctx.report("unknown-heuristic", f"specc's planner has no heuristic '{planner.heuristic.text}' "
                            f"(it knows {choices})", planner.heuristic.span)
+            if planner.flaws is not None and planner.flaws.text not in FLAW_ORDERS:
+                ctx.report("unknown-heuristic", f"specc's planner has no flaw order '{planner.flaws.text}' "
+                           f"(it knows {', '.join(sorted(FLAW_ORDERS))})", planner.flaws.span)
             domain = ctx.lookup(m.Domain, planner.domain, planner.domain.span, "undefined-domain")
             if domain is not None:
                 found = tables(_quiet(ctx), domain.members)

@@ -842,7 +842,8 @@ class Correspondence(Node):
 class Planner(Node):
     name: str
     domain: Ref | None = prop("domain", "ref", doc="planning domain the planner uses")
-    heuristic: Ref | None = prop("heuristic", "ref", doc="flaw/resolver ordering heuristic")
+    heuristic: Ref | None = prop("heuristic", "ref", doc="resolver ordering heuristic")
+    flaws: Ref | None = prop("flaws", "ref", doc="flaw ordering: which task's open conditions come first")
     controllability: str | None = prop("controllability", "symbol", choices=("strong", "pseudo"),
                                        doc="what plans must hold against nature (specc.runtime.planner.search)")
     repair: str | None = prop("repair", "symbol", choices=("on", "off"),

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
+from specc.runtime.planner.heuristics import FLAW_ORDERS as PLANNER_FLAW_ORDERS
 from specc.runtime.planner.heuristics import HEURISTICS as PLANNER_HEURISTICS
 from specc.runtime.planner.model import Interval as Interval  # re-exported: the generated modules name it here
 
@@ -17,6 +18,7 @@ Value = float | str
 # a planner block naming another is refused (by `specc check` and by the planner's process)
 # rather than silently planned with another one.
 HEURISTICS: frozenset[str] = frozenset(PLANNER_HEURISTICS)
+FLAW_ORDERS: frozenset[str] = frozenset(PLANNER_FLAW_ORDERS)
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,8 @@ class PlannerConfig:
     # Partial plans spent improving each first plan (`improve: N`, anytime); under the cost model
     # the node limit caps them, so an improving planner is never late for it.
     improve: int = 0
+    # Which task's open conditions the search solves first (`flaws:`; FLAW_ORDERS), None: the default.
+    flaws: str | None = None
 
 
 @dataclass(frozen=True)

@@ -73,10 +73,10 @@ from multiprocessing.connection import Connection, wait
 from types import ModuleType, TracebackType
 from typing import Final, Literal, Protocol
 
-from specc.runtime.ftplan.config import HEURISTICS, PlannerConfig
+from specc.runtime.ftplan.config import FLAW_ORDERS, HEURISTICS, PlannerConfig
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.heuristics import STANDARD
+from specc.runtime.planner.heuristics import NEWEST_TASK_FIRST, STANDARD
 from specc.runtime.planner.plan import Repair
 
 START_METHOD: Final = "forkserver"
@@ -109,11 +109,15 @@ def standard_planner(config: PlannerConfig, domains: Mapping[str, pm.PlanningDom
         known = ", ".join(sorted(HEURISTICS)) or "none yet: leave the heuristic out"
         raise ValueError(f"planner '{config.name}': specc's planner has no heuristic '{config.heuristic}' "
                          f"(known: {known})")
+    if config.flaws is not None and config.flaws not in FLAW_ORDERS:
+        raise ValueError(f"planner '{config.name}': specc's planner has no flaw order '{config.flaws}' "
+                         f"(known: {', '.join(sorted(FLAW_ORDERS))})")
     if config.domain not in domains:
         raise ValueError(f"planner '{config.name}': no planning domain '{config.domain}' "
                          f"(given: {', '.join(sorted(domains)) or 'none'})")
     return Planner(domains[config.domain], controllability=config.controllability, node_limit=config.node_limit,
-                   heuristic=config.heuristic or STANDARD, improve=config.improve)
+                   heuristic=config.heuristic or STANDARD, improve=config.improve,
+                   flaws=config.flaws or NEWEST_TASK_FIRST)
 
 
 def planning_domains(generated: Mapping[str, ModuleType]) -> dict[str, pm.PlanningDomain]:

@@ -18,7 +18,14 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.heuristics import HEURISTICS, LEAST_ROOM, STANDARD
+from specc.runtime.planner.heuristics import (
+    FLAW_ORDERS,
+    HEURISTICS,
+    LEAST_ROOM,
+    NEWEST_TASK_FIRST,
+    OLDEST_TASK_FIRST,
+    STANDARD,
+)
 from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult, Repair
 from specc.runtime.planner.search import (
@@ -87,12 +94,16 @@ class Attempt:
 class Planner:
     def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
                  exact: bool = True, limits: Limits | None = None, controllability: str = STRONG,
-                 node_limit: int | None = None, heuristic: str = STANDARD, improve: int = 0) -> None:
+                 node_limit: int | None = None, heuristic: str = STANDARD, improve: int = 0,
+                 flaws: str = NEWEST_TASK_FIRST) -> None:
         if controllability not in CONTROLLABILITIES:
             raise ValueError(f"controllability '{controllability}': choose {' or '.join(CONTROLLABILITIES)}")
         if heuristic not in HEURISTICS:
             raise ValueError(f"heuristic '{heuristic}': choose {' or '.join(sorted(HEURISTICS))}")
+        if flaws not in FLAW_ORDERS:
+            raise ValueError(f"flaw order '{flaws}': choose {' or '.join(FLAW_ORDERS)}")
         self.heuristic = heuristic  # the order of the orderings a choice offers (HEURISTICS)
+        self.flaws = flaws  # which task's open conditions come first (FLAW_ORDERS)
         self.domain = domain
         self.controllability = controllability  # what the plans must hold against (search.py's doc)
         self.nodes = nodes  # budget of the search for every goal at once
@@ -110,7 +121,7 @@ class Planner:
     def plan(self, problem: pm.Problem, now: float = 0.0) -> PlanResult:
         started = time.perf_counter()
         try:
-            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic)
+            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic, self.flaws)
         except PlanningInputError as error:
             return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
         try:
@@ -228,7 +239,7 @@ class Planner:
         from scratch (FTplan, `component.FtPlan.execute`)."""
         started = time.perf_counter()
         try:
-            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic)
+            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic, self.flaws)
         except PlanningInputError as error:
             return PlanResult(None, reason=str(error), seconds=time.perf_counter() - started)
         # The goals the plan met (all, when it does not say): one it left aside stays so.
@@ -281,7 +292,7 @@ class Setup:
     """A problem made ready to plan: its goals, the contingent instants and the constraints."""
 
     def __init__(self, domain: pm.PlanningDomain, problem: pm.Problem, now: float, limits: Limits,
-                 controllability: str = STRONG, heuristic: str = STANDARD) -> None:
+                 controllability: str = STRONG, heuristic: str = STANDARD, flaws: str = NEWEST_TASK_FIRST) -> None:
         self.heuristic = heuristic
         if problem.domain != domain.name:
             raise PlanningInputError(f"problem '{problem.name}' is written for domain '{problem.domain}', "
@@ -368,7 +379,8 @@ class Setup:
                       if owners <= goal_indexes and point not in (self.origin, problem.end)}
         self.kept_ids: set[str] = set()  # a repair's instances put back from the plan it repairs
         self.context = Context(problem.end, self.origin, now, limits, {r.name: r.capacity for r in domain.resources},
-                               producers_of(domain), self.nature_before, controllability)
+                               producers_of(domain), self.nature_before, controllability,
+                               flaws == OLDEST_TASK_FIRST)
 
     def root(self, active: list[Goal], repair: Repair | None = None) -> Node:
         node = self.problem_root(active)
@@ -865,19 +877,21 @@ def threat_resolvers(node: Node, threat: Threat) -> list[Resolver]:
 
 def pick_need(node: Node) -> tuple[Assertion, list[Resolver]] | None:
     """The open condition to solve next, with its resolvers: the newest task's first (to bind its
-    arguments early), the one with the fewest resolvers among them (a pan-tilt unit's tilt that
-    only a new pan-tilt move gives goes before its pan, which the same move should give too);
-    then the problem's required assertions; then its goals, those that may come earliest first."""
+    arguments early; the oldest task's with OLDEST_TASK_FIRST), the one with the fewest resolvers
+    among them (a pan-tilt unit's tilt that only a new pan-tilt move gives goes before its pan,
+    which the same move should give too); then the problem's required assertions; then its goals,
+    those that may come earliest first."""
     if not node.open:
         return None
     mine = [node.assertions[i] for i in node.open if node.assertions[i].owner != "problem"]
     if mine:
         # Tasks come in the order they are numbered, each with its assertions: the newest task's
         # assertions are the last ones.
-        newest = max(mine, key=lambda a: a.id).owner
+        first = min if node.ctx.oldest_task_first else max
+        owner = first(mine, key=lambda a: a.id).owner
         # Counted first, ranked only for the need chosen.
         best: tuple[Assertion, list[Assertion], list[tuple[pm.Task, int]]] | None = None
-        for need in sorted((a for a in mine if a.owner == newest), key=lambda a: a.id):
+        for need in sorted((a for a in mine if a.owner == owner), key=lambda a: a.id):
             existing, insertions = node.producers(need), node.insertions(need)
             count = len(existing) + len(insertions)
             if best is None or count < len(best[1]) + len(best[2]):

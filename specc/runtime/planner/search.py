@@ -362,6 +362,7 @@ class Context:
     # Orders nature promises between its own instants (`t_evisi1 < t_svisi2`): (earlier, later).
     nature_before: set[tuple[str, str]] = field(default_factory=set)
     controllability: str = STRONG
+    oldest_task_first: bool = False  # the flaw order (specc.runtime.planner.heuristics.FLAW_ORDERS)
 
 
 def producers_of(domain: pm.PlanningDomain) -> dict[str, list[tuple[pm.Task, int]]]:
