@@ -65,3 +65,26 @@ def hilare() -> Any:
     from specc.run.mission import load_robot
 
     return load_robot(ROOT / "generated", EXAMPLES / "hilare", "hilare")
+
+
+def tug_with(tmp_path: Path, planner: str, line: str) -> tuple[Any, Any, dict[str, Any]]:
+    """examples/tug copied into `tmp_path`, `line` (`repair: on;`) added to its planner block
+    `planner`: the program, its ftplan configuration and its planning domains (by name)."""
+    import shutil
+
+    from specc.analysis.ftplan import ftplan_config
+    from specc.analysis.planning import domain_model
+    from specc.model import nodes as m
+    from specc.pipeline import load
+
+    tug = tmp_path / "tug"
+    shutil.copytree(EXAMPLES / "tug", tug)
+    spec = (tug / "ftplan.spec").read_text()
+    block = f"planner {planner} {{\n"
+    assert block in spec
+    (tug / "ftplan.spec").write_text(spec.replace(block, f"{block}    {line}\n"))
+    loaded = load([tug])
+    assert not loaded.errors and loaded.program is not None
+    ftplan = next(i for i in loaded.program.items if isinstance(i, m.FtPlan))
+    domains = {d.name: domain_model(loaded.program, d) for d in loaded.program.items if isinstance(d, m.Domain)}
+    return loaded.program, ftplan_config(ftplan, loaded.program), domains

@@ -5,7 +5,6 @@ checked by the independent validator; an improved plan is never worse than the f
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
@@ -16,8 +15,8 @@ from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.validate import validate
 from tests.atrv import atrv_models
+from tests.conftest import tug_with
 
-ROOT = Path(__file__).resolve().parents[1]
 MISSIONS = [f"M{k}_model{n}" for n in (1, 2) for k in (1, 2, 3, 4)]
 
 
@@ -87,22 +86,9 @@ def test_any_budget_and_horizon_give_a_valid_plan_no_worse_than_the_first(missio
 
 
 def test_a_planner_block_sets_the_improvement_its_planner_makes(tmp_path: Path) -> None:
-    from specc.analysis.ftplan import ftplan_config
-    from specc.analysis.planning import domain_model
-    from specc.model import nodes as m
-    from specc.pipeline import load
     from specc.runtime.ftplan.planners import standard_planner
 
-    tug = tmp_path / "tug"
-    shutil.copytree(ROOT / "examples" / "tug", tug)
-    spec = (tug / "ftplan.spec").read_text()
-    careful = "planner careful {\n    domain: warehouse_slow;\n"
-    assert careful in spec
-    (tug / "ftplan.spec").write_text(spec.replace(careful, careful + "    improve: 250;\n"))
-    loaded = load([tug])
-    assert not loaded.errors and loaded.program is not None
-    block = next(i for i in loaded.program.items if isinstance(i, m.FtPlan))
-    quick, careful = ftplan_config(block, loaded.program).planners
+    _, config, domains = tug_with(tmp_path, "careful", "improve: 250;")
+    quick, careful = config.planners
     assert (quick.improve, careful.improve) == (0, 250)
-    domains = {d.name: domain_model(loaded.program, d) for d in loaded.program.items if isinstance(d, m.Domain)}
     assert standard_planner(careful, domains).improve == 250

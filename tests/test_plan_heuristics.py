@@ -21,6 +21,7 @@ from specc.runtime.planner import model as pm
 from specc.runtime.planner.heuristics import OLDEST_TASK_FIRST
 from specc.runtime.planner.validate import validate
 from tests.atrv import ATRV, atrv_models
+from tests.conftest import tug_with
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "generated"))
@@ -83,25 +84,10 @@ def test_two_planners_of_one_model_with_diverse_flaw_orders_tolerate_the_fault()
 
 
 def test_a_planner_block_names_its_flaw_order(tmp_path: Path) -> None:
-    import shutil
-
-    from specc.analysis.ftplan import ftplan_config
-    from specc.analysis.planning import domain_model
-    from specc.model import nodes as m
-    from specc.pipeline import load
     from specc.runtime.ftplan.planners import standard_planner
 
-    tug = tmp_path / "tug"
-    shutil.copytree(ROOT / "examples" / "tug", tug)
-    spec = (tug / "ftplan.spec").read_text()
-    careful = "planner careful {\n    domain: warehouse_slow;\n"
-    assert careful in spec
-    (tug / "ftplan.spec").write_text(spec.replace(careful, careful + "    flaws: oldest-task-first;\n"))
-    loaded = load([tug])
-    assert not loaded.errors and loaded.program is not None
-    block = next(i for i in loaded.program.items if isinstance(i, m.FtPlan))
-    quick, slow = ftplan_config(block, loaded.program).planners
+    _, config, domains = tug_with(tmp_path, "careful", "flaws: oldest-task-first;")
+    quick, slow = config.planners
     assert (quick.flaws, slow.flaws) == (None, OLDEST_TASK_FIRST)
-    domains = {d.name: domain_model(loaded.program, d) for d in loaded.program.items if isinstance(d, m.Domain)}
     assert standard_planner(slow, domains).flaws == OLDEST_TASK_FIRST
     assert standard_planner(quick, domains).flaws == "newest-task-first"

@@ -6,7 +6,6 @@ blocked rover's would be; every repaired plan is checked by the independent vali
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 import sys
 from collections import Counter
@@ -26,6 +25,7 @@ from specc.runtime.planner.plan import Action, Plan, Repair
 from specc.runtime.planner.replan import Fact, replanning_problem
 from specc.runtime.planner.validate import validate
 from tests.atrv import atrv_models
+from tests.conftest import tug_with
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "generated"))
@@ -176,21 +176,8 @@ def test_configuration_suffixes_turn_repair_on_or_off_for_every_planner() -> Non
 
 
 def test_a_planner_block_turns_repair_on(tmp_path: Path) -> None:
-    from specc.analysis.ftplan import ftplan_config
-    from specc.model import nodes as m
-    from specc.pipeline import load
-
-    tug = tmp_path / "tug"
-    shutil.copytree(ROOT / "examples" / "tug", tug)
-    spec = (tug / "ftplan.spec").read_text()
-    assert "planner quick {\n    domain: warehouse;\n" in spec
-    (tug / "ftplan.spec").write_text(spec.replace("planner quick {\n    domain: warehouse;\n",
-                                                  "planner quick {\n    domain: warehouse;\n    repair: on;\n"))
-    loaded = load([tug])
-    assert not loaded.errors and loaded.program is not None
-    block = next(i for i in loaded.program.items if isinstance(i, m.FtPlan))
-    assert [(p.name, p.repair) for p in ftplan_config(block, loaded.program).planners] == [
-        ("quick", True), ("careful", False)]
+    _, config, _ = tug_with(tmp_path, "quick", "repair: on;")
+    assert [(p.name, p.repair) for p in config.planners] == [("quick", True), ("careful", False)]
 
 
 def test_a_run_and_a_campaign_with_repair_on_the_rover(tmp_path: Path) -> None:

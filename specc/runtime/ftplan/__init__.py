@@ -14,8 +14,9 @@ next inside `with planner_processes_kept():` (see `planners`).
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from specc.runtime.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from specc.runtime.ftplan.component import (
@@ -32,9 +33,7 @@ if TYPE_CHECKING:
     from specc.runtime.ftplan.planners import planner_processes_kept
     from specc.runtime.ftplan.pools import LocalPool, ProcessPool
 
-# What the package offers, each imported where it is defined on first use (PEP 562): a program
-# that needs one module of the package (a generated configuration reads `specc.runtime.ftplan.config`) does
-# not import the rest (the planners' processes, the search).
+# Each name imported where it is defined on first use (specc.runtime.lazy).
 _OFFERS = {
     "HUNG_PLANNER_SECONDS": "specc.runtime.ftplan.component", "CostModel": "specc.runtime.ftplan.component",
     "FtPlan": "specc.runtime.ftplan.component", "MissionFailure": "specc.runtime.ftplan.component",
@@ -48,14 +47,7 @@ _OFFERS = {
     "ProcessPool": "specc.runtime.ftplan.pools",
 }
 
-
-def __getattr__(name: str) -> Any:
-    module = _OFFERS.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_exports(__name__, _OFFERS)
 
 
 __all__ = ["HUNG_PLANNER_SECONDS", "CostModel", "Executor", "FtPlan", "FtPlanConfig", "LocalPool", "MissionFailure",

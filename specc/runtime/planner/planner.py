@@ -262,6 +262,21 @@ class Planner:
                           notes=(*notes, note))
 
 
+def _push(stack: list[tuple[Node, Resolver | None, int]], node: Node, choice: list[Resolver], used: int,
+          allowed: float) -> bool:
+    """The children of `node`, pushed so that the heuristic's first choice is popped first, each
+    with the discrepancies it costs (any but the first: one more); those beyond `allowed` are left
+    out for this pass: True then. A pass revisits the last one's: the stack never holds the tree."""
+    cut = False
+    for rank in range(len(choice) - 1, -1, -1):
+        cost = used + (1 if rank else 0)
+        if cost > allowed:
+            cut = True
+            continue
+        stack.append((node, choice[rank], cost))
+    return cut
+
+
 def explain(attempt: Attempt) -> str:
     if attempt.node is not None:
         return "planned"
@@ -496,24 +511,13 @@ class Setup:
                 if allowance is not None and nodes > allowance:
                     return Attempt(None, nodes, False, failures)
                 try:
-                    if resolver is not None:
-                        resolver.apply(node)
-                    choice = select(node)
-                    if choice is not None and self.heuristic == LEAST_ROOM and \
-                            all(r.kind == "order" for r in choice):
-                        choice = choice[::-1]
+                    choice = self._expand(node, resolver)
                 except DeadEnd as error:
                     failures[_generic(str(error))] += 1
                     continue
                 if choice is None:
                     return Attempt(node, nodes, False, failures)
-                # Children are pushed so that the heuristic's first choice is popped first.
-                for rank in range(len(choice) - 1, -1, -1):
-                    cost = used + (1 if rank else 0)
-                    if cost > allowed:
-                        cut = True
-                        continue
-                    stack.append((node, choice[rank], cost))  # a pass revisits the last one's: never holds the tree
+                cut = _push(stack, node, choice, used, allowed) or cut
             if not cut:
                 return Attempt(None, nodes, True, failures)
         raise AssertionError("unreachable")
@@ -541,28 +545,30 @@ class Setup:
                 if nodes > budget:
                     return found, nodes - 1
                 try:
-                    if resolver is not None:
-                        resolver.apply(node)
-                    if node.worst_end() >= bound - IMPROVEMENT:
-                        continue
-                    choice = select(node)
+                    choice = self._expand(node, resolver, bound - IMPROVEMENT)
                 except DeadEnd:
                     continue
                 if choice is None:
                     found.append(node)
                     bound = node.worst_end()
                     continue
-                if self.heuristic == LEAST_ROOM and all(r.kind == "order" for r in choice):
-                    choice = choice[::-1]
-                for rank in range(len(choice) - 1, -1, -1):
-                    cost = used + (1 if rank else 0)
-                    if cost > allowed:
-                        cut = True
-                        continue
-                    stack.append((node, choice[rank], cost))
+                cut = _push(stack, node, choice, used, allowed) or cut
             if not cut:
                 return found, nodes
         raise AssertionError("unreachable")
+
+    def _expand(self, node: Node, resolver: Resolver | None, beyond: float = INF) -> list[Resolver] | None:
+        """`resolver` applied to `node` (a copy of its parent), then the resolvers of its next flaw,
+        in the heuristic's order (None: the partial plan is a plan). DeadEnd when it has no
+        completion, or (branch and bound) when its worst-case makespan already reaches `beyond`."""
+        if resolver is not None:
+            resolver.apply(node)
+        if beyond < INF and node.worst_end() >= beyond:
+            raise DeadEnd("no better plan below")
+        choice = select(node)
+        if choice is not None and self.heuristic == LEAST_ROOM and all(r.kind == "order" for r in choice):
+            choice = choice[::-1]
+        return choice
 
     # ------------------------------------------------------------ output
     def extract(self, node: Node, exact: bool) -> tuple[Plan, tuple[str, ...]]:

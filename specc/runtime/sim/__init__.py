@@ -7,8 +7,9 @@ mission runs as fast as the computer allows (seed 004 §4.2.2 could only run Gaz
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from specc.runtime.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from specc.runtime.sim.devices import reliability
@@ -26,9 +27,7 @@ if TYPE_CHECKING:
         world_data,
     )
 
-# What the package offers, each imported where it is defined on first use (PEP 562): a program
-# that needs one module of the package (`specc check` reads world files with `specc.runtime.sim.world`) does
-# not import the rest (numpy, pymunk).
+# Each name imported where it is defined on first use (specc.runtime.lazy).
 _OFFERS = {
     "reliability": "specc.runtime.sim.devices", "RobotConfig": "specc.runtime.sim.rover",
     "Rover": "specc.runtime.sim.rover", "Simulation": "specc.runtime.sim.simulation",
@@ -39,14 +38,7 @@ _OFFERS = {
     "parse_world": "specc.runtime.sim.world", "world_data": "specc.runtime.sim.world",
 }
 
-
-def __getattr__(name: str) -> Any:
-    module = _OFFERS.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_exports(__name__, _OFFERS)
 
 
 __all__ = ["Circle", "Polygon", "RobotConfig", "Rover", "Simulation", "Target",
