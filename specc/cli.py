@@ -470,8 +470,8 @@ def plan(paths: PathsArg,
                                                            "docs/planning.md); '-' prints it.")] = None,
          nodes: Annotated[int, typer.Option(min=1, help="Partial plans each search may expand (one for every "
                                                         "goal at once, then one per goal added).")] = 300,
-         exact: Annotated[bool, typer.Option(help="Durations and schedule by CasADi (else the interval "
-                                                  "enclosures and the temporal network alone).")] = True,
+         exact: Annotated[bool, typer.Option(help="Exact durations by CasADi (else the interval "
+                                                  "enclosures the search computed).")] = True,
          controllability: Annotated[Controllability, typer.Option(
              help="strong: the plan holds whatever nature does; pseudo (IxTeT's): the problem's contingent "
                   "instants one at a time, each anywhere in its bounds.")] = Controllability.strong,

@@ -1,6 +1,6 @@
 """The temporal planner of specc (seed 004 §3.2.1.2): IxTeT-style plan-space search over
 partial plans, a strongly controllable temporal network, interval propagation and CasADi for
-the numeric constraints and the schedule.
+the exact durations the numeric constraints allow.
 
     from specc.runtime.planner import Planner
     result = Planner(domain).plan(problem)

@@ -399,7 +399,7 @@ def exact_duration(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> tuple[f
     """The smallest and largest duration the task's numeric constraints allow once its
     parameters are bound, solved with CasADi; None when the task's duration is not a variable
     of its numeric constraints, or when the solver does not converge."""
-    import casadi  # the planner's only CasADi user at search time is here and in the scheduler
+    import casadi  # the planner's only CasADi user
 
     variable = next((v for c in task.constraints if isinstance(c, pm.Relation) and _duration_constraint(c, task)
                      for v in (c.left, c.right) if isinstance(v, pm.Var)), None)

@@ -108,7 +108,7 @@ class Planner:
         self.controllability = controllability  # what the plans must hold against (search.py's doc)
         self.nodes = nodes  # budget of the search for every goal at once
         self.goal_nodes = goal_nodes  # budget of each smaller search
-        self.exact = exact  # CasADi durations and schedule (else the interval enclosures and the STN)
+        self.exact = exact  # exact durations by CasADi (else the interval enclosures)
         self.limits = limits or Limits()
         # Partial plans one planning may expand in all before it gives up: FTplan sets it to what
         # its watchdog pays for, so that a planning stops where its answer would be late anyway,
@@ -594,20 +594,17 @@ class Setup:
             if spec.contingent:
                 ends[instance.end] = (instance.start, spec.low, spec.high)
         if self.context.controllability == PSEUDO:
-            network, reduced, note = pseudo_network(node, ends, instants)
+            network, note = pseudo_network(node, ends, instants)
         else:
-            network, reduced, note = strong_network(node, ends | instants)
+            network, note = strong_network(node, ends | instants)
         if note:
             notes.append(note)
         links = ends | instants
-        # (The controllable durations are among node.original: the search required them.)
+        # (The controllable durations are among node.original: the search required them.) The
+        # network's constraints are differences of dates, so its earliest schedule puts every
+        # date at its least at once: it is the earliest completion, which no solver improves
+        # (a linear program over the same rows found it to the last digit on M1-M4: it went).
         schedule = network.earliest_schedule()
-        if exact:
-            optimised = optimise_schedule(network, reduced, schedule)
-            if optimised is None:
-                notes.append("CasADi did not return a schedule; the earliest schedule of the network is used")
-            else:
-                schedule = optimised
         schedule.pop("origin", None)
         schedule = {name: max(0.0, date) if abs(date) < 1e-6 else date for name, date in schedule.items()}
         uncontrolled, assumed = {}, {}
@@ -664,108 +661,51 @@ def _where(a: Assertion, node: Node) -> str:
 
 
 Links = dict[str, tuple[str, float, float]]  # nature's timepoint -> (the point it hangs from, low, high)
-Requirements = list[tuple[str, str, float, float]]
 
 
-def _add(network: STN, reduced: Requirements, a: str, b: str, low: float, high: float) -> None:
+def _add(network: STN, a: str, b: str, low: float, high: float) -> None:
     try:
         network.add(a, b, low, high)
     except Inconsistent:  # rounding only: the search's network, with its tolerance, took it
         low, high = low - 1e-6 if low > -INF else -INF, high + 1e-6 if high < INF else INF
         network.add(a, b, low, high)
-    reduced.append((a, b, low, high))
 
 
-def translated_network(node: Node, anchors: Links) -> tuple[STN, Requirements]:
+def translated_network(node: Node, anchors: Links) -> STN:
     """The plan's timepoints but those hanging from another (`anchors`), every requirement
     rewritten on the points they hang from, for nature's worst offsets."""
     network = STN()
     for name in node.stn.names:
         if name not in anchors:
             network.point(name)
-    reduced: Requirements = []
     for a, b, low, high in node.original:
         pa, pb, new_low, new_high = translate(anchors, a, b, low, high)
         if pa != pb:
-            _add(network, reduced, pa, pb, new_low, new_high)
-    return network, reduced
+            _add(network, pa, pb, new_low, new_high)
+    return network
 
 
-def strong_network(node: Node, links: Links) -> tuple[STN, Requirements, str]:
+def strong_network(node: Node, links: Links) -> tuple[STN, str]:
     """The plan's own timepoints, every requirement rewritten for nature's worst case."""
-    network, reduced = translated_network(node, links)
-    return network, reduced, ""
+    return translated_network(node, links), ""
 
 
-def pseudo_network(node: Node, ends: Links, instants: Links) -> tuple[STN, Requirements, str]:
+def pseudo_network(node: Node, ends: Links, instants: Links) -> tuple[STN, str]:
     """The plan's own timepoints and the problem's contingent instants, every requirement
     rewritten for the contingent durations' worst case, and each instant at its latest date: the
     executive cannot see a window open, so it waits until the window surely is. The plan carries
     these dates (`assumed`)."""
-    network, reduced = translated_network(node, ends)
-    latest, pinned = network.copy(), list(reduced)
+    network = translated_network(node, ends)
+    latest = network.copy()
     try:
         for point, (anchor, _, high) in sorted(instants.items()):
-            _add(latest, pinned, anchor, point, high, high)
-        return latest, pinned, ""
+            _add(latest, anchor, point, high, high)
+        return latest, ""
     except Inconsistent:
         for point, (anchor, low, high) in sorted(instants.items()):
-            _add(network, reduced, anchor, point, low, high)
-        return network, reduced, ("nature's instants at their latest do not fit the plan together: the dispatch "
-                                  "assumes the earliest dates of them that fit")
-
-
-def optimise_schedule(network: STN, reduced: list[tuple[str, str, float, float]],
-                      earliest: dict[str, float]) -> dict[str, float] | None:
-    """The dispatch dates, by CasADi: every requirement (already rewritten for nature's worst
-    case) as a linear constraint, and the earliest completion as the objective (the sum of the
-    dates, which the earliest date of every timepoint minimises). The result is checked against
-    the network; None when the solver fails or strays."""
-    import casadi
-
-    points = [name for name in network.names if name != "origin"]
-    index = {name: i for i, name in enumerate(points)}
-    # The tightest bounds per pair, as one sparse system low <= A x <= high (Opti's per-constraint
-    # overhead would dominate otherwise).
-    tightest: dict[tuple[str, str], list[float]] = {}
-    for a, b, low, high in reduced:
-        bounds = tightest.setdefault((a, b), [-INF, INF])
-        bounds[0], bounds[1] = max(bounds[0], low), min(bounds[1], high)
-    rows, columns, entries, lows, highs = [], [], [], [], []
-    for row, ((a, b), (low, high)) in enumerate(sorted(tightest.items())):
-        for name, sign in ((b, 1.0), (a, -1.0)):
-            if name == "origin":
-                continue  # date 0
-            rows.append(row)
-            columns.append(index[name])
-            entries.append(sign)
-        lows.append(low if low > -INF else -1e9)  # IPOPT takes large finite bounds better than inf
-        highs.append(high if high < INF else 1e9)
-    opti = casadi.Opti()
-    x = opti.variable(len(points))
-    matrix = casadi.DM.triplet(rows, columns, casadi.DM(entries), len(tightest), len(points))
-    opti.subject_to(opti.bounded(casadi.DM(lows), casadi.mtimes(matrix, x), casadi.DM(highs)))
-    opti.subject_to(x >= 0)
-    opti.minimize(casadi.sum1(x))
-    opti.set_initial(x, [earliest[p] for p in points])
-    opti.solver("ipopt", {"print_time": False}, {"print_level": 0, "sb": "yes", "max_iter": 500, "tol": 1e-10})
-    try:
-        solution = opti.solve()
-    except RuntimeError:
-        return None
-    values = [float(v) for v in casadi.DM(solution.value(x)).full().ravel()]
-    result = {"origin": 0.0}
-    for name, value in zip(points, values, strict=False):
-        low, high = network.window(name)
-        if not (low - 1e-4 <= value <= high + 1e-4):
-            return None
-        # Snap onto the network's window so that the dates satisfy it exactly.
-        result[name] = min(max(value, low), high)
-    for a, b, low, high in reduced:
-        gap = result[b] - result[a]
-        if gap < low - 1e-4 or gap > high + 1e-4:
-            return None
-    return result
+            _add(network, anchor, point, low, high)
+        return network, ("nature's instants at their latest do not fit the plan together: the dispatch "
+                         "assumes the earliest dates of them that fit")
 
 
 # ---------------------------------------------------------------- resolvers and flaw choice
