@@ -84,7 +84,7 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
                 warning = unsettled_warning(compile_base(normal), f"rule base '{base.name}'", base)
                 found += [warning] if warning is not None else []
         except KheopsError as exc:
-            found.append(error(exc.code, str(exc), exc.node.span))
+            found.append(exc.diagnostic())
     if any(d.severity == "error" for d in found):
         return found
     for executive in (item for item in program.items if isinstance(item, m.Executive)):
@@ -96,7 +96,7 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
                                         f"'{executive.name}'", executive)
             found += [warning] if warning is not None else []
         except KheopsError as exc:
-            found.append(error(exc.code, str(exc), exc.node.span))
+            found.append(exc.diagnostic())
     return found
 
 

@@ -247,12 +247,13 @@ class Controller:
                          for service in self.graph.services}
         service_attribute = self.base.attributes["service"]
         memory = k.initial_memory(self.base)
+        mentions = {id(rule): mentioned(rule) for rule in self.base.rules if id(rule) not in framed}
         parts: dict[str, tuple[k.Base, tuple[str, ...]]] = {}
         for service in service_attribute.values:
             memory["service"] = frozenset({service})
             applicable = [rule for rule in self.base.rules
                           if rule.condition is None or k.truth(rule.condition, memory) != k.FALSE]
-            read = set().union(*(mentioned(rule) for rule in applicable if id(rule) not in framed))
+            read = set().union(*(mentions[id(rule)] for rule in applicable if id(rule) in mentions))
             kept = tuple(output for output in self.base.outputs if output in framed_states
                          and output not in read and output not in member_states.get(service, ()))
             rules = tuple(rule for rule in applicable if framed.get(id(rule)) not in kept)

@@ -27,7 +27,7 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Union
 
-from specc.diagnostics import Diagnostic
+from specc.diagnostics import Diagnostic, error
 from specc.model import nodes as m
 
 OTHER = "*other*"  # the values of an undeclared symbolic domain that no rule mentions
@@ -43,9 +43,12 @@ class KheopsError(Exception):
         super().__init__(message)
         self.node = node
 
+    def diagnostic(self) -> Diagnostic:
+        return error(self.code, str(self), self.node.span)
+
     def headline(self) -> str:
         """`file:line:col: error: message [code]`, as the command line prints it."""
-        return f"{self.node.span}: error: {self} [{self.code}]"
+        return self.diagnostic().headline()
 
 
 class TooLarge(KheopsError):

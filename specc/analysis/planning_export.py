@@ -118,8 +118,7 @@ def impossible_goals(domain: pm.PlanningDomain, problem: pm.Problem) -> dict[int
     """The source lines of the goals specc's planner finds impossible even alone, with why."""
     from specc.runtime.planner.planner import Planner
 
-    result = Planner(domain, exact=False).plan(problem)
-    return {g.line: g.reason for g in result.goals if not g.kept and g.reason.startswith("impossible even alone")}
+    return Planner(domain).impossible_goals(problem)
 
 
 def write_pddl(exported: Exported, folder: Path) -> tuple[Path, Path]:

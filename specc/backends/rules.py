@@ -70,9 +70,10 @@ class DecisionView:
         return self.compiled.part_depths()
 
     @property
-    def decides(self) -> dict[Any, tuple[str, ...]]:
-        """For each part of a base compiled in parts, the outputs it decides (it keeps the others)."""
-        return {value: tuple(o for o in self.outputs if o not in kept) for value, kept in self.compiled.kept.items()}
+    def kept(self) -> dict[Any, tuple[str, ...]]:
+        """For each part of a base compiled in parts, the outputs it keeps as they were (it decides
+        the others), in the base's order of outputs."""
+        return {value: tuple(o for o in self.outputs if o in kept) for value, kept in self.compiled.kept.items()}
 
     @property
     def copies_inputs(self) -> bool:

@@ -32,27 +32,16 @@ class Symbols:
     blocks: Mapping[type, Mapping[str, Any]]  # kind -> name -> the block (its first definition)
     requests: Mapping[str, Mapping[str, m.Request]]  # module -> request name -> request
     posters: Mapping[str, Mapping[str, m.Poster]]  # module -> poster name -> poster
-    services: Mapping[str, Mapping[str, m.Service]]  # executive -> service name -> service
     _module_of: Mapping[int, m.Module]  # id(request) -> the module declaring it
     _own_requests: Mapping[int, Mapping[str, m.Request]]  # id(module) -> its requests (a duplicate module too)
     _own_services: Mapping[int, Mapping[str, m.Service]]  # id(executive) -> its services
     offered: Mapping[str, m.Service]  # every executive's services by name (the first of a name)
-
-    def module(self, name: str) -> m.Module | None:
-        found: m.Module | None = self.blocks[m.Module].get(name)
-        return found
 
     def request(self, ref: m.Ref) -> m.Request | None:
         """`module.request` -> the request, None when it names none (or is not written so)."""
         if len(ref.parts) != 2:
             return None
         return self.requests.get(ref.parts[0], {}).get(ref.parts[1])
-
-    def poster(self, ref: m.Ref) -> m.Poster | None:
-        """`module.Poster` or `module.Poster.field` -> the poster, None when it names none."""
-        if len(ref.parts) < 2:
-            return None
-        return self.posters.get(ref.parts[0], {}).get(ref.parts[1])
 
     def requests_of(self, module: m.Module) -> Mapping[str, m.Request]:
         """The module's own requests by name (of this very block, when two modules share a name)."""
@@ -107,8 +96,7 @@ def build(program: m.Program) -> Symbols:
         for service in executive.services:
             given.setdefault(service.name, service)
             offered.setdefault(service.name, service)
-    services = {name: own_services[id(executive)] for name, executive in blocks[m.Executive].items()}
-    return Symbols(blocks, requests, posters, services, module_of, own_requests, own_services, offered)
+    return Symbols(blocks, requests, posters, module_of, own_requests, own_services, offered)
 
 
 # The tables of the programs in use, by identity: a program is a frozen tree, built once per load,

@@ -140,15 +140,24 @@ def _keep(cache: Path, key: str, result: ParseResult) -> None:
         with os.fdopen(handle, "wb") as stream:
             pickle.dump(result, stream, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(temporary, cache / key)
+    except (OSError, pickle.PicklingError, RecursionError):
+        if temporary is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)
+        return
+    _prune(cache)
+
+
+@functools.lru_cache(maxsize=1)
+def _prune(cache: Path) -> None:
+    """Past PARSED_CACHE_LIMIT files the older half goes; looked at once per process (the folder
+    listing is not redone at every file written)."""
+    with contextlib.suppress(OSError):
         kept = list(cache.glob("*.pickle"))
         if len(kept) > PARSED_CACHE_LIMIT:
             kept.sort(key=lambda f: f.stat().st_mtime)
             for old in kept[:len(kept) // 2]:
                 old.unlink(missing_ok=True)
-    except (OSError, pickle.PicklingError, RecursionError):
-        if temporary is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(temporary)
 
 
 def _parse_text(text: str, path: str) -> ParseResult:

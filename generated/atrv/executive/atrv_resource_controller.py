@@ -17,12 +17,12 @@ INPUTS = ["service", "event", "@GOTOstate", "@PTU_MOVEstate", "@PICTUREstate", "
 OUTPUTS = ["status", "GOTOstate", "PTU_MOVEstate", "PICTUREstate", "COMMUNICATEstate"]
 DEPTH = 3
 FINDINGS = 0
-# One decision per value of service: the tests on its longest path, and the outputs it
-# decides; it leaves the others as they were (each keeps its previous-cycle value, copied without a test).
+# One decision per value of service: the tests on its longest path (seed 000
+# §3.7's bound, per decision), and the outputs it keeps as they were (each its previous-cycle value,
+# copied without a test); it decides the others.
 SPLIT = "service"
 DEPTHS = {"GOTO": 2, "STOP-NAV": 2, "STOP-WHEELS": 1, "PTU-MOVE": 2, "PTU-INIT": 2, "PICTURE": 2, "COMMUNICATE": 2}
-DECIDES = {"GOTO": ("status", "GOTOstate"), "STOP-NAV": ("status",), "STOP-WHEELS": ("status",), "PTU-MOVE": ("status", "PTU_MOVEstate"), "PTU-INIT": ("status",), "PICTURE": ("status", "PICTUREstate"), "COMMUNICATE": ("status", "COMMUNICATEstate")}
-KEPT = {value: tuple(o for o in OUTPUTS if o not in decided) for value, decided in DECIDES.items()}
+KEPT = {"GOTO": ("PTU_MOVEstate", "PICTUREstate", "COMMUNICATEstate"), "STOP-NAV": ("GOTOstate", "PTU_MOVEstate", "PICTUREstate", "COMMUNICATEstate"), "STOP-WHEELS": ("GOTOstate", "PTU_MOVEstate", "PICTUREstate", "COMMUNICATEstate"), "PTU-MOVE": ("GOTOstate", "PICTUREstate", "COMMUNICATEstate"), "PTU-INIT": ("GOTOstate", "PTU_MOVEstate", "PICTUREstate", "COMMUNICATEstate"), "PICTURE": ("GOTOstate", "PTU_MOVEstate", "COMMUNICATEstate"), "COMMUNICATE": ("GOTOstate", "PTU_MOVEstate", "PICTUREstate")}
 
 _LEAF_0 = Decision(MappingProxyType({'status': 'OK', 'GOTOstate': 'GOTO'}), (), (), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'ERROR', 'GOTOstate': 'GOTO'}), (), (), None)

@@ -17,12 +17,12 @@ INPUTS = ["service", "event", "@GOTO_HITCH_UNHITCHstate"]
 OUTPUTS = ["status", "GOTO_HITCH_UNHITCHstate"]
 DEPTH = 3
 FINDINGS = 0
-# One decision per value of service: the tests on its longest path, and the outputs it
-# decides; it leaves the others as they were (each keeps its previous-cycle value, copied without a test).
+# One decision per value of service: the tests on its longest path (seed 000
+# §3.7's bound, per decision), and the outputs it keeps as they were (each its previous-cycle value,
+# copied without a test); it decides the others.
 SPLIT = "service"
 DEPTHS = {"GOTO": 2, "HITCH": 2, "UNHITCH": 2, "SET-LOAD": 1}
-DECIDES = {"GOTO": ("status", "GOTO_HITCH_UNHITCHstate"), "HITCH": ("status", "GOTO_HITCH_UNHITCHstate"), "UNHITCH": ("status", "GOTO_HITCH_UNHITCHstate"), "SET-LOAD": ("status",)}
-KEPT = {value: tuple(o for o in OUTPUTS if o not in decided) for value, decided in DECIDES.items()}
+KEPT = {"GOTO": (), "HITCH": (), "UNHITCH": (), "SET-LOAD": ("GOTO_HITCH_UNHITCHstate",)}
 
 _LEAF_0 = Decision(MappingProxyType({'status': 'OK', 'GOTO_HITCH_UNHITCHstate': 'GOTO'}), (), (), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'ERROR', 'GOTO_HITCH_UNHITCHstate': 'GOTO'}), (), (), None)

@@ -151,12 +151,11 @@ class Planner:
             return PlanResult(None, tuple(GoalOutcome(g.text, g.priority, g.hold.line, False, why) for g in goals),
                               reason=f"{why}: {explain(base)}", nodes=total,
                               seconds=time.perf_counter() - started)
-        candidates = []
+        candidates: list[Goal] = []
         for goal in goals:
-            alone = attempt([goal], self.goal_nodes)
-            if alone.node is None and alone.exhausted:
-                outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False,
-                                                   f"impossible even alone: {explain(alone)}")
+            impossible = impossible_alone(attempt([goal], self.goal_nodes))
+            if impossible is not None:
+                outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, impossible)
             else:
                 candidates.append(goal)
         # Every goal at once, depth first: when the heuristic leads there, the plan comes in a few
@@ -223,6 +222,20 @@ class Planner:
         note = f"improvement: {spent} partial plan(s); " + ("; ".join(said) or "no better plan found")
         return plan, (*notes, note), kept, spent
 
+    def impossible_goals(self, problem: pm.Problem, now: float = 0.0) -> dict[int, str]:
+        """The source lines of the goals that cannot be met even alone (every partial plan of the
+        goal's own search failed), with why: the goals `plan` drops first, found without planning
+        the others (`specc export` leaves them out)."""
+        try:
+            setup = Setup(self.domain, problem, now, self.limits, self.controllability, self.heuristic, self.flaws)
+        except PlanningInputError:
+            return {}
+        found = {}
+        for goal in setup.goals:
+            why = impossible_alone(setup.search([goal], self.goal_nodes))
+            if why is not None:
+                found[goal.hold.line] = why
+        return found
 
     # ------------------------------------------------------------ plan repair
     def repair(self, problem: pm.Problem, now: float, repair: Repair) -> PlanResult:
@@ -275,6 +288,11 @@ def _push(stack: list[tuple[Node, Resolver | None, int]], node: Node, choice: li
             continue
         stack.append((node, choice[rank], cost))
     return cut
+
+
+def impossible_alone(alone: Attempt) -> str | None:
+    """Why a goal searched for alone is impossible (its whole search space failed), else None."""
+    return f"impossible even alone: {explain(alone)}" if alone.node is None and alone.exhausted else None
 
 
 def explain(attempt: Attempt) -> str:
