@@ -14,10 +14,18 @@ from unified_planning.io import PDDLReader
 from unified_planning.model import DurativeAction
 
 from specc.analysis.planning import domain_model, problem_model
-from specc.analysis.planning_export import Exported, bounds, constant_set_names, export, write_pddl
+from specc.analysis.planning_export import (
+    Exported,
+    bounds,
+    constant_set_names,
+    export,
+    in_progress_values,
+    write_pddl,
+)
 from specc.model import nodes as m
 from specc.pipeline import load
 from specc.runtime.planner import model as pm
+from tests.atrv import atrv_models
 
 ATRV = Path(__file__).resolve().parent.parent / "examples" / "atrv"
 
@@ -91,9 +99,8 @@ def test_modele1_move_durations_come_from_the_distance(modele1: Exported) -> Non
     # d = |dx| + |dy|; the longest move lasts d * 1 / 0.17 s, rounded up to a whole second.
     assert static_value(modele1, *move("MOVE_duration", "0", "0", "4", "0")) == 24
     assert static_value(modele1, *move("MOVE_duration", "3", "m3", "0", "0")) == 36
-    # A move shorter than 0.5 m (here: staying put) and a move to the in-motion marker 1000 are not allowed.
+    # A move shorter than 0.5 m (here: staying put) is not allowed.
     assert static_value(modele1, *move("MOVE_allowed", "4", "0", "4", "0")) is False
-    assert static_value(modele1, *move("MOVE_allowed", "0", "0", "1000", "0")) is False
     assert static_value(modele1, *move("MOVE_allowed", "0", "0", "3", "m3")) is True
     communicate = modele1.problem.action("COMMUNICATE")
     assert communicate.duration.lower.constant_value() == communicate.duration.upper.constant_value() == 25
@@ -221,3 +228,47 @@ def test_a_problem_whose_goals_are_all_possible_keeps_them_all(modele1: Exported
     goals = [a for a in problem_model(program, problem).assertions if a.goal is not None]
     assert len(modele1.problem.goals) == len(goals)
     assert not mentions(modele1, "is left out")
+
+
+def test_values_that_only_mark_a_task_in_progress_are_found() -> None:
+    modele1 = in_progress_values(*atrv_models("M1_model1"))
+    assert modele1[("AT_ROBOT_X", pm.Num(1000.0))] == ["MOVE"]
+    assert modele1[("ROBOT_STATUS", pm.Sym("MOVING"))] == ["MOVE"]
+    assert ("ROBOT_STATUS", pm.Sym("STILL")) not in modele1  # the initial value, and COMMUNICATE's condition
+    modele2 = in_progress_values(*atrv_models("M1_model2"))
+    assert modele2[("FRAME_POS", pm.Sym("MOVING"))] == ["MOVE_NOMINAL", "MOVE_RECOV"]
+
+
+def busy_domain(watcher: bool) -> tuple[pm.PlanningDomain, pm.Problem]:
+    """WORK passes through S = BUSY; WATCH (when there) needs S = BUSY, which is then no marker."""
+    idle, busy = pm.Sym("IDLE"), pm.Sym("BUSY")
+    work = pm.Task("WORK", (), assertions=(
+        pm.Event("S", (), idle, busy, "t_start"), pm.Hold("S", (), busy, "t_start", "t_end"),
+        pm.Event("S", (), busy, idle, "t_end"), pm.Event("DONE", (), pm.Sym("NO"), pm.Sym("YES"), "t_end")),
+        constraints=(pm.Member(pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), pm.Interval(2.0, 3.0)),))
+    watch = pm.Task("WATCH", (), assertions=(pm.Hold("S", (), busy, "t_start", "t_end"),),
+                    constraints=(pm.Member(pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), pm.Interval(1.0, 1.0)),))
+    domain = pm.PlanningDomain("busy", tasks=(work, watch) if watcher else (work,))
+    problem = pm.Problem("p", "busy", assertions=(
+        pm.Event("S", (), busy, idle, "t_start", kind="explained"),
+        pm.Event("DONE", (), pm.Sym("YES"), pm.Sym("NO"), "t_start", kind="explained"),
+        pm.Hold("DONE", (), pm.Sym("YES"), "t_end", "t_end", goal=pm.GoalMark(1.0, 0.0))))
+    return domain, problem
+
+
+@pytest.mark.parametrize("watcher", [False, True])
+def test_the_compact_encoding_leaves_out_only_markers(watcher: bool) -> None:
+    domain, problem = busy_domain(watcher)
+    assert (("S", pm.Sym("BUSY")) in in_progress_values(domain, problem)) is not watcher
+    compact, full = export(domain, problem).problem, export(domain, problem, compact=False).problem
+    fluents = {f.name for f in compact.fluents}
+    assert "S_IDLE" in fluents and ("S_BUSY" in fluents) is watcher
+    assert "S_BUSY" in {f.name for f in full.fluents}
+    work = compact.action("WORK")
+    # Without its marker, WORK leaves S at its start (S has no value while it runs) and sets it back at its end.
+    start = {str(e) for timing, effects in work.effects.items() if timing.is_from_start() for e in effects}
+    end = {str(e) for timing, effects in work.effects.items() if timing.is_from_end() for e in effects}
+    assert start == ({"S_IDLE := false", "S_BUSY := true"} if watcher else {"S_IDLE := false"})
+    assert {"S_IDLE := true", "DONE_YES := true"} <= end
+    assert ("S_BUSY := false" in end) is watcher
+    assert mentions(export(domain, problem), "in progress", "S = BUSY (WORK)") is not watcher
