@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import itertools
 import math
+import random
 import re
 import time
 from collections import Counter
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
@@ -52,6 +53,7 @@ from specc.runtime.stn import STN, Inconsistent
 
 INF = math.inf
 IMPROVEMENT = 0.5  # s: a plan must end this much earlier to count as better (not a rounding's worth)
+REORDER_TRIAL = 400  # partial plans at most for one goal order tried by the improvement (Setup.reorder)
 
 
 class NodeLimitReached(Exception):
@@ -193,7 +195,9 @@ class Planner:
         watchdog leaves, under FTplan's cost model): first the goals it dropped that are not
         impossible alone, highest priority first, each tried again with the budget left (more
         priority-weighted goals kept is the better plan); then the worst-case makespan, by branch
-        and bound (`Setup.improve`). A plan replaces the first only when it keeps every goal it
+        and bound near the first plan's choices (`Setup.improve`, half the budget left), then by
+        other orders of taking the goals up (`Setup.reorder`: another tour of the photos). A plan
+        replaces the first only when it keeps every goal it
         kept and ends earlier at worst (`Plan.makespan`, the measure the plans are compared by),
         so the result is never worse. Returns the plan, its notes, the goals kept and the partial
         plans spent."""
@@ -209,13 +213,18 @@ class Planner:
                 plan, notes = setup.extract(node, self.exact)
                 gained.append(goal.text)
         first = plan.makespan
-        found, used = setup.improve(kept, node.worst_end(), budget - spent) if spent < budget else ([], 0)
-        spent += used
-        for better in reversed(found):  # the best by the search's measure first
-            candidate, candidate_notes = setup.extract(better, self.exact)
-            if candidate.makespan < plan.makespan - 1e-6:
-                plan, notes = candidate, candidate_notes
-                break
+        bound = node.worst_end()
+        # Branch and bound near the heuristic's choices (half the budget left), then other orders
+        # of taking the goals up (the rest).
+        for search, share in ((setup.improve, 2), (setup.reorder, 1)):
+            found, used = search(kept, bound, (budget - spent) // share) if spent < budget else ([], 0)
+            spent += used
+            for better in reversed(found):  # the best by the search's measure first
+                candidate, candidate_notes = setup.extract(better, self.exact)
+                if candidate.makespan < plan.makespan - 1e-6:
+                    plan, notes = candidate, candidate_notes
+                    bound = min(bound, better.worst_end())
+                    break
         said = ([f"goal(s) kept by the improvement: {'; '.join(gained)}"] if gained else []) + (
             [f"worst-case makespan improved from {first:.1f} s to {plan.makespan:.1f} s"]
             if plan.makespan < first - 1e-6 else [])
@@ -540,19 +549,21 @@ class Setup:
                 return Attempt(None, nodes, True, failures)
         raise AssertionError("unreachable")
 
-    def improve(self, active: list[Goal], bound: float, budget: int) -> tuple[list[Node], int]:
+    def improve(self, active: list[Goal], bound: float, budget: int,
+                depth_first: bool = False) -> tuple[list[Node], int]:
         """Plans for the `active` goals whose worst-case makespan (`Node.worst_end`) beats `bound`,
         each better than the one before, within `budget` partial plans; and the partial plans
         expanded. Branch and bound over limited discrepancy search: the passes depart from the
         heuristic at no choice, then one, then two..., so the plans nearest the heuristic's come
-        first; a partial plan that can no longer beat the best so far is cut."""
+        first; a partial plan that can no longer beat the best so far is cut. `depth_first`: one
+        depth-first pass, whose local backtracking suits a search the heuristic leads through."""
         found: list[Node] = []
         nodes = 0
         try:
             root = self.root(active)
         except DeadEnd:
             return found, 1
-        for allowed in itertools.count(0):
+        for allowed in (INF,) if depth_first else itertools.count(0):
             stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
             cut = False
             while stack:
@@ -574,6 +585,73 @@ class Setup:
             if not cut:
                 return found, nodes
         raise AssertionError("unreachable")
+
+    def reorder(self, active: list[Goal], bound: float, budget: int) -> tuple[list[Node], int]:
+        """Plans for the `active` goals whose worst-case makespan beats `bound`, each better than
+        the one before, found by taking the goals up in other orders within `budget` partial
+        plans. The search plans first for the goal that may come earliest; among goals that may
+        all come as early (the photos of a tour), the order it takes them up in is the order of
+        the tour. An iterated local search over that order: first improvement over every segment
+        reversed (2-opt), then every goal moved elsewhere, each order searched depth first within
+        REORDER_TRIAL partial plans; at a local optimum, a seeded random reversal of the best
+        order found and on (the same problem gives the same plans)."""
+        found: list[Node] = []
+        try:
+            root = self.root(active)
+        except DeadEnd:
+            return found, 1
+        ties: dict[float, list[int]] = {}
+        for a in root.assertions:
+            if a.owner == "problem" and a.goal is not None:
+                ties.setdefault(round(root.bounds("origin", a.start)[0], 6), []).append(a.line)
+        tour = max(ties.values(), key=len, default=[])
+        if len(tour) < 2:
+            return found, 1
+        context = self.context
+        chance = random.Random(len(tour))
+        nodes = 1
+
+        def makespan(order: list[int]) -> float:
+            """The worst-case makespan of the plan the order leads to (inf: none within the trial)."""
+            nonlocal nodes, bound
+            self.context = replace(context, goal_order={line: rank for rank, line in enumerate(order)})
+            # Depth first without a bound: a bound makes it thrash far from where the order leads.
+            tried = self.search(active, min(REORDER_TRIAL, budget - nodes), discrepancies=False)
+            nodes += tried.nodes
+            if tried.node is None:
+                return INF
+            end = tried.node.worst_end()
+            if end < bound - IMPROVEMENT:
+                found.append(tried.node)
+                bound = end
+            return end
+
+        def neighbours(order: list[int]) -> Iterator[list[int]]:
+            for i, j in itertools.combinations(range(len(order)), 2):
+                yield order[:i] + order[i:j + 1][::-1] + order[j + 1:]
+            for i, j in itertools.permutations(range(len(order)), 2):
+                if abs(i - j) > 1:  # an adjacent move is a reversal of two
+                    moved = order[:]
+                    moved.insert(j, moved.pop(i))
+                    yield moved
+
+        try:
+            current, value = tour, bound
+            while nodes < budget:
+                for order in neighbours(current):
+                    if nodes >= budget:
+                        break
+                    end = makespan(order)
+                    if end < value - IMPROVEMENT:
+                        current, value = order, end
+                        break
+                else:  # a local optimum: start again from a random reversal of it
+                    i, j = sorted(chance.sample(range(len(current)), 2))
+                    current = current[:i] + current[i:j + 1][::-1] + current[j + 1:]
+                    value = makespan(current)
+        finally:
+            self.context = context
+        return found, nodes
 
     def _expand(self, node: Node, resolver: Resolver | None, beyond: float = INF) -> list[Resolver] | None:
         """`resolver` applied to `node` (a copy of its parent), then the resolvers of its next flaw,
@@ -865,10 +943,12 @@ def pick_need(node: Node) -> tuple[Assertion, list[Resolver]] | None:
         assert best is not None
         return best[0], need_resolvers(node, *best)
 
-    def order(a: Assertion) -> tuple[float, float, float, int]:
+    ranks = node.ctx.goal_order
+
+    def order(a: Assertion) -> tuple[float, float, int, float, int]:
         if a.goal is None:
-            return (0.0, 0.0, 0.0, a.id)
-        return (1.0, node.bounds("origin", a.start)[0], a.goal.priority, a.id)
+            return (0.0, 0.0, 0, 0.0, a.id)
+        return (1.0, node.bounds("origin", a.start)[0], ranks.get(a.line, 0), a.goal.priority, a.id)
     need = min((node.assertions[i] for i in node.open), key=order)
     return need, need_resolvers(node, need, node.producers(need), node.insertions(need))
 

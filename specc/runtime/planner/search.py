@@ -363,6 +363,9 @@ class Context:
     nature_before: set[tuple[str, str]] = field(default_factory=set)
     controllability: str = STRONG
     oldest_task_first: bool = False  # the flaw order (specc.runtime.planner.heuristics.FLAW_ORDERS)
+    # The order the goals are taken up in, by source line (an improvement's trial); absent: the
+    # goal that may come earliest first.
+    goal_order: Mapping[int, int] = field(default_factory=dict)
 
 
 def producers_of(domain: pm.PlanningDomain) -> dict[str, list[tuple[pm.Task, int]]]:
