@@ -4,6 +4,8 @@ explained; replanning starts from the present; bad input ends in a reason, not a
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import textwrap
 from dataclasses import replace
 from functools import cache, lru_cache
@@ -19,6 +21,7 @@ from specc.runtime.planner import model as pm
 from specc.runtime.planner.numeric import Closure, Empty, duration_of, exact_duration
 from specc.runtime.planner.replan import Fact, replanning_problem
 from specc.runtime.planner.validate import validate
+from tests.conftest import ROOT
 
 ATRV = Path(__file__).resolve().parent.parent / "examples" / "atrv"
 MISSIONS = [f"M{k}_model{n}" for n in (1, 2) for k in (1, 2, 3, 4)]
@@ -216,6 +219,29 @@ def test_move_durations_follow_the_distance_and_the_speed_interval() -> None:
         duration_of(move, {"?x1": 0.0, "?y1": 0.0, "?x2": 0.2, "?y2": 0.1})
     key = tuple(sorted({"?x1": 0.0, "?y1": 0.0, "?x2": 3.0, "?y2": -3.0}.items()))
     assert exact_duration(move, key) == pytest.approx((12.0, 6 / 0.17), abs=1e-4)
+
+
+def test_an_enclosure_met_at_both_bounds_is_exact_without_casadi() -> None:
+    # MOVE's duration bounds are reached by points meeting its constraints (the slowest speed and
+    # the largest uncertainty, the fastest and the smallest): the enclosure is exact, and a plan
+    # needs no CasADi. A fresh process plans M1 without importing it.
+    code = ("import sys; from tests.atrv import atrv_models; from specc.runtime.planner import Planner; "
+            "result = Planner(atrv_models('M1_model1')[0]).plan(atrv_models('M1_model1')[1]); "
+            "assert result.plan is not None; print('casadi' in sys.modules)")
+    ran = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert ran.stdout.strip() == "False"
+
+
+def test_an_enclosure_wider_than_the_durations_is_solved_by_casadi() -> None:
+    # d = x (10 - x) with x in [0, 10]: intervals give [0, 100], as x appears twice; the true
+    # durations are [0, 25] (x = 5). No point reaches 100, so CasADi decides.
+    x, d = pm.Var("?x"), pm.Var("?d")
+    task = pm.Task("BUMP", (), variables=("?x", "?d"), constraints=(
+        pm.Member(x, pm.Interval(0.0, 10.0)),
+        pm.Relation("=", d, pm.Op("*", (x, pm.Op("-", (pm.Num(10.0), x))))),
+        pm.Relation("=", d, pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), contingent=True)))
+    assert duration_of(task, {}).high == pytest.approx(100.0)
+    assert exact_duration(task, ()) == pytest.approx((0.0, 25.0), abs=1e-4)
 
 
 def test_modele2_distance_tables_decide_the_distance_symbol() -> None:

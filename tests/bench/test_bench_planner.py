@@ -10,7 +10,7 @@ What is compared, exactly:
   closing, every goal is required (a goal impossible even alone is left out, as specc drops it),
   and the values that only mark a task in progress are left out. That is a deterministic
   relaxation: Aries' problem is no harder than specc's.
-- The times. specc: `Planner(domain).plan(problem)` in this process once CasADi and the caches are
+- The times. specc: `Planner(domain).plan(problem)` in this process once its caches are
   warm, median of 5 (the cold command is `make bench`'s front-end line and docs/planning.md).
   Aries: the whole `OneshotPlanner.solve` call, median of 3, which includes its solver process'
   fixed cost, printed apart (a one-action problem).
@@ -146,7 +146,7 @@ def test_planning_time_per_mission_against_aries() -> None:
         for k in (1, 2, 3, 4):
             name = f"M{k}_{model}"
             domain, problem = atrv_models(name)
-            result = Planner(domain).plan(problem)  # warm-up: CasADi's import, the caches
+            result = Planner(domain).plan(problem)  # warm-up: the caches
             assert result.plan is not None
             assert validate(domain, problem, result.plan, dropped_lines={g.line for g in result.dropped}) == []
             ours = median_seconds(lambda: Planner(domain).plan(problem))  # noqa: B023

@@ -80,10 +80,11 @@ from specc.runtime.planner.heuristics import NEWEST_TASK_FIRST, STANDARD
 from specc.runtime.planner.plan import Repair
 
 START_METHOD: Final = "forkserver"
-# Imported once by the forkserver, so that a planner's process starts without importing them
-# (casadi, which the planner imports at its first plan, is 0.2 s of it); then the modules of
-# specc the program has imported (`forkserver_preload`).
-PRELOAD = ["specc.runtime.planner", "specc.runtime.ftplan.planners", "casadi"]
+# Imported once by the forkserver, so that a planner's process starts without importing them;
+# then the modules of specc the program has imported (`forkserver_preload`). Not casadi (0.1-0.2 s):
+# the planner imports it only for a task whose duration enclosure is not exact, which no mission
+# of the examples has (specc.runtime.planner.numeric.exact_duration).
+PRELOAD = ["specc.runtime.planner", "specc.runtime.ftplan.planners"]
 KILL_GRACE = 1.0  # seconds a planner has to exit on SIGTERM before it gets SIGKILL
 
 
