@@ -10,6 +10,7 @@ import textwrap
 from dataclasses import replace
 from functools import cache, lru_cache
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -19,6 +20,7 @@ from specc.pipeline import load
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.numeric import Closure, Empty, duration_of, exact_duration
+from specc.runtime.planner.planner import Setup
 from specc.runtime.planner.replan import Fact, replanning_problem
 from specc.runtime.planner.validate import validate
 from tests.conftest import ROOT
@@ -432,3 +434,28 @@ def test_the_least_room_first_heuristic_searches_otherwise_and_plans_validly() -
     assert built.heuristic == "least-room-first"
     with pytest.raises(ValueError, match="heuristic 'fastest'"):
         Planner(model, heuristic="fastest")
+
+
+def test_no_search_is_run_twice_for_one_plan(monkeypatch: pytest.MonkeyPatch) -> None:
+    # The tug's shuttle: every goal at once, depth first, runs out of its budget, so the goals are
+    # added one by one; the first of them alone was searched already (to find the impossible
+    # ones), with the same budget: that search serves again rather than being run anew.
+    loaded = load([ROOT / "examples" / "tug"])
+    assert loaded.program is not None
+    chosen = next(p for p in loaded.program.items if isinstance(p, m.Problem) and p.name == "shuttle")
+    domain = next(d for d in loaded.program.items if isinstance(d, m.Domain) and d.name == chosen.domain.text)
+    planning_domain, problem = domain_model(loaded.program, domain), problem_model(loaded.program, chosen)
+    searched: list[tuple[tuple[int, ...], tuple[Any, ...]]] = []  # (goals, budget and search mode)
+    search = Setup.search
+
+    def recorded(self: Setup, active: list[Any], *args: Any, **kwargs: Any) -> Any:
+        searched.append((tuple(g.index for g in active), args + tuple(sorted(kwargs.items()))))
+        return search(self, active, *args, **kwargs)
+
+    monkeypatch.setattr(Setup, "search", recorded)
+    result = Planner(planning_domain).plan(problem)
+    checked(planning_domain, problem, result)
+    assert len({goals for goals, _ in searched if len(goals) == 1}) == 2  # each goal alone, once
+    assert len(searched) == len(set(searched))
+    # None, each goal alone, both at once depth first, then the second added to the first.
+    assert [len(goals) for goals, _ in searched] == [0, 1, 1, 2, 2]

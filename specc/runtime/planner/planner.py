@@ -154,8 +154,10 @@ class Planner:
                               reason=f"{why}: {explain(base)}", nodes=total,
                               seconds=time.perf_counter() - started)
         candidates: list[Goal] = []
+        alone: dict[int, Attempt] = {}  # each goal's search alone: the first of those below, if it comes to them
         for goal in goals:
-            impossible = impossible_alone(attempt([goal], self.goal_nodes))
+            alone[goal.index] = attempt([goal], self.goal_nodes)
+            impossible = impossible_alone(alone[goal.index])
             if impossible is not None:
                 outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, impossible)
             else:
@@ -168,7 +170,8 @@ class Planner:
             # Highest priority first; within a priority, in the order the problem lists them.
             best = base
             for goal in sorted(candidates, key=lambda g: (-g.priority, g.index)):
-                tried = attempt(kept + [goal], self.goal_nodes)
+                # The first goal alone was searched already, with the same budget: the same search.
+                tried = alone[goal.index] if not kept else attempt(kept + [goal], self.goal_nodes)
                 if tried.node is not None:
                     kept.append(goal)
                     best = tried
