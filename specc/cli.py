@@ -532,6 +532,9 @@ def export_problem(paths: PathsArg,
                    output: Annotated[Path, typer.Option("--output", "-o", help="Folder receiving domain.pddl and "
                                                         "problem.pddl.")],
                    domain: Annotated[Optional[str], typer.Option(help="Keep the problems of this domain.")] = None,
+                   keep_markers: Annotated[bool, typer.Option(
+                       help="Keep the values that only mark a task in progress (MOVE's AT_ROBOT_X = 1000), which "
+                            "the compact encoding leaves out.")] = False,
                    ) -> None:
     """Export a planning domain and problem through unified-planning to PDDL 2.1, saying what could not
     be expressed.
@@ -552,7 +555,7 @@ def export_problem(paths: PathsArg,
         raise typer.Exit(1) from None
     block = domain_block(loaded.program, chosen)
     exported = export(domain_model(loaded.program, block), problem_model(loaded.program, chosen),
-                      constant_set_names(loaded.program, block))
+                      constant_set_names(loaded.program, block), compact=not keep_markers)
     try:
         written = write_pddl(exported, output)
     except OSError as exc:

@@ -434,3 +434,14 @@ def test_export_writes_pddl_and_says_what_it_could_not_express(tmp_path: Path) -
     assert "(:init" in (tmp_path / "problem.pddl").read_text().lower()
     notes = [line for line in result.stdout.splitlines() if line.startswith("not expressed:")]
     assert any("priorit" in line for line in notes) and any("contingent" in line for line in notes)
+
+
+def test_export_leaves_the_in_progress_markers_out_unless_kept(tmp_path: Path) -> None:
+    compact, full = tmp_path / "compact", tmp_path / "full"
+    for folder, extra in ((compact, ()), (full, ("--keep-markers",))):
+        result = specc("export", str(EXAMPLES / "atrv"), "--problem", "M1_model1", "-o", str(folder), *extra)
+        assert result.returncode == 0, result.stderr
+        said = "only mark a task in progress are left out" in result.stdout
+        assert said is (folder == compact)
+    assert "robot_status_moving" not in (compact / "domain.pddl").read_text().lower()
+    assert "robot_status_moving" in (full / "domain.pddl").read_text().lower()

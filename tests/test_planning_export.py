@@ -6,6 +6,7 @@ Aries run that solves M1 is a benchmark (`make bench`)."""
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 
@@ -272,3 +273,18 @@ def test_the_compact_encoding_leaves_out_only_markers(watcher: bool) -> None:
     assert {"S_IDLE := true", "DONE_YES := true"} <= end
     assert ("S_BUSY := false" in end) is watcher
     assert mentions(export(domain, problem), "in progress", "S = BUSY (WORK)") is not watcher
+
+
+def test_a_value_another_task_ends_with_is_no_marker() -> None:
+    # WORK passes through BUSY; FINISH passes through WRAPPING and ends with BUSY: BUSY is a value
+    # like any other there, and WRAPPING alone only marks a task in progress.
+    domain, problem = busy_domain(False)
+    idle, busy, wrapping = pm.Sym("IDLE"), pm.Sym("BUSY"), pm.Sym("WRAPPING")
+    finish = pm.Task("FINISH", (), assertions=(
+        pm.Event("S", (), idle, wrapping, "t_start"), pm.Hold("S", (), wrapping, "t_start", "t_end"),
+        pm.Event("S", (), wrapping, busy, "t_end")),
+        constraints=(pm.Member(pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), pm.Interval(1.0, 1.0)),))
+    domain = replace(domain, tasks=(*domain.tasks, finish))
+    assert in_progress_values(domain, problem) == {("S", wrapping): ["FINISH"]}
+    fluents = {f.name for f in export(domain, problem).problem.fluents}
+    assert "S_BUSY" in fluents and "S_WRAPPING" not in fluents

@@ -23,7 +23,7 @@ The encoding, chosen for the temporal planners of unified_planning (Aries) and f
   AT_ROBOT_X = 1000, ROBOT_STATUS = MOVING) is left out. The task's start only deletes the old
   value and its end only adds the new one: in between the attribute has no value, which keeps
   every other task needing a value out as the marker did, with a fluent and objects fewer. Aries
-  solves M1-M4 of both models in 0.3-4.5 s this way; with the markers, it took 2-12 s or timed out;
+  solves M1-M4 of both models in 0.3-5 s this way; with the markers, it took 2-12 s or timed out;
 - the problem's explained events at t_start are the initial state; its other given events are
   timed initial literals, pessimistic for nature: the old value stops being true at the
   event's earliest date, the new one starts at its latest date (a window is open from its latest
@@ -154,16 +154,20 @@ def _transits(task: pm.Task) -> list[_Transit]:
 def in_progress_values(domain: pm.PlanningDomain, problem: pm.Problem) -> dict[tuple[str, pm.Expr], list[str]]:
     """The values that only mark a task in progress (Modele1's AT_ROBOT_X = 1000 while the robot
     moves, ROBOT_STATUS = MOVING), with the tasks that pass through them: every assertion naming
-    the value belongs to a passage (`_Transit`) of a task, but for the meaningless old value of an
-    event given at the problem's start. Such a value says only "this task runs", which the absence
-    of any value of the attribute says as well: the compact encoding leaves it out."""
+    the value belongs to a passage (`_Transit`) of a task, as the value passed through (a
+    passage's values before and after are values like any other), but for the meaningless old
+    value of an event given at the problem's start. Such a value says only "this task runs",
+    which the absence of any value of the attribute says as well: the compact encoding leaves it
+    out."""
     passages: dict[tuple[str, pm.Expr], list[str]] = {}
     inside: set[int] = set()
+    named: set[tuple[str, pm.Expr]] = set()
     for task in domain.tasks:
         for transit in _transits(task):
-            passages.setdefault((transit.hold.attribute, transit.hold.value), []).append(task.name)
+            attribute = transit.hold.attribute
+            passages.setdefault((attribute, transit.hold.value), []).append(task.name)
             inside |= {id(transit.leave), id(transit.hold), id(transit.arrive)}
-    named: set[tuple[str, pm.Expr]] = set()
+            named |= {(attribute, transit.leave.before), (attribute, transit.arrive.after)}
     for task in domain.tasks:
         for a in task.assertions:
             if isinstance(a, (pm.Event, pm.Hold)) and id(a) not in inside:
@@ -1113,15 +1117,15 @@ class _Exporter:
     def add_assertion(self, task: pm.Task, action: Any, a: pm.Event | pm.Hold, bound: Mapping[str, Any]) -> bool:
         timing = {task.start: StartTiming(), task.end: EndTiming()}
         passage = self.passage_parts.get(id(a))
-        if passage is not None:
-            # Through an in-progress value, left out: the attribute has no value while the task runs.
-            if isinstance(a, pm.Event) and passage == "leave":
-                action.add_condition(StartTiming(), self.atom(a.attribute, a.args, a.before, bound))
-                self.effect(action, StartTiming(), a.attribute, a.args, a.before, bound, False)
-            elif isinstance(a, pm.Event):
-                self.effect(action, EndTiming(), a.attribute, a.args, a.after, bound, True)
-            return True
         try:
+            if passage is not None:
+                # Through an in-progress value, left out: the attribute has no value while the task runs.
+                if isinstance(a, pm.Event) and passage == "leave":
+                    action.add_condition(StartTiming(), self.atom(a.attribute, a.args, a.before, bound))
+                    self.effect(action, StartTiming(), a.attribute, a.args, a.before, bound, False)
+                elif isinstance(a, pm.Event):
+                    self.effect(action, EndTiming(), a.attribute, a.args, a.after, bound, True)
+                return True
             if isinstance(a, pm.Event):
                 if a.time not in timing:
                     return False

@@ -399,8 +399,10 @@ def _duration_constraint(c: pm.Constraint, task: pm.Task) -> Interval | None:
 @lru_cache(maxsize=1024)
 def exact_duration(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> tuple[float, float] | None:
     """The smallest and largest duration the task's numeric constraints allow once its
-    parameters are bound, solved with CasADi; None when the task's duration is not a variable
-    of its numeric constraints, or when the solver does not converge."""
+    parameters are bound: the interval enclosure's bounds when points reach them (`_attained`),
+    else solved with CasADi; None when the task's duration is not a variable of its numeric
+    constraints, or when the solver does not converge. Strict inequalities count as non-strict
+    (a bound only approached counts as reached), as CasADi's constraints do."""
     variable = next((v for c in task.constraints if isinstance(c, pm.Relation) and _duration_constraint(c, task)
                      for v in (c.left, c.right) if isinstance(v, pm.Var)), None)
     if variable is None:

@@ -552,21 +552,19 @@ class Setup:
                 return Attempt(None, nodes, True, failures)
         raise AssertionError("unreachable")
 
-    def improve(self, active: list[Goal], bound: float, budget: int,
-                depth_first: bool = False) -> tuple[list[Node], int]:
+    def improve(self, active: list[Goal], bound: float, budget: int) -> tuple[list[Node], int]:
         """Plans for the `active` goals whose worst-case makespan (`Node.worst_end`) beats `bound`,
         each better than the one before, within `budget` partial plans; and the partial plans
         expanded. Branch and bound over limited discrepancy search: the passes depart from the
         heuristic at no choice, then one, then two..., so the plans nearest the heuristic's come
-        first; a partial plan that can no longer beat the best so far is cut. `depth_first`: one
-        depth-first pass, whose local backtracking suits a search the heuristic leads through."""
+        first; a partial plan that can no longer beat the best so far is cut."""
         found: list[Node] = []
         nodes = 0
         try:
             root = self.root(active)
         except DeadEnd:
             return found, 1
-        for allowed in (INF,) if depth_first else itertools.count(0):
+        for allowed in itertools.count(0):
             stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
             cut = False
             while stack:
@@ -596,8 +594,8 @@ class Setup:
         all come as early (the photos of a tour), the order it takes them up in is the order of
         the tour. An iterated local search over that order: first improvement over every segment
         reversed (2-opt), then every goal moved elsewhere, each order searched depth first within
-        REORDER_TRIAL partial plans; at a local optimum, a seeded random reversal of the best
-        order found and on (the same problem gives the same plans)."""
+        REORDER_TRIAL partial plans; at a local optimum, a seeded random reversal of the current
+        order and on from there (the same problem gives the same plans)."""
         found: list[Node] = []
         try:
             root = self.root(active)
