@@ -13,9 +13,9 @@ resolve, with their own codes.
 from __future__ import annotations
 
 import weakref
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 from specc.model import nodes as m
 
@@ -25,6 +25,14 @@ KIND_WORDS: dict[type, str] = {
     m.Domain: "domain", m.Problem: "problem", m.Fragment: "fragment", m.FtPlan: "ftplan",
     m.System: "system",
 }
+
+
+class _HasName(Protocol):
+    @property
+    def name(self) -> str: ...
+
+
+Named = TypeVar("Named", bound=_HasName)
 
 
 @dataclass(frozen=True)
@@ -72,30 +80,25 @@ class Symbols:
         return [(key[0], target) for key, target in found.items()]
 
 
+def first_by_name(items: Iterable[Named]) -> dict[str, Named]:
+    """Items by name, the first of each name (the checks report a name defined twice)."""
+    found: dict[str, Named] = {}
+    for item in items:
+        found.setdefault(item.name, item)
+    return found
+
+
 def build(program: m.Program) -> Symbols:
-    blocks: dict[type, dict[str, Any]] = {kind: {} for kind in KIND_WORDS}
-    for item in program.items:
-        blocks[type(item)].setdefault(item.name, item)
-    own_requests: dict[int, dict[str, m.Request]] = {}
-    module_of: dict[int, m.Module] = {}
-    for module in (item for item in program.items if isinstance(item, m.Module)):
-        own = own_requests[id(module)] = {}
-        for request in module.requests:
-            own.setdefault(request.name, request)
-            module_of[id(request)] = module
+    blocks: dict[type, dict[str, Any]] = {
+        kind: first_by_name(item for item in program.items if type(item) is kind) for kind in KIND_WORDS}
+    modules = [item for item in program.items if isinstance(item, m.Module)]
+    executives = [item for item in program.items if isinstance(item, m.Executive)]
+    own_requests = {id(module): first_by_name(module.requests) for module in modules}
+    module_of = {id(request): module for module in modules for request in module.requests}
     requests = {name: own_requests[id(module)] for name, module in blocks[m.Module].items()}
-    posters: dict[str, dict[str, m.Poster]] = {}
-    for module in blocks[m.Module].values():
-        board = posters.setdefault(module.name, {})
-        for poster in module.posters:
-            board.setdefault(poster.name, poster)
-    own_services: dict[int, dict[str, m.Service]] = {}
-    offered: dict[str, m.Service] = {}
-    for executive in (item for item in program.items if isinstance(item, m.Executive)):
-        given = own_services[id(executive)] = {}
-        for service in executive.services:
-            given.setdefault(service.name, service)
-            offered.setdefault(service.name, service)
+    posters = {module.name: first_by_name(module.posters) for module in blocks[m.Module].values()}
+    own_services = {id(executive): first_by_name(executive.services) for executive in executives}
+    offered = first_by_name(service for executive in executives for service in executive.services)
     return Symbols(blocks, requests, posters, module_of, own_requests, own_services, offered)
 
 

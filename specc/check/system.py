@@ -12,6 +12,7 @@ from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.check.executive import resolve_poster, resolve_request
 from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks
+from specc.check.symbols import first_by_name
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
@@ -138,9 +139,8 @@ def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
     """The system's worlds by name; each a TOML world file the simulator can load."""
     entries = system.worlds.entries if system.worlds is not None else ()
     ctx.duplicates(entries, "world")
-    worlds: dict[str, m.Setting] = {}
+    worlds = first_by_name(entries)
     for entry in entries:
-        worlds.setdefault(entry.name, entry)
         if not isinstance(entry.value, m.String):
             ctx.report("bad-property-value", f"world '{entry.name}' is a world file: give its path in quotes, "
                        "relative to this spec", entry.value.span)

@@ -6,15 +6,18 @@ does not import the rest (the search, numpy, pymunk)."""
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 
-def lazy_exports(package: str, offers: Mapping[str, str]) -> Callable[[str], Any]:
-    """The package's module `__getattr__`: each name of `offers` (name -> the module defining it)
-    imported on first use, then kept in the package's namespace."""
+def lazy_exports(package: str, offers: Mapping[str, Iterable[str]]) -> Callable[[str], Any]:
+    """The package's module `__getattr__`: the names each of its modules offers (module name,
+    relative to the package -> names), each imported on first use, then kept in the package's
+    namespace."""
+    defined_in = {name: f"{package}.{module}" for module, names in offers.items() for name in names}
+
     def __getattr__(name: str) -> Any:
-        module = offers.get(name)
+        module = defined_in.get(name)
         if module is None:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
         value = getattr(importlib.import_module(module), name)

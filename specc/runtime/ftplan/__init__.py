@@ -35,16 +35,12 @@ if TYPE_CHECKING:
 
 # Each name imported where it is defined on first use (specc.runtime.lazy).
 _OFFERS = {
-    "HUNG_PLANNER_SECONDS": "specc.runtime.ftplan.component", "CostModel": "specc.runtime.ftplan.component",
-    "FtPlan": "specc.runtime.ftplan.component", "MissionFailure": "specc.runtime.ftplan.component",
-    "MissionResult": "specc.runtime.ftplan.component", "planners_as_run": "specc.runtime.ftplan.component",
-    "FtPlanConfig": "specc.runtime.ftplan.config", "PlannerConfig": "specc.runtime.ftplan.config",
-    "configurations": "specc.runtime.ftplan.config", "Executor": "specc.runtime.ftplan.execution",
-    "Outcome": "specc.runtime.ftplan.execution", "Report": "specc.runtime.ftplan.execution",
-    "ScriptedExecutor": "specc.runtime.ftplan.execution", "MissionSetup": "specc.runtime.ftplan.missions",
-    "UnknownName": "specc.runtime.ftplan.missions", "mission_setup": "specc.runtime.ftplan.missions",
-    "planner_processes_kept": "specc.runtime.ftplan.planners", "LocalPool": "specc.runtime.ftplan.pools",
-    "ProcessPool": "specc.runtime.ftplan.pools",
+    "component": ("HUNG_PLANNER_SECONDS", "CostModel", "FtPlan", "MissionFailure", "MissionResult", "planners_as_run"),
+    "config": ("FtPlanConfig", "PlannerConfig", "configurations"),
+    "execution": ("Executor", "Outcome", "Report", "ScriptedExecutor"),
+    "missions": ("MissionSetup", "UnknownName", "mission_setup"),
+    "planners": ("planner_processes_kept",),
+    "pools": ("LocalPool", "ProcessPool"),
 }
 
 __getattr__ = lazy_exports(__name__, _OFFERS)

@@ -18,9 +18,8 @@ if TYPE_CHECKING:
 
 # Each name imported where it is defined on first use (specc.runtime.lazy).
 _OFFERS = {
-    "Action": "specc.runtime.planner.plan", "GoalOutcome": "specc.runtime.planner.plan",
-    "Plan": "specc.runtime.planner.plan", "PlanResult": "specc.runtime.planner.plan",
-    "Planner": "specc.runtime.planner.planner", "PlanningInputError": "specc.runtime.planner.planner",
+    "plan": ("Action", "GoalOutcome", "Plan", "PlanResult"),
+    "planner": ("Planner", "PlanningInputError"),
 }
 
 __getattr__ = lazy_exports(__name__, _OFFERS)

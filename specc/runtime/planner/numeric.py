@@ -347,11 +347,17 @@ _DURATIONS: dict[tuple[int, tuple[tuple[str, Value], ...]], tuple[pm.Task, Durat
 IDENTITY_CACHE_LIMIT = 4096
 
 
-def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> DurationSpec:
+def _propagated(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> Closure:
+    """The task's numeric constraints propagated with its parameters bound (Empty: inconsistent)."""
     closure = Closure(constraints=tuple(c for c in task.constraints if not is_duration(c, task)))
     for name, value in key:
         closure.domains[name] = frozenset((value,)) if isinstance(value, str) else (float(value), float(value))
     closure.propagate()
+    return closure
+
+
+def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> DurationSpec:
+    closure = _propagated(task, key)
     low, high, contingent = 0.0, INF, False
     for c in task.constraints:
         span = _duration_constraint(c, task)
@@ -411,12 +417,11 @@ def exact_duration(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> tuple[f
     # The interval enclosure is sound (no duration outside it); when a point meeting every
     # constraint has the duration at each of its bounds, it is exact, and CasADi (its import
     # is 0.1-0.2 s of a first plan) has nothing to add. On the rover's missions it always is.
-    known = _closure(task, key)
-    if known is not None:
-        low, high = Closure.numeric(known.forward(variable))
-        if math.isfinite(low) and math.isfinite(high) and all(
-                _attained(known, variable.name, bound) for bound in (low, high)):
-            return (low, high)
+    known = _propagated(task, key)  # consistent: the enclosure above was found
+    low, high = Closure.numeric(known.forward(variable))
+    if math.isfinite(low) and math.isfinite(high) and all(
+            _attained(known, variable.name, bound) for bound in (low, high)):
+        return (low, high)
     import casadi  # the planner's only CasADi user
 
     bound = dict(key)
@@ -463,18 +468,6 @@ def exact_duration(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> tuple[f
         except (RuntimeError, ValueError):
             return None
     return (min(result), max(result))
-
-
-def _closure(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> Closure | None:
-    """The task's numeric constraints propagated with its parameters bound (None: inconsistent)."""
-    closure = Closure(constraints=tuple(c for c in task.constraints if not is_duration(c, task)))
-    for name, value in key:
-        closure.domains[name] = frozenset((value,)) if isinstance(value, str) else (float(value), float(value))
-    try:
-        closure.propagate()
-    except Empty:
-        return None
-    return closure
 
 
 def _attained(closure: Closure, variable: str, value: float) -> bool:

@@ -525,30 +525,19 @@ class Setup:
         # problem the heuristic leads through.
         nodes = 0
         for allowed in itertools.chain((INF,), itertools.count(1)):
-            stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
-            cut = False  # some branch was left out for lack of discrepancies
-            limit = budget // 20 if allowed == INF and discrepancies else budget
-            while stack:
-                node, resolver, used = stack.pop()
-                if resolver is not None:
-                    node = node.copy()
-                nodes += 1
-                if nodes > limit:
-                    if allowed == INF and discrepancies:
-                        cut = True
-                        break
-                    return Attempt(None, nodes - 1, False, failures)
-                if allowance is not None and nodes > allowance:
-                    return Attempt(None, nodes, False, failures)
-                try:
-                    choice = self._expand(node, resolver)
-                except DeadEnd as error:
-                    failures[_generic(str(error))] += 1
-                    continue
-                if choice is None:
-                    return Attempt(node, nodes, False, failures)
-                cut = _push(stack, node, choice, used, allowed) or cut
-            if not cut:
+            dive = allowed == INF and discrepancies
+            limit = budget // 20 if dive else budget
+            nodes, end, found = self._pass(root, allowed, nodes, limit if allowance is None else min(limit, allowance),
+                                           failures=failures)
+            if end == "plan":
+                return Attempt(found[0], nodes, False, failures)
+            if end == "limit" and nodes > limit:
+                if dive:
+                    continue  # the dive is over: discrepancies now
+                return Attempt(None, nodes - 1, False, failures)
+            if end == "limit":  # the planning's node limit
+                return Attempt(None, nodes, False, failures)
+            if end == "done":
                 return Attempt(None, nodes, True, failures)
         raise AssertionError("unreachable")
 
@@ -565,27 +554,47 @@ class Setup:
         except DeadEnd:
             return found, 1
         for allowed in itertools.count(0):
-            stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
-            cut = False
-            while stack:
-                node, resolver, used = stack.pop()
-                if resolver is not None:
-                    node = node.copy()
-                nodes += 1
-                if nodes > budget:
-                    return found, nodes - 1
-                try:
-                    choice = self._expand(node, resolver, bound - IMPROVEMENT)
-                except DeadEnd:
-                    continue
-                if choice is None:
-                    found.append(node)
-                    bound = node.worst_end()
-                    continue
-                cut = _push(stack, node, choice, used, allowed) or cut
-            if not cut:
+            nodes, end, better = self._pass(root, allowed, nodes, budget, bound=bound)
+            found += better
+            bound = better[-1].worst_end() if better else bound
+            if end == "limit":
+                return found, nodes - 1
+            if end == "done":
                 return found, nodes
         raise AssertionError("unreachable")
+
+    def _pass(self, root: Node, allowed: float, nodes: int, limit: int, bound: float | None = None,
+              failures: Counter[str] | None = None) -> tuple[int, str, list[Node]]:
+        """One depth-first pass from `root` departing from the heuristic at `allowed` choices at
+        most, counting on from `nodes` partial plans up to `limit`. Without `bound` it stops at
+        the first plan; with it, branch and bound: it goes on, each plan found beating the one
+        before by IMPROVEMENT. Returns the count, how the pass ended ("plan"; "limit"; "cut": a
+        branch was left out for lack of discrepancies; "done": every branch was tried) and the
+        plans found; each dead end counts in `failures`."""
+        found: list[Node] = []
+        stack: list[tuple[Node, Resolver | None, int]] = [(root, None, 0)]
+        cut = False
+        while stack:
+            node, resolver, used = stack.pop()
+            if resolver is not None:
+                node = node.copy()
+            nodes += 1
+            if nodes > limit:
+                return nodes, "limit", found
+            try:
+                choice = self._expand(node, resolver, INF if bound is None else bound - IMPROVEMENT)
+            except DeadEnd as error:
+                if failures is not None:
+                    failures[_generic(str(error))] += 1
+                continue
+            if choice is None:
+                found.append(node)
+                if bound is None:
+                    return nodes, "plan", found
+                bound = node.worst_end()
+                continue
+            cut = _push(stack, node, choice, used, allowed) or cut
+        return nodes, "cut" if cut else "done", found
 
     def reorder(self, active: list[Goal], bound: float, budget: int) -> tuple[list[Node], int]:
         """Plans for the `active` goals whose worst-case makespan beats `bound`, each better than

@@ -29,13 +29,11 @@ if TYPE_CHECKING:
 
 # Each name imported where it is defined on first use (specc.runtime.lazy).
 _OFFERS = {
-    "reliability": "specc.runtime.sim.devices", "RobotConfig": "specc.runtime.sim.rover",
-    "Rover": "specc.runtime.sim.rover", "Simulation": "specc.runtime.sim.simulation",
-    "Trace": "specc.runtime.sim.simulation", "Circle": "specc.runtime.sim.world",
-    "Polygon": "specc.runtime.sim.world", "Target": "specc.runtime.sim.world",
-    "Window": "specc.runtime.sim.world", "World": "specc.runtime.sim.world",
-    "WorldError": "specc.runtime.sim.world", "load_world": "specc.runtime.sim.world",
-    "parse_world": "specc.runtime.sim.world", "world_data": "specc.runtime.sim.world",
+    "devices": ("reliability",),
+    "rover": ("RobotConfig", "Rover"),
+    "simulation": ("Simulation", "Trace"),
+    "world": ("Circle", "Polygon", "Target", "Window", "World", "WorldError", "load_world", "parse_world",
+              "world_data"),
 }
 
 __getattr__ = lazy_exports(__name__, _OFFERS)
