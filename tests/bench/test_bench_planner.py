@@ -24,10 +24,15 @@ first plan, and specc's improved makespan no longer than Aries' anytime best."""
 
 from __future__ import annotations
 
+import importlib.util
+import re
 import statistics
+import subprocess
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
 from typing import Any, TypeVar
 
 import pytest
@@ -231,13 +236,22 @@ def with_integer_functions(problem: Any) -> Any:
     return result
 
 
-def test_exported_pddl_files_are_solved_by_aries_and_validated(tmp_path: Any) -> None:
-    """#25 item 7: the PDDL files `specc export` writes for M1-M3 of both models, read back by
-    unified-planning's reader, solved by Aries and validated by unified-planning's own validator
-    of time-triggered plans (not specc's)."""
-    pytest.importorskip("up_aries")
+PDDL_MISSIONS = tuple(f"M{k}_{model}" for model in ("model1", "model2") for k in (1, 2, 3))
+# LPG-td (the binary of the up-lpg wheel), from the files: `-speed` (its first plan), a fixed seed so
+# that runs repeat, and restarts enough for Modele1's M1, on which its default ten restarts end empty.
+LPG_OPTIONS = ("-speed", "-seed", "1", "-restarts", "100")
+LPG_TIMEOUT = 120.0
+# A line of LPG's plan file: `127.0002:   (COMMUNICATE W1) [25.0000])`.
+LPG_PLAN_LINE = re.compile(r"^\s*([\d.]+):\s*\(([^)]*)\)\s*\[([\d.]+)\]")
+
+
+def solve_exported_files(tmp_path: Any, planner: str, solve: Callable[[Path, Path, Any], tuple[Any, str]],
+                         read: Callable[[Any], Any] = lambda problem: problem) -> tuple[list[str], int]:
+    """#25 item 7: for M1-M3 of both models, the PDDL files `specc export` writes, read back by
+    unified-planning's reader (then given to `read`); `solve(domain file, problem file, that
+    problem)` gives a plan of it (or None and why not), checked by unified-planning's own validator of
+    time-triggered plans (not specc's). The lines to print and how many plans are valid."""
     import unified_planning.shortcuts as up
-    from unified_planning.engines import PlanGenerationResultStatus as Status
     from unified_planning.engines import ValidationResultStatus
     from unified_planning.io import PDDLReader
 
@@ -246,26 +260,90 @@ def test_exported_pddl_files_are_solved_by_aries_and_validated(tmp_path: Any) ->
     up.get_environment().credits_stream = None
     lines = []
     solved = 0
-    for model in ("model1", "model2"):
-        for k in (1, 2, 3):
-            name = f"M{k}_{model}"
-            folder = tmp_path / name
-            domain_file, problem_file = write_pddl(export(*atrv_models(name)), folder)
-            problem = with_integer_functions(PDDLReader().parse_problem(str(domain_file), str(problem_file)))
-            started = time.perf_counter()
-            with up.OneshotPlanner(name="aries") as planner:
-                result = planner.solve(problem, timeout=ARIES_TIMEOUT)
-            seconds = time.perf_counter() - started
-            if result.status not in (Status.SOLVED_SATISFICING, Status.SOLVED_OPTIMALLY):
-                lines.append(f"{name:12} {result.status.name} after {seconds:.2f} s")
-                continue
-            with up.PlanValidator(name="up_time_triggered_validator") as validator:
-                verdict = validator.validate(problem, result.plan)
-            valid = verdict.status is ValidationResultStatus.VALID
-            solved += valid
-            lines.append(f"{name:12} solved in {seconds:.2f} s, makespan {worst_case_makespan(result.plan):.1f} s, "
-                         f"{'VALID' if valid else 'INVALID: ' + str(verdict.reason)} (unified-planning's validator)")
+    for name in PDDL_MISSIONS:
+        domain_file, problem_file = write_pddl(export(*atrv_models(name)), tmp_path / planner / name)
+        problem = read(PDDLReader().parse_problem(str(domain_file), str(problem_file)))
+        started = time.perf_counter()
+        plan, failure = solve(domain_file, problem_file, problem)
+        seconds = time.perf_counter() - started
+        if plan is None:
+            lines.append(f"{name:12} {failure} after {seconds:.2f} s")
+            continue
+        with up.PlanValidator(name="up_time_triggered_validator") as validator:
+            verdict = validator.validate(problem, plan)
+        valid = verdict.status is ValidationResultStatus.VALID
+        solved += valid
+        lines.append(f"{name:12} solved in {seconds:.2f} s, makespan {worst_case_makespan(plan):.1f} s, "
+                     f"{'VALID' if valid else 'INVALID: ' + str(verdict.reason)} (unified-planning's validator)")
+    return lines, solved
+
+
+def test_exported_pddl_files_are_solved_by_aries_and_validated(tmp_path: Any) -> None:
+    """The files read back and solved by Aries (the reader's problem with its static functions
+    of whole numbers typed as integers: Aries takes only integer durations)."""
+    pytest.importorskip("up_aries")
+    import unified_planning.shortcuts as up
+    from unified_planning.engines import PlanGenerationResultStatus as Status
+
+    def aries(domain_file: Path, problem_file: Path, problem: Any) -> tuple[Any, str]:
+        with up.OneshotPlanner(name="aries") as planner:
+            result = planner.solve(problem, timeout=ARIES_TIMEOUT)
+        solved = result.status in (Status.SOLVED_SATISFICING, Status.SOLVED_OPTIMALLY)
+        return (result.plan if solved else None), result.status.name
+
+    lines, solved = solve_exported_files(tmp_path, "aries", aries, with_integer_functions)
     print("\nexported PDDL files read back by unified-planning's PDDL reader and solved by Aries (static "
           "functions of whole numbers typed as integers after reading: PDDL has only `number`):\n  "
-          + "\n  ".join(lines) + f"\n  {solved} of 6 solved and valid (#25 item 7)")
-    assert solved == 6
+          + "\n  ".join(lines) + f"\n  {solved} of {len(PDDL_MISSIONS)} solved and valid (#25 item 7)")
+    assert solved == len(PDDL_MISSIONS)
+
+
+def lpg_binary() -> Path:
+    """LPG-td as the up-lpg wheel ships it. Its Python engine is not used: it imports
+    pkg_resources, refuses these problems' kind (timed initial literals, disjunctive
+    conditions) before LPG sees them, and reads a plan format LPG's -out file does not have."""
+    spec = importlib.util.find_spec("up_lpg")
+    if spec is None or not spec.submodule_search_locations:
+        pytest.skip("up-lpg is not installed (pip install -e '.[bench]')")
+    return Path(next(iter(spec.submodule_search_locations))) / "lpg"
+
+
+def lpg_plan(text: str, problem: Any) -> Any:
+    """LPG's plan file as unified-planning's time-triggered plan of `problem` (names upper-cased
+    by LPG, matched case-blind as PDDL's are)."""
+    from unified_planning.plans import ActionInstance, TimeTriggeredPlan
+
+    timed = []
+    for line in text.splitlines():
+        found = LPG_PLAN_LINE.match(line)
+        if found is None:
+            continue
+        action, *arguments = found.group(2).lower().split()
+        timed.append((Fraction(found.group(1)),
+                      ActionInstance(problem.action(action), [problem.object(a) for a in arguments]),
+                      Fraction(found.group(3))))
+    return TimeTriggeredPlan(timed)
+
+
+def test_exported_pddl_files_are_solved_by_lpg_and_validated(tmp_path: Any) -> None:
+    """The same files given to LPG-td as they are (its own PDDL 2.2 reader: no retyping), its
+    plan read back and validated as Aries' are."""
+    binary = lpg_binary()
+
+    def lpg(domain_file: Path, problem_file: Path, problem: Any) -> tuple[Any, str]:
+        plan_file = problem_file.with_name("lpg-plan")
+        try:
+            run = subprocess.run([str(binary), "-o", domain_file.name, "-f", problem_file.name, *LPG_OPTIONS,
+                                  "-out", plan_file.name], cwd=problem_file.parent, capture_output=True, text=True,
+                                 timeout=LPG_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            return None, "TIMEOUT"
+        if not plan_file.exists():
+            return None, f"no plan (LPG exit {run.returncode}: {run.stdout.strip().splitlines()[-1:]})"
+        return lpg_plan(plan_file.read_text(), problem), ""
+
+    lines, solved = solve_exported_files(tmp_path, "lpg", lpg)
+    print(f"\nexported PDDL files solved by LPG-td from the files ({' '.join(LPG_OPTIONS)}), its plans read "
+          "back and validated by unified-planning's validator:\n  " + "\n  ".join(lines)
+          + f"\n  {solved} of {len(PDDL_MISSIONS)} solved and valid (#25 item 7)")
+    assert solved == len(PDDL_MISSIONS)
