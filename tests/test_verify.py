@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from specc.analysis.verify import PROPERTIES, Verification, verify
+from specc.analysis.verify import PROPERTIES, Verification, describe, verify
 from specc.model import nodes as m
 from specc.pipeline import load
 from tests.conftest import EXAMPLES, ROOT
@@ -219,3 +219,75 @@ def test_a_service_that_takes_inputs_is_explored_like_any_other(tmp_path: Path) 
     result = run(paths, "shop", 2)
     assert "exclusion" in result.violations, result
     assert any("BACK" in step for step in result.violations["exclusion"].trace)
+
+
+def test_a_state_limit_refutes_no_liveness_property_it_could_not_explore_to_the_end(tmp_path: Path) -> None:
+    # Stopped early, the states at the limit have successors nobody looked at: they are no
+    # evidence that a request can never get its reply (stopped at 40 states, this executive was
+    # once reported "one-reply: REFUTED ... stuck with GO in EXEC"; so was Hilare's at 500,000).
+    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    spec = tmp_path / "shop.spec"
+    spec.write_text(SENDING % "service HEAR { request: ear.Hear; }")
+    assert run([spec], "shop", 2).ok
+    loaded = load([spec])
+    assert loaded.program is not None
+    stopped = verify(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Executive)), 2,
+                     limit=40)
+    assert not stopped.complete and stopped.states == 40
+    assert stopped.violations == {}
+
+
+def test_a_stuck_state_explored_to_the_end_refutes_even_when_the_limit_stops_the_rest(tmp_path: Path) -> None:
+    rule = 'backNever: event == "START", service == "BACK" ==> restrict status == "WAIT";'
+    loaded = load(robot(tmp_path, rule))
+    assert loaded.program is not None
+    executive = next(i for i in loaded.program.items if isinstance(i, m.Executive))
+    whole = verify(loaded.program, executive, 2)
+    stopped = verify(loaded.program, executive, 2, limit=whole.states // 2)
+    assert not stopped.complete
+    assert stopped.violations["no-starvation"].trace == whole.violations["no-starvation"].trace == [
+        "task: RQST EXEC BACK"]
+
+
+SENDING = """
+module arm {
+  codels: "arm_codels";
+  request Go { type: exec; task: T; codel exec: go; incompatible_with: Go; sends: eye.Look; }
+  exec_task T { period: 10 ms; }
+}
+module eye {
+  codels: "arm_codels";
+  request Look { type: exec; task: T; codel exec: go; sends: ear.Listen; }
+  exec_task T { period: 10 ms; }
+}
+module ear {
+  codels: "arm_codels";
+  request Listen { type: exec; task: T; codel exec: go; }
+  request Hear { type: exec; task: T; codel exec: go; }
+  exec_task T { period: 10 ms; }
+}
+executive shop {
+  service GO { request: arm.Go; }
+  %s
+}
+"""
+
+
+@pytest.mark.parametrize("addition, left_out", [
+    ("", ("arm.Go sends eye.Look",)),  # Look and what it sends reach nothing the executive sees
+    ("service HEAR { request: ear.Hear; }", ()),  # Listen shares a module with a service: it may freeze it
+    ("reflex heard on reply ear.Listen == OK => abort GO;", ()),  # Listen's reply triggers a reflex
+])
+def test_a_sent_request_the_executive_cannot_observe_is_left_out_and_said(
+        tmp_path: Path, addition: str, left_out: tuple[str, ...]) -> None:
+    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    spec = tmp_path / "shop.spec"
+    spec.write_text(SENDING % addition)
+    result = run([spec], "shop", 2)
+    assert result.ok and result.left_out == left_out
+    lines = list(describe(result))
+    assert any("left out" in line and "arm.Go sends eye.Look" in line for line in lines) == bool(left_out)
+    # Left out, the sends change no state: the same states as without them.
+    spec.write_text((SENDING % addition).replace(" sends: eye.Look;", ""))
+    alone = run([spec], "shop", 2)
+    assert (result.states == alone.states) == bool(left_out)

@@ -4,13 +4,17 @@ The executive that runs is the real one (`specc.runtime.executive`) deciding wit
 controller; only its surroundings are abstract. Modules are models of the functional level
 (requests, physical incompatibilities, intermediate replies when an activity starts, final
 replies, ZOMBIE, aborts, as in `specc.runtime.functional`), whose activities may end, fail or
-freeze at any moment, and send once, at any moment, each request their codels send (`sends:`);
+freeze at any moment, and send once, at any moment, each request their codels send (`sends:`)
+that the executive can observe (see `observable_requests`: a sent request whose activity can
+reach neither a module the executive uses nor a reflex is left out, and said so);
 any pending timeout may expire at any moment; the task level may ask for any service while
 fewer than `requests` are outstanding, and interrupt any of them. Time is
 abstracted away, so every interleaving is covered.
 
 The exploration is breadth-first over canonical states (activity ids renumbered by age), so
-each counterexample is a shortest event sequence. Properties:
+each counterexample is a shortest event sequence. When the state limit stops it, the states it
+could not finish expanding count as able to reach anything: a liveness property is refuted only
+by states whose every continuation was explored. Properties:
 
 - exclusion: an activity never enters EXEC while a service it has an arc to (must interrupt
   or wait for) is in EXEC;
@@ -30,6 +34,7 @@ import functools
 import itertools
 from collections import deque
 from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
@@ -213,11 +218,30 @@ def _ignore(reply: Reply) -> None:
     """Where a sent request's replies go: its sender's codels, which the model leaves free."""
 
 
+class ModelModules(dict[str, ModelModule]):
+    """The registry's modules, each made when first looked up: a state names few of them, and
+    the exploration makes a registry for every transition."""
+
+    def __init__(self, make: Callable[[str], ModelModule], names: Mapping[str, Any]):
+        super().__init__()
+        self._make = make
+        self._names = names
+
+    def __missing__(self, name: str) -> ModelModule:
+        if name not in self._names:
+            raise KeyError(name)
+        module = self[name] = self._make(name)
+        return module
+
+    def get(self, name: str, default: Any = None) -> Any:  # type: ignore[override]
+        return self[name] if name in self._names else default
+
+
 class ModelRegistry:
     def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]], codes: tuple[str, ...] = ()):
         self.kernel = ModelKernel()
         self._ids = itertools.count(1)
-        self.modules = {name: ModelModule(name, requests, self, codes) for name, requests in modules.items()}
+        self.modules = ModelModules(lambda name: ModelModule(name, modules[name], self, codes), modules)
 
     def new_id(self) -> int:
         return next(self._ids)
@@ -230,13 +254,22 @@ class ModelRegistry:
 
 
 def decision_function(compiled: k.Compiled) -> Callable[..., Decision]:
-    """The compiled decision graph as the runtime calls it (the generated code unrolls the same graph)."""
+    """The compiled decision graph as the runtime calls it (the generated code unrolls the same graph).
+    A decision depends on its inputs alone, and the exploration asks the same ones again and
+    again: each is worked out once (the executive only reads a decision)."""
+    known: dict[tuple[Any, ...], tuple[Decision, tuple[tuple[str, tuple[Any, ...]], ...]]] = {}
 
     def decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
-        outcome = k.evaluate(compiled, inputs)
-        for function, args in outcome.calls:
+        key = tuple(inputs.items())
+        found = known.get(key)
+        if found is None:
+            outcome = k.evaluate(compiled, inputs)
+            found = known[key] = (Decision(outcome.outputs, tuple(outcome.inconsistent), tuple(outcome.incomplete),
+                                           outcome.impossible), tuple(outcome.calls))
+        decision, made = found
+        for function, args in made:
             calls(function, args)
-        return Decision(outcome.outputs, tuple(outcome.inconsistent), tuple(outcome.incomplete), outcome.impossible)
+        return decision
 
     return decide
 
@@ -271,6 +304,7 @@ class Verification:
     transitions: int
     complete: bool  # False when the state limit stopped the exploration
     violations: dict[str, Violation]
+    left_out: tuple[str, ...] = ()  # the sends the model leaves out ("module.request sends module.request")
 
     @property
     def ok(self) -> bool:
@@ -283,7 +317,13 @@ class Explorer:
         self.spec = dataclasses.replace(spec, services={
             name: dataclasses.replace(s, args={}, input=None, output=None) for name, s in spec.services.items()})
         self.decide = decide
-        self.modules = modules
+        observable = observable_requests(spec, modules)
+        self.left_out = tuple(sorted(f"{module}.{name} sends {target}" for module, requests_ in modules.items()
+                                     for name, request in requests_.items() if f"{module}.{name}" in observable
+                                     for target in request.sends if target not in observable))
+        self.modules = {module: {name: dataclasses.replace(request, sends=tuple(
+                            t for t in request.sends if t in observable)) for name, request in requests_.items()}
+                        for module, requests_ in modules.items()}
         self.arcs = arcs
         self.requests = requests
         # The report codes reflexes look for: module activities may end with them too.
@@ -310,12 +350,14 @@ class Explorer:
                 timers.setdefault(ranks[activity.id], []).append(which)
         modules = []
         for name, module in sorted(world.registry.modules.items()):
+            if not module.activities:
+                continue
             entries = sorted(module.activities.values(), key=lambda a: (owners.get((name, a.id), len(ordered)), a.id))
             index = {a.id: i for i, a in enumerate(entries)}
-            modules.append(tuple((owners.get((name, a.id), -1), a.spec.name, a.state, a.cause,
-                                  tuple(sorted(index[w] for w in a.waiting_for if w in index)),
-                                  tuple(sorted(a.sent)), a.sent_by_codel) for a in entries))
-        activities = tuple((a.service.name, str(a.state), a.holds_group, a.answered, a.abort_sent,
+            modules.append((name, tuple((owners.get((name, a.id), -1), a.spec.name, a.state, a.cause,
+                                         tuple(sorted(index[w] for w in a.waiting_for if w in index)),
+                                         tuple(sorted(a.sent)), a.sent_by_codel) for a in entries)))
+        activities = tuple((a.service.name, a.state, a.holds_group, a.answered, a.abort_sent,
                             tuple(sorted(timers.get(rank, ()))))
                            for rank, a in enumerate(ordered))
         zombies = tuple(sorted((module, ranks[a.id]) for module, listed in executive.zombies.items()
@@ -328,14 +370,14 @@ class Explorer:
         executive, registry = world.executive, world.registry
         made = []
         for rank, (service, state, holds, answered, abort_sent, timers) in enumerate(activities):
-            activity = rx.Activity(rank + 1, self.spec.services[service], 0.0, rx.Phase(state), None,
+            activity = rx.Activity(rank + 1, self.spec.services[service], 0.0, state, None,
                                    None, holds, answered, abort_sent)
             for which in timers:
                 activity.timers.append(registry.kernel.call_later(  # type: ignore[arg-type]
                     0.0, functools.partial(executive._post, executive._on_timeout, activity, which)))
             executive.activities[activity.id] = activity
             made.append(activity)
-        for name, entries in zip(sorted(registry.modules), modules, strict=True):
+        for name, entries in modules:
             module = registry.modules[name]
             built = []
             for owner, request, state, cause, _, sent, sent_by_codel in entries:
@@ -421,6 +463,7 @@ class Explorer:
         queue = deque([0])
         transitions = 0
         complete = True
+        unfinished: set[int] = set()  # states with a successor the limit kept out
         while queue:
             index = queue.popleft()
             key = states[index]
@@ -436,6 +479,7 @@ class Explorer:
                 if target is None:
                     if len(states) >= limit:
                         complete = False
+                        unfinished.add(index)
                         continue
                     target = len(states)
                     keys[reached] = target
@@ -446,11 +490,17 @@ class Explorer:
                 edges[index].append((target, event.helped))
             if progress is not None and index % 1000 == 0:
                 progress(len(states))
-        self.liveness(states, edges, parents, violations)
-        return Verification(self.spec.name, self.requests, len(states), transitions, complete, violations)
+        self.liveness(states, edges, parents, violations, unfinished)
+        return Verification(self.spec.name, self.requests, len(states), transitions, complete, violations,
+                            self.left_out)
 
     def liveness(self, states: list[Key], edges: list[list[tuple[int, bool]]],
-                 parents: list[tuple[int, str] | None], violations: dict[str, Violation]) -> None:
+                 parents: list[tuple[int, str] | None], violations: dict[str, Violation],
+                 unfinished: AbstractSet[int] = frozenset()) -> None:
+        """One-reply's and no-starvation's "from every state, without the task level": a state
+        from which no goal state can be reached refutes them. A state the limit kept from being
+        expanded fully (`unfinished`) may reach one through what was not explored: it counts as
+        reaching it, so that what is refuted is refuted by states explored to the end."""
         untimed = {name for name, s in self.spec.services.items() if s.start_timeout is None}
         goals: dict[str, Callable[[Key], bool]] = {
             "one-reply": lambda key: not key[0],
@@ -464,7 +514,7 @@ class Explorer:
         for prop, goal in goals.items():
             if prop in violations:
                 continue
-            reached = {i for i, key in enumerate(states) if goal(key)}
+            reached = {i for i, key in enumerate(states) if goal(key)} | unfinished
             queue = deque(reached)
             while queue:
                 for source in backwards[queue.popleft()]:
@@ -543,6 +593,43 @@ def _check_exclusion(world: World, arcs: set[tuple[str, str]], activity: rx.Acti
 # ---------------------------------------------------------------- from a spec
 
 
+def observable_requests(spec: rx.ExecutiveSpec, modules: Mapping[str, Mapping[str, RequestSpec]]) -> set[str]:
+    """The module requests ("module.request") whose activities can change what the executive
+    sees: a cone of influence. What can run at all: the services' requests, what a running
+    request's codels send, and what a reflex whose source can run requests. Of those, the
+    executive observes its services' requests and the reflexes' sources, every request of a
+    module where it observes one (they conflict, wait for each other, freeze the module), and
+    every request that sends one it observes. The others, however they end, fail, freeze or
+    send, leave every executive state as it is: the model need not send them."""
+
+    def sends(request: str) -> tuple[str, ...]:
+        module, _, name = request.partition(".")
+        found = modules.get(module, {}).get(name)
+        return found.sends if found is not None else ()
+
+    def requested_by_reflexes(source: str) -> list[str]:
+        return [target for reflex in spec.reflexes if reflex.source == source
+                for verb, target in reflex.actions if verb == "request"]
+
+    services = {f"{s.module}.{s.request}" for s in spec.services.values()}
+    # A service's replies can come whenever the task level asks for it: its reflexes can run.
+    pending = sorted(services) + [t for service in spec.services for t in requested_by_reflexes(service)]
+    live: set[str] = set()
+    while pending:
+        request = pending.pop()
+        if request not in live:
+            live.add(request)
+            pending.extend(sends(request))
+            pending.extend(requested_by_reflexes(request))
+    observable = services | {r.source for r in spec.reflexes if r.source in live}
+    while True:
+        seen = {request.partition(".")[0] for request in observable}
+        grown = observable | {r for r in live if r.partition(".")[0] in seen or any(t in observable for t in sends(r))}
+        if grown == observable:
+            return observable
+        observable = grown
+
+
 def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) -> Explorer:
     controller = executive_controller(program, executive)
     compiled = controller.compile()
@@ -572,3 +659,6 @@ def describe(result: Verification) -> Iterator[str]:
         yield f"  {violation.message}"
         for number, label in enumerate(violation.trace, start=1):
             yield f"  {number:3}. {label}"
+    if result.left_out:
+        yield (f"left out of the model, as nothing the requests they send do can reach the executive: "
+               f"{'; '.join(result.left_out)}")
