@@ -608,6 +608,9 @@ class Recorder:
     def _check_incidents(self) -> None:
         """A permanent codel, a listener or an observer that raised: the robot keeps going and
         notes it; the log says so."""
+        if len(self.registry.incidents) == self._seen["registry"] and (
+                self.executive is None or len(self.executive.incidents) == self._seen["executive"]):
+            return  # asked after every kernel event: most often nothing new
         sources: list[tuple[str, list[str]]] = [("registry", self.registry.incidents)]
         if self.executive is not None:
             sources.append(("executive", self.executive.incidents))
