@@ -281,13 +281,35 @@ class Controller:
 
 def mentioned(rule: k.Rule) -> set[str]:
     """Every attribute a rule tests, restricts, assigns or passes to a call."""
-    found = {atom.attribute for atom in k.atoms(rule.condition)} | k.targets(rule)
+    return {atom.attribute for atom in k.atoms(rule.condition)} | _acted_on(rule)
+
+
+def _acted_on(rule: k.Rule) -> set[str]:
+    """Every attribute a rule's actions restrict, assign, compute from or pass to a call."""
+    found = set(k.targets(rule))
     for action in rule.actions:
         if isinstance(action, k.Call):
             found |= set().union(*(arg.attributes() for arg in action.args))
         elif isinstance(action, k.Assign):
             found |= action.expr.attributes()
     return found
+
+
+def mentioned_where(rule: k.Rule, memory: Mapping[str, frozenset[Any]]) -> set[str]:
+    """What `mentioned` says, leaving out the tests whose truth `memory` already decides: the
+    generated rules step aside where a hand-written one applies by a condition that names its
+    own service, and for any other service that part is false whatever it tests."""
+
+    def tested(cond: k.Cond | None) -> set[str]:
+        if cond is None or k.truth(cond, memory) != k.UNKNOWN:
+            return set()
+        if isinstance(cond, k.Atom):
+            return {cond.attribute}
+        if isinstance(cond, k.Not):
+            return tested(cond.operand)
+        return set().union(*(tested(operand) for operand in cond.operands))
+
+    return tested(rule.condition) | _acted_on(rule)
 
 
 def controller_name(executive: m.Executive) -> str:

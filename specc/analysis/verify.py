@@ -33,14 +33,14 @@ import dataclasses
 import functools
 import itertools
 from collections import deque
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
 
 from specc.analysis import kheops as k
-from specc.analysis.controller import executive_controller
+from specc.analysis.controller import Controller, executive_controller, mentioned_where
 from specc.analysis.service_list import executive_spec
 from specc.check.symbols import symbols_of
 from specc.model import nodes as m
@@ -305,6 +305,7 @@ class Verification:
     complete: bool  # False when the state limit stopped the exploration
     violations: dict[str, Violation]
     left_out: tuple[str, ...] = ()  # the sends the model leaves out ("module.request sends module.request")
+    parts: tuple[tuple[str, ...], ...] = ()  # the independent parts explored one by one (services), if several
 
     @property
     def ok(self) -> bool:
@@ -313,10 +314,16 @@ class Verification:
 
 class Explorer:
     def __init__(self, spec: rx.ExecutiveSpec, decide: Callable[..., Decision],
-                 modules: Mapping[str, Mapping[str, RequestSpec]], arcs: set[tuple[str, str]], requests: int):
+                 modules: Mapping[str, Mapping[str, RequestSpec]], arcs: set[tuple[str, str]], requests: int,
+                 parts: Sequence[tuple[str, ...]] = ()):
         self.spec = dataclasses.replace(spec, services={
             name: dataclasses.replace(s, args={}, input=None, output=None) for name, s in spec.services.items()})
-        self.decide = decide
+        self.decide = self._watched(decide)
+        # Services that share nothing (see `independent_parts`) are explored part by part: the
+        # executive's states are then the products of the parts' states, which are not listed.
+        self.parts = tuple(parts) if len(parts) > 1 else ()
+        self.asked: frozenset[str] | None = None  # the services the task level may ask for (None: all)
+        self.parts_interact = False  # a decision a part's exploration met ties it to the others
         observable = observable_requests(spec, modules)
         self.left_out = tuple(sorted(f"{module}.{name} sends {target}" for module, requests_ in modules.items()
                                      for name, request in requests_.items() if f"{module}.{name}" in observable
@@ -411,7 +418,8 @@ class Explorer:
         sent = sum(a.sent_by_codel for module in world.registry.modules.values() for a in module.activities.values())
         if len(executive.activities) + sent < self.requests:
             for service in self.spec.services:
-                found.append(Event(f"task: RQST EXEC {service}", True, functools.partial(_request, service)))
+                if self.asked is None or service in self.asked:
+                    found.append(Event(f"task: RQST EXEC {service}", True, functools.partial(_request, service)))
         for activity in executive.activities.values():
             zombie = activity.state is rx.Phase.ZOMBIE
             found.append(Event(f"task: RQST INT of {activity.service.name}{' (ZOMBIE)' if zombie else ''}",
@@ -453,7 +461,60 @@ class Explorer:
         return world
 
     # -- the search
+    def _watched(self, decide: Callable[..., Decision]) -> Callable[..., Decision]:
+        """`decide`, noting, while a part is explored, a decision that ties it to another part:
+        one changing the state of a group outside the part or naming a service outside it in a
+        call (what `independent_parts` rules out, checked again), or a START answered WAIT that
+        changes a group's state (a WAIT activity asks again after every event of any part)."""
+
+        def watched(inputs: Mapping[str, Any], calls: Calls) -> Decision:
+            asked = self.asked
+            if asked is None:
+                return decide(inputs, calls)
+
+            def checked(function: str, args: tuple[Any, ...]) -> None:
+                if args and args[0] in self.spec.services and args[0] not in asked:
+                    self.parts_interact = True
+                calls(function, args)
+
+            decision = decide(inputs, checked)
+            waiting = inputs.get("event") == "START" and decision.outputs.get("status") == "WAIT"
+            for group, members in self.spec.groups.items():
+                if decision.outputs.get(group) != inputs.get("@" + group) and (
+                        waiting or not asked.issuperset(members)):
+                    self.parts_interact = True
+            return decision
+
+        return watched
+
     def explore(self, limit: int = 200_000, progress: Callable[[int], None] | None = None) -> Verification:
+        """Every state, part by part when the services split into independent parts: a property
+        fails in the whole executive exactly when it fails in a part (the others idle), with the
+        same shortest trace. The parts are explored as one whole when one of them enters the
+        general ERROR state (which reaches every part) or a decision ties them (`_watched`)."""
+        if self.parts:
+            results: list[Verification] = []
+            for part in self.parts:
+                explored = sum(r.states for r in results)
+                self.asked = frozenset(part)
+                try:
+                    results.append(self._explore(limit - explored, _offset(progress, explored)))
+                finally:
+                    self.asked = None
+                if self.parts_interact or "no-error" in results[-1].violations:
+                    return self._explore(limit, progress)
+                if not results[-1].complete:
+                    break  # the state limit: the parts left are not explored either
+            violations: dict[str, Violation] = {}
+            for result in results:
+                for prop, violation in result.violations.items():
+                    violations.setdefault(prop, violation)
+            return Verification(self.spec.name, self.requests, sum(r.states for r in results),
+                                sum(r.transitions for r in results), all(r.complete for r in results)
+                                and len(results) == len(self.parts), violations, self.left_out, self.parts)
+        return self._explore(limit, progress)
+
+    def _explore(self, limit: int, progress: Callable[[int], None] | None) -> Verification:
         start = self.key(self.initial())
         keys = {start: 0}
         states = [start]
@@ -539,6 +600,14 @@ class Explorer:
 
 
 Key = tuple[Any, ...]
+
+
+def _offset(progress: Callable[[int], None] | None, before: int) -> Callable[[int], None] | None:
+    """`progress`, told the states of the parts explored before too."""
+    if progress is None:
+        return None
+    report = progress
+    return lambda states: report(before + states)
 
 
 def _request(service: str, world: World) -> None:
@@ -630,6 +699,72 @@ def observable_requests(spec: rx.ExecutiveSpec, modules: Mapping[str, Mapping[st
         observable = grown
 
 
+def independent_parts(controller: Controller, spec: rx.ExecutiveSpec,
+                      modules: Mapping[str, Mapping[str, RequestSpec]]) -> list[tuple[str, ...]]:
+    """The services split into parts that share nothing the executive or the modules act on:
+    two services are in one part when their requests are in one module (conflicts, a ZOMBIE
+    freezing it), when an arc or a group joins them, when a decision for one reads, decides or
+    names (changeInterState, sendAbortRequest) what concerns the other (its group's state, the
+    service itself), when a request one runs sends (observably) to the other's module, and when
+    a reflex on one acts on the other. A call whose argument the analysis cannot name joins
+    everything. In spec order."""
+    parent: dict[str, str] = {}
+
+    def find(node: str) -> str:
+        while parent.setdefault(node, node) != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    def union(a: str, b: str) -> None:
+        parent[find(a)] = find(b)
+
+    def node_of(name: str) -> str:
+        """A service, else the module of a `module.request`."""
+        return f"service {name}" if name in spec.services else f"module {name.partition('.')[0]}"
+
+    everything = "everything"
+    for name, service in spec.services.items():
+        union(f"service {name}", f"module {service.module}")
+        for other in service.conflicts | service.group:
+            union(f"service {name}", f"service {other}")
+    for attribute, members in spec.groups.items():
+        for member in members:
+            union(f"group {attribute}", f"service {member}")
+    memory = k.initial_memory(controller.base)
+    for name, (base, _) in controller.parts().items():
+        memory["service"] = frozenset({name})
+        touched: set[str] = set()
+        for rule in base.rules:
+            touched |= mentioned_where(rule, memory)
+            for action in rule.actions:
+                if not isinstance(action, k.Call):
+                    continue
+                for arg in action.args:
+                    named = arg.attributes()
+                    if not named:
+                        union(f"service {name}", node_of(str(arg.evaluate({}))))
+                    elif any(a.lstrip("@") not in spec.groups for a in named):
+                        union(f"service {name}", everything)
+        for attribute in touched:
+            if attribute.lstrip("@") in spec.groups:
+                union(f"service {name}", f"group {attribute.lstrip('@')}")
+    observable = observable_requests(spec, modules)
+    for module, requests in modules.items():
+        for request_name, request in requests.items():
+            if f"{module}.{request_name}" in observable:
+                for target in request.sends:
+                    if target in observable:
+                        union(f"module {module}", node_of(target))
+    for reflex in spec.reflexes:
+        for _, target in reflex.actions:
+            union(node_of(reflex.source), node_of(target))
+    parts: dict[str, list[str]] = {}
+    for name in spec.services:
+        parts.setdefault(find(f"service {name}"), []).append(name)
+    return [tuple(services) for services in parts.values()]
+
+
 def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) -> Explorer:
     controller = executive_controller(program, executive)
     compiled = controller.compile()
@@ -640,7 +775,8 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
                       for r in declared.values()}
                for name, declared in symbols_of(program).requests.items()}
     arcs = {(a.source, a.target) for a in controller.graph.arcs}
-    return Explorer(spec, decision_function(compiled), modules, arcs, requests)
+    return Explorer(spec, decision_function(compiled), modules, arcs, requests,
+                    independent_parts(controller, spec, modules))
 
 
 def verify(program: m.Program, executive: m.Executive, requests: int = 2, limit: int = 200_000,
@@ -659,6 +795,10 @@ def describe(result: Verification) -> Iterator[str]:
         yield f"  {violation.message}"
         for number, label in enumerate(violation.trace, start=1):
             yield f"  {number:3}. {label}"
+    if result.parts:
+        yield (f"explored as {len(result.parts)} independent parts (no event of one changes what another does; "
+               f"the states counted are theirs, not their products): "
+               + " | ".join(", ".join(part) for part in result.parts))
     if result.left_out:
         yield (f"left out of the model, as nothing the requests they send do can reach the executive: "
                f"{'; '.join(result.left_out)}")
