@@ -170,7 +170,10 @@ def test_configuration_suffixes_turn_repair_on_or_off_for_every_planner() -> Non
     assert [p.repair for p in both.planners] == [True, True] and both.policy == "successive"
     stacked = configuration_named(known, "Robot1/2c-repair-noanalyzer")
     assert all(p.repair for p in stacked.planners) and stacked.analyzer == () and stacked.policy == "concurrent"
-    assert not any(p.repair for p in configuration_named(known, "Robot1/2-repair-norepair").planners)
+    with pytest.raises(ValueError, match="both on .* and off"):
+        configuration_named(known, "Robot1/2-repair-norepair")
+    with pytest.raises(ValueError, match="-noanalyzer twice"):
+        configuration_named(known, "Robot1/2-noanalyzer-noanalyzer")
     with pytest.raises(KeyError):
         configuration_named(known, "Robot9-repair")
 

@@ -195,14 +195,20 @@ def configuration_named(configurations: Mapping[str, FtPlanConfig], name: str) -
     """The configuration `name` of `configurations`, or one of them with variant suffixes
     (VARIANTS, in any order): `<name>-noanalyzer` is it without the plan analyzer (the thesis'
     own FTplan, which never had one), `<name>-repair` / `<name>-norepair` with every planner
-    repairing its plans after an action failure or none. KeyError when unknown."""
+    repairing its plans after an action failure or none. KeyError when unknown; ValueError when
+    it names a variant twice, or both -repair and -norepair (which one was meant?)."""
     base, applied = name, []
     while base not in configurations:
         suffix = next((v for v in VARIANTS if base.endswith(v)), None)
         if suffix is None:
             raise KeyError(name)
+        if suffix in applied:
+            raise ValueError(f"configuration '{name}' says {suffix} twice: once is enough")
         base = base.removesuffix(suffix)
         applied.append(suffix)
+    if {WITH_REPAIR, WITHOUT_REPAIR} <= set(applied):
+        raise ValueError(f"configuration '{name}' turns repair both on ({WITH_REPAIR}) and off ({WITHOUT_REPAIR}): "
+                         "keep one of them")
     config = configurations[base]
     for suffix in reversed(applied):
         config = VARIANTS[suffix](config)

@@ -42,6 +42,8 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
     except KeyError:
         raise UnknownName(f"no robot configuration '{configuration}' (known: {', '.join(configurations)}; "
                           f"{VARIANTS_HELP})") from None
+    except ValueError as error:
+        raise UnknownName(str(error)) from None
     try:
         config = base.for_mission(mission)
         statement = base.mission(mission)
