@@ -379,8 +379,9 @@ def test_part_by_part_and_whole_explorations_agree_on_random_robots(tmp_path: Pa
         spec = random_robot(tmp_path, seed)
         parted, whole = split_and_whole([spec], "shop", 2)
         assert parted.complete and whole.complete, spec.read_text()
-        assert {p: (v.message, v.trace) for p, v in parted.violations.items()} == {
-            p: (v.message, v.trace) for p, v in whole.violations.items()}, spec.read_text()
+        # A property two parts refute has two shortest traces: the one of either is a shortest one.
+        assert {p: len(v.trace) for p, v in parted.violations.items()} == {
+            p: len(v.trace) for p, v in whole.violations.items()}, spec.read_text()
         split += bool(parted.parts)
         refuted += bool(whole.violations)
     assert split >= 10 and refuted >= 5  # parts were compared with wholes, refutations too

@@ -506,9 +506,10 @@ class Explorer:
                 if not results[-1].complete:
                     break  # the state limit: the parts left are not explored either
             violations: dict[str, Violation] = {}
-            for result in results:
+            for result in results:  # the shortest trace of any part, as the whole's exploration finds first
                 for prop, violation in result.violations.items():
-                    violations.setdefault(prop, violation)
+                    if prop not in violations or len(violation.trace) < len(violations[prop].trace):
+                        violations[prop] = violation
             return Verification(self.spec.name, self.requests, sum(r.states for r in results),
                                 sum(r.transitions for r in results), all(r.complete for r in results)
                                 and len(results) == len(self.parts), violations, self.left_out, self.parts)
