@@ -223,6 +223,63 @@ def test_a_service_that_takes_inputs_is_explored_like_any_other(tmp_path: Path) 
     assert any("BACK" in step for step in result.violations["exclusion"].trace)
 
 
+LISTENED = """
+module m1 {
+  codels: "arm_codels";
+  request Rs { type: exec; task: T; codel exec: go; sends: n.Y; }
+  request Rp { type: exec; task: T; codel exec: go; incompatible_with: Rp; }
+  request Rq { type: exec; task: T; codel exec: go; }
+  request Rk { type: exec; task: T; codel exec: go; incompatible_with: Rk; }
+  exec_task T { period: 10 ms; }
+}
+module n {
+  codels: "arm_codels";
+  request W { type: exec; task: T; codel exec: go; }
+  request Y { type: exec; task: T; codel exec: go; }
+  exec_task T { period: 10 ms; }
+}
+executive shop {
+  rules: policy;
+  service S { request: m1.Rs; }
+  service P { request: m1.Rp; }
+  service Q { request: m1.Rq; }
+  service K { request: m1.Rk; }
+  reflex both on interm S => start P, start Q;
+  reflex never on reply n.W => abort P;
+}
+rules policy {
+  inputs service: {"S", "P", "Q", "K"}, event: {"START", "INTERM", "END", "ABORT", "ZOMBIE"};
+  outputs status: {"OK", "WAIT", "REFUSE", "ERROR"}, Kstate: {"K", "IDLE"}, Pstate: {"P", "IDLE"};
+  init @Kstate = "IDLE";
+  init @Pstate = "IDLE";
+  kRef: event == "START", service == "K", @Kstate == "K" ==> restrict status == "REFUSE";
+  pWait: event == "START", service == "P", @Kstate == "IDLE" ==> restrict status == "WAIT";
+  qRef: event == "START", service == "Q" ==> restrict status == "REFUSE", restrict Kstate == "K";
+  sReset: event != "START", service == "S" ==> restrict Kstate == "IDLE";
+  sEndErr: event == "END", service == "S", @Pstate == "P" ==> restrict status == "ERROR";
+}
+"""
+
+
+def test_a_send_to_a_module_a_reflex_listens_to_is_kept_though_the_reflex_never_fires(tmp_path: Path) -> None:
+    # Found by review: the executive hears every reply of a module some reflex takes as its source
+    # (here n, for n.W, which nothing runs): each runs a cycle, and the WAIT activities ask again.
+    # Leaving n.Y out hid the ERROR that extra cycle leads to (S ending while P runs): the
+    # explorer now sees that such a pass changes a state, and keeps n.Y.
+    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    spec = tmp_path / "listened.spec"
+    spec.write_text(LISTENED)
+    from specc.analysis.verify import explorer_for
+
+    loaded = load([spec])
+    assert loaded.program is not None
+    explorer = explorer_for(loaded.program, next(i for i in loaded.program.items if isinstance(i, m.Executive)), 1)
+    assert explorer.left_out == ("m1.Rs sends n.Y",)  # n.Y's replies taken to change nothing, at first
+    result = explorer.explore()
+    assert explorer.passes_matter and result.left_out == ()  # a pass did change something: n.Y kept
+    assert result.violations["no-error"].trace == ["task: RQST EXEC S", "m1: Rs sends n.Y", "m1: Rs ends"]
+
+
 def test_a_state_limit_refutes_no_liveness_property_it_could_not_explore_to_the_end(tmp_path: Path) -> None:
     # Stopped early, the states at the limit have successors nobody looked at: they are no
     # evidence that a request can never get its reply (stopped at 40 states, this executive was

@@ -324,13 +324,13 @@ class Explorer:
         self.parts = tuple(parts) if len(parts) > 1 else ()
         self.asked: frozenset[str] | None = None  # the services the task level may ask for (None: all)
         self.parts_interact = False  # a decision a part's exploration met ties it to the others
-        observable = observable_requests(spec, modules)
-        self.left_out = tuple(sorted(f"{module}.{name} sends {target}" for module, requests_ in modules.items()
-                                     for name, request in requests_.items() if f"{module}.{name}" in observable
-                                     for target in request.sends if target not in observable))
-        self.modules = {module: {name: dataclasses.replace(request, sends=tuple(
-                            t for t in request.sends if t in observable)) for name, request in requests_.items()}
-                        for module, requests_ in modules.items()}
+        self._declared = modules
+        self._model(observable_requests(spec, modules, listened=False))
+        # Leaving out the requests whose replies only run a cycle (those of a module a reflex
+        # listens to), and exploring parts apart, both hold when a start authorisation pass
+        # changes nothing right after a cycle: every transition checks it (`step`).
+        self.check_passes = bool(self.parts) or observable_requests(spec, modules) != self._observable
+        self.passes_matter = False
         self.arcs = arcs
         self.requests = requests
         # The report codes reflexes look for: module activities may end with them too.
@@ -458,14 +458,31 @@ class Explorer:
         for ident, answered in before.items():
             if ident not in executive.activities and not answered and ident not in replied:
                 world.problems.append(("one-reply", f"request {ident} left the activity list without a reply"))
+        if self.check_passes and not self.passes_matter and executive.error is None:
+            reached = self.key(world)
+            executive._post(_nothing)  # a cycle with no event: a start authorisation pass
+            if self.key(world) != reached:
+                self.passes_matter = True
         return world
 
     # -- the search
+    def _model(self, observable: set[str]) -> None:
+        """Model the modules sending only the requests in `observable`."""
+        modules = self._declared
+        self._observable = observable
+        self.left_out = tuple(sorted(f"{module}.{name} sends {target}" for module, requests_ in modules.items()
+                                     for name, request in requests_.items() if f"{module}.{name}" in observable
+                                     for target in request.sends if target not in observable))
+        self.modules = {module: {name: dataclasses.replace(request, sends=tuple(
+                            t for t in request.sends if t in observable)) for name, request in requests_.items()}
+                        for module, requests_ in modules.items()}
+
     def _watched(self, decide: Callable[..., Decision]) -> Callable[..., Decision]:
         """`decide`, noting, while a part is explored, a decision that ties it to another part:
         one changing the state of a group outside the part or naming a service outside it in a
-        call (what `independent_parts` rules out, checked again), or a START answered WAIT that
-        changes a group's state (a WAIT activity asks again after every event of any part)."""
+        call (what `independent_parts` rules out, checked again), or a START not granted that
+        changes a group's state (WAIT activities ask again after every event of any part, and
+        such a decision would make that pass depend on how often it runs)."""
 
         def watched(inputs: Mapping[str, Any], calls: Calls) -> Decision:
             asked = self.asked
@@ -478,7 +495,7 @@ class Explorer:
                 calls(function, args)
 
             decision = decide(inputs, checked)
-            waiting = inputs.get("event") == "START" and decision.outputs.get("status") == "WAIT"
+            waiting = inputs.get("event") == "START" and decision.outputs.get("status") != "OK"
             for group, members in self.spec.groups.items():
                 if decision.outputs.get(group) != inputs.get("@" + group) and (
                         waiting or not asked.issuperset(members)):
@@ -489,9 +506,20 @@ class Explorer:
 
     def explore(self, limit: int = 200_000, progress: Callable[[int], None] | None = None) -> Verification:
         """Every state, part by part when the services split into independent parts: a property
-        fails in the whole executive exactly when it fails in a part (the others idle), with the
-        same shortest trace. The parts are explored as one whole when one of them enters the
-        general ERROR state (which reaches every part) or a decision ties them (`_watched`)."""
+        fails in the whole executive exactly when it fails in a part (the others idle), with a
+        trace as short (where two parts refute it as soon, the whole's search may show the
+        other's). The parts are explored as one whole when one of them enters the
+        general ERROR state (which reaches every part) or a decision ties them (`_watched`); and
+        the whole with every request a reflex's module replies to when a start authorisation
+        pass right after a transition changed a state (`step`): then every cycle counts."""
+        result = self._explore_parts(limit, progress)
+        if self.passes_matter:  # a pass changed something: every cycle counts, explore the whole
+            self._model(observable_requests(self.spec, self._declared))
+            self.parts, self.check_passes = (), False
+            return self._explore(limit, progress)
+        return result
+
+    def _explore_parts(self, limit: int, progress: Callable[[int], None] | None) -> Verification:
         if self.parts:
             results: list[Verification] = []
             for part in self.parts:
@@ -501,7 +529,7 @@ class Explorer:
                     results.append(self._explore(limit - explored, _offset(progress, explored)))
                 finally:
                     self.asked = None
-                if self.parts_interact or "no-error" in results[-1].violations:
+                if self.parts_interact or "no-error" in results[-1].violations or self.passes_matter:
                     return self._explore(limit, progress)
                 if not results[-1].complete:
                     break  # the state limit: the parts left are not explored either
@@ -603,6 +631,10 @@ class Explorer:
 Key = tuple[Any, ...]
 
 
+def _nothing() -> None:
+    """The event of a cycle that only asks again for the start of every WAIT activity."""
+
+
 def _offset(progress: Callable[[int], None] | None, before: int) -> Callable[[int], None] | None:
     """`progress`, told the states of the parts explored before too."""
     if progress is None:
@@ -663,13 +695,15 @@ def _check_exclusion(world: World, arcs: set[tuple[str, str]], activity: rx.Acti
 # ---------------------------------------------------------------- from a spec
 
 
-def observable_requests(spec: rx.ExecutiveSpec, modules: Mapping[str, Mapping[str, RequestSpec]]) -> set[str]:
+def observable_requests(spec: rx.ExecutiveSpec, modules: Mapping[str, Mapping[str, RequestSpec]],
+                        listened: bool = True) -> set[str]:
     """The module requests ("module.request") whose activities can change what the executive
     sees: a cone of influence. What can run at all: the services' requests, what a running
     request's codels send, and what a reflex whose source can run requests. Of those, the
-    executive observes its services' requests and the reflexes' sources, every request of a
-    module where it observes one (they conflict, wait for each other, freeze the module), and
-    every request that sends one it observes. The others, however they end, fail, freeze or
+    executive observes its services' requests and every request of a module a reflex takes as
+    its source (it hears all their replies), every request of a module where it observes one
+    (they conflict, wait for each other, freeze the module), and every request that sends one
+    it observes. The others, however they end, fail, freeze or
     send, leave every executive state as it is: the model need not send them."""
 
     def sends(request: str) -> tuple[str, ...]:
@@ -691,7 +725,13 @@ def observable_requests(spec: rx.ExecutiveSpec, modules: Mapping[str, Mapping[st
             live.add(request)
             pending.extend(sends(request))
             pending.extend(requested_by_reflexes(request))
-    observable = services | {r.source for r in spec.reflexes if r.source in live}
+    # The executive listens to every module a reflex names as its source: any reply of any of
+    # its requests runs an executive cycle (a new start authorisation for every WAIT activity),
+    # whether or not the reflex matches it. Without `listened`, those replies are taken to change
+    # nothing (which the explorer then checks: `passes_matter`).
+    heard = {r.source.partition(".")[0] for r in spec.reflexes if "." in r.source} if listened else set()
+    observable = services | {r.source for r in spec.reflexes if r.source in live} | {
+        r for r in live if r.partition(".")[0] in heard}
     while True:
         seen = {request.partition(".")[0] for request in observable}
         grown = observable | {r for r in live if r.partition(".")[0] in seen or any(t in observable for t in sends(r))}
