@@ -70,8 +70,13 @@ rules policy {
 """
 
 
+def write_codels(folder: Path) -> None:
+    """The codels every robot of these tests names: one that ends at once."""
+    (folder / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+
+
 def robot(tmp_path: Path, rule: str, back: str = "", policy: str = "wait") -> list[Path]:
-    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    write_codels(tmp_path)
     spec = tmp_path / "shop.spec"
     spec.write_text(ROBOT % {"rule": rule, "back": back, "policy": policy})
     return [spec]
@@ -147,7 +152,7 @@ executive ex {
 def test_two_instances_of_a_grouped_service_that_does_not_exclude_itself_stay_safe(tmp_path: Path) -> None:
     """S runs in several instances, yet W waits for it, so it has a group whose state names one
     running S: a second S waits for the first rather than drive the controller to ERROR."""
-    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    write_codels(tmp_path)
     (tmp_path / "shared.spec").write_text(SHARED)
     result = run([tmp_path / "shared.spec"], "ex", 2)
     assert result.ok, result.violations
@@ -266,7 +271,7 @@ def test_a_send_to_a_module_a_reflex_listens_to_is_kept_though_the_reflex_never_
     # (here n, for n.W, which nothing runs): each runs a cycle, and the WAIT activities ask again.
     # Leaving n.Y out hid the ERROR that extra cycle leads to (S ending while P runs): the
     # explorer now sees that such a pass changes a state, and keeps n.Y.
-    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    write_codels(tmp_path)
     spec = tmp_path / "listened.spec"
     spec.write_text(LISTENED)
     from specc.analysis.verify import explorer_for
@@ -284,7 +289,7 @@ def test_a_state_limit_refutes_no_liveness_property_it_could_not_explore_to_the_
     # Stopped early, the states at the limit have successors nobody looked at: they are no
     # evidence that a request can never get its reply (stopped at 40 states, this executive was
     # once reported "one-reply: REFUTED ... stuck with GO in EXEC"; so was Hilare's at 500,000).
-    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    write_codels(tmp_path)
     spec = tmp_path / "shop.spec"
     spec.write_text(SENDING % "service HEAR { request: ear.Hear; }")
     assert run([spec], "shop", 2).ok
@@ -339,7 +344,7 @@ executive shop {
 ])
 def test_a_sent_request_the_executive_cannot_observe_is_left_out_and_said(
         tmp_path: Path, addition: str, left_out: tuple[str, ...]) -> None:
-    (tmp_path / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    write_codels(tmp_path)
     spec = tmp_path / "shop.spec"
     spec.write_text(SENDING % addition)
     result = run([spec], "shop", 2)
@@ -424,7 +429,7 @@ def random_robot(folder: Path, seed: int) -> Path:
     lines += ["rules policy {", f"  inputs service: {{{', '.join(map(repr, services))}}}, ".replace("'", '"')
               + 'event: {"START", "INTERM", "END", "ABORT", "ZOMBIE"};',
               '  outputs status: {"OK", "WAIT", "REFUSE", "ERROR"};', f"  {rule}", "}"]
-    (folder / "arm_codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    write_codels(folder)
     spec = folder / f"robot{seed}.spec"
     spec.write_text("\n".join(lines) + "\n")
     return spec
