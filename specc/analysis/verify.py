@@ -458,12 +458,15 @@ class Explorer:
         for ident, answered in before.items():
             if ident not in executive.activities and not answered and ident not in replied:
                 world.problems.append(("one-reply", f"request {ident} left the activity list without a reply"))
-        if self.check_passes and not self.passes_matter and executive.error is None:
-            reached = self.key(world)
-            executive._post(_nothing)  # a cycle with no event: a start authorisation pass
+        return world
+
+    def check_pass(self, world: World, reached: Key) -> None:
+        """With `check_passes`: one more start authorisation pass on `world` (whose key is
+        `reached`, just stepped), noting whether it changes a state (`passes_matter`)."""
+        if self.check_passes and not self.passes_matter and world.executive.error is None:
+            world.executive._post(_nothing)  # a cycle with no event
             if self.key(world) != reached:
                 self.passes_matter = True
-        return world
 
     # -- the search
     def _model(self, observable: set[str]) -> None:
@@ -529,7 +532,9 @@ class Explorer:
                     results.append(self._explore(limit - explored, _offset(progress, explored)))
                 finally:
                     self.asked = None
-                if self.parts_interact or "no-error" in results[-1].violations or self.passes_matter:
+                if self.passes_matter:
+                    return results[-1]  # `explore` starts again with every request kept
+                if self.parts_interact or "no-error" in results[-1].violations:
                     return self._explore(limit, progress)
                 if not results[-1].complete:
                     break  # the state limit: the parts left are not explored either
@@ -565,6 +570,7 @@ class Explorer:
                     if prop not in violations:
                         violations[prop] = Violation(prop, message, self.trace(parents, index) + [event.label])
                 reached = self.key(after)
+                self.check_pass(after, reached)
                 target = keys.get(reached)
                 if target is None:
                     if len(states) >= limit:
@@ -700,11 +706,11 @@ def observable_requests(spec: rx.ExecutiveSpec, modules: Mapping[str, Mapping[st
     """The module requests ("module.request") whose activities can change what the executive
     sees: a cone of influence. What can run at all: the services' requests, what a running
     request's codels send, and what a reflex whose source can run requests. Of those, the
-    executive observes its services' requests and every request of a module a reflex takes as
-    its source (it hears all their replies), every request of a module where it observes one
-    (they conflict, wait for each other, freeze the module), and every request that sends one
-    it observes. The others, however they end, fail, freeze or
-    send, leave every executive state as it is: the model need not send them."""
+    executive observes its services' requests, the reflexes' sources and, with `listened`,
+    every request of a module a reflex takes as its source (it hears all their replies); then
+    every request of a module where it observes one (they conflict, wait for each other, freeze
+    the module), and every request that sends one it observes. The others, however they end,
+    fail, freeze or send, leave every executive state as it is: the model need not send them."""
 
     def sends(request: str) -> tuple[str, ...]:
         module, _, name = request.partition(".")
