@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
 import os
 import sys
 import time
@@ -19,7 +18,6 @@ from specc.diagnostics import error, render
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.pipeline import Loaded, load
-from specc.syntax.printer import format_source
 
 if TYPE_CHECKING:
     from specc.analysis.prs_net import Translation
@@ -146,6 +144,10 @@ def fmt(paths: PathsArg,
 
     Example: specc fmt --check examples/
     """
+    import difflib
+
+    from specc.syntax.printer import format_source
+
     loaded = load(paths, check=False)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
@@ -1124,17 +1126,45 @@ class CampaignProgress:
 
 
 def main() -> None:
+    """The `specc` command: runs one subcommand, then ends the process at once."""
     try:
         app()
     except KeyboardInterrupt:
         err.print("interrupted", markup=False)
-        sys.exit(130)
+        exit_now(130)
+    except SystemExit as exit_:
+        exit_now(exit_.code)
     except Exception as exc:  # a bug in specc itself: one line for the user, the trace on request
         if os.environ.get("SPECC_DEBUG"):
             raise
         err.print(f"internal error: {type(exc).__name__}: {exc} -- this is a bug in specc; "
                   "rerun with SPECC_DEBUG=1 to see where, and report it", markup=False)
-        sys.exit(2)
+        exit_now(2)
+    exit_now(0)
+
+
+def exit_now(code: object) -> None:
+    """End the process with `code` (as `sys.exit` reads it) without the interpreter's teardown.
+
+    Tearing down the modules and collecting the objects a plan or a check leaves took 0.1 s, a
+    fifth of a cold `specc plan`. What libraries registered for the exit (logging's flush,
+    temporary folders, worker pools) still runs, and the output is flushed first."""
+    import atexit
+
+    if code is None:
+        status = 0
+    elif isinstance(code, int):
+        status = code
+    else:  # sys.exit("message"): the message on stderr, status 1
+        print(code, file=sys.stderr)
+        status = 1
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe (specc plan ... | head): nothing left to say
+            pass
+    os._exit(status)
 
 
 if __name__ == "__main__":

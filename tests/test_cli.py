@@ -254,6 +254,20 @@ def test_an_internal_bug_is_one_line_not_a_traceback(tmp_path: Path) -> None:
     assert "Traceback" not in result.stderr
 
 
+
+def test_the_command_ends_without_teardown_but_runs_exit_handlers_and_keeps_its_exit_code(tmp_path: Path) -> None:
+    # main() ends the process at once (os._exit); what a library registered with atexit still runs.
+    (tmp_path / "bad.spec").write_text("module a { number: x; }\n")
+    script = ("import atexit, pathlib, sys\n"
+              "atexit.register(lambda: pathlib.Path('handler-ran').write_text('yes'))\n"
+              "import specc.cli as c\nsys.argv = ['specc', 'check', 'bad.spec']\nc.main()\n"
+              "pathlib.Path('after-main').write_text('main returned')\n")
+    result = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 1 and "bad.spec:1:" in result.stderr and "1 error(s)" in result.stderr
+    assert (tmp_path / "handler-ran").read_text() == "yes"
+    assert not (tmp_path / "after-main").exists()
+
 def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> None:
     proved = specc("verify", str(EXAMPLES / "generic"), "--executive", "fig35", "--requests", "1")
     assert proved.returncode == 0, proved.stderr

@@ -8,20 +8,29 @@ from typing import Any
 
 from specc.model.nodes import Node
 
+_CHILD_FIELDS: dict[type, tuple[str, ...]] = {}
+
+
+def _child_fields(node_class: type) -> tuple[str, ...]:
+    """The fields of a node class that may hold child nodes: all but its span. Computed once per
+    class, as every check walks every node."""
+    found = _CHILD_FIELDS.get(node_class)
+    if found is None:
+        found = _CHILD_FIELDS[node_class] = tuple(f.name for f in fields(node_class) if f.name != "span")
+    return found
+
 
 def child_steps(node: Node) -> Iterator[tuple[str, int | None, Node]]:
     """The direct child nodes of `node`, in field order, with where each sits: the field's name
     and, in a field holding a tuple, its index there (None otherwise)."""
-    for f in fields(node):
-        if f.name == "span":
-            continue
-        value = getattr(node, f.name)
+    for name in _child_fields(type(node)):
+        value = getattr(node, name)
         if isinstance(value, Node):
-            yield f.name, None, value
+            yield name, None, value
         elif isinstance(value, tuple):
             for index, element in enumerate(value):
                 if isinstance(element, Node):
-                    yield f.name, index, element
+                    yield name, index, element
 
 
 def children(node: Node) -> Iterator[Node]:

@@ -922,6 +922,8 @@ class Validator:
                                                      f"at {date_text(t)}")
             prior = last_before(timeline, t1 + TOLERANCE)
             value = prior[2].after if prior is not None else None
+            if value is not None and h.value is not None and same(value, h.value):
+                continue  # met: the findings' texts below are only built when one is added
             prefix = f"{h.owner}: {h.describe()}" + (" not met" if h.what == "goal hold" else "")
             if value is None:
                 add(("hold-value", k), f"{prefix}: {instance_text(h.instance)} has no value at {date_text(t1)} "
