@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -139,12 +140,15 @@ def compile(paths: PathsArg,
 def fmt(paths: PathsArg,
         check_only: Annotated[bool, typer.Option("--check", help="Change nothing; exit 1 if a file would change.")]
         = False,
-        diff: Annotated[bool, typer.Option("--diff", help="Show what would change.")] = False) -> None:
+        diff: Annotated[bool, typer.Option("--diff", help="Show what would change, and change nothing.")]
+        = False) -> None:
     """Rewrite specs in canonical form, keeping comments.
 
     Example: specc fmt --check examples/
     """
     import difflib
+
+    write = not (check_only or diff)
 
     from specc.syntax.printer import format_source
 
@@ -163,14 +167,14 @@ def fmt(paths: PathsArg,
             sys.stdout.writelines(difflib.unified_diff(
                 text.splitlines(keepends=True), formatted.splitlines(keepends=True),
                 f"{source.path} (now)", f"{source.path} (formatted)"))
-        if not check_only:
+        if write:
             try:
                 loaded.paths[source.path].write_text(formatted, encoding="utf-8")
             except OSError as exc:
                 changed.pop()
                 unwritable.append(error("unwritable-file", f"cannot rewrite '{source.path}': {exc.strerror}",
                                         Span.unknown(source.path)))
-    verb = "would reformat" if check_only else "reformatted"
+    verb = "reformatted" if write else "would reformat"
     for path in changed:
         out.print(f"{verb} {path}", markup=False)
     for problem in unwritable:
@@ -290,6 +294,13 @@ def verify(paths: PathsArg,
         verify_procedures(paths, goal, fact or [], fail or [], reach or [], procedures, max_states, pnml, pnml_full,
                           strict, steps)
         return
+    only_with_goal = [name for name, given in (("--fact", fact), ("--fail", fail), ("--reach", reach),
+                                               ("--procedures", procedures), ("--pnml", pnml),
+                                               ("--pnml-full", pnml_full)) if given]
+    if only_with_goal:
+        err.print(f"error: {', '.join(only_with_goal)}: for verifying procedures only; add --goal '!(GOAL ...)' "
+                  "(the goal posted), or leave out what verifies procedures to verify the executive", markup=False)
+        raise typer.Exit(1)
     from rich.status import Status
 
     from specc.analysis import kheops
@@ -634,12 +645,17 @@ def skeleton(paths: PathsArg) -> None:
     loaded = load(paths, check=False)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
+    # New codel modules go to the robot's folder, where `specc run` imports them from: the nearest
+    # folder above a spec (or its own) holding the system block; beside the spec when none does.
+    robots = {loaded.paths[f.path].resolve().parent for f in loaded.program.files
+              if any(isinstance(item, m.System) for item in f.items)}
     wrote = 0
     for source in loaded.program.files:
         spec_dir = loaded.paths[source.path].resolve().parent
+        robot_dir = next((folder for folder in (spec_dir, *spec_dir.parents) if folder in robots), None)
         for wanted in (needs for item in source.items for needs in stubs.needs(item)):
             try:
-                change = stubs.write_stubs(wanted, spec_dir)
+                change = stubs.write_stubs(wanted, spec_dir, robot_dir)
             except (OSError, SyntaxError) as exc:
                 err.print(f"{source.path}: error: {wanted.owner}: {exc} [skeleton-failed]", markup=False)
                 raise typer.Exit(1) from None
@@ -667,11 +683,12 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         mission: Annotated[Optional[str], typer.Option(help="One of the system block's missions (default: its only "
                                                             "one).")] = None,
         world: Annotated[Optional[str], typer.Option(help="One of the system's worlds or a world file (default: "
-                                                          "the mission's).")] = None,
+                                                          "the mission's; with --goal, the system's first).")] = None,
         config: Annotated[Optional[str], typer.Option(help="FTplan's configuration for a planned mission: Robot1, "
-                                                           "Robot2 (one planner), Robot1/2 (successive), Robot1/2c "
-                                                           "(concurrent), any with -repair, -norepair or "
-                                                           "-noanalyzer; default: the ftplan block's own.")] = None,
+                                                           "Robot2 (one planner; or that planner's name), Robot1/2 "
+                                                           "(successive), Robot1/2c (concurrent), any with -repair, "
+                                                           "-norepair or -noanalyzer; default: the ftplan block's "
+                                                           "own.")] = None,
         seed: Annotated[int, typer.Option(min=0, help="Draws the run's randomness: one seed, one event log.")] = 0,
         generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to (compiled "
                                                 "first when stale).")] = Path("generated"),
@@ -762,10 +779,17 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
     from specc.run.replay import check_kinds, describe, load_run, select
 
     try:
+        for option, value in (("--from", start), ("--to", end)):
+            if value is not None and not math.isfinite(value):
+                raise RunError(f"{option} {value}: give a mission time in seconds")
+        if start is not None and end is not None and start > end:
+            raise RunError(f"--from {start:g} is after --to {end:g}: nothing between them")
         folder, events = load_run(run_path)
-        check_kinds(events, kind or ())
+        note = check_kinds(events, kind or ())
     except RunError as error:
         raise _run_error(error, 2) from None
+    if note is not None:
+        err.print(f"note: {note}", markup=False)
     previous: float | None = None
     for event in select(events, kind or (), start, end):
         if speed > 0 and previous is not None and event["t"] > previous:
@@ -808,12 +832,16 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
 
     Examples: specc table examples/tug --seeds 10; specc table examples/tug --mission shuttle --world hall
     --config Robot1 --config Robot1/2."""
-    from specc.run import RunError
+    from specc.run import RunError, writable_folder
     from specc.run.measures import rich_table
     from specc.run.session import RunCrashed, RunRequest, compile_robot
     from specc.run.sweep import sweep, write_table
 
     try:
+        if output is not None:
+            if output.is_dir():
+                raise RunError(f"--output '{output}' is a folder: give the table's file, e.g. {output / 'table.md'}")
+            writable_folder(output.parent, "the table's folder")
         robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
         base = RunRequest(specs, generated=generated, runs=runs, pictures=pictures)
         with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} run(s) done") as progress:
@@ -823,7 +851,9 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
                 elif not quiet and label:
                     err.print(f"[{done + 1}/{total}] {label}", markup=False)
 
-            result = sweep(robot, base, missions=mission or (), worlds=world or (), configurations=config or (),
+            # An option given twice runs once: each run has one folder, counted once in the table.
+            result = sweep(robot, base, missions=tuple(dict.fromkeys(mission or ())),
+                           worlds=tuple(dict.fromkeys(world or ())), configurations=tuple(dict.fromkeys(config or ())),
                            seeds=range(seeds), step=step)
         written = write_table(result, output or runs / f"{robot}-table.md")
     except RunCrashed as crash:  # stopped by a signal: the runs so far keep their folders
@@ -1004,12 +1034,14 @@ def campaign(
     from specc.campaign.report import build_report
     from specc.campaign.store import ResultStore
     from specc.mutation import default_workers
-    from specc.run import RunError
+    from specc.run import RunError, writable_folder
     from specc.run.session import compile_robot
 
     try:
         if mutants != "all" and not (mutants.isdigit() and int(mutants) > 0):
             raise RunError(f"--mutants {mutants}: give a number of mutants, or 'all'")
+        if output is not None:
+            writable_folder(output, "the report's folder")
         def robot_name() -> str:
             return compile_robot(specs, generated, lambda text: err.print(text, markup=False))
 

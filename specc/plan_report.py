@@ -15,7 +15,7 @@ from specc.model import nodes as m
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import format_value
-from specc.runtime.planner.replan import Fact, replanning_problem
+from specc.runtime.planner.replan import Fact, checked_facts, replanning_problem
 from specc.runtime.planner.validate import validate
 
 
@@ -56,16 +56,19 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
     model = domain_model(program, domain_block(program, chosen))
     problem = problem_model(program, chosen)
     if horizon is not None:
-        if horizon <= 0:
-            raise ValueError(f"--horizon must be positive, not {horizon:g}")
+        if not (math.isfinite(horizon) and horizon > 0):
+            raise ValueError(f"--horizon must be a positive number of seconds, not {horizon:g}")
         problem = pm.with_horizon(problem, horizon)
+    if not (math.isfinite(now) and now >= 0):
+        raise ValueError(f"--now must be a mission time of 0 s or more, not {now:g}")
     if facts or goals is not None or now:
         lines = {a.line for a in problem.assertions if a.goal is not None}
         unknown = sorted(set(goals or ()) - lines)
         if unknown:
             raise ValueError(f"no goal on line(s) {', '.join(map(str, unknown))} of {problem.source} "
                              f"(goal lines: {', '.join(map(str, sorted(lines)))})")
-        problem = replanning_problem(problem, [Fact.parse(f) for f in facts], lines if goals is None else goals, now)
+        parsed = checked_facts(model, [Fact.parse(f) for f in facts])
+        problem = replanning_problem(problem, parsed, lines if goals is None else goals, now)
     result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability,
                      improve=improve).plan(problem, now=now)
     violations = []
@@ -117,7 +120,9 @@ def print_result(outcome: Outcome, out: Console) -> None:
         for v in outcome.violations:
             out.print(f"  {v}", markup=False)
     else:
-        out.print("validator: the plan is valid for every duration and window instant nature may pick", markup=False)
+        holds_for = ("duration and window instant nature may pick" if plan.controllability == "strong" else
+                     "duration nature may pick, with its contingent instants at the dates it assumes (above)")
+        out.print(f"validator: the plan is valid for every {holds_for}", markup=False)
 
 
 PLAN_FORMAT = "specc-plan/1"

@@ -242,6 +242,18 @@ def test_a_goal_from_the_command_line_is_posted_in_the_named_world(cart: Path) -
     assert events[0]["goals"] == ["!(GO 2 5)"]
     last = [e for e in events if e["kind"] == "pose"][-1]
     assert math.hypot(last["x"] - 2, last["y"] - 5) < 0.2
+    # A world file named from the robot's folder, as its system block names them, from another folder.
+    relative = specc(work, "run", cart, "--goal", "!(GO 2 5)", "--world", "worlds/shop.toml", "--folder",
+                     work / "relative", "-q")
+    assert relative.returncode == 0, relative.stderr
+    # Without --folder, runs of other goals go to folders of their own: none overwrites another.
+    for goal in ("!(GO 2 5)", "!(GO 3 4)"):
+        assert specc(work, "run", cart, "--goal", goal, "--runs", work / "goals", "-q").returncode == 0
+    folders = sorted(p.name for p in (work / "goals").iterdir())
+    assert [f[:-7] for f in folders] == ["cart-goal-shop-s0-GO-2-5", "cart-goal-shop-s0-GO-3-4"]  # and a digest
+    # The same text once cleaned, another goal: a folder of its own.
+    test = specc(work, "run", cart, "--goal", "?(GO 2 5)", "--runs", work / "goals", "-q")
+    assert len(list((work / "goals").iterdir())) == 3, test.stderr
 
 
 def test_a_goal_the_robot_cannot_reach_fails_with_the_modules_reason(cart: Path) -> None:
@@ -253,12 +265,60 @@ def test_a_goal_the_robot_cannot_reach_fails_with_the_modules_reason(cart: Path)
     assert "GOTO answered BLOCKED" in report["why"], report["why"]
 
 
+
+def test_a_reflex_that_fires_is_in_the_log_before_what_it_does(tmp_path: Path) -> None:
+    stop = "  request Stop { type: control; validate: stopNow; }\n"
+    spec = SPEC.replace("  exec_task Motion", stop + "  exec_task Motion")
+    spec = spec.replace("    conflicts { GOTO: interrupt; }\n  }\n",
+                        "    conflicts { GOTO: interrupt; }\n  }\n"
+                        "  reflex halt on reply drive.Goto == BLOCKED => request drive.Stop;\n")
+    cart = write_robot(tmp_path, spec, CODELS + "\n\ndef stopNow(sdi, request):\n    sdi.hardware.wheels.stop()\n"
+                                             "    return 'OK'\n")
+    result = specc(tmp_path, "run", cart, "--goal", "!(GO 4.5 1.5)", "--folder", tmp_path / "blocked", "-q")
+    assert result.returncode == 1, result.stderr
+    events = read_events(tmp_path / "blocked" / "events.jsonl")
+    reflex = [e for e in events if e["kind"] == "reflex"]
+    assert [(e["reflex"], e["on"], e["code"], e["actions"]) for e in reflex] == [
+        ("halt", "reply drive.Goto", "BLOCKED", ["request drive.Stop"])]
+    blocked = next(e for e in events if e["kind"] == "reply" and e["result"] == "BLOCKED")
+    assert blocked["t"] <= reflex[0]["t"]
+    replay = specc(tmp_path, "replay", tmp_path / "blocked", "--kind", "reflex", "--no-render")
+    assert "halt on reply drive.Goto BLOCKED: request drive.Stop" in replay.stdout, replay.stdout + replay.stderr
+
+
+def test_a_world_file_broken_since_the_last_run_leaves_that_run_s_folder_whole(tmp_path: Path) -> None:
+    cart = write_robot(tmp_path)
+    assert specc(tmp_path, "run", cart, "-q").returncode == 0
+    folder = tmp_path / "runs" / "cart-deliver-shop-s0"
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    with (cart / "worlds" / "shop.toml").open("a") as world:
+        world.write("x = = 3\n")
+    again = specc(tmp_path, "run", cart, "-q")
+    assert again.returncode == 2 and "shop.toml: not valid TOML" in again.stderr, again.stderr
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+
+
+@pytest.mark.parametrize("hook", ["prepare", "measure"])
+def test_an_extension_hook_that_raises_is_named_with_where_it_raised(tmp_path: Path, hook: str) -> None:
+    spec = SPEC.replace("  supervisor: tasks;\n", '  supervisor: tasks;\n  extension: "cart_codels.ext";\n')
+    cart = write_robot(tmp_path, spec)
+    (cart / "cart_codels" / "ext.py").write_text(f"def {hook}(*args):\n    raise KeyError('boom')\n")
+    result = specc(tmp_path, "run", cart, "--folder", tmp_path / "run", "-q")
+    said = f"robot 'cart': its extension's {hook}() raised KeyError: 'boom' ({cart / 'cart_codels' / 'ext.py'}:2)"
+    assert said in result.stderr and "internal error" not in result.stderr, result.stderr
+    # prepare is the run's set-up: bad input, nothing run; measure comes at the end: the run crashed, its log kept.
+    assert result.returncode == (2 if hook == "prepare" else 1)
+    assert (tmp_path / "run" / "events.jsonl").exists() == (hook == "measure")
+
 @pytest.mark.parametrize(("args", "message"), [
     (("--mission", "collect"), "has no mission 'collect' (its missions: deliver)"),
     (("--world", "yard"), "has no world 'yard' (its worlds: shop"),
+    (("--world", "worlds/yard.toml"), "no world file 'worlds/yard.toml' (looked from the current folder and from "
+                                      "the robot's"),
     (("--goal", "!(GOO 1 2)"), "no KA of procedures 'tasks' is invoked by GOO (did you mean 'GO'?)"),
     (("--goal", "!(GO 1)"), "GO takes 2 argument(s), 1 given"),
     (("--goal", "!(GO $X 1)"), "goal of constants"),
+    (("--goal", "!(GO 1e999 1)"), "not a PRS goal (number 1e999 is too large)"),
     (("--goal", "!(GO 1 2)", "--mission", "deliver"), "give --mission or --goal, not both"),
     (("--config", "Robot1"), "--config: mission deliver of robot 'cart' is not planned"),
 ])

@@ -233,8 +233,13 @@ def test_a_report_needs_a_store_that_holds_a_campaign(tmp_path: Path) -> None:
     (["--configs", "Robot7"], "no robot configuration 'Robot7'"),
     (["--configs", "Robot2"], "configuration Robot2 does not plan in 'model1'"),
     (["--domain", "model9", "--mutants", "2"], "model9"),
+    (["--scheduler", "bogus"], "--scheduler bogus: missing port number in address 'bogus'; give tcp://HOST:PORT"),
+    (["-o", "{tmp}/afile"], "the report's folder '{tmp}/afile' is a file, not a folder"),
 ])
 def test_bad_campaign_input_is_one_line_and_exit_2(tmp_path: Path, args: list[str], message: str) -> None:
+    (tmp_path / "afile").write_text("")
+    args = [a.format(tmp=tmp_path) for a in args]
+    message = message.format(tmp=tmp_path)
     result = specc("campaign", ATRV, "--missions", "M1", "--worlds", "W1", "--runs", "1", *args,
                    "--store", tmp_path / "bad.sqlite", "-q")
     assert result.returncode == 2, result.stderr

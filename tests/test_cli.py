@@ -67,6 +67,9 @@ def test_binary_file_is_a_clear_error(tmp_path: Path) -> None:
     result = specc("check", str(spec))
     assert result.returncode == 1 and "[bad-encoding]" in result.stderr
     assert "Traceback" not in result.stderr
+    # Latin-1 in a comment: the line and column of the first byte that is not UTF-8.
+    spec.write_bytes("module a {\n  number: 1; // é ".encode() + b"caf\xe9\n}\n")
+    assert "blob.spec:2:22: error:" in specc("check", str(spec)).stderr  # é counts one column
 
 
 @pytest.mark.parametrize("content", [b"def go(sdi, request):\n    return '\xe9t\xe9'\n",  # Latin-1
@@ -113,6 +116,9 @@ def test_fmt_check_reports_and_fmt_rewrites(tmp_path: Path) -> None:
     spec.write_text("module loco{number:700; // the number\n}\n")
     result = specc("fmt", "--check", str(spec))
     assert result.returncode == 1 and "would reformat" in result.stdout
+    assert spec.read_text() == "module loco{number:700; // the number\n}\n"
+    shown = specc("fmt", "--diff", str(spec))  # shows the change, makes none
+    assert shown.returncode == 0 and "+  number: 700;" in shown.stdout and "would reformat" in shown.stdout
     assert spec.read_text() == "module loco{number:700; // the number\n}\n"
     assert specc("fmt", str(spec)).returncode == 0
     assert spec.read_text() == "module loco {\n  number: 700;  // the number\n}\n"
@@ -268,6 +274,19 @@ def test_the_command_ends_without_teardown_but_runs_exit_handlers_and_keeps_its_
     assert (tmp_path / "handler-ran").read_text() == "yes"
     assert not (tmp_path / "after-main").exists()
 
+def test_verify_options_of_procedures_without_a_goal_are_refused(tmp_path: Path) -> None:
+    result = specc("verify", str(EXAMPLES / "tug"), "--pnml", str(tmp_path / "net.pnml"), "--fact", "(BUSY)")
+    assert result.returncode == 1 and "--fact, --pnml: for verifying procedures only; add --goal" in result.stderr
+    assert not (tmp_path / "net.pnml").exists()
+
+
+def test_replay_refuses_a_time_window_that_holds_nothing(tmp_path: Path) -> None:
+    (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\n')
+    for args, said in ((("--from", "50", "--to", "10"), "--from 50 is after --to 10"),
+                       (("--from", "nan"), "--from nan: give a mission time in seconds")):
+        result = specc("replay", str(tmp_path), *args)
+        assert result.returncode == 2 and said in result.stderr, result.stderr
+
 def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> None:
     proved = specc("verify", str(EXAMPLES / "generic"), "--executive", "fig35", "--requests", "1")
     assert proved.returncode == 0, proved.stderr
@@ -405,6 +424,9 @@ def test_plan_asks_the_controllability_the_user_chooses(controllability: str, w2
     assert f"{controllability}ly controllable" in result.stdout
     if controllability == "pseudo":
         assert "t_svisi2=152.00" in result.stdout  # the opening it waits for
+    # What the validator's verdict covers: every instant nature may pick, or the dates assumed.
+    assert ("window instant nature may pick" in result.stdout) == (controllability == "strong")
+    assert ("contingent instants at the dates it assumes" in result.stdout) == (controllability == "pseudo")
 
 
 def test_plan_replans_from_facts_given_on_the_command_line() -> None:
@@ -418,8 +440,18 @@ def test_plan_replans_from_facts_given_on_the_command_line() -> None:
 @pytest.mark.parametrize(("args", "message"), [
     (("--problem", "M1"), "ambiguous (M1_model1, M1_model2); add --domain"),
     (("--problem", "M9"), "no problem 'M9'"),
-    (("--problem", "M1_model1", "--horizon", "-5"), "--horizon must be positive"),
+    (("--problem", "M1_model1", "--horizon", "-5"), "--horizon must be a positive number of seconds, not -5"),
+    (("--problem", "M1_model1", "--horizon", "nan"), "--horizon must be a positive number of seconds, not nan"),
+    (("--problem", "M1_model1", "--now", "-5"), "--now must be a mission time of 0 s or more, not -5"),
     (("--problem", "M1_model1", "--fact", "AT_ROBOT_X = 3"), "is not a fact"),
+    # Facts are checked against the domain: arity, each argument's and the value's domain, one value each.
+    (("--problem", "M1_model1", "--now", "10", "--fact", "PTU_POSITION() = SIDEWAYS"),
+     "fact 'PTU_POSITION() = SIDEWAYS': SIDEWAYS is not one of"),
+    (("--problem", "M1_model1", "--fact", "PTU_POSITION(3) = STRAIGHT"), "PTU_POSITION takes 0 argument(s), 1 given"),
+    (("--problem", "M1_model1", "--fact", "AT_ROBOT_X() = abc"), "fact 'AT_ROBOT_X() = abc': abc is not a number"),
+    (("--problem", "M1_model1", "--fact", "AT_ROBOT_X() = 2", "--fact", "AT_ROBOT_X() = 3"),
+     "AT_ROBOT_X() is already 2: give one value"),
+    (("--problem", "M1_model1", "--fact", "NOWHERE() = 2"), "domain 'model1' has no attribute NOWHERE"),
     (("--problem", "M1_model1", "--goal", "5"), "no goal on line(s) 5"),
 ])
 def test_plan_bad_input_is_one_clear_error(args: tuple[str, ...], message: str) -> None:
@@ -429,8 +461,6 @@ def test_plan_bad_input_is_one_clear_error(args: tuple[str, ...], message: str) 
 
 
 @pytest.mark.parametrize(("args", "message"), [
-    (("--now", "10", "--fact", "PTU_POSITION() = SIDEWAYS"),  # a value unknown to the model, at run time
-     "no plan: fact PTU_POSITION() = SIDEWAYS: 'SIDEWAYS' is not a value of PTU_POSITION"),
     (("--now", "900"),  # the mission must end by 800 s: contradictory constraints
      "no plan: no plan satisfies the problem's required assertions and constraints"),
     (("--horizon", "1"), "no plan: every goal is dropped, for the reasons above"),  # unsolvable

@@ -232,3 +232,26 @@ def test_mutation_1_592_goes_unseen_without_the_analyzer_and_is_refused_with_it(
     assert not any(e.kind == "execute" for e in refused.events)
     assert refused.failure == MISSION_FAILED_IN_TIME
     assert any(e.kind == "invalid-plan" and "PTU_POSITION" in e.text for e in refused.events)
+
+
+def test_a_planner_s_own_problem_gets_its_goals_that_stand_for_ftplan_s_open_ones() -> None:
+    """In FTplan's vocabulary, each goal of the planner's problem pairs with FTplan's goal of the same
+    fact, in order: of two `AT() = DOCK`, the one met leaves its partner alone; a goal FTplan's problem
+    does not have is kept."""
+    import math
+    from types import SimpleNamespace
+
+    from specc.runtime.ftplan.state import Goal, SystemState
+
+    def goal(line: int, attribute: str, value: str) -> Goal:
+        return Goal(line, attribute, (), value, 1.0, math.inf, False)
+
+    state = SystemState({}, (goal(10, "AT", "DOCK"), goal(11, "CART", "C"), goal(12, "AT", "DOCK")), {})
+    state.met.add(10)
+    own = SystemState({}, (goal(50, "AT", "DOCK"), goal(51, "CART", "C"), goal(52, "AT", "DOCK"),
+                           goal(53, "LIGHT", "ON")), {})
+    component = SimpleNamespace(state=state, planner_ledgers={"careful": own})
+    component._paired_goals = lambda k: FtPlan._paired_goals(component, k)  # type: ignore[arg-type]
+    assert FtPlan.open_planner_goals(component, "careful", None) == [51, 52, 53]  # type: ignore[arg-type]
+    state.met.add(11)
+    assert FtPlan.open_planner_goals(component, "careful", None) == [52, 53]  # type: ignore[arg-type]

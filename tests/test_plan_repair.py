@@ -176,6 +176,10 @@ def test_configuration_suffixes_turn_repair_on_or_off_for_every_planner() -> Non
         configuration_named(known, "Robot1/2-noanalyzer-noanalyzer")
     with pytest.raises(KeyError):
         configuration_named(known, "Robot9-repair")
+    # A planner's name: that planner alone, as its RobotN (and with suffixes too).
+    second = rover.CONFIG.planners[1].name
+    assert configuration_named(known, second) == known["Robot2"]
+    assert [p.repair for p in configuration_named(known, f"{second}-repair").planners] == [True]
 
 
 def test_a_planner_block_turns_repair_on(tmp_path: Path) -> None:

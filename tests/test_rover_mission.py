@@ -219,7 +219,8 @@ def test_the_rover_s_procedures_take_goals_of_their_own(robot: Robot) -> None:
 
 
 @pytest.mark.parametrize("configuration, mission, world, message", [
-    ("Robot3", "M1", "W1", "no robot configuration 'Robot3' (known: Robot1, Robot2, Robot1/2, Robot1/2c; add"),
+    ("Robot3", "M1", "W1", "no robot configuration 'Robot3' (known: Robot1 (p1 alone), Robot2 (p2 alone), "
+                           "Robot1/2, Robot1/2c, or a planner's name for it alone; add"),
     ("Robot1", "M9", "W1", "robot 'atrv' has no mission 'M9' (its missions: M1, M2, M3, M4)"),
     ("Robot1", "M1", "W9", "robot 'atrv' has no world 'W9' (its worlds: W1, W2, W3, W4; or give a .toml file)"),
 ])

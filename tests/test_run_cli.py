@@ -277,6 +277,10 @@ def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:
     (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\n')
     assert_clean_failure(specc("replay", tmp_path, "--kind", "actoin"), 2,
                          "no event of kind 'actoin' in this log (it has: mission-start)")
+    # One kind of several absent: the others are shown, the absent one noted.
+    some = specc("replay", tmp_path, "--kind", "action", "--kind", "mission-start", "--no-render")
+    assert some.returncode == 0 and "mission-start" in some.stdout
+    assert "note: no event of kind 'action' in this log" in some.stderr
     (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\nnot json\n')
     assert_clean_failure(specc("replay", tmp_path), 2, "events.jsonl")
 

@@ -47,6 +47,7 @@ def test_room_world_loads():
     ({**EMPTY, "obstacles": [{"circle": [1, 1, -2]}]}, "radius > 0"),
     ({**EMPTY, "obstacles": [{"circle": [0, 0, 1.0]}]}, "start (0, 0) is inside"),
     ({**EMPTY, "start": {"x": "near"}}, "'x' must be a finite number"),
+    ({"room": {"width": 1e308, "height": 5.0}}, "the walls reach 1e+308 m from the origin: at most 100000 m"),
     ({**EMPTY, "windows": [{"start": 10.0, "end": 5.0}]}, "windows[0]"),
     ({**EMPTY, "rooms": {}}, "unknown section [rooms]"),
     ({**EMPTY, "start": {"x": 1.0, "thetaa": 1.0}}, "[start]: unknown key 'thetaa'"),

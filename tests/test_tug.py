@@ -58,9 +58,33 @@ def test_a_planned_mission_shows_each_action_s_goal_service_and_module_request(t
     ]
 
 
+
+def test_when_the_first_planner_plans_nothing_the_second_plans_the_goals_of_its_own_problem(tmp_path: Path) -> None:
+    # The quick planner's model made wrong (a hitched cart stays where it was): it finds no plan, and
+    # FTplan asks the careful one, whose problem states the same mission on other lines. It must be
+    # asked for those goals (by what they say, not by the first problem's lines) and deliver.
+    import shutil
+
+    tug = tmp_path / "tug"
+    shutil.copytree(TUG, tug)
+    planning = (tug / "planning.spec").read_text()
+    wrong = planning.replace("event(CART_AT(?c): (?p, TUG), t_end);", "event(CART_AT(?c): (?p, ?p), t_end);", 1)
+    assert wrong != planning
+    (tug / "planning.spec").write_text(wrong)
+    # From its own folder: the copy compiles into tmp_path/generated, not over the project's generated/.
+    result = subprocess.run([sys.executable, "-m", "specc.cli", "run", "tug", "--mission", "shuttle", "--runs", "runs",
+                             "-q"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout + result.stderr
+    folder = tmp_path / "runs" / "tug-shuttle-hall-Robot1-2-s0"
+    assert json.loads((folder / "report.json").read_text())["measures"]["planned_goals_met"] == 2
+    plans = [e["text"] for e in read_events(folder / "events.jsonl") if e["kind"] == "ftplan" and e["event"] == "plan"]
+    assert plans[0].startswith("quick: 0 actions") and plans[1].startswith("careful: 5 actions"), plans
+
+
 def test_a_table_of_the_tug(tmp_path: Path) -> None:
-    result = specc("table", TUG, "--mission", "deliver", "--world", "hall", "--world", "crowded", "--runs",
-                   tmp_path, "--quiet")
+    # hall given twice: run once, counted once.
+    result = specc("table", TUG, "--mission", "deliver", "--world", "hall", "--world", "crowded", "--world", "hall",
+                   "--runs", tmp_path, "--quiet")
     assert result.returncode == 0, result.stderr
     data = json.loads((tmp_path / "tug-table.json").read_text())
     assert [(row["mission"], row["world"], row["succeeded"]) for row in data["missions"]] == [
@@ -78,3 +102,34 @@ def test_bad_options_for_the_tug_are_one_line(tmp_path: Path, args: tuple[str, .
     result = specc("run", TUG, *args, "--runs", tmp_path, "-q")
     assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("output, message", [
+    ("afile/table.md", "the table's folder '{tmp}/afile' is a file, not a folder"),
+    ("afolder", "--output '{tmp}/afolder' is a folder: give the table's file"),
+])
+def test_a_table_that_could_not_be_written_is_refused_before_any_run(tmp_path: Path, output: str,
+                                                                      message: str) -> None:
+    (tmp_path / "afile").write_text("")
+    (tmp_path / "afolder").mkdir()
+    result = specc("table", TUG, "--mission", "deliver", "--runs", tmp_path / "runs", "-o", tmp_path / output, "-q")
+    assert result.returncode == 2 and message.format(tmp=tmp_path) in result.stderr, result.stderr
+    assert not (tmp_path / "runs").exists()
+
+
+def test_a_planned_mission_whose_problem_has_no_goal_is_refused_not_reported_a_success(tmp_path: Path) -> None:
+    import shutil
+
+    tug = tmp_path / "tug"
+    shutil.copytree(TUG, tug)
+    planning = (tug / "planning.spec").read_text()
+    shuttle = planning.index("problem shuttle ")
+    end = planning.index("\n}", shuttle)
+    goalless = planning[:shuttle] + planning[shuttle:end].replace(" goal(2, 0)", "").replace(" goal(1, 0)", "") \
+        + planning[end:]
+    (tug / "planning.spec").write_text(goalless)
+    result = subprocess.run([sys.executable, "-m", "specc.cli", "run", "tug", "--mission", "shuttle", "--runs", "runs",
+                             "-q"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "plans problem 'shuttle', which has no goal" in result.stderr
+    assert not (tmp_path / "runs").exists()

@@ -1236,7 +1236,7 @@ class _Exporter:
         if goals_with_windows:
             self.note("the goals' time windows are reduced to final goals (PDDL 2.1 has no timed goals), with a "
                       "deadline when the window's end is bounded (see above): a goal must still hold at the end of "
-                      "the plan, and the minimal delays (e.g. home 2 s before the horizon) are dropped.")
+                      "the plan, and the minimal delays (e.g. a goal holding from 2 s before the horizon) are dropped.")
 
     def instances(self, a: pm.Event) -> list[dict[str, pm.Expr]]:
         """Bindings of the problem variables in the arguments of a given event: those that unify it

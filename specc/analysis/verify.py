@@ -463,8 +463,11 @@ class Explorer:
     def check_pass(self, world: World, reached: Key) -> None:
         """With `check_passes`: one more start authorisation pass on `world` (whose key is
         `reached`, just stepped), noting whether it changes a state (`passes_matter`)."""
-        if self.check_passes and not self.passes_matter and world.executive.error is None:
-            world.executive._post(_nothing)  # a cycle with no event
+        executive = world.executive
+        # A pass only asks again for the starts of WAIT activities: with none, it changes nothing.
+        if (self.check_passes and not self.passes_matter and executive.error is None
+                and any(a.state is rx.Phase.WAIT for a in executive.activities.values())):
+            executive._post(_nothing)  # a cycle with no event
             if self.key(world) != reached:
                 self.passes_matter = True
 

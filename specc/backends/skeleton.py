@@ -128,21 +128,25 @@ def next_state(codel: m.Codel) -> str:
     return "ether" if "ether" in codel.yields else codel.yields[0]
 
 
-def write_stubs(wanted: Needs, spec_dir: Path) -> Change | None:
+def write_stubs(wanted: Needs, spec_dir: Path, robot_dir: Path | None = None) -> Change | None:
+    """Add the missing stubs to the module `wanted` names, found as `specc check` finds it (from
+    the spec's folder up); a module found nowhere is created in `robot_dir` (the robot's folder,
+    where `specc run` imports codels from), else beside the spec."""
     if not wanted.stubs or not all(part.isidentifier() for part in wanted.dotted.split(".")):
         return None  # no Python module can take that name: `specc check` says so
     dotted = wanted.dotted
     path = find_module(dotted, spec_dir)
     created = path is None
     if path is None:
-        path = spec_dir.joinpath(*dotted.split(".")).with_suffix(".py")
+        base = robot_dir or spec_dir
+        path = base.joinpath(*dotted.split(".")).with_suffix(".py")
         path.parent.mkdir(parents=True, exist_ok=True)
-        for folder in path.parent.relative_to(spec_dir).parents:
-            init = spec_dir / folder / "__init__.py" if str(folder) != "." else None
+        for folder in path.parent.relative_to(base).parents:
+            init = base / folder / "__init__.py" if str(folder) != "." else None
             if init is not None and not init.exists():
                 init.write_text("")
         package_init = path.parent / "__init__.py"
-        if path.parent != spec_dir and not package_init.exists():
+        if path.parent != base and not package_init.exists():
             package_init.write_text("")
         path.write_text(f'"""Functions of {wanted.owner} (stubs written by `specc skeleton`)."""\n')
         clear_caches()

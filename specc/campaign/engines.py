@@ -194,6 +194,15 @@ class DaskEngine:
     package and the robot's folder at the same paths as this machine (a shared file system)."""
 
     def __init__(self, setting: Setting, address: str, workers: int, timeout: float) -> None:
+        if address != "local":  # said at once, not when the first experiment is sent
+            try:
+                from distributed.comm.addressing import parse_address, parse_host_port
+
+                parse_host_port(parse_address(address)[1])
+            except ImportError as error:
+                raise RunError(f"--scheduler needs dask.distributed ({error})") from None
+            except ValueError as error:
+                raise RunError(f"--scheduler {address}: {error}; give tcp://HOST:PORT or local") from None
         self.setting, self.address, self.timeout = setting, address, timeout
         self.workers = workers
         self.client: Any = None
@@ -217,8 +226,9 @@ class DaskEngine:
                                             dashboard_address=None)
                 return Client(self.cluster)
             client = Client(self.address, timeout=10)
-        except (OSError, TimeoutError) as error:
-            raise RunError(f"cannot reach the Dask scheduler at {self.address}: {error}") from None
+        except (OSError, TimeoutError, ValueError) as error:  # ValueError: not an address (no port...)
+            raise RunError(f"cannot reach the Dask scheduler at {self.address}: {error}; give tcp://HOST:PORT "
+                           "or local") from None
         self.workers = max(1, sum(client.nthreads().values()))
         return client
 

@@ -174,10 +174,19 @@ class ScopeChecker(Visitor):
         self.attr_value(s.attr, self.scope, resource=True)
         for time in (s.when.start, s.when.end) if isinstance(s.when, m.Window) else (s.when,):
             self.time(time, self.scope)
+        amount = None if isinstance(s.attr.value, m.Transition) else constant_value(s.attr.value)
+        if amount is not None and amount < 0:
+            self.ctx.warn("negative-amount", f"a task {s.verb}s {amount:g} of {s.attr.attribute}: an amount is 0 or "
+                          "more (what it gives back is its end)", s.attr.value.span)
 
     def visit_InConstraint(self, s: m.InConstraint) -> None:
         self.expr(s.expr, self.scope)
         self.domain_value(s.domain, self.scope)
+        if s.contingent and isinstance(s.domain, m.Interval):
+            low = constant_value(s.domain.low)
+            if low is not None and low < 0:
+                self.ctx.warn("negative-amount", f"a contingent duration of at least {low:g} s: nature's durations "
+                              "are 0 s or more (the planner cuts it at 0)", s.domain.low.span)
 
     def visit_RelConstraint(self, s: m.RelConstraint) -> None:
         self.expr(s.left, self.scope)

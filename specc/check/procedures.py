@@ -28,12 +28,15 @@ class ProcedureVisitor(Visitor):
         # Primitive actions are called from a KA's `action:` only, in a namespace of their own
         # (Fig. 4.2: goal SEND-REQUEST $REQUEST $ID is achieved by action SEND-REQUEST $REQUEST).
         self.actions = {a.name: a.params for a in procedures.actions}
-        # A goal achieved by a KA needs no predicate declaration: its invocation declares it.
+        # A goal achieved by a KA needs no predicate declaration: its invocation declares it, and
+        # the number of arguments it takes (the KAs invoked by one head may take several).
+        self.invoked: dict[str, set[int]] = {}
         for ka in procedures.kas:
             invocation = ka.invocation
             head = invocation.body if isinstance(invocation, m.Goal) else invocation
             if head is not None and head.head not in self.signatures:
-                self.signatures[head.head] = None
+                self.invoked.setdefault(head.head, set()).add(len(head.args))
+        self.signatures.update(dict.fromkeys(self.invoked))
 
     def visit_KAAction(self, node: m.KAAction) -> None:
         call = node.call
@@ -72,6 +75,11 @@ class ProcedureVisitor(Visitor):
     def check_arguments(self, node: m.SExp) -> None:
         params = self.signatures[node.head]
         if params is None:
+            taken = self.invoked.get(node.head, set())
+            if taken and len(node.args) not in taken:
+                counts = " or ".join(str(n) for n in sorted(taken))
+                self.ctx.report("arity-mismatch", f"'{node.head}' takes {counts} argument(s) (the KAs invoked by it), "
+                                f"{len(node.args)} given", node.span)
             return
         if len(node.args) != len(params):
             self.ctx.report("arity-mismatch",

@@ -165,6 +165,10 @@ def check_missions(ctx: Context, system: m.System, worlds: dict[str, m.Setting])
     ctx.duplicates(system.missions, "mission")
     supervisor = ctx.named(m.Procedures).get(system.supervisor.text) if system.supervisor else None
     goals = achievable_goals(supervisor) if supervisor is not None else {}
+    needs = numeric_positions(supervisor) if supervisor is not None else {}
+    for node in walk(supervisor) if supervisor is not None else ():  # the KAs' own subgoals of constants
+        if isinstance(node, m.Goal) and node.op == "!":
+            check_numeric_arguments(ctx, node.body, needs)
     for mission in system.missions:
         if mission.world is not None:
             if mission.world.text not in worlds:
@@ -184,7 +188,7 @@ def check_missions(ctx: Context, system: m.System, worlds: dict[str, m.Setting])
                            f"'{system.name}' has no supervisor to achieve it: give it 'supervisor: NAME;'", goal.span)
             elif supervisor is not None:
                 check_mission_goal(ctx, goal, goals, supervisor.name)
-                check_goal_values(ctx, goal, supervisor)
+                check_goal_values(ctx, goal, supervisor, needs)
 
 
 def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | None,
@@ -313,8 +317,12 @@ def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], proced
                    body.span)
 
 
-def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures) -> None:
-    """A mission's constant arguments lie in the finite domains the goal's predicate declares."""
+def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures,
+                      needs: Mapping[tuple[str, int], str]) -> None:
+    """A mission's constant arguments lie in the finite domains the goal's predicate declares, and
+    a symbol never stands where every KA the goal invokes needs a number (`needs`, the procedures'
+    `numeric_positions`)."""
+    check_numeric_arguments(ctx, goal.body, needs)
     declared = next((p for p in procedures.predicates if p.name == goal.body.head), None)
     if declared is None or len(declared.params) != len(goal.body.args):
         return
@@ -325,6 +333,64 @@ def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures) -> N
             shown = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
             ctx.report("bad-argument", f"{value} is not in the domain of '{param.name}' of {declared.name} "
                        f"({shown})", arg.span)
+
+
+def check_numeric_arguments(ctx: Context, goal: m.SExp, needs: Mapping[tuple[str, int], str]) -> None:
+    """`bad-argument` for a symbol where the goal's KAs pass the argument on to a number."""
+    for position, arg in enumerate(goal.args):
+        reason = needs.get((goal.head, position))
+        if reason is not None and isinstance(arg, m.Ref | m.String):
+            shown = arg.text if isinstance(arg, m.Ref) else repr(arg.value)
+            ctx.report("bad-argument", f"{shown} is not a number: argument {position + 1} of {goal.head} reaches "
+                       f"{reason}", arg.span)
+
+
+def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], str]:
+    """The (goal head, argument position) that every KA invoked by the head passes on to a number:
+    a primitive action's parameter of a numeric domain, or such a position of a subgoal; with the
+    parameter reached (for the message). A fixed point over the KAs, as a goal's KAs call goals."""
+    actions = {a.name: a for a in procedures.actions}
+    kas: dict[str, list[m.KA]] = {}
+    for ka in procedures.kas:
+        if isinstance(ka.invocation, m.Goal) and ka.invocation.op == "!":
+            kas.setdefault(ka.invocation.body.head, []).append(ka)
+    found: dict[tuple[str, int], str] = {}
+
+    def reached(ka: m.KA, var: str) -> str | None:
+        """What numeric parameter `var` of `ka` is passed to, if any."""
+        if ka.action is not None:
+            action = actions.get(ka.action.call.head)
+            for arg, param in zip(ka.action.call.args, action.params if action is not None else (), strict=False):
+                if isinstance(arg, m.LogicVar) and arg.name == var and \
+                        domain_kind(procedures, param.domain) in ("int", "number"):
+                    return f"'{param.name}' ({describe_domain(param.domain)}) of action {ka.action.call.head}"
+        for node in walk(ka.body) if ka.body is not None else ():
+            if isinstance(node, m.Goal) and node.op == "!":
+                for position, arg in enumerate(node.body.args):
+                    if isinstance(arg, m.LogicVar) and arg.name == var and (node.body.head, position) in found:
+                        return found[(node.body.head, position)]
+        return None
+
+    changed = True
+    while changed:
+        changed = False
+        for head, invoked in kas.items():
+            for position in range(max(len(ka.invocation.body.args) for ka in invoked  # type: ignore[union-attr]
+                                      )):
+                if (head, position) in found:
+                    continue
+                reasons = []
+                for ka in invoked:
+                    args = ka.invocation.body.args  # type: ignore[union-attr]
+                    arg = args[position] if position < len(args) else None
+                    reason = reached(ka, arg.name) if isinstance(arg, m.LogicVar) else None
+                    if reason is None:
+                        break
+                    reasons.append(reason)
+                else:
+                    found[(head, position)] = reasons[0]
+                    changed = True
+    return found
 
 
 def finite_values(procedures: m.Procedures, domain: m.PDomain, seen: frozenset[str] = frozenset()
@@ -388,11 +454,18 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
             if not (isinstance(node, m.Goal) and node.op == "!" and node.body.head in protocols):
                 continue
             named = node.body.args[0]
-            if isinstance(named, m.Ref) and named.text not in services:
-                which = f"executive '{executives[0].name}' does not offer" if len(executives) == 1 \
-                    else "no executive offers"
-                ctx.warn("undefined-service", f"goal {node.body.head} asks for service '{named.text}', which "
-                         f"{which}{did_you_mean(named.text, services)}: it will be answered BAD-SERVICE", named.span)
+            which = f"executive '{executives[0].name}' does not offer" if len(executives) == 1 \
+                else "no executive offers"
+            # A string is the service's name too, once compiled (`"AVOID-ON"`); a number never is.
+            name = named.text if isinstance(named, m.Ref) else named.value if isinstance(named, m.String) else None
+            if name is not None and name not in services:
+                ctx.warn("undefined-service", f"goal {node.body.head} asks for service '{name}', which "
+                         f"{which}{did_you_mean(name, services)}: it will be answered BAD-SERVICE", named.span)
+            elif isinstance(named, m.Number):  # a value where the protocol's goal names the service
+                ctx.warn("undefined-service", f"goal {node.body.head} names the service first (KA "
+                         f"'{protocols[node.body.head].name}' is the executive's request protocol), not "
+                         f"{named.value}, which {which} (services: {', '.join(sorted(services))}): it will be "
+                         "answered BAD-SERVICE", named.span)
 
 
 def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:

@@ -17,6 +17,23 @@ What a user can get wrong (a bad seed, an unreadable log, a package that is not 
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 
 class RunError(ValueError):
     """A run that cannot start or a log that cannot be read: the message says why and what to do."""
+
+
+def writable_folder(folder: Path, what: str) -> None:
+    """RunError unless `folder` is, or can be made, a folder this process may write in: checked
+    before long work (a table's runs, a campaign's experiments) whose results would otherwise
+    have nowhere to go at the end."""
+    if folder.exists() and not folder.is_dir():
+        raise RunError(f"{what} '{folder}' is a file, not a folder: give a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise RunError(f"cannot make {what} '{folder}': {error.strerror or error}") from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise RunError(f"{what} '{folder}' is not writable: give another (--output)")

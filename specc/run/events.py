@@ -20,6 +20,7 @@ know):
 | `activity` | an executive activity changes phase (Fig 3.3; WAIT→INIT is its start) | `service`, `id`, `from`, `to` |
 | `reply` | the executive answers `(REPLY id result)` | `service`, `id`, `result`, `detail` |
 | `warning` | the executive sends `(WARNING service id type)` | `service`, `id`, `type`, `detail` |
+| `reflex` | a reflex of the executive fires (§3.5) | `reflex`, `on` (trigger, source), `code`, `actions` |
 | `fact` | a fact of the supervisor's database is concluded or retracted | `fact`, `change` |
 | `operator` | a procedure tells the operator something (WARN-OPERATOR) | `text` |
 | `robot-motion` | the robot starts or stops moving (true motion, from the simulator) | `moving`, `x`, `y`, `theta` |

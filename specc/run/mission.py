@@ -108,19 +108,40 @@ class Robot:
 
     def hook(self, name: str) -> Callable[..., Any] | None:
         """The extension's function `name` (prepare, attach, measure or judge: the module's
-        docstring), None when it has none."""
+        docstring), None when it has none. What it raises (but a WorldError, which says what a
+        world cannot give) becomes a RunError naming the hook and where it raised."""
+        from specc.runtime.functional import where_raised
+        from specc.runtime.sim import WorldError
+
         function = getattr(self.extension, name, None)
-        return function if callable(function) else None
+        if not callable(function):
+            return None
+
+        def guarded(*args: Any, **kwargs: Any) -> Any:
+            try:
+                return function(*args, **kwargs)
+            except (WorldError, RunError):
+                raise
+            except Exception as error:  # the user's code: said where, as a codel's error is
+                raise RunError(f"robot '{self.name}': its extension's {name}() raised {type(error).__name__}: "
+                               f"{error}{where_raised(error)}") from error
+
+        return guarded
 
     def world_file(self, name: str) -> Path:
-        """The world file of the system's world `name`, or a world file's path as it is."""
+        """The world file of the system's world `name`, or a world file's path: as given (from the
+        current folder), else from the robot's folder, as the system block's worlds are."""
         worlds = self.system.worlds
         folded = {key.lower(): key for key in worlds}
         if name.lower() in folded:
             return self.folder / worlds[folded[name.lower()]]
         path = Path(name)
-        if path.suffix == ".toml" and path.is_file():
-            return path
+        if path.suffix == ".toml":
+            for candidate in (path, self.folder / path):
+                if candidate.is_file():
+                    return candidate
+            raise RunError(f"no world file '{name}' (looked from the current folder and from the robot's, "
+                           f"{self.folder})")
         known = ", ".join(worlds) or "none: add 'worlds { NAME: \"file.toml\"; }' to the system block"
         raise RunError(f"robot '{self.name}' has no world '{name}' (its worlds: {known}; or give a .toml file)")
 
@@ -232,6 +253,7 @@ class CheckedMission:
     world: Path  # the world file
     planning: Any = None  # specc.runtime.ftplan.MissionSetup when FTplan plans the mission
     configuration: str | None = None  # FTplan's, the default one resolved (None: not planned)
+    ground: Any = None  # the world read and prepared for the run (the extension's draws made)
 
 
 TIMINGS = ("model", "wall")  # FtPlan's: a deterministic planning charge, or the measured wall time
@@ -261,7 +283,7 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
         if configuration is not None or domains:
             raise RunError(f"{'--config' if configuration is not None else 'a planning domain'}: mission "
                            f"{mission.name} of robot '{robot.name}' is not planned (FTplan plans in them)")
-        return CheckedMission(world_file)
+        return CheckedMission(world_file, ground=prepared_world(robot, mission, seed, world_file, None))
     block = robot.part("ftplan").FTPLANS[robot.system.planning]
     try:
         chosen = configuration or default_configuration(block)
@@ -269,13 +291,35 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
                               robot.part("planner"))
     except UnknownName as error:
         raise RunError(str(error)) from None
+    if not any(getattr(a, "goal", None) is not None for a in setup.problem.assertions):
+        raise RunError(f"mission {mission.name} plans problem '{setup.problem.name}', which has no goal: FTplan "
+                       "would have nothing to plan (mark its goals `goal(priority, ...)`)")
     if domains:
         unused = sorted(set(domains) - setup.planned_in)
         if unused:
             raise RunError(f"configuration {chosen} plans in "
                            f"{', '.join(sorted(setup.planned_in))}, not in {', '.join(unused)}")
         setup = dataclasses.replace(setup, domains={**setup.domains, **domains})
-    return CheckedMission(world_file, setup, chosen)
+    return CheckedMission(world_file, setup, chosen, prepared_world(robot, mission, seed, world_file, setup))
+
+
+def prepared_world(robot: Robot, mission: MissionSpec, seed: int, world_file: Path, planning: Any) -> Any:
+    """The world file read, then as the extension's `prepare` draws it for this run (where its
+    objects lie...); RunError when the file is not a world or its draws cannot be made, before
+    anything of the run is built or written."""
+    from specc.runtime.sim import WorldError, load_world
+
+    try:
+        ground = load_world(world_file)
+    except WorldError as error:
+        raise RunError(str(error)) from None
+    prepare = robot.hook("prepare")
+    if prepare is not None:
+        try:
+            ground = prepare(ground, RunSetup(robot, mission, seed, planning))
+        except WorldError as error:  # what the world asks cannot be drawn
+            raise RunError(str(error)) from None
+    return ground
 
 
 def default_configuration(block: ModuleType) -> str:
@@ -290,28 +334,20 @@ def default_configuration(block: ModuleType) -> str:
 def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str | None = None,
                 horizon: float | None = None, log: EventLog | None = None,
                 progress: Callable[[MissionProgress], None] | None = None, configuration: str | None = None,
-                timing: str = "model", domains: Mapping[str, Any] | None = None) -> MissionRun:
+                timing: str = "model", domains: Mapping[str, Any] | None = None,
+                checked: CheckedMission | None = None) -> MissionRun:
     """Run `mission` on `robot` (see the module's docstring), in `world` (a name of the system's
     worlds or a world file) instead of the mission's when given, for `horizon` seconds of
     simulated time instead of the mission's; a planned mission with FTplan's `configuration`
     (Robot1, Robot1/2...), planning charge `timing`, and `domains` (planning domains by name)
-    in place of the generated ones. Bad arguments raise RunError before anything runs."""
+    in place of the generated ones. Bad arguments raise RunError before anything runs; `checked`:
+    what `check_mission` said of these very arguments already (its world prepared once)."""
     from specc.runtime.ftplan.state import SystemState
-    from specc.runtime.sim import WorldError, load_world
 
-    checked = check_mission(robot, mission, world, seed, horizon, configuration, timing, domains)
-    world_path = checked.world
+    if checked is None:
+        checked = check_mission(robot, mission, world, seed, horizon, configuration, timing, domains)
+    world_path, ground = checked.world, checked.ground
     limit = horizon if horizon is not None else mission.horizon if mission.horizon is not None else DEFAULT_HORIZON
-    try:
-        ground = load_world(world_path)
-    except WorldError as error:
-        raise RunError(str(error)) from None
-    prepare = robot.hook("prepare")
-    if prepare is not None:  # the robot's own random draws (where its objects lie...)
-        try:
-            ground = prepare(ground, RunSetup(robot, mission, seed, checked.planning))
-        except WorldError as error:  # what the world asks cannot be drawn
-            raise RunError(str(error)) from None
     events = log if log is not None else EventLog()
     # Everything is logged through the journal, so that FTplan's own events come in time order.
     journal = FtplanJournal(events)
@@ -505,6 +541,7 @@ class Recorder:
         if executive is not None:
             executive.observers.append(self._activity)
             executive.listeners.append(self._message)
+            executive.reflex_listeners.append(self._reflex)
 
     # ------------------------------------------------------------ the executive
     def _activity(self, activity: rx.Activity, source: rx.Phase, target: rx.Phase) -> None:
@@ -517,6 +554,11 @@ class Recorder:
         else:
             self.log.emit(self.kernel.now, "activity", service=service, id=activity.id, **{"from": source.value},
                           to=target.value)
+
+    def _reflex(self, reflex: rx.ReflexSpec, code: str) -> None:
+        self.poll_facts()
+        self.log.emit(self.kernel.now, "reflex", reflex=reflex.name, on=f"{reflex.trigger} {reflex.source}",
+                      code=str(code), actions=[f"{verb} {target}" for verb, target in reflex.actions])
 
     def _message(self, message: rx.Message) -> None:
         now = self.kernel.now

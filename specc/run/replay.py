@@ -35,13 +35,18 @@ def load_run(run: Path) -> tuple[Path, list[dict[str, Any]]]:
     return folder, events
 
 
-def check_kinds(events: Iterable[Mapping[str, Any]], kinds: Sequence[str]) -> None:
-    """RunError naming the kinds the log has when one asked for is not among them (a typo)."""
+def check_kinds(events: Iterable[Mapping[str, Any]], kinds: Sequence[str]) -> str | None:
+    """The kinds asked for that the log lacks: RunError naming the kinds it has when it has none
+    of them (a typo, or the wrong run); a note to print when it has some (a run without actions
+    asked for its actions and its FTplan events shows the latter)."""
     present = sorted({str(e["kind"]) for e in events})
-    missing = [k for k in kinds if k not in present]
-    if missing:
-        raise RunError(f"no event of kind {', '.join(repr(k) for k in missing)} in this log "
-                       f"(it has: {', '.join(present)})")
+    missing = [k for k in dict.fromkeys(kinds) if k not in present]
+    if not missing:
+        return None
+    said = f"no event of kind {', '.join(repr(k) for k in missing)} in this log (it has: {', '.join(present)})"
+    if set(missing) == set(kinds):
+        raise RunError(said)
+    return said
 
 
 def select(events: Iterable[Mapping[str, Any]], kinds: Sequence[str] = (), start: float | None = None,
@@ -106,6 +111,8 @@ _DESCRIBERS = {"mission-start": _mission_start, "action": _action, "ftplan": _ft
                "request": lambda f: f"{f.get('service')} #{f.get('id')}",
                "activity": lambda f: f"{f.get('service')} #{f.get('id')} {f.get('from')} -> {f.get('to')}",
                "fact": lambda f: f"{f.get('change')} {f.get('fact')}",
+               "reflex": lambda f: f"{f.get('reflex')} on {f.get('on')} {f.get('code')}: "
+                                   + ", ".join(f.get("actions") or ()),
                "operator": lambda f: str(f.get("text")),
                "alarm": lambda f: f"{f.get('what')}: {f.get('detail')}",
                "trajectory": lambda f: f"{f.get('service')}: {len(f.get('points') or ())} points",

@@ -126,6 +126,9 @@ class RunOutcome:
         return bool(self.report.get("outcome") == "succeeded")
 
 
+GOALS_IN_NAME = 40  # characters of the goals a `--goal` run's folder is named by
+
+
 def folder_name(robot: str, mission: str, world: str, configuration: str | None, seed: int) -> str:
     """runs/<robot>-<mission>-<world>[-<configuration>]-s<seed>, readable and safe as a path."""
     parts = [robot, mission, world, *([configuration] if configuration else [])]
@@ -177,6 +180,12 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     # Options that change what a run does name its folder too: it never holds another run's files.
     variant = f"-horizon{request.horizon:g}" if request.horizon is not None else ""
     variant += "-wall" if request.timing != "model" else ""
+    if request.goals:  # the goals posted, readable (cut short past a length), and a digest of them all
+        import hashlib
+
+        said = re.sub(r"[^A-Za-z0-9_.-]+", "-", " ".join(request.goals)).strip("-")[:GOALS_IN_NAME]
+        digest = hashlib.sha256("\0".join(request.goals).encode()).hexdigest()[:6]
+        variant = f"-{said}-{digest}{variant}"
     name = folder_name(robot, *plan.name_parts, request.seed)
     return PlannedRun(robot, request, plan, request.runs / (name + variant))
 
@@ -259,9 +268,9 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         if request.mission is not None:
             raise RunError("give --mission or --goal, not both: --goal posts its goals instead of a mission's")
         worlds = list(robot.system.worlds)
-        if request.world is None and len(worlds) != 1:
-            raise RunError(f"--goal needs --world (robot '{robot.name}' has {len(worlds)} worlds: "
-                           f"{', '.join(worlds) or 'none'})")
+        if request.world is None and not worlds:
+            raise RunError(f"--goal needs --world: robot '{robot.name}' names no world (give a .toml file)")
+        # Without --world, the first world the system block names.
         mission = MissionSpec("goal", request.world or worlds[0], tuple(_checked_goal(robot, g) for g in request.goals))
     elif request.mission is None:
         missions = list(robot.system.missions)
@@ -285,7 +294,7 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
                 progress(step.time, step.horizon, f"{step.goals_done}/{step.goals} goal(s) ended")
 
         result = run_mission(robot, mission, request.seed, world=request.world, horizon=request.horizon, log=log,
-                             progress=tell, configuration=configuration, timing=request.timing)
+                             progress=tell, configuration=configuration, timing=request.timing, checked=checked)
         why = result.why
         planners_said = [e["text"] for e in result.events if e["kind"] == "ftplan" and e["event"] in PLANNER_FAILURES]
         if result.extension_measures.get("planning_failure") and planners_said:  # what the planner itself said

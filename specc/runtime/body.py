@@ -97,14 +97,19 @@ BODY_KEYS: dict[str, BodyKey] = {
 }
 
 
+MAX_COUNT = 10_000  # sonars, laser beams, arm joints: past it a reading alone would take seconds and gigabytes
+
+
 def body_problem(key: str, value: float) -> str | None:
-    """Why `value` cannot be the body's `key` (None when it can): counts are whole numbers, every
-    value is finite and not negative, the footprint is not empty."""
+    """Why `value` cannot be the body's `key` (None when it can): counts are whole numbers up to
+    MAX_COUNT, every value is finite and not negative, the footprint is not empty."""
     spec = BODY_KEYS[key]
     if not math.isfinite(value) or value < 0:
         return f"'{key}' must be a finite number >= 0 ({spec.unit or 'a count'})"
     if spec.is_count and value != int(value):
         return f"'{key}' is a count: give a whole number"
+    if spec.is_count and value > MAX_COUNT:
+        return f"'{key}' is {value:g}: at most {MAX_COUNT:,} (each is simulated at every reading)"
     if key in ("radius", "wheel_base", "mass") and value == 0:
         return f"'{key}' must be > 0"
     return None

@@ -225,6 +225,8 @@ class Executive:
         self.messages: deque[Message] = deque(maxlen=HISTORY)  # the latest ones; listeners get them all
         self.listeners: list[Callable[[Message], None]] = []
         self.observers: list[Callable[[Activity, Phase, Phase], None]] = []
+        # Told of each reflex that fires (§3.5), with the report code it fired on: the run's log.
+        self.reflex_listeners: list[Callable[[ReflexSpec, str], None]] = []
         self.reflex_replies: list[Reply] = []  # replies to requests sent by reflexes
         self.incidents: list[str] = []  # exceptions raised by listeners and observers
         # With `measure`: each cycle's duration, without the time modules spend handling what it
@@ -578,6 +580,8 @@ class Executive:
     def _reflexes(self, trigger: str, source: str, reply: Reply) -> None:
         for reflex in self.spec.reflexes:
             if reflex.matches(trigger, source, reply.report.code):
+                for listener in self.reflex_listeners:
+                    self._guarded(listener, reflex, reply.report.code)
                 for verb, target in reflex.actions:
                     self._reflex_action(verb, target)
 
@@ -676,10 +680,6 @@ def load_codels(spec: ExecutiveSpec, codels: Any = None) -> Any:
     """The module of input and output functions: the one given, else the one the spec names."""
     if codels is not None or spec.codel_module is None:
         return codels
-    import importlib
+    from specc.runtime.functional import import_user_module
 
-    try:
-        return importlib.import_module(spec.codel_module)
-    except ImportError as exc:
-        raise ImportError(f"executive '{spec.name}': cannot import its functions '{spec.codel_module}' ({exc}); "
-                          "put the folder holding them on sys.path, or pass `codels=`") from exc
+    return import_user_module(spec.codel_module, f"executive '{spec.name}'", "its functions", "pass `codels=`")

@@ -1148,10 +1148,34 @@ def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
         import types
 
         return types.SimpleNamespace()
+    return import_user_module(spec.codel_module, f"module '{spec.name}'", "its codels", "pass `codels=`")
+
+
+def import_user_module(dotted: str, owner: str, what: str, instead: str) -> Any:
+    """The user's Python module `dotted` (`owner`'s `what`: "module 'arm'", "its codels"). When it
+    cannot be found: ImportError saying to put its folder on sys.path (or `instead`); when it is
+    found but its import fails (an import inside it, a typo at its top level): ImportError with
+    the reason and the file and line where it failed."""
     import importlib
 
     try:
-        return importlib.import_module(spec.codel_module)
-    except ImportError as exc:
-        raise ImportError(f"module '{spec.name}': cannot import its codels '{spec.codel_module}' ({exc}); "
-                          "put the folder holding them on sys.path, or pass `codels=`") from exc
+        return importlib.import_module(dotted)
+    except ModuleNotFoundError as exc:
+        if exc.name is not None and (dotted == exc.name or dotted.startswith(exc.name + ".")):
+            raise ImportError(f"{owner}: cannot import {what} '{dotted}' ({exc}); put the folder holding them on "
+                              f"sys.path, or {instead}") from exc
+        raise ImportError(f"{owner}: {what} '{dotted}' import what cannot be found: {exc}{where_raised(exc)}") from exc
+    except Exception as exc:  # the file itself, run as Python imports it
+        raise ImportError(f"{owner}: importing {what} '{dotted}' failed: {type(exc).__name__}: {exc}"
+                          f"{where_raised(exc)}") from exc
+
+
+def where_raised(exc: BaseException) -> str:
+    """` (file:line)`: the last place the exception went through, the user's code that raised it
+    (not the import machinery's frozen frames); empty when there is none."""
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if not f.filename.startswith("<")]
+    if isinstance(exc, SyntaxError) and exc.filename:
+        return f" ({exc.filename}:{exc.lineno})"
+    return f" ({frames[-1].filename}:{frames[-1].lineno})" if frames else ""

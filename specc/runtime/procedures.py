@@ -226,7 +226,7 @@ def bindings(library: Library) -> list[str]:
 def load_functions(library: Library, given: Mapping[str, Callable[..., Any]] | None = None
                    ) -> dict[str, Callable[..., Any]]:
     """The Python function behind every binding: from `given` when it has it, else imported."""
-    import importlib
+    from specc.runtime.functional import import_user_module
 
     functions: dict[str, Callable[..., Any]] = {}
     for binding in bindings(library):
@@ -234,11 +234,8 @@ def load_functions(library: Library, given: Mapping[str, Callable[..., Any]] | N
             functions[binding] = given[binding]
             continue
         module_name, _, name = binding.rpartition(".")
-        try:
-            module = importlib.import_module(module_name)
-        except ImportError as exc:
-            raise ImportError(f"procedures '{library.name}': cannot import '{module_name}' for '{binding}' ({exc}); "
-                              "put the folder holding it on sys.path, or pass `functions=`") from exc
+        module = import_user_module(module_name, f"procedures '{library.name}'", f"the module of '{binding}'",
+                                    "pass `functions=`")
         function = getattr(module, name, None)
         if not callable(function):
             raise ImportError(f"procedures '{library.name}': '{module_name}' has no function '{name}'")
@@ -314,7 +311,7 @@ def _read(tokens: list[str], text: str) -> Term:
 
 
 _INTEGER = re.compile(r"-?\d+")
-_REAL = re.compile(r"-?(\d+\.\d*|\.\d+)([eE][-+]?\d+)?")
+_REAL = re.compile(r"-?(\d+\.\d*|\.\d+|\d+(?=[eE]))([eE][-+]?\d+)?")  # 2.5, .5, 1e9 (as specs write them)
 
 
 def _atom(token: str) -> Term:
@@ -325,5 +322,8 @@ def _atom(token: str) -> Term:
     if _INTEGER.fullmatch(token):
         return int(token)
     if _REAL.fullmatch(token):
-        return float(token)
+        number = float(token)
+        if not math.isfinite(number):  # 1e999: no symbol either; what a spec's number gets
+            raise ValueError(f"number {token} is too large")
+        return number
     return token

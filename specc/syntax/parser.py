@@ -368,8 +368,14 @@ def read_source(path: Path) -> tuple[str | None, Diagnostic | None]:
         # utf-8-sig: a byte-order mark some Windows editors write is not part of the text.
         return path.read_text(encoding="utf-8-sig"), None
     except UnicodeDecodeError as exc:
-        return None, error("bad-encoding", f"'{path}' is not UTF-8 text (byte {exc.start}); save it as UTF-8",
-                           Span.unknown(display_path(path)))
+        # Where the first byte that is not UTF-8 sits: its line, and its column in characters (what
+        # comes before it on its line is UTF-8).
+        before = exc.object[:exc.start]
+        line = before.count(b"\n") + 1
+        column = len(before[before.rfind(b"\n") + 1:].decode("utf-8", errors="replace")) + 1
+        return None, error("bad-encoding", f"'{path}' is not UTF-8 text (byte {exc.start}, "
+                           f"0x{exc.object[exc.start]:02x}); save it as UTF-8",
+                           Span(display_path(path), line, column, line, column + 1))
     except OSError as exc:
         return None, error("unreadable-file", f"cannot read '{path}': {exc.strerror}",
                            Span.unknown(display_path(path)))

@@ -6,6 +6,10 @@ from __future__ import annotations
 
 import types
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
 
 from specc.runtime import functional as rt
 from specc.runtime.functional import State, Status
@@ -256,3 +260,27 @@ def test_a_request_sent_by_a_validate_codel_is_nobody_s_child(robot: Robot) -> N
     assert child.spec.name == "Checked" and not child.children
     (sent,) = other.beta.activities.values()
     assert sent.parent is None
+
+
+@pytest.mark.parametrize(("body", "said"), [
+    ("from greenhouse.rules.waterin import decide\n", "its codels 'broken_codels_{n}.arm' import what cannot be found"
+                                                      ": No module named 'greenhouse'"),
+    ("x = 1\nundefined_name()\n", "importing its codels 'broken_codels_{n}.arm' failed: NameError"),
+])
+def test_codels_that_fail_to_import_are_told_apart_from_codels_not_found(tmp_path: Path, monkeypatch: Any,
+                                                                         body: str, said: str) -> None:
+    from specc.runtime.functional import load_codels
+
+    n = len(body)  # a package name of its own per case: nothing cached from the other
+    package = tmp_path / f"broken_codels_{n}"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "arm.py").write_text(body)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(ImportError) as raised:
+        load_codels(types.SimpleNamespace(name="arm", codel_module=f"broken_codels_{n}.arm"))  # type: ignore[arg-type]
+    message = str(raised.value)
+    assert said.format(n=n) in message and "sys.path" not in message
+    assert f"{package / 'arm.py'}:{body.count(chr(10))}" in message  # where: the line that failed
+    with pytest.raises(ImportError, match="put the folder holding them on sys.path"):
+        load_codels(types.SimpleNamespace(name="arm", codel_module="no_such_codels_anywhere.arm"))  # type: ignore[arg-type]

@@ -126,3 +126,18 @@ def test_skeleton_covers_executive_functions_prs_actions_and_evaluable_predicate
     assert "def send(ctx, service):" in tasks and "def ready(ctx, lambda_):" in tasks
     after = subprocess.run(check, capture_output=True, text=True, timeout=60)
     assert after.returncode == 0, after.stdout + after.stderr
+
+
+def test_skeleton_of_a_robot_folder_writes_new_codels_where_the_run_imports_them(tmp_path: Path) -> None:
+    """Specs in a subfolder (modules/): the codels package a run imports is the robot folder's."""
+    robot = tmp_path / "robot"
+    (robot / "modules").mkdir(parents=True)
+    (robot / "modules" / "arm.spec").write_text('module arm {\n  codels: "robot_codels.arm";\n  request Go {\n'
+                                                '    type: control;\n    validate: checkGo;\n  }\n}\n')
+    (robot / "robot.spec").write_text("system robot { modules: arm; }\n")
+    # Given the folder above the robot's: the robot's folder is the one holding its system block.
+    wrote = subprocess.run([sys.executable, "-m", "specc.cli", "skeleton", str(tmp_path)], capture_output=True,
+                           text=True, timeout=60)
+    assert wrote.returncode == 0, wrote.stderr
+    assert "def checkGo(" in (robot / "robot_codels" / "arm.py").read_text()
+    assert (robot / "robot_codels" / "__init__.py").exists() and not (robot / "modules" / "robot_codels").exists()

@@ -45,7 +45,7 @@ from specc.runtime.ftplan.analyzer import Violation, analyse
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
 from specc.runtime.ftplan.planners import Answer, Watchdog
-from specc.runtime.ftplan.state import SystemState, fact_list
+from specc.runtime.ftplan.state import Goal, SystemState, fact_list
 from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Plan, Repair, format_value
@@ -193,9 +193,11 @@ class FtPlan:
         if missing:
             raise ValueError(f"planner(s) {', '.join(missing)} speak another vocabulary than FTplan's state: "
                              "give their own problems (`problems=`)")
-        # Each such planner's problem as a ledger: its goals, to tell which are still FTplan's,
-        # and its timepoints' dates.
-        self.planner_ledgers = {k: SystemState.from_problem(self.problems[k]) for k in self.views}
+        # Each planner's own problem (one in another vocabulary, or the same mission written for
+        # another domain, its goals on other lines) as a ledger: its goals, to tell which are
+        # still FTplan's, and its timepoints' dates.
+        self.planner_ledgers = {k: SystemState.from_problem(own) for k, own in self.problems.items()
+                                if k in self.views or own is not self.problem}
         self.now = 0.0
         self.events: list[Event] = []
         self.trace: list[tuple[int, str]] = []
@@ -413,15 +415,20 @@ class FtPlan:
         if first:
             return own
         view = self.views.get(k)
-        if view is None:
+        if k not in self.planner_ledgers:  # FTplan's own problem
             return replanning_problem(own, fact_list(self.state.facts), [g.line for g in self.state.open_goals()],
                                       self.now, self.state.dates)
-        return replanning_problem(own, fact_list(view.read(self.state.facts)), self.open_planner_goals(k, view),
-                                  self.now, self.planner_ledgers[k].dates)
+        facts = self.state.facts if view is None else view.read(self.state.facts)
+        return replanning_problem(own, fact_list(facts), self.open_planner_goals(k, view), self.now,
+                                  self.planner_ledgers[k].dates)
 
-    def open_planner_goals(self, k: str, view: View) -> list[int]:
-        """The lines of k's goals standing for a goal FTplan still has open; a goal no
-        correspondence names is kept."""
+    def open_planner_goals(self, k: str, view: View | None) -> list[int]:
+        """The lines of k's goals (in k's own problem) standing for a goal FTplan still has open:
+        through k's view, those whose correspondences give an open goal's fact; in FTplan's own
+        vocabulary, k's goal paired with FTplan's goal of the same fact (the n-th of a fact with
+        the n-th: two goals `AT() = DOCK` stay two). A goal nothing pairs is kept."""
+        if view is None:
+            return [line for line, partner in self._paired_goals(k) if partner is None or self.state.is_open(partner)]
         open_facts = [(g.key, g.value) for g in self.state.open_goals()]
         lines = []
         for goal in self.planner_ledgers[k].goals:
@@ -429,6 +436,18 @@ class FtPlan:
             if not stands_for or any(same_fact(f, o) for f in stands_for for o in open_facts):
                 lines.append(goal.line)
         return lines
+
+    def _paired_goals(self, k: str) -> list[tuple[int, Goal | None]]:
+        """Each goal line of k's own problem with FTplan's goal of the same fact, in the order
+        both problems list them (None: FTplan has no such goal)."""
+        unpaired = list(self.state.goals)
+        pairs: list[tuple[int, Goal | None]] = []
+        for goal in self.planner_ledgers[k].goals:
+            partner = next((g for g in unpaired if same_fact((g.key, g.value), (goal.key, goal.value))), None)
+            if partner is not None:
+                unpaired.remove(partner)
+            pairs.append((goal.line, partner))
+        return pairs
 
     def request(self, k: str, problem: pm.Problem | None = None) -> None:
         problem = problem or self.planning_problem(k, self.plannings == 0)

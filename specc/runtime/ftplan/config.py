@@ -195,10 +195,13 @@ def configuration_named(configurations: Mapping[str, FtPlanConfig], name: str) -
     """The configuration `name` of `configurations`, or one of them with variant suffixes
     (VARIANTS, in any order): `<name>-noanalyzer` is it without the plan analyzer (the thesis'
     own FTplan, which never had one), `<name>-repair` / `<name>-norepair` with every planner
-    repairing its plans after an action failure or none. KeyError when unknown; ValueError when
-    it names a variant twice, or both -repair and -norepair (which one was meant?)."""
+    repairing its plans after an action failure or none. A planner's own name stands for the
+    configuration of that planner alone (`quick` for the Robot1 whose planner is quick). KeyError
+    when unknown; ValueError when it names a variant twice, or both -repair and -norepair (which
+    one was meant?)."""
+    alone = {config.planners[0].name: key for key, config in configurations.items() if len(config.planners) == 1}
     base, applied = name, []
-    while base not in configurations:
+    while base not in configurations and base not in alone:
         suffix = next((v for v in VARIANTS if base.endswith(v)), None)
         if suffix is None:
             raise KeyError(name)
@@ -209,7 +212,7 @@ def configuration_named(configurations: Mapping[str, FtPlanConfig], name: str) -
     if {WITH_REPAIR, WITHOUT_REPAIR} <= set(applied):
         raise ValueError(f"configuration '{name}' turns repair both on ({WITH_REPAIR}) and off ({WITHOUT_REPAIR}): "
                          "keep one of them")
-    config = configurations[base]
+    config = configurations[base] if base in configurations else configurations[alone[base]]
     for suffix in reversed(applied):
         config = VARIANTS[suffix](config)
     return config

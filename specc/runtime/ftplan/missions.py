@@ -40,8 +40,10 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
     try:
         base = configuration_named(configurations, configuration)
     except KeyError:
-        raise UnknownName(f"no robot configuration '{configuration}' (known: {', '.join(configurations)}; "
-                          f"{VARIANTS_HELP})") from None
+        known = ", ".join(f"{key} ({config.planners[0].name} alone)" if len(config.planners) == 1 else key
+                          for key, config in configurations.items())
+        raise UnknownName(f"no robot configuration '{configuration}' (known: {known}, or a planner's name for it "
+                          f"alone; {VARIANTS_HELP})") from None
     except ValueError as error:
         raise UnknownName(str(error)) from None
     try:

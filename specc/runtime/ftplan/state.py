@@ -141,7 +141,10 @@ class SystemState:
         return value is not None and same(value, goal.value)
 
     def open_goals(self) -> list[Goal]:
-        return [g for g in self.goals if g.line not in self.met and g.line not in self.missed]
+        return [g for g in self.goals if self.is_open(g)]
+
+    def is_open(self, goal: Goal) -> bool:
+        return goal.line not in self.met and goal.line not in self.missed
 
 
 def fact_list(facts: Mapping[FactKey, Value]) -> list[Fact]:

@@ -39,12 +39,59 @@ class Fact:
         return cls(name.strip(), args, _value(value))
 
 
+def checked_facts(domain: pm.PlanningDomain, facts: Iterable[Fact]) -> list[Fact]:
+    """`facts` as they fit `domain`, or ValueError saying which does not: an attribute it has,
+    with as many arguments, each (and the value) in its domain, and one value per attribute
+    instance."""
+    seen: dict[tuple[str, tuple[Value, ...]], Fact] = {}
+    for fact in facts:
+        text = f"{fact.attribute}({', '.join(map(_text, fact.args))}) = {_text(fact.value)}"
+        attribute = domain.attribute(fact.attribute)
+        if attribute is None:
+            known = ", ".join(sorted(a.name for a in domain.attributes))
+            raise ValueError(f"fact '{text}': domain '{domain.name}' has no attribute {fact.attribute} ({known})")
+        if len(fact.args) != len(attribute.params):
+            raise ValueError(f"fact '{text}': {fact.attribute} takes {len(attribute.params)} argument(s), "
+                             f"{len(fact.args)} given")
+        slots = [*zip(fact.args, attribute.param_domains or (None,) * len(fact.args), strict=True),
+                 (fact.value, attribute.values)]
+        for value, allowed in slots:
+            problem = _outside(value, allowed)
+            if problem is not None:
+                raise ValueError(f"fact '{text}': {problem}")
+        key = (fact.attribute, fact.args)
+        if key in seen and seen[key].value != fact.value:
+            raise ValueError(f"fact '{text}': {fact.attribute}({', '.join(map(_text, fact.args))}) is already "
+                             f"{_text(seen[key].value)}: give one value")
+        seen[key] = fact
+    return list(seen.values())
+
+
+def _outside(value: Value, allowed: pm.Values | None) -> str | None:
+    """Why `value` is not in `allowed` (None when it is, or when nothing is declared)."""
+    if isinstance(allowed, pm.Symbols) and value not in allowed.values:
+        return f"{_text(value)} is not one of {', '.join(allowed.values)}"
+    if isinstance(allowed, pm.Interval):
+        if not isinstance(value, float):
+            bounded = math.isfinite(allowed.low) or math.isfinite(allowed.high)
+            return f"{value} is not a number" + (f" (the domain is [{allowed.low:g}, {allowed.high:g}])" if bounded
+                                                 else "")
+        if not (allowed.low <= value <= allowed.high):
+            return f"{value:g} is outside [{allowed.low:g}, {allowed.high:g}]"
+    return None
+
+
+def _text(value: Value) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
 def _value(text: str) -> Value:
     text = text.strip()
     try:
-        return float(text)
+        number = float(text)
     except ValueError:
         return text
+    return number if math.isfinite(number) else text  # `nan`, `inf`: no value a domain holds
 
 
 def _expr(value: Value) -> pm.Expr:

@@ -267,9 +267,9 @@ def draw_background(ax: Any, scene: Scene) -> None:
         ax.plot(target.x, target.y, marker="*", ms=12, ls="", color="#16a34a" if done else PLANNED_COLOUR, zorder=4)
         ax.annotate(target.name, (target.x, target.y), textcoords="offset points", xytext=(5, 5), fontsize=7)
     if any(t.name not in photographed for t in scene.targets):
-        ax.plot([], [], marker="*", ls="", color=PLANNED_COLOUR, label="photo target")
+        ax.plot([], [], marker="*", ls="", color=PLANNED_COLOUR, label="target")
     if any(t.name in photographed for t in scene.targets):
-        ax.plot([], [], marker="*", ls="", color="#16a34a", label="photo target, photographed")
+        ax.plot([], [], marker="*", ls="", color="#16a34a", label="target, done (photographed)")
     if scene.goal is not None:
         ax.plot(*scene.goal, marker="s", ms=9, mfc="none", mec="#dc2626", ls="", label="observation goal", zorder=4)
     ax.set_xlim(*focus(scene, 0))

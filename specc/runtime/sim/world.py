@@ -150,6 +150,9 @@ class World:
         return [o if isinstance(o, Polygon) else o.outline() for o in self.obstacles]
 
 
+MAX_EXTENT = 100_000.0  # m from the origin a world's walls may reach
+
+
 def load_world(path: str | Path) -> World:
     path = Path(path)
     try:
@@ -191,6 +194,9 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     else:
         raise WorldError(f"{source}: the world needs walls: a [room] (width, height) or [bounds] "
                          "(xmin, xmax, ymin, ymax)")
+    if max(abs(b) for b in bounds) > MAX_EXTENT:
+        raise WorldError(f"{source}: the walls reach {max(abs(b) for b in bounds):g} m from the origin: at most "
+                         f"{MAX_EXTENT:g} m (the physics and the pictures lose precision beyond)")
     start_table = where.table(data, "start", ("x", "y", "theta"))
     start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
              where.number(start_table, "theta", "start", 0.0))
