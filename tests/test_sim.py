@@ -328,3 +328,13 @@ def test_the_executive_s_reflex_stops_the_robot_when_the_sonar_watch_replies(hil
     assert executive.reflex_replies and executive.reflex_replies[0].request == "Stop"  # the reflex's, not ours
     x, _, _ = sim.pose
     assert x + HILARE.radius < 10.0 and not sim.rover.in_contact
+
+
+def test_a_body_built_from_python_is_checked_as_a_body_block_is():
+    from specc.runtime.body import RobotConfig
+
+    with pytest.raises(ValueError, match="body 'x': no key 'radious' \\(did you mean 'radius'\\?\\)"):
+        RobotConfig.from_spec("x", {"radious": 0.3})
+    with pytest.raises(ValueError, match="body 'x': 'radius' must be a finite number >= 0"):
+        RobotConfig.from_spec("x", {"radius": -1})
+    assert RobotConfig.from_spec("x", {"radius": 0.3, "mass": 20}).mass == 20.0

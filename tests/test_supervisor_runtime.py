@@ -620,3 +620,11 @@ def test_exec_request_interrupts_a_zombie_and_returns_the_final_reply(executive:
     after = s.post("!(EXEC-REQUEST FREE $RESULT)")  # the module accepts requests again
     until_done(s, after)
     assert after.bindings == {"$RESULT": "OK"}
+
+
+def test_a_failed_test_says_what_its_variables_held() -> None:
+    # The reply a procedure tested is in the trace: why a goal failed, without listening to the executive.
+    s = supervisor(ka("Go", "!(GO $R)", step("?(= $R OK)", 2), line=1), seed=None)
+    intention = done(s, "!(GO ERROR)")
+    assert intention.status == "failed"
+    assert "Go:2: ?(= $R OK) failed: no solution ($R = ERROR)" in intention.lines()

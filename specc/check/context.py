@@ -13,6 +13,8 @@ from specc.model import nodes as m
 from specc.model.span import Span
 
 T = TypeVar("T")
+KNOWN_SHOWN = 12  # known names an unknown name's message lists when none is close
+
 
 @dataclass
 class Context:
@@ -53,7 +55,13 @@ class Context:
         self.diagnostics.append(Diagnostic(code, message, span, "warning"))
 
     def unknown(self, code: str, what: str, name: str, candidates: Any, span: Span, where: str = "") -> None:
-        self.report(code, f"unknown {what} '{name}'{where}{did_you_mean(name, candidates)}", span)
+        """`unknown <what> '<name>'`, with the closest known name, or the known names when none is
+        close and they are few enough to read."""
+        hint = did_you_mean(name, candidates)
+        known = sorted(str(c) for c in candidates) if candidates is not None else []
+        if not hint and 0 < len(known) <= KNOWN_SHOWN and "(" not in where:
+            hint = f" (known: {', '.join(known)})"
+        self.report(code, f"unknown {what} '{name}'{where}{hint}", span)
 
     def duplicates(self, nodes: Any, what: str, key: str = "name") -> None:
         """Report every node whose `key` was already used by an earlier node of the list."""

@@ -64,10 +64,20 @@ class RobotConfig:
     @classmethod
     def from_spec(cls, name: str, values: Mapping[str, float | int]) -> RobotConfig:
         """The body a `body { }` block declares: its values in the units of BODY_KEYS (degrees
-        for angles), every other key at its default. KeyError for a key that is no body key."""
+        for angles), every other key at its default. ValueError for a key that is no body key or
+        a value it cannot take (`body_problem`: what `specc check` says of a body block)."""
         converted: dict[str, Any] = {}
         for key, value in values.items():
-            spec = BODY_KEYS[key]
+            spec = BODY_KEYS.get(key)
+            if spec is None:
+                from difflib import get_close_matches
+
+                close = get_close_matches(key, BODY_KEYS, n=1)
+                raise ValueError(f"body '{name}': no key '{key}'" + (f" (did you mean '{close[0]}'?)" if close else
+                                                                     f"; keys: {', '.join(BODY_KEYS)}"))
+            problem = body_problem(key, float(value))
+            if problem is not None:
+                raise ValueError(f"body '{name}': {problem}")
             if spec.is_count:
                 converted[key] = int(value)
             else:  # a float field holds a float (`mass: 120` is 120.0), as a log writes it

@@ -244,9 +244,14 @@ class Executive:
     # ------------------------------------------------------------ the task level's interface
     def request(self, service: str, ident: int | None = None, inputs: tuple[Any, ...] = ()) -> int:
         """RQST EXEC: ask for `service`, giving the inputs it takes; its (REPLY id result) comes
-        later. Returns the id."""
+        later. Returns the id: `ident`, or one the executive picks (negative: never a task level's).
+        TypeError, before anything is sent, when `inputs` is not a tuple or list of values in the
+        order the service `takes` them."""
+        if not isinstance(inputs, (tuple, list)):
+            raise TypeError(f"inputs of {service}: give a tuple of values in the order the service takes them, e.g. "
+                            f"(3.0, 4.0), not {type(inputs).__name__} {inputs!r}")
         ident = next(self._internal_ids) if ident is None else ident
-        self._post(self._on_request, service, ident, inputs)
+        self._post(self._on_request, service, ident, tuple(inputs))
         return ident
 
     def interrupt(self, ident: int) -> None:

@@ -419,8 +419,8 @@ class TaskRunner:
 
     def initialise(self) -> None:
         if not self.initialised and self.spec.init is not None:
-            self.module.call_permanent(self.spec.init)
-            self.module.cycle_done(self.spec.init)
+            if self.module.call_permanent(self.spec.init):
+                self.module.cycle_done(self.spec.init)
         self.initialised = True
 
     def schedule(self) -> None:
@@ -445,8 +445,8 @@ class TaskRunner:
             self.initialise()
         permanent = self.spec.permanent
         if permanent is not None:
-            module.call_permanent(permanent)
-            module.cycle_done(permanent)
+            if module.call_permanent(permanent):
+                module.cycle_done(permanent)
         if self.activities:
             for activity in list(self.activities):
                 module.step(activity)
@@ -745,12 +745,16 @@ class Module:
         finally:
             self.registry.current = previous
 
-    def call_permanent(self, name: str) -> None:
+    def call_permanent(self, name: str) -> bool:
+        """Run a permanent (or init) codel; False when it raised (an incident): then the posters
+        named after it keep their last date, so that no reader takes stale data for fresh."""
         try:
             self.function(name)(self.sdi)
         except Exception as exc:
             self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: permanent codel '{name}' "
                                            f"raised {self.explain(exc)}")
+            return False
+        return True
 
     # -- endings
     def end(self, activity: Activity, report: Report) -> None:
@@ -972,6 +976,9 @@ class Registry:
         return next(self._ids)
 
     def add(self, spec: ModuleSpec, codels: Any) -> Module:
+        if spec.name in self.modules:  # two of one module would both run on the kernel, one unreachable
+            raise ValueError(f"module '{spec.name}' is already on this registry: create the modules once (a "
+                             "fresh rt.Registry() starts over)")
         module = Module(spec, self, codels)
         self.modules[spec.name] = module
         module.start()
@@ -1098,8 +1105,9 @@ class ModuleClient:
             return self.reply(rqst_id)
         done = self._wait(lambda: exchange.interm is None and exchange.final is None, timeout)
         if not done and exchange.interm is None and exchange.final is None:
+            # The client gave up, not the module: the request goes on, its final reply is still to come.
             return Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT,
-                         Report("interm", "gave up waiting"), time=self.kernel.now)
+                         Report("interm", "gave up waiting"), final=False, time=self.kernel.now)
         return exchange.interm or self.reply(rqst_id)
 
     def final(self, rqst_id: int, timeout: float | None = None) -> Reply:
@@ -1109,8 +1117,9 @@ class ModuleClient:
             return self.reply(rqst_id)
         done = self._wait(lambda: exchange.final is None, timeout)
         if not done and exchange.final is None:
+            # The client gave up, not the module: the request goes on, its final reply is still to come.
             return Reply(rqst_id, self.module.name, exchange.request, Status.TIMEOUT,
-                         Report("final", "gave up waiting"), time=self.kernel.now)
+                         Report("final", "gave up waiting"), final=False, time=self.kernel.now)
         return self.reply(rqst_id)
 
     def _wait(self, pending: Callable[[], bool], timeout: float | None) -> bool:
@@ -1141,7 +1150,10 @@ class ModuleClient:
 
 
 def load_codels(spec: ModuleSpec, codels: Any = None) -> Any:
-    """The user's codel module: the one given, else imported by the name the spec declares."""
+    """The user's codel module: the one given (an object, or a module's dotted name), else imported
+    by the name the spec declares."""
+    if isinstance(codels, str):
+        return import_user_module(codels, f"module '{spec.name}'", "its codels", "pass `codels=`")
     if codels is not None:
         return codels
     if not spec.codel_module:  # a module naming no codel function needs no codel module (checked)

@@ -99,6 +99,7 @@ from specc.runtime.procedures import (
     compute,
     parse_fact,
     parse_goal,
+    show,
 )
 
 if TYPE_CHECKING:
@@ -778,7 +779,12 @@ class Supervisor:
             if op == "!":
                 return (yield from self._achieve(thread, frame, goal))
             if op == "?":
-                return None if self._test(frame, expr) else "no solution"
+                if self._test(frame, expr):
+                    return None
+                # What the variables held: a reply's result the test looked at (`$RESULT = ERROR`).
+                bound = {v.name: frame.env[v.name] for v in _variables(expr) if v.name in frame.env}
+                held = ", ".join(f"{name} = {show(value)}" for name, value in bound.items())
+                return "no solution" + (f" ({held})" if held else "")
             if op == "^":  # never fails (§4.4.6): look again after every change
                 while True:
                     version = self._version

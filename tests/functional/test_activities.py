@@ -152,6 +152,7 @@ def test_status_dictionary_of_table_2_1(robot: Robot) -> None:
     seen[Status.SERVER_ERROR] = client.call("Parent", robot.package.alpha.ParentInput(script="send:raise,exec,exec"))
     assert {status: reply.status for status, reply in seen.items()} == {status: status for status in Status}
     assert seen[Status.TIMEOUT].report.code == "final"
+    assert not seen[Status.TIMEOUT].final and seen[Status.END].final  # the client gave up; the request went on
     assert seen[Status.FINAL_ERROR].report.code == "BAD_INPUT"
     assert seen[Status.INTERRUPTED].report.code == "ABORT"
     chain = seen[Status.SERVER_ERROR].report.chain()

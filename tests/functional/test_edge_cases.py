@@ -284,3 +284,50 @@ def test_codels_that_fail_to_import_are_told_apart_from_codels_not_found(tmp_pat
     assert f"{package / 'arm.py'}:{body.count(chr(10))}" in message  # where: the line that failed
     with pytest.raises(ImportError, match="put the folder holding them on sys.path"):
         load_codels(types.SimpleNamespace(name="arm", codel_module="no_such_codels_anywhere.arm"))  # type: ignore[arg-type]
+
+
+def test_a_permanent_codel_that_raises_leaves_its_poster_s_date_alone(robot: Robot) -> None:
+    import scripted_codels.alpha as codels  # the fixture put tests/functional on sys.path
+
+    unplugged = False
+
+    def perm(sdi: Any) -> str:
+        if unplugged:
+            raise RuntimeError("sensor unplugged")
+        return str(codels.perm(sdi))
+
+    registry = rt.Registry()
+    robot.package.create_all(registry, {"alpha": types.SimpleNamespace(**{**vars(codels), "perm": perm})})
+    registry.kernel.run_for(0.1)
+    before = registry.read_poster("alpha.Status")
+    assert before is not None and before.data.counter > 0
+    unplugged = True
+    registry.kernel.run_for(0.1)
+    assert any("permanent codel 'perm' raised" in i for i in registry.incidents)
+    after = registry.read_poster("alpha.Status")
+    assert after is not None and after.date == before.date  # not published as fresh
+
+
+def test_modules_created_twice_on_one_registry_are_refused(robot: Robot) -> None:
+    with pytest.raises(ValueError, match="module 'alpha' is already on this registry"):
+        robot.package.create_all(robot.registry)
+
+
+def test_executive_inputs_that_are_no_tuple_are_refused_before_anything_is_sent() -> None:
+    from specc.runtime import executive as rx
+
+    sent: list[Any] = []
+    executive = types.SimpleNamespace(_post=lambda *args: sent.append(args), _internal_ids=iter([-1]))
+    with pytest.raises(TypeError, match=r"inputs of GOTO: give a tuple .* not dict \{'x': 3.0\}"):
+        rx.Executive.request(executive, "GOTO", inputs={"x": 3.0})  # type: ignore[arg-type]
+    assert not sent
+
+
+def test_codels_given_by_their_module_s_dotted_name_are_imported(robot: Robot) -> None:
+    registry = rt.Registry()
+    made = robot.package.create_all(registry, {"alpha": "scripted_codels.alpha"})
+    import scripted_codels.alpha as codels
+
+    assert made["alpha"].codels is codels
+    with pytest.raises(ImportError, match="cannot import its codels 'no_such_codels.alpha'"):
+        robot.package.create_all(rt.Registry(), {"alpha": "no_such_codels.alpha"})
