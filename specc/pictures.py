@@ -34,11 +34,15 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
     for arc in graph.arcs:
         start, end = position[arc.source], position[arc.target]
         style = "-" if arc.policy == "interrupt" else "--"
-        if arc.source == arc.target:
+        if arc.source == arc.target:  # a loop on the inner side of the node, clear of its marker
             x, y = start
-            axes.add_patch(FancyArrowPatch((x + 0.04, y + 0.05), (x - 0.04, y + 0.05),
-                                           connectionstyle="arc3,rad=-2.5", arrowstyle="-|>",
-                                           mutation_scale=10, linestyle=style, color="#555555"))
+            ux, uy = x / radius, y / radius  # the node's direction from the centre
+            tx, ty = -uy, ux
+            inner = (x - 0.12 * ux, y - 0.12 * uy)
+            axes.add_patch(FancyArrowPatch((inner[0] + 0.06 * tx, inner[1] + 0.06 * ty),
+                                           (inner[0] - 0.06 * tx, inner[1] - 0.06 * ty),
+                                           connectionstyle="arc3,rad=1.6", arrowstyle="-|>", mutation_scale=10,
+                                           linestyle=style, color="#555555", zorder=4))
             continue
         axes.add_patch(FancyArrowPatch(start, end, connectionstyle="arc3,rad=0.08", arrowstyle="-|>",
                                        mutation_scale=12, shrinkA=14, shrinkB=14, linestyle=style,

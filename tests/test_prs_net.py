@@ -335,9 +335,34 @@ NO_STORE = SEVERAL_KAS.replace("body { =>(HAVE $T); }\n  }\n}", "body { fail; }\
 NOBODY_LISTENS = FACT_INVOKED.replace("invocation: (ALARM);", "invocation: (HANDLED);")
 
 
+# A program variable set by a subgoal, then compared: the test reads the value it holds (A), it does
+# not bind it afresh to B.
+PROGRAM_VARIABLE_TESTED = """
+procedures mini {
+  predicate GET(v: {A, B});
+  predicate GO();
+  ka Get { invocation: !(GET $V); body { !(= $V A); } }
+  ka Main {
+    invocation: !(GO);
+    body {
+      !(GET @R);
+      if ?(= @R B) { fail; }
+    }
+  }
+}
+"""
+
+
+def test_a_test_compares_the_value_a_program_variable_holds(tmp_path: Path) -> None:
+    report = check(PROGRAM_VARIABLE_TESTED, "!(GO)", tmp_path)
+    assert report.succeeded >= 1 and report.failed == 0, report.kinds()
+    assert finding(report, "unreachable").endswith("10 fail")
+
+
 @pytest.mark.parametrize("text, goal", [
     (DEADLOCK, "!(MEET)"), (FIXED_HANDSHAKE, "!(MEET)"), (DEAD_BRANCH, "!(GO)"), (SEVERAL_KAS, "!(START)"),
     (NO_STORE, "!(START)"), (FACT_INVOKED, "!(RAISE)"), (NOBODY_LISTENS, "!(RAISE)"),
+    (PROGRAM_VARIABLE_TESTED, "!(GO)"),
 ])
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_the_interpreter_ends_only_where_the_net_says_it_can(tmp_path: Path, text: str, goal: str, seed: int) -> None:

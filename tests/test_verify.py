@@ -283,6 +283,7 @@ def test_a_send_to_a_module_a_reflex_listens_to_is_kept_though_the_reflex_never_
     result = explorer.explore()
     assert explorer.passes_matter and result.left_out == ()  # a pass did change something: n.Y kept
     assert result.violations["no-error"].trace == ["task: RQST EXEC S", "m1: Rs sends n.Y", "m1: Rs ends"]
+    assert "(groups: " in result.violations["no-error"].message  # the controller's state it failed in
 
 
 def test_a_state_limit_refutes_no_liveness_property_it_could_not_explore_to_the_end(tmp_path: Path) -> None:
@@ -529,3 +530,29 @@ def test_hilare_splits_where_its_hand_written_rules_do_not_reach() -> None:
     assert [set(p) for p in parts][1:] == [{"INIT-MODEL", "READ-OBST", "TURN-CAMERA", "TAKE-IMAGE", "SEARCH-OBJ",
                                             "GET-NEAR-OBJ"}]
     assert {"CALC-TRAJ-OBJ", "ARM-OBJ", "EXEC-TRAJ-GOAL"} <= set(parts[0])
+
+
+ZOMBIE_REFLEX = """
+module cam {
+  codels: "arm_codels";
+  request Scan { type: exec; task: T; codel exec: go; incompatible_with: Scan; }
+  exec_task T { period: 10 ms; }
+}
+executive eye {
+  service SCAN { request: cam.Scan; }
+  reflex bump on warning %s => abort SCAN;
+}
+"""
+
+
+@pytest.mark.parametrize("source", ["cam.Scan", "SCAN"])
+def test_a_reflex_aborting_a_service_gone_zombie_frees_it_whichever_the_source_named(tmp_path: Path,
+                                                                                     source: str) -> None:
+    # Found by a user trial: on the module request's warning, the reflex used to act before the
+    # executive had recorded the ZOMBIE; its abort's reply was lost and SCAN stayed ZOMBIE for good.
+    # The module's client hears a reply before the reflexes do, as for the service's own warning.
+    write_codels(tmp_path)
+    spec = tmp_path / "eye.spec"
+    spec.write_text(ZOMBIE_REFLEX % source)
+    result = run([spec], "eye", 1)
+    assert result.complete and result.violations == {}, result.violations

@@ -213,7 +213,9 @@ def _reads(term: Any, everything: bool) -> set[str]:
     found: set[str] = set()
     for a in term.args:
         if isinstance(a, rp.Var):
-            if not a.is_program:
+            # A program variable a predicate's argument is given afresh (`outputs`); one that `=`
+            # compares is read, as the interpreter reads it: `?(= @R B)` tests the value @R holds.
+            if not a.is_program or term.head == "=":
                 found.add(a.name)
         else:
             found |= _reads(a, term.head == "=")

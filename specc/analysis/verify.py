@@ -51,7 +51,7 @@ from specc.runtime.rules import Calls, Decision
 PROPERTIES = {
     "exclusion": "never two mutually incompatible services in EXEC",
     "one-reply": "every accepted request ends with exactly one final reply",
-    "no-starvation": "no WAIT service without a start timeout starves forever",
+    "no-starvation": "a WAIT service without a start timeout can always still start, with no new request",
     "no-error": "the executive never enters its general ERROR state",
 }
 
@@ -113,9 +113,9 @@ class ModelModule:
         self.reply_listeners: list[Callable[[Reply], None]] = []
 
     def emit(self, sink: Callable[[Reply], None], reply: Reply) -> None:
+        sink(reply)  # as specc.runtime.functional.Module.emit: the client, then the reflexes
         for listener in self.reply_listeners:
             listener(reply)
-        sink(reply)
 
     def reply(self, rqst_id: int, request: str, status: Status, code: str = "OK", final: bool = True) -> Reply:
         return Reply(rqst_id, self.name, request, status, Report(code), None, final)

@@ -180,3 +180,8 @@ def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Servic
         elif target.text not in services:
             ctx.unknown("undefined-service", "service", target.text, services, target.span,
                         f" (reflexes '{action.verb}' executive services)")
+        elif action.verb == "start" and services[target.text].takes:
+            taken = ", ".join(t.text for t in services[target.text].takes)
+            ctx.report("reflex-needs-input", f"a reflex starts '{target.text}' without input, but it takes {taken} "
+                       "from the task level: it would always end BAD-INPUT; give the service `args { }` instead "
+                       "of `takes:`, or let the task level ask for it", target.span)

@@ -553,8 +553,7 @@ class Executive:
         status = decision.outputs.get("status")
         if not decision.ok or status is None:
             what = decision.impossible or ", ".join(decision.inconsistent or decision.incomplete)
-            self._fatal(f"the controller cannot decide {event} of {service}: {what} "
-                        f"(groups: {', '.join(f'{k}={v}' for k, v in self.groups.items())})")
+            self._fatal(f"the controller cannot decide {event} of {service}: {what}")
             return "ERROR"
         for attribute in self.groups:
             self.groups[attribute] = decision.outputs[attribute]
@@ -573,6 +572,8 @@ class Executive:
         interrupted so the system can be reviewed."""
         if self.error is not None:
             return
+        if self.groups:  # the controller's state, which most reasons depend on
+            reason += f" (groups: {', '.join(f'{k}={v}' for k, v in self.groups.items())})"
         self.error = reason
         self._tell("WARNING", "EXECUTIVE", 0, "ERROR", reason)
         for activity in list(self.activities.values()):

@@ -563,9 +563,11 @@ class Module:
             child_failed(parent, reply, activated=False)
 
     def emit(self, sink: ReplySink, reply: Reply) -> None:
+        # The client first, then who watches (the executive's reflexes): a reflex on a module's
+        # reply acts on what the executive made of that reply (a ZOMBIE it has recorded), not before.
+        sink(reply)
         for listener in self.reply_listeners:
             listener(reply)
-        sink(reply)
 
     def run_control(self, rqst_id: int, spec: RequestSpec, input_: Any, sink: ReplySink) -> None:
         """A control request takes no time: its validate codel runs and the final reply goes now."""

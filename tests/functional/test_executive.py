@@ -264,3 +264,26 @@ def test_a_listener_that_raises_is_recorded_and_the_executive_goes_on(shop: Shop
     shop.run(0.1)
     assert shop.facts() == [("REPLY", 1, "OK")] and shop.executive.activities == {}
     assert shop.executive.incidents and "listener bug" in shop.executive.incidents[0]
+
+
+def test_a_reflex_on_a_module_request_s_warning_acts_once_the_executive_has_heard_the_zombie(
+        shop_package: ModuleType) -> None:
+    # `on warning alpha.C` (the module's request) as `on warning FREE` (the service): the abort the
+    # reflex sends finds FREE already ZOMBIE in the executive, and frees it. Acting first, it used
+    # to be lost, and FREE stayed ZOMBIE with its module refusing every request.
+    import dataclasses
+
+    registry = rt.Registry()
+    importlib.import_module("shop.modules").create_all(registry)
+    generated = importlib.import_module("shop.executive.shop")
+    free = rx.ReflexSpec("freeIt", "warning", "alpha.C", actions=(("abort", "FREE"),))
+    spec = dataclasses.replace(generated.SPEC, reflexes=(free,))
+    executive = rx.Executive(spec, generated.decide, registry, rx.load_codels(spec))
+    shop = Shop(registry, executive)
+    shop.ask("FREE", 1, "exec,zombie")
+    shop.run(0.2)
+    assert ("WARNING", "FREE", 1, "ZOMBIE") in shop.facts() and shop.facts()[-1] == ("REPLY", 1, "ZOMBIE")
+    assert shop.state(1) is rx.Phase.ETHER and not registry.modules["alpha"].zombies
+    shop.ask("FREE", 2, "exec")
+    shop.run(0.1)
+    assert shop.facts()[-1] == ("REPLY", 2, "OK")
