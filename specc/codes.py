@@ -100,6 +100,8 @@ CODES: dict[str, Code] = {
     "missing-python-module": Code("the Python module a spec names is not next to it", 'codels: "cart_codles";'),
     "python-syntax-error": Code("a codel module has a syntax error", "cart_codels.py with `def go(sdi:`"),
     # ---------------------------------------------------------------- executive
+    "reflex-loop": Code("reflexes that restart a service on every reply it gives, directly or through others",
+                        "reflex again on interm DOCK => start DOCK;"),
     "reflex-needs-input": Code("a reflex sends a request that takes inputs it cannot give",
                                "reflex on reply loco.Track => request loco.GoTo;"),
     "reflex-never-fires": Code("a reflex compares a reply with a value the request never replies (warning)",

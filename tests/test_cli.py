@@ -247,29 +247,29 @@ def test_compile_refuses_a_package_name_python_cannot_import(tmp_path: Path) -> 
     assert not (tmp_path / "out").exists()
 
 
+def python(script: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """`script` run by a new Python process in `cwd` (what happens around the command's main())."""
+    return subprocess.run([sys.executable, "-c", script], cwd=cwd, capture_output=True, text=True, timeout=60)
+
+
 def test_an_internal_bug_is_one_line_not_a_traceback(tmp_path: Path) -> None:
     # Simulate a bug in specc: the front end raises an unexpected exception.
-    script = ("import sys, specc.pipeline as p\n"
-              "def boom(*a, **k):\n    raise ValueError('boom')\n"
-              "p.load = boom\nimport specc.cli as c\nc.load = boom\nsys.argv = ['specc', 'check', 'x.spec']\n"
-              "c.main()\n")
-    result = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
-                            timeout=60)
+    result = python("import sys, specc.pipeline as p\n"
+                    "def boom(*a, **k):\n    raise ValueError('boom')\n"
+                    "p.load = boom\nimport specc.cli as c\nc.load = boom\nsys.argv = ['specc', 'check', 'x.spec']\n"
+                    "c.main()\n", tmp_path)
     assert result.returncode == 2
     assert "internal error: ValueError: boom" in result.stderr and "SPECC_DEBUG=1" in result.stderr
     assert "Traceback" not in result.stderr
 
 
-
 def test_the_command_ends_without_teardown_but_runs_exit_handlers_and_keeps_its_exit_code(tmp_path: Path) -> None:
     # main() ends the process at once (os._exit); what a library registered with atexit still runs.
     (tmp_path / "bad.spec").write_text("module a { number: x; }\n")
-    script = ("import atexit, pathlib, sys\n"
-              "atexit.register(lambda: pathlib.Path('handler-ran').write_text('yes'))\n"
-              "import specc.cli as c\nsys.argv = ['specc', 'check', 'bad.spec']\nc.main()\n"
-              "pathlib.Path('after-main').write_text('main returned')\n")
-    result = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
-                            timeout=60)
+    result = python("import atexit, pathlib, sys\n"
+                    "atexit.register(lambda: pathlib.Path('handler-ran').write_text('yes'))\n"
+                    "import specc.cli as c\nsys.argv = ['specc', 'check', 'bad.spec']\nc.main()\n"
+                    "pathlib.Path('after-main').write_text('main returned')\n", tmp_path)
     assert result.returncode == 1 and "bad.spec:1:" in result.stderr and "1 error(s)" in result.stderr
     assert (tmp_path / "handler-ran").read_text() == "yes"
     assert not (tmp_path / "after-main").exists()

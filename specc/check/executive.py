@@ -137,6 +137,7 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                            parameter.set.span)
     for reflex in executive.reflexes:
         check_reflex(ctx, reflex, services)
+    check_reflex_loops(ctx, executive.reflexes, services)
     # How its own rule bases name its service groups is checked from the incompatibility graph,
     # an analysis: `specc.pipeline` reports it after these passes.
 
@@ -146,6 +147,42 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
 RUNTIME_CODES = frozenset({"ABORT", "INTERRUPTED", "BAD_INPUT", "CODEL_ERROR", "NO_EXEC_TASK", "UNDECLARED_STATE",
                            "UNKNOWN_ACTIVITY", "UNKNOWN_ID", "UNKNOWN_MODULE", "UNKNOWN_REQUEST", "ZOMBIE",
                            "MODULE_FROZEN"})
+
+
+def check_reflex_loops(ctx: Context, reflexes: tuple[m.Reflex, ...], services: Mapping[str, m.Service]) -> None:
+    """A warning for reflexes that start, on any intermediate or final reply of a service (no
+    condition on its report), that service again, directly or through others: each start brings
+    the reply that starts the next, for as long as the executive runs."""
+    starts: dict[str, list[tuple[str, m.Reflex]]] = {}
+    for reflex in reflexes:
+        if reflex.comparison is None and reflex.trigger in ("interm", "reply") and reflex.source.text in services:
+            for action in reflex.actions:
+                if action.verb == "start" and action.target.text in services:
+                    starts.setdefault(reflex.source.text, []).append((action.target.text, reflex))
+    warned: set[int] = set()
+    for first in sorted(starts):
+        path: list[tuple[str, m.Reflex]] = []
+
+        def follow(service: str, seen: frozenset[str]) -> list[tuple[str, m.Reflex]] | None:
+            for target, reflex in starts.get(service, ()):
+                path.append((target, reflex))
+                if target == first:
+                    return list(path)
+                if target not in seen:
+                    found = follow(target, seen | {target})
+                    if found is not None:
+                        return found
+                path.pop()
+            return None
+
+        loop = follow(first, frozenset({first}))
+        if loop is None or any(id(reflex) in warned for _, reflex in loop):
+            continue
+        warned.update(id(reflex) for _, reflex in loop)
+        chain = " -> ".join([first] + [target for target, _ in loop])
+        ctx.warn("reflex-loop", f"these reflexes start {first} again on every reply it gives ({chain}): once "
+                 "started, it never stops being restarted; give the reflex a condition on the reply "
+                 "(`== FAILED`) or start another service", loop[0][1].span)
 
 
 def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Service]) -> None:
