@@ -100,6 +100,8 @@ CODES: dict[str, Code] = {
     "missing-python-module": Code("the Python module a spec names is not next to it", 'codels: "cart_codles";'),
     "python-syntax-error": Code("a codel module has a syntax error", "cart_codels.py with `def go(sdi:`"),
     # ---------------------------------------------------------------- executive
+    "rule-never-applies": Code("an executive's hand-written rule a declared or sends-derived wait always overrides",
+                               'START MOVE, @MotionState == "REACH" ==> ... (MOVE waits for REACH)'),
     "reflex-loop": Code("reflexes that restart a service on every reply it gives, directly or through others",
                         "reflex again on interm DOCK => start DOCK;"),
     "reflex-needs-input": Code("a reflex sends a request that takes inputs it cannot give",

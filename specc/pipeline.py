@@ -8,7 +8,7 @@ from pathlib import Path
 from lark import Token
 
 from specc.check import check_program
-from specc.diagnostics import Diagnostic, error, sort_key
+from specc.diagnostics import Diagnostic, error, sort_key, warning
 from specc.model import nodes as m
 from specc.syntax.parser import display_path, parse_text, read_source, spec_files
 
@@ -61,10 +61,11 @@ def _controller_naming_diagnostics(program: m.Program) -> list[Diagnostic]:
     """How each executive's own rule bases name its service groups (seed 000 Fig 5.6 calls the
     pilo group ExecTrajState): what they get wrong, from the incompatibility graph (an analysis,
     so reported here, after the check passes, and before anything is compiled)."""
-    from specc.analysis.controller import naming
+    from specc.analysis.controller import naming, rules_waits_override
 
-    return [error(p.code, p.message, p.node.span) for e in program.items if isinstance(e, m.Executive)
-            for p in naming(program, e).problems]
+    executives = [e for e in program.items if isinstance(e, m.Executive)]
+    return [error(p.code, p.message, p.node.span) for e in executives for p in naming(program, e).problems] + [
+        warning(p.code, p.message, p.node.span) for e in executives for p in rules_waits_override(program, e)]
 
 
 def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:

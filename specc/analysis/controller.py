@@ -418,6 +418,43 @@ def fixed_values(condition: k.Cond) -> dict[str, Any]:
     return {a.attribute: a.value for a in atoms if isinstance(a, k.Atom) and a.op == "=="}
 
 
+def rules_waits_override(program: m.Program, executive: m.Executive) -> list[Problem]:
+    """The executive's hand-written rules that a wait always overrides: whenever one applies, so
+    does the generated rule making its service WAIT (a declared `wait`, or one a `sends:` adds),
+    which no hand-written rule takes over (`take_over`), so the rule never decides anything."""
+    named = naming(program, executive)
+    if named.problems:
+        return []
+    generated = k.normalise(controller_rules(controller_name(executive), named.graph, named.groups, named.names))
+    waits = declared_waits(named.graph, named.groups)
+    guards = [rule for rule in generated.rules if rule.name in waits and rule.condition is not None]
+    found = []
+    for base in named.hand:
+        nodes = {rule.name: rule for rule in base.rules if isinstance(rule, m.Rule)}
+        for rule in k.normalise(base).rules:
+            if rule.kind != "when" or rule.condition is None or rule.name not in nodes:
+                continue
+            mine = fixed_values(rule.condition)
+            wait = next((g for g in guards if _implies(mine, g.condition)), None)  # type: ignore[arg-type]
+            if wait is not None:
+                service, _, group = wait.name.partition("_waits_")
+                found.append(Problem("rule-never-applies", (
+                    f"rule '{rule.name}' never applies: where it does, {service} waits for what runs in group "
+                    f"{group} (a declared `wait`, or one a `sends:` adds), and no hand-written rule takes a wait "
+                    "over; drop the rule, or declare that conflict an interrupt"), nodes[rule.name]))
+    return found
+
+
+def _implies(fixed: Mapping[str, Any], condition: k.Cond) -> bool:
+    """Do the attribute values `fixed` make `condition` (tests of `==` and `in` only) true?"""
+    atoms = condition.operands if isinstance(condition, k.All) else (condition,)
+    if not all(isinstance(a, k.Atom) and a.op in ("==", "in") for a in atoms):
+        return False
+    return all(a.attribute in fixed  # type: ignore[union-attr]
+               and (fixed[a.attribute] == a.value if a.op == "==" else fixed[a.attribute] in a.value)  # type: ignore
+               for a in atoms)
+
+
 def step_aside(rule: k.Rule, guards: list[k.Cond]) -> k.Rule:
     """`rule`, holding only where none of `guards` applies. Guards that cannot hold with it (they
     test another service or event) are left out: the decision graph stays as it was elsewhere."""
