@@ -653,11 +653,11 @@ def skeleton(paths: PathsArg) -> None:
     for source in loaded.program.files:
         spec_dir = loaded.paths[source.path].resolve().parent
         robot_dir = next((folder for folder in (spec_dir, *spec_dir.parents) if folder in robots), None)
-        for wanted in (needs for item in source.items for needs in stubs.needs(item)):
+        for owner, wanted in ((item, needs) for item in source.items for needs in stubs.needs(item)):
             try:
                 change = stubs.write_stubs(wanted, spec_dir, robot_dir)
             except (OSError, SyntaxError) as exc:
-                err.print(f"{source.path}: error: {wanted.owner}: {exc} [skeleton-failed]", markup=False)
+                err.print(f"{owner.span}: error: {wanted.owner}: {exc} [skeleton-failed]", markup=False)
                 raise typer.Exit(1) from None
             if change is None or not change.functions:
                 continue
@@ -672,8 +672,18 @@ TABLE_WIDTH = 140  # columns of `specc table` when it does not print to a termin
 
 
 def _run_error(error: Exception, code: int = 1) -> typer.Exit:
-    """One clear line (or a spec's diagnostics) for a run that cannot go on."""
-    err.print(f"error: {error}" if "error:" not in str(error) else str(error), markup=False)
+    """One clear line (or a spec's diagnostics) for a run that cannot go on; a message that starts
+    with a spec's position says it gcc-style (`file:line:col: error: ...`)."""
+    import re
+
+    text = str(error)
+    located = re.match(r"(\S+:\d+:\d+): (.*)", text, re.DOTALL)
+    if "error:" in text:
+        err.print(text, markup=False)
+    elif located is not None:
+        err.print(f"{located.group(1)}: error: {located.group(2)}", markup=False)
+    else:
+        err.print(f"error: {text}", markup=False)
     return typer.Exit(code)
 
 

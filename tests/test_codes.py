@@ -81,6 +81,7 @@ def test_a_folder_without_specs_and_a_skeleton_that_cannot_be_written_say_so_wit
                            text=True, timeout=60)
     shown = stubs.stdout + stubs.stderr
     assert stubs.returncode != 0 and "[skeleton-failed]" in shown and "Traceback" not in shown, shown
+    assert "m.spec:1:1: error: " in shown  # where the spec names the module the stubs were for
 
 
 # Codes no test produces yet: this list only shrinks.

@@ -454,3 +454,10 @@ def test_the_command_refuses_bad_input_in_one_line(args: tuple[str | Path, ...],
     assert result.returncode == 2, result.stderr
     assert "Traceback" not in result.stderr and "internal error" not in result.stderr
     assert result.stderr.startswith("error: ") and message in result.stderr and result.stderr.count("\n") == 1
+
+
+def test_a_spec_error_met_by_the_command_is_said_gcc_style(tmp_path: Path) -> None:
+    spec = tmp_path / "x.spec"
+    spec.write_text("domain d {\n  oops\n}\n")
+    result = specc("mutants", spec)
+    assert result.returncode == 2 and result.stderr.startswith(f"{spec}:2:3: error: unexpected 'oops'"), result.stderr

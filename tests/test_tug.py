@@ -96,6 +96,7 @@ def test_a_table_of_the_tug(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("args, message", [
     (("--mission", "shuttle", "--config", "Robot3"), "no robot configuration 'Robot3'"),
+    (("--mission", "shuttle", "--config", "Robot1,Robot2"), "one configuration each time: repeat the option"),
     (("--mission", "fetch", "--world", "hall"), "robot 'tug' has no mission 'fetch'"),
 ])
 def test_bad_options_for_the_tug_are_one_line(tmp_path: Path, args: tuple[str, ...], message: str) -> None:

@@ -63,7 +63,8 @@ class Headline:
 
     def text(self) -> str:
         below = "still below" if self.faulty[1] < self.fault_free[1] else "not below"
-        relative = f"{self.relative:+.0%} relative" if self.relative is not None else "no relative change from 0"
+        relative = (f"{self.relative:+.0%} relative" if self.relative is not None
+                    else "relative change undefined (from 0 %)")
         cut = (f"; failures cut from {1 - self.faulty[0]:.0%} to {1 - self.faulty[1]:.0%}, {self.failure_cut:.0%} "
                "relative (the seed's basis)") if self.failure_cut is not None else ""
         return (f"{self.worlds}: under injected faults, {self.second} succeeds in {self.faulty[1]:.0%} of missions "
@@ -216,6 +217,13 @@ def markdown(report: CampaignReport) -> str:
             _pct(m.kappa), f"{m.replannings:.2f}", f"{m.activity_time:.0f}", f"{m.distance:.1f}"]
         lines.append(f"| {mean.configuration} | {mean.faults} | {mean.worlds} | {mean.experiments} | "
                      + " | ".join(cells) + " |")
+    lines += ["", "What the columns say (seed 004 §4.1.4; `specc/run/measures.py`): faults F* are the kept "
+              "mutants, ∅ the original model; worlds W* every world, W* \\ X without those set apart (`--set-apart`); "
+              "σ̄_X the share of goals of kind X met, ν̄ of missions with every goal met; κ̄ of missions "
+              "where planning gave no plan in time (a planner whose plans leave every goal aside is not counted: "
+              "the robot then simply stays); R̄ the replannings per mission; T̄ the physical activity time, how "
+              "long at least one action ran (neither planning nor waiting counts, so a recovery's cost shows in "
+              "R̄ and in each result's `mission_time`, not here); D̄ the distance travelled."]
     configurations = list(d.get("configurations", []))
     lines += ["", "## Kept mutants (F*): mission success ν̄ over every activity", "",
               "| mutant | class | mutation | " + " | ".join(configurations) + " |",

@@ -25,6 +25,11 @@ from specc.run import RunError
 GROWING = {"configurations": True, "mutants": False}
 
 
+def _shown(value: Any) -> str:
+    """A description's value as a message shows it: a list as its items, anything else as it is."""
+    return ", ".join(map(str, value)) if isinstance(value, list) else "none" if value is None else str(value)
+
+
 def _grows(key: str, stored: Any, given: Any) -> bool:
     return (isinstance(stored, list) and isinstance(given, list) and set(stored) <= set(given)
             and (not GROWING[key] or given[:1] == stored[:1]))
@@ -113,8 +118,10 @@ class ResultStore:
             differs = sorted(k for k in set(stored) | set(description) if stored.get(k) != description.get(k))
             grows = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))]
             if set(differs) - set(grows):
-                raise RunError(f"'{self.path}' holds another campaign (it differs in {', '.join(differs)}): "
-                               "give another --store, or the same options to resume it")
+                said = "; ".join(f"{k}: {_shown(stored.get(k))} stored, {_shown(description.get(k))} asked"
+                                 for k in differs)
+                raise RunError(f"'{self.path}' holds another campaign ({said}): give another --store, or the "
+                               "options it was run (or last grown) with to resume it")
             with self.db:
                 self.db.executemany("UPDATE campaign SET value = ? WHERE name = ?",
                                     [(json.dumps(description[k]), k) for k in grows])

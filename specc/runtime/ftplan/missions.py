@@ -42,8 +42,9 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
     except KeyError:
         known = ", ".join(f"{key} ({config.planners[0].name} alone)" if len(config.planners) == 1 else key
                           for key, config in configurations.items())
+        several = "; one configuration each time: repeat the option for more" if "," in configuration else ""
         raise UnknownName(f"no robot configuration '{configuration}' (known: {known}, or a planner's name for it "
-                          f"alone; {VARIANTS_HELP})") from None
+                          f"alone; {VARIANTS_HELP}){several}") from None
     except ValueError as error:
         raise UnknownName(str(error)) from None
     try:
