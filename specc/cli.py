@@ -6,7 +6,7 @@ import math
 import os
 import sys
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Optional
@@ -1059,7 +1059,8 @@ def campaign(
         defaults = campaign_defaults(generated, specs, robot)
         domain = domain or defaults.domain
         if report_only:  # the store is all a report needs
-            _campaign_report(store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite", output)
+            _campaign_report(store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite", output,
+                             _names(configs) if configs is not None else None)
             return
         setting = Setting(generated.resolve(), specs.resolve(), robot)
         plan = CampaignPlan(specs, setting, domain, None if mutants == "all" else int(mutants), seed,
@@ -1098,8 +1099,9 @@ def campaign(
         raise _run_error(error, 2) from None
 
 
-def _campaign_report(path: Path, output: Path | None) -> None:
-    """`specc campaign --report-only`: the report of the store at `path`, nothing run."""
+def _campaign_report(path: Path, output: Path | None, configurations: Sequence[str] | None = None) -> None:
+    """`specc campaign --report-only`: the report of the store at `path`, nothing run. Asked for
+    `configurations`, RunError naming those the store has no experiment of."""
     from specc.campaign.report import build_report
     from specc.campaign.store import ResultStore
     from specc.run import RunError
@@ -1107,8 +1109,14 @@ def _campaign_report(path: Path, output: Path | None) -> None:
     if not path.is_file():
         raise RunError(f"no results store '{path}': give the campaign's --store, or its --mutants")
     with ResultStore(path) as results:
-        if not results.description():
+        description = results.description()
+        if not description:
             raise RunError(f"'{path}' holds no campaign: give the campaign's --store")
+        stored = list(description.get("configurations", []))
+        missing = [c for c in configurations or () if c not in stored]
+        if missing:
+            raise RunError(f"'{path}' has no experiment of {', '.join(missing)} (its configurations: "
+                           f"{', '.join(stored)}): run the campaign with them first, or leave --configs out")
         report = build_report(results)
     out.print(f"{len(report.outcomes)} experiments in {path}", markup=False)
     _print_report(report, output or path.parent, path.stem)

@@ -226,6 +226,12 @@ def test_a_report_needs_a_store_that_holds_a_campaign(tmp_path: Path) -> None:
     ResultStore(tmp_path / "empty.sqlite").close()
     empty = specc("campaign", ATRV, *SMALL, "--store", tmp_path / "empty.sqlite", "--report-only")
     assert empty.returncode == 2 and "holds no campaign" in empty.stderr
+    with ResultStore(tmp_path / "two.sqlite") as store:
+        store.describe({"robot": "atrv", "configurations": ["Robot1", "Robot1/2"]})
+    asked = specc("campaign", ATRV, *SMALL, "--store", tmp_path / "two.sqlite", "--report-only", "--configs",
+                  "Robot1,Robot1/2c")  # a configuration the store has no experiment of: said, not left out
+    assert asked.returncode == 2 and "has no experiment of Robot1/2c (its configurations: Robot1, Robot1/2)" \
+        in asked.stderr, asked.stderr
 
 
 @pytest.mark.parametrize(("args", "message"), [
@@ -316,5 +322,6 @@ def test_a_damaged_or_foreign_store_is_one_clear_message_and_loses_no_verdict(tm
             assert [(m.id, m.verdict) for m in store.mutants()] == [("model1-0001", KEPT)]
     # Through the command: one line, exit 2, no traceback.
     damaged = tmp_path / "status.sqlite"
-    result = specc("campaign", ATRV, *SMALL, "--store", damaged, "--report-only", "-o", tmp_path / "out")
+    result = specc("campaign", ATRV, *SMALL, "--configs", "Robot1", "--store", damaged, "--report-only", "-o",
+                   tmp_path / "out")  # the configurations the store was described with
     assert result.returncode == 2 and "has the status 'weird'" in result.stderr and "Traceback" not in result.stderr
