@@ -150,9 +150,14 @@ def declared_wait(service: str, group: Group) -> str:
     return f"{service}_waits_{group.name}"
 
 
+def wait_rules(graph: IncompatibilityGraph, groups: list[Group]) -> dict[str, tuple[str, str]]:
+    """The generated wait rules by name, each with the service it makes WAIT and the group it waits on."""
+    return {declared_wait(a.source, g): (a.source, g.name) for a in graph.arcs if a.policy == "wait"
+            for g in groups if a.target in g.services}
+
+
 def declared_waits(graph: IncompatibilityGraph, groups: list[Group]) -> frozenset[str]:
-    return frozenset(declared_wait(a.source, g) for a in graph.arcs if a.policy == "wait"
-                     for g in groups if a.target in g.services)
+    return frozenset(wait_rules(graph, groups))
 
 
 def physical(graph: IncompatibilityGraph, source: str, target: str) -> bool:
@@ -426,7 +431,7 @@ def rules_waits_override(program: m.Program, executive: m.Executive) -> list[Pro
     if named.problems:
         return []
     generated = k.normalise(controller_rules(controller_name(executive), named.graph, named.groups, named.names))
-    waits = declared_waits(named.graph, named.groups)
+    waits = wait_rules(named.graph, named.groups)
     guards = [rule for rule in generated.rules if rule.name in waits and rule.condition is not None]
     found = []
     for base in named.hand:
@@ -435,9 +440,9 @@ def rules_waits_override(program: m.Program, executive: m.Executive) -> list[Pro
             if rule.kind != "when" or rule.condition is None or rule.name not in nodes:
                 continue
             mine = fixed_values(rule.condition)
-            wait = next((g for g in guards if _implies(mine, g.condition)), None)  # type: ignore[arg-type]
+            wait = next((g for g in guards if g.condition is not None and _implies(mine, g.condition)), None)
             if wait is not None:
-                service, _, group = wait.name.partition("_waits_")
+                service, group = waits[wait.name]
                 found.append(Problem("rule-never-applies", (
                     f"rule '{rule.name}' never applies: where it does, {service} waits for what runs in group "
                     f"{group} (a declared `wait`, or one a `sends:` adds), and no hand-written rule takes a wait "
@@ -447,11 +452,12 @@ def rules_waits_override(program: m.Program, executive: m.Executive) -> list[Pro
 
 def _implies(fixed: Mapping[str, Any], condition: k.Cond) -> bool:
     """Do the attribute values `fixed` make `condition` (tests of `==` and `in` only) true?"""
-    atoms = condition.operands if isinstance(condition, k.All) else (condition,)
-    if not all(isinstance(a, k.Atom) and a.op in ("==", "in") for a in atoms):
+    operands = condition.operands if isinstance(condition, k.All) else (condition,)
+    atoms = [a for a in operands if isinstance(a, k.Atom) and a.op in ("==", "in")]
+    if len(atoms) != len(operands):
         return False
-    return all(a.attribute in fixed  # type: ignore[union-attr]
-               and (fixed[a.attribute] == a.value if a.op == "==" else fixed[a.attribute] in a.value)  # type: ignore
+    return all(a.attribute in fixed
+               and (fixed[a.attribute] == a.value if a.op == "==" else fixed[a.attribute] in a.value)
                for a in atoms)
 
 
