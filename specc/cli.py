@@ -15,7 +15,7 @@ import typer
 from rich.console import Console
 
 from specc.check.symbols import symbols_of
-from specc.diagnostics import error, render
+from specc.diagnostics import did_you_mean, error, render
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.pipeline import Loaded, load
@@ -61,7 +61,6 @@ def explain(code: Annotated[Optional[str], typer.Argument(help="A diagnostic's c
     Example: specc explain missing-semicolon
     """
     from specc.codes import CODES
-    from specc.diagnostics import did_you_mean
 
     shown = code.strip("[]") if code is not None else None
     if shown is not None and shown not in CODES:
@@ -359,18 +358,25 @@ def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], fac
 
     assert loaded.program is not None
     blocks: Mapping[str, m.Procedures] = symbols_of(loaded.program).blocks[m.Procedures]
-    chosen = blocks.get(name) if name else next(iter(blocks.values()), None)
-    if chosen is None or (name is None and len(blocks) > 1):
-        what = f"no procedures '{name}'" if name else "no procedures block" if not blocks else \
-            f"several procedures ({', '.join(sorted(blocks))}); pick one with --procedures"
-        err.print(f"error: {what}", markup=False)
-        raise typer.Exit(1)
     try:
         posted = [rp.parse_goal(g) for g in goals]
         initial = [rp.parse_fact(f) for f in facts]
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(1) from None
+    candidates = list(blocks.values())
+    if name is None and len(candidates) > 1:  # the blocks whose KAs achieve every goal posted
+        heads = {g.expr.head for g in posted}
+        candidates = [b for b in candidates
+                      if heads <= {ka.invocation.body.head for ka in b.kas if isinstance(ka.invocation, m.Goal)}]
+    chosen = blocks.get(name) if name else candidates[0] if len(candidates) == 1 else None
+    if chosen is None:
+        what = f"no procedures '{name}'{did_you_mean(name, blocks)}" if name else \
+            "no procedures block" if not blocks else \
+            f"several procedures ({', '.join(sorted(blocks))}) achieve the goal, or none does; pick one with " \
+            "--procedures"
+        err.print(f"error: {what}", markup=False)
+        raise typer.Exit(1)
     try:
         return translate(loaded.program, chosen, posted, initial, ["*" if f == "all" else f for f in failing])
     except ValueError as exc:
@@ -433,8 +439,13 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
     if not result.space.complete:
         # Only a growing place is a finding before every marking is known.
         out.print(f"{result.states} states of the reduced net in {elapsed:.1f} s, and more not explored", markup=False)
-        err.print(f"warning: stopped at {result.states} states: deadlocks, cycles and dead statements are not "
-                  "established; raise --max-states (or post a smaller goal) to explore them all", markup=False)
+        if result.space.limit_reached:
+            err.print(f"warning: stopped at {result.states} states: deadlocks, cycles and dead statements are not "
+                      "established; raise --max-states (or post a smaller goal) to explore them all", markup=False)
+        else:  # only the growing branches were cut: more states would not end them
+            err.print("warning: the net grows without bound (the 'unbounded' finding above): deadlocks, cycles and "
+                      "dead statements are not established; bound what grows (a recursion, a goal posted in a "
+                      "loop) and verify again: raising --max-states cannot help", markup=False)
         raise typer.Exit(1 if strict else 0)
     if not result.findings:
         out.print("no finding: no deadlock, no unbounded place, no statement that never runs or never succeeds, "
@@ -578,6 +589,10 @@ def export_problem(paths: PathsArg,
         out.print(f"wrote {path}", markup=False)
     for note in exported.unsupported:
         out.print(f"not expressed: {note}", markup=False)
+    if not exported.problem.actions:  # files a planner can only answer "unsolvable": say so, and fail
+        err.print(f"error: no task of domain '{block.name}' could be exported (each one's reason is above): the "
+                  "PDDL files have no action", markup=False)
+        raise typer.Exit(1)
 
 
 @app.command(name="rules")

@@ -85,6 +85,8 @@ CODES: dict[str, Code] = {
     "undefined-name": Code("a name in a planning block that is not a timepoint, a macro parameter or a declared "
                            "symbolic value", "t_midle - t_start in [1, 2];"),
     "undefined-loop-variable": Code("a rule uses a foreach index it does not declare", "r7[i]: speed > 3 ==> ..."),
+    "unused-timepoint": Code("a timepoint declared in a task or a problem that no statement uses",
+                             "timepoint t1, t2;  // t2 appears nowhere else"),
     "unused-fragment": Code("a fragment no block includes", "fragment spare { ... }"),
     # ---------------------------------------------------------------- modules
     "missing-property": Code("a block lacks a property it needs", "request Nothing { doc: \"no type\"; }"),
@@ -100,6 +102,10 @@ CODES: dict[str, Code] = {
     "missing-python-module": Code("the Python module a spec names is not next to it", 'codels: "cart_codles";'),
     "python-syntax-error": Code("a codel module has a syntax error", "cart_codels.py with `def go(sdi:`"),
     # ---------------------------------------------------------------- executive
+    "intermediate-never-read": Code("an undeclared attribute rules deduce and no rule tests (a misspelt output?)",
+                                    'outputs o; ... r: x > 1 ==> restrict oo == "a";'),
+    "comparison-never-holds": Code("a rule compares a numeric attribute with a number outside its declared range",
+                                   "inputs x: [0, 10]; ... r: x > 20 ==> ..."),
     "rule-never-applies": Code("an executive's hand-written rule a declared or sends-derived wait always overrides",
                                'START MOVE, @MotionState == "REACH" ==> ... (MOVE waits for REACH)'),
     "reflex-loop": Code("reflexes that restart a service on every reply it gives, directly or through others",

@@ -379,7 +379,7 @@ def draw_timeline(plan: Any, problem: Any, target: Path) -> Path:
     axes.set_xlabel("mission time (s): solid = shortest duration, hatched = what nature may add")
     axes.set_xlim(left=first - 2)
     axes.set_title(f"plan for {plan.problem} ({plan.domain}): {len(plan.actions)} actions, "
-                   f"strongly controllable, done by {plan.makespan:.0f} s at worst", fontsize=10)
+                   f"{plan.controllability_text}, done by {plan.makespan:.0f} s at worst", fontsize=10)
     axes.grid(axis="x", alpha=0.3)
     figure.tight_layout()
     target.parent.mkdir(parents=True, exist_ok=True)

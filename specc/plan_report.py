@@ -11,6 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from specc.analysis.planning import domain_block, domain_model, problem_model
+from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
@@ -37,7 +38,11 @@ class Outcome:
 def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Problem:
     problems = [p for p in program.items if isinstance(p, m.Problem)]
     if domain is not None:
+        domains = sorted({p.domain.text for p in problems})
         problems = [p for p in problems if p.domain.text.startswith(domain)]  # model2 takes model2_M1
+        if not problems:
+            raise ValueError(f"no domain '{domain}' has a problem{did_you_mean(domain, domains)} (domains with "
+                             f"problems: {', '.join(domains) or 'none'})")
     found = [p for p in problems if p.name == name] or [p for p in problems if p.name.startswith(name)]
     if len(found) == 1:
         return found[0]
@@ -96,18 +101,17 @@ def print_result(outcome: Outcome, out: Console) -> None:
     holds = ("whatever nature picks" if plan.controllability == "strong" else
              "whatever durations nature picks, with its instants at " +
              ", ".join(f"{name}={date:.2f}" for name, date in sorted(plan.assumed.items(), key=lambda kv: kv[1])))
-    table = Table(title=f"plan ({len(plan.actions)} actions, {plan.controllability}ly controllable: the dates hold "
+    table = Table(title=f"plan ({len(plan.actions)} actions, {plan.controllability_text}: the dates hold "
                         f"{holds})", title_justify="left", show_edge=False)
     for column in ("start", "action", "duration", "ends by", "may start", ""):
         table.add_column(column, justify="right" if column in ("start", "ends by") else "left", no_wrap=True)
     for a in plan.ordered():
         low, high = a.duration
         kind = "contingent" if a.contingent else "controllable"
-        table.add_row(f"{a.dispatch:.2f}", a.text(), f"{low:.2f}-{high:.2f} {kind}",
-                      f"{plan.ends_by(a):.2f}",
-                      f"{a.window[0]:.2f}-{a.window[1]:.2f}", "preemptible" if a.preemptible else "")
+        table.add_row(_date(a.dispatch), a.text(), f"{_date(low)}-{_date(high)} {kind}", _date(plan.ends_by(a)),
+                      f"{_date(a.window[0])}-{_date(a.window[1])}", "preemptible" if a.preemptible else "")
     out.print(table)
-    points = ", ".join(f"{name}={date:.2f}" for name, date in sorted(plan.schedule.items(), key=lambda kv: kv[1])
+    points = ", ".join(f"{name}={_date(date)}" for name, date in sorted(plan.schedule.items(), key=lambda kv: kv[1])
                        if "." not in name)
     out.print(f"mission timepoints: {points}", markup=False)
     if plan.bindings:
@@ -170,3 +174,8 @@ def plan_document(outcome: Outcome) -> dict[str, Any]:
         "bindings": dict(plan.bindings),
     }
     return document
+
+
+def _date(seconds: float) -> str:
+    """A date or a duration to the hundredth: never "-0.00" (a date a rounding error put at -1e-9)."""
+    return f"{round(seconds, 2) + 0.0:.2f}"

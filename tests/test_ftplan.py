@@ -184,6 +184,27 @@ def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner(policy: 
         assert any("(not p1: its last plan met no goal)" in text for line, text in result.trace if line == 3)
 
 
+@pytest.mark.parametrize("policy", ["successive", "concurrent"])
+def test_goals_abandoned_when_every_plan_leaves_them_aside_spare_the_final_goals_that_hold(policy: str) -> None:
+    # Both planners drop COMMUNICATION(W2): FTplan gives it up. The robot is home by then, so the
+    # final goals of being home (X and Y) hold: they are met when the mission ends, not abandoned.
+    _, problem = mission()
+    w2 = next(g for g in problem.assertions if g.goal is not None and getattr(g, "args", ()) == (pm.Sym("W2"),))
+
+    @dataclass
+    class DropsW2:
+        def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+            kept = replace(problem, assertions=tuple(a for a in problem.assertions if a is not w2))
+            return Planner(mission()[0]).plan(kept, now)
+
+    result = FtPlan(config(("p1", "p2"), policy), problem, LocalPool({"p1": DropsW2(), "p2": DropsW2()}),
+                    ScriptedExecutor()).run()
+    goals = [g for g in problem.assertions if g.goal is not None]
+    assert list(result.missed) == [next(text for text in result.missed if "COMMUNICATION(W2)" in text)]
+    assert len(result.met) == len(goals) - 1 and any("AT_ROBOT_X" in text for text in result.met)
+    assert any(e.kind == "operator" and "abandoned" in e.text for e in result.events)
+
+
 # ---------------------------------------------------------------- Fig 3.2
 
 

@@ -352,6 +352,43 @@ def from_text(text: str) -> tuple[pm.PlanningDomain, pm.Problem]:
     return domain, problem
 
 
+BATTERY_SPEC = """
+domain hops {
+  attribute AT() { ?value in {HOME, A, B}; }
+  attribute CHARGE() { ?value in [0, 3]; }
+  task HOP(?from, ?to, ?b) (t_start, t_end) {
+    ?from in {HOME, A, B};
+    ?to in {HOME, A, B};
+    ?from != ?to;
+    ?b in [1, 3];
+    variable ?left;
+    ?left =. ?b - 1;
+    event(AT(): (?from, ?to), t_end);
+    event(CHARGE(): (?b, ?left), t_end);
+    contingent (t_end - t_start) in [5, 10];
+  } nonPreemptive
+}
+problem visit for hops {
+  timepoint ta, t_forgotten;
+  explained event(AT(): (B, HOME), t_start);
+  explained event(CHARGE(): (0, 3), t_start);
+  hold(AT(): A, (ta, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 100];
+}
+"""
+
+
+def test_a_local_numeric_variable_and_a_timepoint_nothing_uses_leave_the_plan_valid() -> None:
+    # HOP's ?left is worked out from its parameter ?b (`?left =. ?b - 1`): the plan carries its
+    # value, which the validator needs for CHARGE's event; t_forgotten has no date to check.
+    domain, problem = from_text(BATTERY_SPEC)
+    result = Planner(domain, exact=False).plan(problem)
+    checked(domain, problem, result)
+    assert result.plan is not None
+    (hop,) = result.plan.actions
+    assert dict(hop.values) == {"?left": 2.0} and hop.args[2] == 3.0
+
+
 def test_strong_controllability_drops_a_message_the_shortest_window_cannot_hold() -> None:
     domain, problem = radio()
     result = Planner(domain, exact=False).plan(problem)
@@ -459,3 +496,29 @@ def test_no_search_is_run_twice_for_one_plan(monkeypatch: pytest.MonkeyPatch) ->
     assert len(searched) == len(set(searched))
     # None, each goal alone, both at once depth first, then the second added to the first.
     assert [len(goals) for goals, _ in searched] == [0, 1, 1, 2, 2]
+
+
+def test_a_parameter_another_one_computes_gets_its_value_from_the_constraint() -> None:
+    # HOP(?from, ?to, ?b, ?left) with ?left =. ?b - 1: once the battery's link binds ?b (3), ?left
+    # is 2; it used to be given the first value of its domain (0) and the search never found HOP.
+    text = BATTERY_SPEC.replace("HOP(?from, ?to, ?b)", "HOP(?from, ?to, ?b, ?left)").replace(
+        "    variable ?left;\n", "    ?left in [0, 2];\n")
+    domain, problem = from_text(text)
+    result = Planner(domain, exact=False).plan(problem)
+    checked(domain, problem, result)
+    assert result.plan is not None
+    (hop,) = result.plan.actions
+    assert hop.args == ("HOME", "A", 3.0, 2.0) and result.nodes < 50
+
+
+def test_a_goal_impossible_alone_names_the_constraints_on_its_dates() -> None:
+    # A hop takes 5 to 10 s: being at A by 3 s cannot be; the search speaks of two timepoints,
+    # the reason also names the deadline the problem writes, with its line.
+    text = BATTERY_SPEC.replace("  (t_end - t_start) in [0, 100];\n",
+                                "  (ta - t_start) in [0, 3];\n  (t_end - t_start) in [0, 100];\n")
+    domain, problem = from_text(text)
+    result = Planner(domain, exact=False).plan(problem)
+    (goal,) = result.goals
+    line = next(c.line for c in problem.constraints if "ta" in pm.timepoints_of(c))
+    assert not goal.kept and goal.reason.startswith("impossible even alone")
+    assert goal.reason.endswith(f"the goal's dates: (ta - t_start) in [0, 3] (line {line})")

@@ -288,3 +288,17 @@ def test_a_value_another_task_ends_with_is_no_marker() -> None:
     assert in_progress_values(domain, problem) == {("S", wrapping): ["FINISH"]}
     fluents = {f.name for f in export(domain, problem).problem.fluents}
     assert "S_BUSY" in fluents and "S_WRAPPING" not in fluents
+
+
+def test_numbers_a_task_computes_are_ground_too() -> None:
+    # HOP's ?left =. ?b - 1: the problem writes only 3 (and the 0 it replaces at the start), and
+    # HOP needs 2, 1 and 0 to be ground at all. They are reached from 3, within CHARGE's [0, 3].
+    from tests.test_planner import BATTERY_SPEC, from_text
+
+    domain, problem = from_text(BATTERY_SPEC)
+    result = export(domain, problem)
+    (hop,) = result.problem.actions
+    assert [p.name for p in hop.parameters] == ["from", "to", "b", "left"]
+    assert mentions(result, "?b in {1, 2, 3}", "?left in {0, 1, 2, 3}")
+    objects = {o.name for o in result.problem.all_objects}
+    assert {"CHARGE_0", "CHARGE_1", "CHARGE_2", "CHARGE_3"} <= objects and "CHARGE_4" not in objects

@@ -719,6 +719,9 @@ class Compiler:
         self.tree_nodes = spent  # the work done before (the other parts of a base compiled in parts)
         self.shared: dict[Any, Node] = {} if shared is None else shared
         self.explored: dict[tuple[Any, ...], Node] = {}
+        # Per explored state: the path and rules fired that first reached it, and the slice of
+        # `findings` its subgraph gave; a path reaching it again gets those findings too.
+        self.reached_first: dict[tuple[Any, ...], tuple[int, int, int, int]] = {}
         self.reads: dict[int, tuple[str, ...]] = {}
         self.rule_atoms: dict[int, tuple[Atom, ...]] = {}
         self.restricting: dict[int, frozenset[str]] = {}
@@ -730,7 +733,7 @@ class Compiler:
         memory = initial_memory(self.base)
         alive = tuple(r for r in self.base.rules if r.kind != "else")
         root = self.node(memory, alive, frozenset(self.observable), (), ())
-        return Compiled(self.base, root, self.findings, self.tree_nodes, len(self.shared))
+        return Compiled(self.base, root, merged_findings(self.findings), self.tree_nodes, len(self.shared))
 
     def state(self, memory: Mapping[str, frozenset[Any]], alive: tuple[Rule, ...],
               testable: frozenset[str]) -> tuple[Any, ...]:
@@ -822,9 +825,26 @@ class Compiler:
         key = (self.state(memory, alive, testable), tuple(id(r) for r in alive), elses_fired)
         found = self.explored.get(key)
         if found is None:
+            start = len(self.findings)
             found = self.explore(memory, alive, testable, path, history, elses_fired, tested)
             self.explored[key] = found
+            self.reached_first[key] = (len(path), len(history), start, len(self.findings))
+        else:
+            self.findings_again(key, path, history)
         return found
+
+    def findings_again(self, key: tuple[Any, ...], path: tuple[tuple[str, Any], ...],
+                       history: tuple[str, ...]) -> None:
+        """Another path reaches an explored state: the inputs it stands for are unsettled wherever
+        the first path's were below it. Each finding is listed again with this path's tests and
+        rules fired (up to FINDINGS_LIMIT findings: past it the list is cut, and said so)."""
+        tests, fired, start, end = self.reached_first[key]
+        for finding in self.findings[start:end]:
+            if len(self.findings) >= FINDINGS_LIMIT:
+                self.findings_cut = True
+                return
+            self.findings.append(Finding(finding.kind, finding.attributes, path + finding.witness[tests:],
+                                         history + finding.fired[fired:]))
 
     def explore(self, memory: dict[str, frozenset[Any]], alive: tuple[Rule, ...], testable: frozenset[str],
                 path: tuple[tuple[str, Any], ...], history: tuple[str, ...], elses_fired: bool,
@@ -917,6 +937,8 @@ class Compiler:
             child_of.update(dict.fromkeys(values, child))
         branches = tuple((value, child_of[value]) for value in self.ordered(chosen, memory[chosen]))
         return self.wrap(procedural, self.intern(Test(chosen, branches)))
+
+    findings_cut = False  # FINDINGS_LIMIT was reached
 
     def too_large(self) -> TooLarge:
         bound, largest = paths_bound_text(self.base)
@@ -1089,13 +1111,72 @@ def sample_of(element: Any) -> Any:
 
 # ---------------------------------------------------------------- findings, as people read them
 
+FINDINGS_LIMIT = 10_000  # unsettled cases listed for one base, before they are merged
+
+
+def merged_findings(findings: Sequence[Finding]) -> list[Finding]:
+    """The findings with the cases that differ in one test only merged into one (`temp=[0, 30[ |
+    [30, 40[`), until none can be: each finding still stands for a box of inputs, and the list
+    reads as few cases as the paths allow. The rules fired are those of the first case merged."""
+    merged = list(findings)
+    changed = True
+    while changed:
+        changed = False
+        groups: dict[tuple[Any, ...], int] = {}
+        out: list[Finding] = []
+        widened: set[int] = set()  # merged into in this pass: its keys in `groups` are stale until the next
+        for finding in merged:
+            joined = False
+            for position in range(len(finding.witness)):
+                key = (finding.kind, finding.attributes, position,
+                       tuple(test for i, test in enumerate(finding.witness) if i != position),
+                       tuple(attribute for attribute, _ in finding.witness))
+                index = groups.get(key)
+                if index is not None and index not in widened:
+                    widened.add(index)
+                    other = out[index]
+                    attribute, value = other.witness[position]
+                    values = (*_elements(value), *_elements(finding.witness[position][1]))
+                    witness = (*other.witness[:position], (attribute, values), *other.witness[position + 1:])
+                    out[index] = Finding(other.kind, other.attributes, witness, other.fired)
+                    joined = changed = True
+                    break
+            if not joined:
+                for position in range(len(finding.witness)):
+                    groups[(finding.kind, finding.attributes, position,
+                            tuple(test for i, test in enumerate(finding.witness) if i != position),
+                            tuple(attribute for attribute, _ in finding.witness))] = len(out)
+                out.append(finding)
+        merged = out
+    return merged
+
+
+def _elements(value: Any) -> tuple[Any, ...]:
+    """A witness's domain elements: a tuple stands for any of them."""
+    return value if isinstance(value, tuple) else (value,)
+
+
 
 def describe(finding: Finding) -> str:
-    witness = ", ".join(f"{a}={' | '.join(map(str, v)) if isinstance(v, tuple) else v}"
+    witness = ", ".join(f"{a}={' | '.join(map(str, _joined(v))) if isinstance(v, tuple) else v}"
                         for a, v in finding.witness) or "any input"
     fired = ", ".join(finding.fired) or "none"
     what = "no value left for" if finding.kind == "inconsistent" else "undetermined"
     return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
+
+
+def _joined(values: tuple[Any, ...]) -> list[Any]:
+    """A witness's values with the intervals that touch written as one (`[0, 3[ | [3, 6[` as
+    `[0, 6[`): the pieces of a numeric input's partition are disjoint, so what touches adds up."""
+    out: list[Any] = []
+    for value in sorted(values, key=lambda v: (v.low, v.high) if isinstance(v, Piece) else (math.inf, math.inf)):
+        last = out[-1] if out else None
+        if (isinstance(value, Piece) and isinstance(last, Piece) and last.high == value.low
+                and last.high_closed != value.low_closed):
+            out[-1] = Piece(last.low, value.high, last.low_closed, value.high_closed)
+        else:
+            out.append(value)
+    return out
 
 
 def worst_first(findings: Sequence[Finding]) -> list[Finding]:

@@ -281,6 +281,7 @@ class StateSpace:
     parents: list[tuple[int, int] | None]  # state -> (previous state, step index)
     complete: bool
     unbounded: list[Finding]
+    limit_reached: bool = False  # incomplete because of the state limit (else: growing places cut)
 
     @property
     def states(self) -> int:
@@ -421,7 +422,7 @@ def _explore(net: Net | Unfolded, limit: int, progress: Callable[[int], None] | 
     parents: list[tuple[int, int] | None] = [None]
     edges: list[list[tuple[int, int]]] = []
     unbounded: list[Finding] = []
-    complete = True
+    complete, limit_reached = True, False
     queue = deque([0])
     # Index the steps by their first input slot: a marking only ever enables steps whose first
     # input slot holds tokens, and markings are sparse.
@@ -468,7 +469,7 @@ def _explore(net: Net | Unfolded, limit: int, progress: Callable[[int], None] | 
                             complete = False
                             continue
                     if len(markings) >= limit:
-                        complete = False
+                        complete, limit_reached = False, True
                         continue
                     target = len(markings)
                     seen[successor] = target
@@ -483,7 +484,7 @@ def _explore(net: Net | Unfolded, limit: int, progress: Callable[[int], None] | 
             progress(len(markings))
     while len(edges) < len(markings):  # states left unexplored when the limit was reached
         edges.append([])
-    return StateSpace(unfolded, markings, edges, parents, complete, unbounded)
+    return StateSpace(unfolded, markings, edges, parents, complete, unbounded, limit_reached)
 
 
 def _covered_ancestor(markings: list[bytes], totals: list[int], parents: list[tuple[int, int] | None],

@@ -32,6 +32,7 @@ with a goal.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -39,7 +40,7 @@ from typing import Any
 from specc.analysis import petri
 from specc.analysis.procedures import library
 from specc.check.procedures import Domains
-from specc.diagnostics import Diagnostic
+from specc.diagnostics import Diagnostic, did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
 from specc.runtime import procedures as rp
@@ -128,6 +129,8 @@ class Translation:
     # the transitions that cross them, and their text.
     statements: dict[tuple[str, int, int], list[str]] = field(default_factory=dict)
     successes: dict[tuple[str, int, int], list[str]] = field(default_factory=dict)
+    # ... those of its successes that change nothing (a retraction with an unbound argument).
+    idle_successes: dict[tuple[str, int, int], list[str]] = field(default_factory=dict)
     text: dict[tuple[str, int, int], str] = field(default_factory=dict)
     kas: list[str] = field(default_factory=list)
     solver: Solver | None = None  # evaluates conditions over a marking's database
@@ -411,6 +414,28 @@ class Solver:
                 args.append(IDLE)
         return [(head, key) for key in self.db.keys(head, args)]
 
+    def problems(self, expr: rp.Compound) -> list[str]:
+        """What makes a condition given from outside the specs (a --reach query) unable to mean
+        anything: an unknown predicate, a wrong number of arguments, a value outside a domain."""
+        head, args = expr.head, expr.args
+        if head in ("&", "|", "~"):
+            return [p for a in args if isinstance(a, rp.Compound) for p in self.problems(a)]
+        if head in COMPARISONS or head in ARITHMETIC or head in ("=", "BOUNDP"):
+            return []
+        predicate = self.db.predicates.get(head)
+        if predicate is None:
+            known = ", ".join(sorted(self.db.predicates))
+            return [f"no predicate '{head}'{did_you_mean(head, self.db.predicates)} (predicates: {known})"]
+        if len(args) != predicate.arity:
+            return [f"'{head}' takes {predicate.arity} argument(s), {len(args)} given in '{expr}'"]
+        found = []
+        for i, arg in enumerate(args):
+            values = self.db.domains.argument(head, i)
+            if not isinstance(arg, (rp.Var, rp.Compound)) and values is not None and arg not in values:
+                found.append(f"{arg} is not in the domain of argument {i + 1} of '{head}' "
+                             f"({', '.join(map(str, values))})")
+        return found
+
     def readings(self, expr: rp.Compound, env: Env) -> Iterator[Reading]:
         keys = list(dict.fromkeys(self.atoms(expr, env)))
         evaluables = [a for a in _subterms(expr) if self.db.kind(a.head) == "evaluable"]
@@ -627,7 +652,9 @@ class Translator:
             raise ValueError(f"only achievement goals '!(...)' can be posted, not '{goal}'")
         invoked = [k for k in self.library.kas if k.goal_invoked and k.trigger.head == head]
         if head not in self.predicates and not invoked:
-            raise ValueError(f"no KA achieves '{head}' and no predicate is called so: '{goal}' cannot be posted")
+            known = {k.trigger.head for k in self.library.kas if k.goal_invoked} | set(self.predicates)
+            raise ValueError(f"no KA achieves '{head}' and no predicate is called so{did_you_mean(head, known)}: "
+                             f"'{goal}' cannot be posted")
         arity = self.predicates[head].arity if head in self.predicates else len(invoked[0].trigger.args)
         if len(args) != arity:
             raise ValueError(f"'{head}' takes {arity} argument(s), {len(args)} given in '{goal}'")
@@ -646,14 +673,24 @@ class Translator:
         if name not in self.predicates or kind in ("evaluable", "event"):
             raise ValueError(f"'{fact}' cannot start in the database: declare '{name}' as a closed, functional or "
                              "standard predicate")
-        if len(args) != self.predicates[name].arity or any(isinstance(a, (rp.Var, rp.Compound)) for a in args):
-            raise ValueError(f"'{fact}': a fact gives '{name}' {self.predicates[name].arity} value(s)")
+        if len(args) != self.predicates[name].arity:
+            raise ValueError(f"'{fact}': a fact gives '{name}' {self.predicates[name].arity} value(s), "
+                             f"{len(args)} given")
+        if any(isinstance(a, (rp.Var, rp.Compound)) for a in args):
+            raise ValueError(f"'{fact}': a fact is ground: give each argument a value, not a variable or an "
+                             "expression")
+        for i, arg in enumerate(args):  # a functional predicate's value too: the net has no place for another
+            values = self.domains.argument(name, i)
+            if values is not None and arg not in values:
+                raise ValueError(f"'{fact}': {arg} is not in the domain of argument {i + 1} of '{name}' "
+                                 f"({', '.join(map(str, values))})")
         for place, _, marking in self.db.places():
             initial.setdefault(place, dict(marking))
         key = args[:-1] if kind == "functional" else args
         undefined = f"{name}.UNDEF" if kind in ("closed", "functional") else f"{name}.AFF.UNDEF"
         if initial.get(undefined, {}).get(key, 0) != 1:
-            raise ValueError(f"'{fact}' is outside the domain of '{name}', or given twice")
+            given = "a value" if kind == "functional" else "its truth"
+            raise ValueError(f"'{fact}' is given twice: each fact of '{name}' is given {given} once")
         initial[undefined][key] = 0
         defined = {"closed": f"{name}.DEF", "functional": f"{name}.DEF"}.get(kind, f"{name}.AFF.DEF")
         colour = key + (args[-1],) if kind == "functional" else key
@@ -753,20 +790,26 @@ class Translator:
         for statement in _statements(ka.body or ()):
             if isinstance(statement, rp.Assign):
                 links.append((statement.var.name, statement.value))
-        changed = True
-        while changed:  # comparisons and assignments share domains both ways
-            changed = False
-            for var, other in links:
-                if isinstance(other, rp.Var):
-                    for a, b in ((var, other.name), (other.name, var)):
-                        before = len(found.get(a, {}))
-                        if b in found:
-                            found.setdefault(a, {}).update(found[b])
-                        changed |= len(found.get(a, {})) != before
-                elif not isinstance(other, rp.Compound):
-                    before = len(found.get(var, {}))
-                    found.setdefault(var, {})[other] = None
-                    changed |= len(found[var]) != before
+        grown, bounds = True, None
+        while grown:
+            changed = True
+            while changed:  # comparisons and assignments share domains both ways
+                changed = False
+                for var, other in links:
+                    if isinstance(other, rp.Var):
+                        for a, b in ((var, other.name), (other.name, var)):
+                            before = len(found.get(a, {}))
+                            if b in found:
+                                found.setdefault(a, {}).update(found[b])
+                            changed |= len(found.get(a, {})) != before
+                    elif not isinstance(other, rp.Compound):
+                        before = len(found.get(var, {}))
+                        found.setdefault(var, {})[other] = None
+                        changed |= len(found[var]) != before
+            if bounds is None:  # the numbers given and compared with, before any arithmetic
+                bounds = {var: (min(numbers), max(numbers)) for var, values in found.items()
+                          if (numbers := [v for v in values if _is_number(v)])}
+            grown = _arithmetic_closure(links, found, bounds)
         every = {v for expr in _compounds(ka) for v in variables(expr)}
         if ka.action is not None and ka.action.result is not None:
             every.add(ka.action.result.name)
@@ -1113,6 +1156,9 @@ class Translator:
         crossed = [origin] if goal.op in ("=>", "~>") else [f"{origin} [true]", f"{origin} in database [true]"]
         if where:  # a statement's (not an effect's)
             self.result.successes.setdefault(self._keys[-1], []).extend(crossed)
+            if goal.op == "~>":  # Fig 4.12: an unbound argument retracts nothing, and the KA goes on
+                self.result.successes[self._keys[-1]].append(f"{origin} [unbound]")
+                self.result.idle_successes.setdefault(self._keys[-1], []).append(f"{origin} [unbound]")
         if goal.op == "?":
             self._test(ka, goal, source, target, fail, origin)
         elif goal.op == "^":
@@ -1410,13 +1456,26 @@ class Translator:
                                                  "an unbound variable: bind it before the request")
                     self.emit.fire(f"{origin} is unbound", origin, [(f"{head}.POST", colour)], [(error, petri.BLACK)])
                     continue
+                # The executive answers BAD-SERVICE and the KA goes on with that answer (§3.9); a
+                # result domain without that value gets the failure it has instead.
+                failure = next((r for r in ("BAD-SERVICE", "ERROR", "REFUSED") if r in results),
+                               next((r for r in results if not _success(r)), None))
+                answered = ("it answers BAD-SERVICE" if failure == "BAD-SERVICE" else
+                            f"it answers BAD-SERVICE, taken here as {failure}, the failure the answer's domain has"
+                            if failure is not None else "it answers BAD-SERVICE, which the answer's domain lacks: "
+                            "the request waits for ever here")
                 self.result.errors[error] = ("unknown-service", f"a KA asks the executive for a service it does "
-                                             f"not offer ({', '.join(str(c) for c in colour[:1])}...): it would "
-                                             "answer BAD-SERVICE; declare the service or fix the request")
-                self.emit.fire(f"{origin} is not offered", origin, [(f"{head}.POST", colour)], [(error, petri.BLACK)])
+                                             f"not offer ({name}, asked through {head}): "
+                                             f"{answered}; declare the service or fix the request")
+                puts: list[tuple[str, Any]] = [(error, petri.BLACK)]
+                if failure is not None:
+                    answer = colour[:-1] + (failure,)
+                    puts.append((f"{head}.SUCC", answer))
+                    out["SUCC"][answer] = None
+                self.emit.fire(f"{origin} is not offered", origin, [(f"{head}.POST", colour)], puts)
                 continue
             takes: list[tuple[str, Any]] = [(f"{head}.POST", colour)]
-            puts: list[tuple[str, Any]] = [(f"{head}.RUN", colour)]
+            puts = [(f"{head}.RUN", colour)]
             if service.group is not None:
                 takes.append((service.group, IDLE))
                 puts.append((service.group, name))
@@ -1458,6 +1517,52 @@ class Translator:
                                    [(pending.wait.place, pending.wait.colour(env)),
                                     (f"{pending.goal}.{outcome}", answer)],
                                    [(node.place, node.colour(after))])
+
+
+ARITHMETIC_VALUES = 256  # the most values an arithmetic assignment may add to a variable's domain
+
+
+def _arithmetic_closure(links: Sequence[tuple[str, Any]], found: dict[str, dict[Any, None]],
+                        bounds: Mapping[str, tuple[float, float]]) -> bool:
+    """Widen each variable assigned an arithmetic expression (`assign @I = (+ @I 1)`, a loop's
+    counter) with the values the expression takes over the domains known, kept within `bounds`,
+    the range of the numbers the variable is given or compared with, widened by the
+    expression's largest constant (the step a loop takes past its bound as it exits). True when
+    a domain grew."""
+    grown = False
+    for var, expr in links:
+        if not (isinstance(expr, rp.Compound) and expr.head in ARITHMETIC) or var not in bounds:
+            continue
+        names = sorted(variables(expr))
+        if any(name not in found for name in names):
+            continue
+        step = max((abs(c) for c in _constants(expr)), default=0)
+        low, high = bounds[var][0] - step, bounds[var][1] + step
+        values = found[var]
+        pool = [tuple(found[name]) for name in names]
+        if math.prod(len(p) for p in pool) > ARITHMETIC_VALUES:
+            continue
+        for combination in itertools.product(*pool):
+            try:
+                value = evaluate(expr, dict(zip(names, combination, strict=True)))
+            except (Undefined, TypeError, ArithmeticError):
+                continue
+            if (_is_number(value) and low <= value <= high and value not in values
+                    and len(values) < ARITHMETIC_VALUES):
+                values[value] = None
+                grown = True
+    return grown
+
+
+def _constants(term: Any) -> list[float]:
+    """The numbers written in an arithmetic expression."""
+    if isinstance(term, rp.Compound):
+        return [c for a in term.args for c in _constants(a)]
+    return [term] if _is_number(term) else []
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def _success(result: Any) -> bool:

@@ -7,6 +7,7 @@ Findings:
 - unbounded: a place that grows without bound (unbounded recursion, §4.5);
 - out-of-domain: a value leaves its finite domain (the net would need more colours);
 - never-succeeds: a statement is reached but its arc can never be crossed (a dead transition);
+- changes-nothing: a retraction that only ever runs with an unbound argument (it retracts nothing);
 - unreachable: statements of an invoked KA that can never run; never-invoked: a KA never started;
 - no-way-out: intentions cycle forever and nothing can take them out (a terminal strongly
   connected component other than the expected end);
@@ -157,6 +158,10 @@ def query_places(translation: Translation, query: Query) -> dict[Clause, list[st
             known = f"its statements are on lines {', '.join(map(str, lines))}" if lines else \
                 f"KA '{clause.ka}' is not among the KAs the goal reaches ({', '.join(translation.kas)})"
             raise ValueError(f"no statement at {clause.ka}:{clause.line}: {known}")
+        if clause.condition is not None and translation.solver is not None:
+            problems = translation.solver.problems(clause.condition.expr)
+            if problems:
+                raise ValueError(f"'{clause.condition}' in --reach '{query.text}': {'; '.join(problems)}")
         places[clause] = found
     return places
 
@@ -329,6 +334,13 @@ def _statements(translation: Translation, space: petri.StateSpace, reader: Reade
                 trace = _first_marking(space, reader, set(places))
                 findings.append(Finding("never-succeeds", f"{ka}:{line} {text} is reached but can never succeed "
                                         "(its success transition is dead): what follows it never runs", trace))
+                continue
+            idle = translation.idle_successes.get((owner, line, n), [])
+            if idle and all(name in idle for name in crossed or () if name in fired_names):
+                trace = _first_marking(space, reader, set(places))
+                findings.append(Finding("changes-nothing", f"{ka}:{line} {text} only ever runs with an unbound "
+                                        "argument: it retracts nothing (§4.4.2, Fig 4.12); bind the argument "
+                                        "first, or retract by a value", trace))
         if unreachable:
             findings.append(Finding("unreachable", f"KA '{ka}': these statements can never run: "
                                     + "; ".join(unreachable)))

@@ -49,7 +49,7 @@ from specc.runtime.functional import Reply, Report, RequestSpec, Status
 from specc.runtime.rules import Calls, Decision
 
 PROPERTIES = {
-    "exclusion": "never two mutually incompatible services in EXEC",
+    "exclusion": "no service enters EXEC while one it must wait for or interrupt (its conflicts) is in EXEC",
     "one-reply": "every accepted request ends with exactly one final reply",
     "no-starvation": "a WAIT service without a start timeout can always still start, with no new request",
     "no-error": "the executive never enters its general ERROR state",

@@ -95,7 +95,11 @@ class DecisionView:
     def root_body(self) -> list[Code]:
         """The decision function's lines: Python the compiler wrote from the rules' names and
         their values written as literals (`repr`)."""
-        return [Code(line) for line in self.body(self.compiled.root, 1, root=True)]
+        return [Code(line) for line in self.body(self.compiled.root, 2, root=True)]  # under `try:`
+
+    @property
+    def numeric_inputs(self) -> list[str]:
+        return [name for name in self.base.inputs if self.base.attributes[name].kind == "number"]
 
     @property
     def shared_functions(self) -> list[tuple[Code, list[Code]]]:
@@ -181,8 +185,8 @@ def condition(attribute: k.Attribute, value: Any) -> str:
         if not math.isinf(value.high):
             parts.append(f"v {'<=' if value.high_closed else '<'} {value.high!r}")
         return " and ".join(parts) or "True"
-    if attribute.kind == "bool":
-        return "v" if value else "not v"
+    if attribute.kind == "bool":  # as the interpreter's membership test: "no" or None is no bool
+        return "v in (True,)" if value else "v in (False,)"
     return f"v == {value!r}"
 
 

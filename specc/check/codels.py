@@ -110,7 +110,8 @@ def python_functions(ctx: Context, dotted: m.String) -> Mapping[str, FunctionSha
     if path is None:
         ctx.report("missing-python-module",
                    f"Python module '{dotted.value}' not found next to the spec (looked for "
-                   f"{dotted.value.replace('.', '/')}.py from {ctx.base_dir(dotted.span)} upwards)", dotted.span)
+                   f"{dotted.value.replace('.', '/')}.py from {ctx.base_dir(dotted.span)} upwards); `specc "
+                   "skeleton` writes it with a stub for every codel the specs name", dotted.span)
         return None
     functions = top_level_functions(path)
     if isinstance(functions, SyntaxError):

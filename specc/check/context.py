@@ -40,8 +40,7 @@ class Context:
         table = self.by_kind[kind]
         if name in table:
             return table[name]  # type: ignore[no-any-return]
-        word = KIND_WORDS[kind]
-        self.report(code, f"unknown {word} '{name}'{did_you_mean(name, table)}", span)
+        self.unknown(code, KIND_WORDS[kind], name, table, span)
         return None
 
     def base_dir(self, span: Span) -> Path:

@@ -125,6 +125,7 @@ class ScopeChecker(Visitor):
         self.domain = domain
         self.symbols = domain.symbols()
         self.scope = Scope("task")
+        self.named: set[str] = set()  # the names the statements checked mention: timepoints among them
 
     def scope_for(self, kind: str, body: Iterable[Any], params: Iterable[m.IxVar] = (),
                   timepoints: Iterable[str] = (), macro_params: Iterable[str] = ()) -> Scope:
@@ -144,12 +145,21 @@ class ScopeChecker(Visitor):
 
     def statements(self, body: Iterable[Any], scope: Scope) -> None:
         self.scope = scope
+        self.named = set()
         for statement in body:
             goal = getattr(statement, "goal", None)
             if goal is not None and not scope.goals_allowed:
                 self.ctx.report("goal-outside-problem",
                                 "goals belong to a problem (or a fragment it includes), not to a task", goal.span)
             self.visit(statement)
+        if scope.kind in ("task", "problem"):
+            for statement in body:
+                unused = [name for name in statement.names if name not in self.named] if isinstance(
+                    statement, m.TimepointDecl) else []
+                if unused:
+                    self.ctx.warn("unused-timepoint", f"timepoint {', '.join(unused)} is declared but no statement "
+                                  "uses it: nothing dates it; remove it, or use it in an assertion or a constraint",
+                                  statement.span)
 
     # One visit method per statement kind; expressions are checked by `expr`, not visited.
     def visit_Hold(self, s: m.Hold) -> None:
@@ -268,6 +278,8 @@ class ScopeChecker(Visitor):
                 self.ctx.unknown("undefined-constant", "constant set", part.name, self.domain.constants, part.span)
 
     def time(self, e: m.IxExpr, scope: Scope) -> None:
+        if isinstance(e, m.IxName):
+            self.named.add(e.name)
         if isinstance(e, m.IxName) and e.name not in scope.timepoints and e.name not in scope.macro_params:
             self.ctx.report("undeclared-timepoint",
                             f"timepoint '{e.name}' is not declared; add 'timepoint {e.name};'", e.span)
@@ -286,6 +298,7 @@ class ScopeChecker(Visitor):
                 self.ctx.report("undeclared-variable",
                                 f"variable '{node.name}' is not declared; add 'variable {node.name};'", node.span)
             elif isinstance(node, m.IxName):
+                self.named.add(node.name)
                 known = scope.timepoints | scope.macro_params | self.symbols
                 if node.name not in known:
                     self.ctx.unknown("undefined-name", "name", node.name, known, node.span,

@@ -9,10 +9,14 @@ domain, and `foreach` variables are in scope.
 
 from __future__ import annotations
 
+import math
+
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import Visitor
+
+BOOL_WORDS = ("true", "false")  # what a bool is compared with by mistake
 
 
 class RuleVisitor(Visitor):
@@ -27,6 +31,7 @@ class RuleVisitor(Visitor):
         self.restricted: set[str] = set()
         self.tested: set[str] = set()
         self.first_read: dict[str, m.AttrRef] = {}  # where each attribute is first tested
+        self.first_set: dict[str, m.AttrRef] = {}  # where each attribute is first deduced
         self.in_action = False
 
     def visit_RuleForeach(self, node: m.RuleForeach) -> None:
@@ -66,9 +71,34 @@ class RuleVisitor(Visitor):
     def visit_KCompare(self, node: m.KCompare) -> None:
         self.use(node.attr)
         self.check_value(node.attr, node.value, numeric=node.op not in ("==", "!="))
+        self.check_range(node)
+        if isinstance(node.value, m.AttrRef) and node.value.name.lower() in BOOL_WORDS and self.is_bool(node.attr):
+            return  # `e == false`: said by check_value, not also as an undefined attribute 'false'
         self.in_action, was = False, self.in_action
         self.visit(node.value)
         self.in_action = was
+
+    def check_range(self, node: m.KCompare) -> None:
+        """A comparison of a numeric attribute with a number it can never satisfy within its declared
+        range (`x > 20` with x in [0, 10]): the rule testing it never fires, a typo the likeliest cause."""
+        declared = self.declared.get(node.attr.name)
+        domain = declared.domain if declared is not None else None
+        if not (isinstance(domain, m.NumericDomain) and isinstance(node.value, m.Number)
+                and math.isfinite(node.value.value)):  # a number too large is an error of its own
+            return
+        low = domain.low.value if isinstance(domain.low, m.Number) else -math.inf
+        high = domain.high.value if isinstance(domain.high, m.Number) else math.inf
+        value = node.value.value
+        never = {"<": low >= value, "<=": low > value, ">": high <= value, ">=": high < value,
+                 "==": not low <= value <= high}.get(node.op, False)
+        if never:
+            self.ctx.warn("comparison-never-holds", f"{node.attr.name} {node.op} {value:g} never holds: "
+                          f"'{node.attr.name}' lies in [{low:g}, {high:g}]; the rule testing it never fires",
+                          node.span)
+
+    def is_bool(self, attr: m.AttrRef) -> bool:
+        declared = self.declared.get(attr.name)
+        return declared is not None and isinstance(declared.domain, m.BoolDomain)
 
     def visit_KMember(self, node: m.KMember) -> None:
         self.use(node.attr)
@@ -99,6 +129,7 @@ class RuleVisitor(Visitor):
             return
         if self.in_action:
             self.restricted.add(attr.name)
+            self.first_set.setdefault(attr.name, attr)
             self.check_not_input(attr.name, attr.span)
         else:
             self.tested.add(attr.name)
@@ -132,6 +163,12 @@ class RuleVisitor(Visitor):
                     self.ctx.report("value-outside-domain",
                                     f"{value.value!r} is not a value of '{attr.name}' "
                                     f"(domain: {', '.join(repr(a) for a in allowed)})", value.span)
+        elif isinstance(domain, m.BoolDomain):
+            if numeric or isinstance(value, (m.String, m.Number)) or (
+                    isinstance(value, m.AttrRef) and value.name.lower() in BOOL_WORDS):
+                shown = value.value if isinstance(value, (m.String, m.Number)) else getattr(value, "name", "")
+                self.ctx.report("type-mismatch", f"'{attr.name}' is a bool: test it as '{attr.name}' (true) or "
+                                f"'!{attr.name}' (false), not against {shown!r}", value.span)
         elif isinstance(domain, m.NumericDomain) and isinstance(value, m.String):
             self.ctx.report("type-mismatch", f"'{attr.name}' is numeric; it cannot equal the string {value.value!r}",
                             value.span)
@@ -148,6 +185,16 @@ def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> Non
         ctx.report("undefined-attribute", f"'{name}' is tested, but it is no input, has no init and no rule sets "
                    f"it: the rule can never fire (a misspelt input or constant?){did_you_mean(name, known)}",
                    ref.span)
+
+
+def check_set_never_read(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:
+    """An undeclared attribute rules deduce and no rule tests is an intermediate that changes
+    nothing: most likely a misspelt output (`restrict oo == ...` for `o`)."""
+    outputs = [a.name for a in base.attributes if a.role == "outputs"]
+    for name, ref in visitor.first_set.items():
+        if name not in visitor.declared and name not in visitor.tested:
+            ctx.warn("intermediate-never-read", f"rules deduce '{name}', which is not declared and no rule tests: "
+                     f"it changes no decision{did_you_mean(name, outputs) or ' (a misspelt output?)'}", ref.span)
 
 
 def check_never_read(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:
@@ -171,6 +218,7 @@ def check(ctx: Context) -> None:
         visitor.visit(base)
         if base.name not in completed:  # an executive's own rules read the controller's attributes
             check_never_set(ctx, base, visitor)
+            check_set_never_read(ctx, base, visitor)
         check_never_read(ctx, base, visitor)
         for attr in base.attributes:
             domain = attr.domain

@@ -33,10 +33,17 @@ def child_steps(node: Node) -> Iterator[tuple[str, int | None, Node]]:
                     yield name, index, element
 
 
-def children(node: Node) -> Iterator[Node]:
-    """The direct child nodes of `node`, in field order."""
-    for _, _, child in child_steps(node):
-        yield child
+def children(node: Node) -> list[Node]:
+    """The direct child nodes of `node`, in field order. A list built in one loop, not through
+    `child_steps`: every check walks every node, and the walk is most of a check's time."""
+    found: list[Node] = []
+    for name in _child_fields(type(node)):
+        value = getattr(node, name)
+        if isinstance(value, Node):
+            found.append(value)
+        elif isinstance(value, tuple):
+            found.extend(element for element in value if isinstance(element, Node))
+    return found
 
 
 def walk(node: Node) -> Iterator[Node]:
@@ -45,7 +52,7 @@ def walk(node: Node) -> Iterator[Node]:
     while stack:
         current = stack.pop()
         yield current
-        stack.extend(reversed(list(children(current))))
+        stack.extend(reversed(children(current)))
 
 
 class Visitor:

@@ -249,8 +249,11 @@ def default_domain(program: m.Program) -> str:
     if planners:
         return planners[0].domain.text  # type: ignore[union-attr]
     domains = sorted(i.name for i in program.items if isinstance(i, m.Domain))
+    if not domains:
+        raise MutationError("these specs have no planning domain: mutants are made of an IxTeT domain (seed 004 "
+                            "§4.1.3's mutation of the planner's model), so there is nothing to mutate")
     if len(domains) != 1:
-        raise MutationError(f"name the domain to mutate with --domain (domains: {', '.join(domains) or 'none'})")
+        raise MutationError(f"name the domain to mutate with --domain (domains: {', '.join(domains)})")
     return domains[0]
 
 

@@ -34,6 +34,15 @@ def no_calls(function: str, args: tuple[Any, ...]) -> None:
     """The default for `do {f(...)}` actions: nothing to call."""
 
 
+def check_numbers(numeric: tuple[str, ...], inputs: Mapping[str, Any], error: TypeError) -> None:
+    """After a decision raised `error`: a TypeError naming the numeric input given something other
+    than a number (`soc='50'`), if one was; else nothing (the caller raises `error` itself)."""
+    for name in numeric:
+        value = inputs.get(name)
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise TypeError(f"input {name}={value!r}: give a number ({error})") from None
+
+
 def divide(left: float, right: float) -> float:
     if right:
         return left / right

@@ -15,7 +15,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 from lark.lexer import PatternStr
 
-from specc.diagnostics import Diagnostic, error
+from specc.diagnostics import Diagnostic, did_you_mean, error
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.resources import grammar_path
@@ -240,7 +240,18 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
     width = max(len(str(token)), 1)
     span = Span(path, line, column, line, column + width)
     expected = describe_expected(exc.expected, keyword_texts())
-    return error("unexpected-token", f"unexpected {describe_token(token)}; expected {expected}", span)
+    # A misspelt keyword reads as a name, and where the keyword was optional (a task's preemption
+    # after its '}') the parser no longer expects it: say which keyword the word is close to.
+    words = [k for k in keyword_texts().values() if k.isidentifier()]
+    close = did_you_mean(str(token), words) if token.type == "NAME" and str(token) not in words else ""
+    if not close:  # an operator written a character short (`=>` where a rule wants `==>`)
+        texts = keyword_texts()
+        operators = [texts[t] for t in exc.expected if t in texts and len(texts[t]) > 1 and not texts[t].isalnum()]
+        near = [op for op in operators if any(text.startswith(op[:i] + op[i + 1:], position) for i in range(len(op)))]
+        written = text[position:position + 3]
+        near.sort(key=lambda op: (-len(os.path.commonprefix([op, written])), -len(op)))
+        close = f" (did you mean '{near[0]}'?)" if near else ""
+    return error("unexpected-token", f"unexpected {describe_token(token)}{close}; expected {expected}", span)
 
 
 UNITS = ("us", "ms", "s", "min")

@@ -11,9 +11,11 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@GOTOstate", "@PTU_MOVEstate", "@PICTUREstate", "@COMMUNICATEstate"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "GOTOstate", "PTU_MOVEstate", "PICTUREstate", "COMMUNICATEstate"]
 DEPTH = 3
 FINDINGS = 0
@@ -53,156 +55,160 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
 
 def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
-    v = a['service']
-    if v == 'GOTO':
-        v = a['@GOTOstate']
+    try:
+        v = a['service']
         if v == 'GOTO':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@GOTOstate'],))
-                return _LEAF_0
-            elif v == 'INTERM':
-                return _LEAF_1
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_0
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_0
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_3
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@GOTOstate={v!r} is outside its domain")
-    elif v == 'STOP-NAV':
-        v = a['event']
-        if v == 'START':
             v = a['@GOTOstate']
             if v == 'GOTO':
-                calls('changeInterState', (a['@GOTOstate'],))
-                return _LEAF_4
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@GOTOstate'],))
+                    return _LEAF_0
+                elif v == 'INTERM':
+                    return _LEAF_1
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             elif v == 'IDLE':
-                return _LEAF_4
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_0
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_3
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
                 raise ValueError(f"@GOTOstate={v!r} is outside its domain")
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _LEAF_5
-        elif v == 'END':
-            return _LEAF_4
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'STOP-WHEELS':
-        v = a['event']
-        if v in ('START', 'END'):
-            return _LEAF_4
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _LEAF_5
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'PTU-MOVE':
-        v = a['@PTU_MOVEstate']
-        if v == 'PTU-MOVE':
+        elif v == 'STOP-NAV':
             v = a['event']
             if v == 'START':
-                calls('changeInterState', (a['@PTU_MOVEstate'],))
-                return _LEAF_6
-            elif v == 'INTERM':
-                return _LEAF_7
+                v = a['@GOTOstate']
+                if v == 'GOTO':
+                    calls('changeInterState', (a['@GOTOstate'],))
+                    return _LEAF_4
+                elif v == 'IDLE':
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"@GOTOstate={v!r} is outside its domain")
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_5
             elif v == 'END':
-                return _LEAF_8
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_6
+                return _LEAF_4
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
+        elif v == 'STOP-WHEELS':
             v = a['event']
-            if v == 'START':
-                return _LEAF_8
-            elif v == 'INTERM':
-                return _LEAF_6
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_9
+            if v in ('START', 'END'):
+                return _LEAF_4
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_5
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain")
-    elif v == 'PTU-INIT':
-        v = a['event']
-        if v == 'START':
+        elif v == 'PTU-MOVE':
             v = a['@PTU_MOVEstate']
             if v == 'PTU-MOVE':
-                calls('changeInterState', (a['@PTU_MOVEstate'],))
-                return _LEAF_4
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@PTU_MOVEstate'],))
+                    return _LEAF_6
+                elif v == 'INTERM':
+                    return _LEAF_7
+                elif v == 'END':
+                    return _LEAF_8
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             elif v == 'IDLE':
-                return _LEAF_4
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_8
+                elif v == 'INTERM':
+                    return _LEAF_6
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_9
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
                 raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain")
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _LEAF_5
-        elif v == 'END':
-            return _LEAF_4
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'PICTURE':
-        v = a['@PICTUREstate']
-        if v == 'PICTURE':
+        elif v == 'PTU-INIT':
             v = a['event']
             if v == 'START':
-                calls('changeInterState', (a['@PICTUREstate'],))
-                return _LEAF_10
-            elif v == 'INTERM':
-                return _LEAF_11
+                v = a['@PTU_MOVEstate']
+                if v == 'PTU-MOVE':
+                    calls('changeInterState', (a['@PTU_MOVEstate'],))
+                    return _LEAF_4
+                elif v == 'IDLE':
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain")
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_5
             elif v == 'END':
-                return _LEAF_12
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_10
+                return _LEAF_4
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_12
-            elif v == 'INTERM':
-                return _LEAF_10
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_13
+        elif v == 'PICTURE':
+            v = a['@PICTUREstate']
+            if v == 'PICTURE':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@PICTUREstate'],))
+                    return _LEAF_10
+                elif v == 'INTERM':
+                    return _LEAF_11
+                elif v == 'END':
+                    return _LEAF_12
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_10
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_12
+                elif v == 'INTERM':
+                    return _LEAF_10
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_13
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@PICTUREstate={v!r} is outside its domain")
+        elif v == 'COMMUNICATE':
+            v = a['@COMMUNICATEstate']
+            if v == 'COMMUNICATE':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@COMMUNICATEstate'],))
+                    return _LEAF_14
+                elif v == 'INTERM':
+                    return _LEAF_15
+                elif v == 'END':
+                    return _LEAF_16
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_14
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_16
+                elif v == 'INTERM':
+                    return _LEAF_14
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_17
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@COMMUNICATEstate={v!r} is outside its domain")
         else:
-            raise ValueError(f"@PICTUREstate={v!r} is outside its domain")
-    elif v == 'COMMUNICATE':
-        v = a['@COMMUNICATEstate']
-        if v == 'COMMUNICATE':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@COMMUNICATEstate'],))
-                return _LEAF_14
-            elif v == 'INTERM':
-                return _LEAF_15
-            elif v == 'END':
-                return _LEAF_16
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_14
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_16
-            elif v == 'INTERM':
-                return _LEAF_14
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_17
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@COMMUNICATEstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise

@@ -11,9 +11,11 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@Bstate", "@DEFstate", "@Gstate", "@HIstate", "@Jstate"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "Bstate", "DEFstate", "Gstate", "HIstate", "Jstate"]
 DEPTH = 4
 FINDINGS = 0
@@ -73,313 +75,317 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
 
 def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
-    v = a['service']
-    if v == 'A':
-        return _LEAF_0
-    elif v == 'B':
-        v = a['@Bstate']
-        if v == 'B':
+    try:
+        v = a['service']
+        if v == 'A':
+            return _LEAF_0
+        elif v == 'B':
+            v = a['@Bstate']
+            if v == 'B':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@Bstate'],))
+                    calls('sendAbortRequest', (a['@Bstate'],))
+                    return _LEAF_1
+                elif v == 'INTERM':
+                    return _LEAF_2
+                elif v == 'END':
+                    return _LEAF_3
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_3
+                elif v == 'INTERM':
+                    return _LEAF_4
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_5
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@Bstate={v!r} is outside its domain")
+        elif v == 'C':
             v = a['event']
             if v == 'START':
-                calls('changeInterState', (a['@Bstate'],))
-                calls('sendAbortRequest', (a['@Bstate'],))
-                return _LEAF_1
-            elif v == 'INTERM':
-                return _LEAF_2
-            elif v == 'END':
-                return _LEAF_3
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_3
-            elif v == 'INTERM':
-                return _LEAF_4
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_5
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@Bstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['event']
-        if v == 'START':
-            v = a['@DEFstate']
-            if v in ('D', 'F', 'IDLE'):
+                v = a['@DEFstate']
+                if v in ('D', 'F', 'IDLE'):
+                    return _LEAF_0
+                elif v == 'E':
+                    calls('changeInterState', (a['@DEFstate'],))
+                    calls('sendAbortRequest', (a['@DEFstate'],))
+                    return _LEAF_6
+                else:
+                    raise ValueError(f"@DEFstate={v!r} is outside its domain")
+            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'D':
+            v = a['@DEFstate']
+            if v == 'D':
+                v = a['event']
+                if v == 'START':
+                    return _node_0(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_8
+                elif v == 'END':
+                    return _LEAF_9
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_10
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             elif v == 'E':
-                calls('changeInterState', (a['@DEFstate'],))
-                calls('sendAbortRequest', (a['@DEFstate'],))
-                return _LEAF_6
+                return _node_1(a, calls)
+            elif v == 'F':
+                return _node_3(a, calls)
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_9
+                elif v == 'INTERM':
+                    return _LEAF_10
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_15
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
                 raise ValueError(f"@DEFstate={v!r} is outside its domain")
-        elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-            return _LEAF_0
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'D':
-        v = a['@DEFstate']
-        if v == 'D':
-            v = a['event']
-            if v == 'START':
-                return _node_0(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_8
-            elif v == 'END':
-                return _LEAF_9
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_10
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'E':
-            return _node_1(a, calls)
-        elif v == 'F':
-            return _node_3(a, calls)
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_9
-            elif v == 'INTERM':
-                return _LEAF_10
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_15
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@DEFstate={v!r} is outside its domain")
-    elif v == 'E':
-        v = a['@DEFstate']
-        if v == 'D':
-            return _node_5(a, calls)
-        elif v == 'E':
-            v = a['event']
-            if v == 'START':
-                return _node_2(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_12
-            elif v == 'END':
-                return _LEAF_9
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_16
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'F':
-            return _node_3(a, calls)
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_9
-            elif v == 'INTERM':
-                return _LEAF_16
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_15
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@DEFstate={v!r} is outside its domain")
-    elif v == 'F':
-        v = a['@DEFstate']
-        if v == 'D':
-            return _node_5(a, calls)
-        elif v == 'E':
-            return _node_1(a, calls)
-        elif v == 'F':
-            v = a['event']
-            if v == 'START':
-                return _node_4(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_14
-            elif v == 'END':
-                return _LEAF_9
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_17
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_9
-            elif v == 'INTERM':
-                return _LEAF_17
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_15
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@DEFstate={v!r} is outside its domain")
-    elif v == 'G':
-        v = a['@Gstate']
-        if v == 'G':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@Gstate'],))
-                calls('sendAbortRequest', (a['@Gstate'],))
-                v = a['@HIstate']
-                if v in ('H', 'I'):
-                    return _node_6(a, calls)
-                elif v == 'IDLE':
-                    return _LEAF_18
+            v = a['@DEFstate']
+            if v == 'D':
+                return _node_5(a, calls)
+            elif v == 'E':
+                v = a['event']
+                if v == 'START':
+                    return _node_2(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_12
+                elif v == 'END':
+                    return _LEAF_9
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_16
                 else:
-                    raise ValueError(f"@HIstate={v!r} is outside its domain")
-            elif v == 'INTERM':
-                return _LEAF_19
-            elif v == 'END':
-                return _LEAF_20
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_21
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'F':
+                return _node_3(a, calls)
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_9
+                elif v == 'INTERM':
+                    return _LEAF_16
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_15
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                v = a['@HIstate']
-                if v in ('H', 'I'):
-                    return _node_7(a, calls)
-                elif v == 'IDLE':
+                raise ValueError(f"@DEFstate={v!r} is outside its domain")
+        elif v == 'F':
+            v = a['@DEFstate']
+            if v == 'D':
+                return _node_5(a, calls)
+            elif v == 'E':
+                return _node_1(a, calls)
+            elif v == 'F':
+                v = a['event']
+                if v == 'START':
+                    return _node_4(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_14
+                elif v == 'END':
+                    return _LEAF_9
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_17
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_9
+                elif v == 'INTERM':
+                    return _LEAF_17
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_15
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@DEFstate={v!r} is outside its domain")
+        elif v == 'G':
+            v = a['@Gstate']
+            if v == 'G':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@Gstate'],))
+                    calls('sendAbortRequest', (a['@Gstate'],))
+                    v = a['@HIstate']
+                    if v in ('H', 'I'):
+                        return _node_6(a, calls)
+                    elif v == 'IDLE':
+                        return _LEAF_18
+                    else:
+                        raise ValueError(f"@HIstate={v!r} is outside its domain")
+                elif v == 'INTERM':
+                    return _LEAF_19
+                elif v == 'END':
                     return _LEAF_20
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_21
                 else:
-                    raise ValueError(f"@HIstate={v!r} is outside its domain")
-            elif v == 'INTERM':
-                return _LEAF_21
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_23
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    v = a['@HIstate']
+                    if v in ('H', 'I'):
+                        return _node_7(a, calls)
+                    elif v == 'IDLE':
+                        return _LEAF_20
+                    else:
+                        raise ValueError(f"@HIstate={v!r} is outside its domain")
+                elif v == 'INTERM':
+                    return _LEAF_21
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_23
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@Gstate={v!r} is outside its domain")
-    elif v == 'H':
-        v = a['@HIstate']
-        if v == 'H':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@HIstate'],))
-                calls('sendAbortRequest', (a['@HIstate'],))
-                return _LEAF_24
-            elif v == 'INTERM':
-                return _LEAF_25
-            elif v == 'END':
-                return _LEAF_26
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_27
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'I':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@HIstate'],))
-                calls('sendAbortRequest', (a['@HIstate'],))
-                return _LEAF_28
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_29
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_26
-            elif v == 'INTERM':
-                return _LEAF_27
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_30
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@HIstate={v!r} is outside its domain")
-    elif v == 'I':
-        v = a['@HIstate']
-        if v == 'H':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@HIstate'],))
-                calls('sendAbortRequest', (a['@HIstate'],))
-                v = a['@Jstate']
-                if v == 'J':
-                    calls('changeInterState', (a['@Jstate'],))
-                    calls('sendAbortRequest', (a['@Jstate'],))
+                raise ValueError(f"@Gstate={v!r} is outside its domain")
+        elif v == 'H':
+            v = a['@HIstate']
+            if v == 'H':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@HIstate'],))
+                    calls('sendAbortRequest', (a['@HIstate'],))
                     return _LEAF_24
-                elif v == 'IDLE':
-                    return _LEAF_24
-                else:
-                    raise ValueError(f"@Jstate={v!r} is outside its domain")
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_25
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'I':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@HIstate'],))
-                calls('sendAbortRequest', (a['@HIstate'],))
-                v = a['@Jstate']
-                if v == 'J':
-                    calls('changeInterState', (a['@Jstate'],))
-                    calls('sendAbortRequest', (a['@Jstate'],))
-                    return _LEAF_28
-                elif v == 'IDLE':
-                    return _LEAF_28
-                else:
-                    raise ValueError(f"@Jstate={v!r} is outside its domain")
-            elif v == 'INTERM':
-                return _LEAF_29
-            elif v == 'END':
-                return _LEAF_26
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_31
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                v = a['@Jstate']
-                if v == 'J':
-                    calls('changeInterState', (a['@Jstate'],))
-                    calls('sendAbortRequest', (a['@Jstate'],))
-                    return _LEAF_32
-                elif v == 'IDLE':
+                elif v == 'INTERM':
+                    return _LEAF_25
+                elif v == 'END':
                     return _LEAF_26
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_27
                 else:
-                    raise ValueError(f"@Jstate={v!r} is outside its domain")
-            elif v == 'INTERM':
-                return _LEAF_31
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_30
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'I':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@HIstate'],))
+                    calls('sendAbortRequest', (a['@HIstate'],))
+                    return _LEAF_28
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_29
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_26
+                elif v == 'INTERM':
+                    return _LEAF_27
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_30
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@HIstate={v!r} is outside its domain")
+        elif v == 'I':
+            v = a['@HIstate']
+            if v == 'H':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@HIstate'],))
+                    calls('sendAbortRequest', (a['@HIstate'],))
+                    v = a['@Jstate']
+                    if v == 'J':
+                        calls('changeInterState', (a['@Jstate'],))
+                        calls('sendAbortRequest', (a['@Jstate'],))
+                        return _LEAF_24
+                    elif v == 'IDLE':
+                        return _LEAF_24
+                    else:
+                        raise ValueError(f"@Jstate={v!r} is outside its domain")
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_25
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'I':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@HIstate'],))
+                    calls('sendAbortRequest', (a['@HIstate'],))
+                    v = a['@Jstate']
+                    if v == 'J':
+                        calls('changeInterState', (a['@Jstate'],))
+                        calls('sendAbortRequest', (a['@Jstate'],))
+                        return _LEAF_28
+                    elif v == 'IDLE':
+                        return _LEAF_28
+                    else:
+                        raise ValueError(f"@Jstate={v!r} is outside its domain")
+                elif v == 'INTERM':
+                    return _LEAF_29
+                elif v == 'END':
+                    return _LEAF_26
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_31
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    v = a['@Jstate']
+                    if v == 'J':
+                        calls('changeInterState', (a['@Jstate'],))
+                        calls('sendAbortRequest', (a['@Jstate'],))
+                        return _LEAF_32
+                    elif v == 'IDLE':
+                        return _LEAF_26
+                    else:
+                        raise ValueError(f"@Jstate={v!r} is outside its domain")
+                elif v == 'INTERM':
+                    return _LEAF_31
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_30
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@HIstate={v!r} is outside its domain")
+        elif v == 'J':
+            v = a['@Jstate']
+            if v == 'J':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@Jstate'],))
+                    calls('sendAbortRequest', (a['@Jstate'],))
+                    return _LEAF_33
+                elif v == 'INTERM':
+                    return _LEAF_34
+                elif v == 'END':
+                    return _LEAF_35
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_36
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_35
+                elif v == 'INTERM':
+                    return _LEAF_36
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_37
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@Jstate={v!r} is outside its domain")
         else:
-            raise ValueError(f"@HIstate={v!r} is outside its domain")
-    elif v == 'J':
-        v = a['@Jstate']
-        if v == 'J':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@Jstate'],))
-                calls('sendAbortRequest', (a['@Jstate'],))
-                return _LEAF_33
-            elif v == 'INTERM':
-                return _LEAF_34
-            elif v == 'END':
-                return _LEAF_35
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_36
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_35
-            elif v == 'INTERM':
-                return _LEAF_36
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_37
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@Jstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:

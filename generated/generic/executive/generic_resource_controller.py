@@ -11,9 +11,11 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@ABCstate", "@EFGstate"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "ABCstate", "EFGstate"]
 DEPTH = 4
 FINDINGS = 0
@@ -78,603 +80,607 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
 
 def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
-    v = a['service']
-    if v == 'A':
-        v = a['@ABCstate']
+    try:
+        v = a['service']
         if v == 'A':
-            v = a['event']
-            if v == 'START':
-                return _node_0(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_1
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_0
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'B':
-            v = a['event']
-            if v == 'START':
-                return _node_1(a, calls)
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'C':
-            return _node_2(a, calls)
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_0
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_7
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'B':
-        v = a['@ABCstate']
-        if v == 'A':
-            v = a['event']
-            if v == 'START':
-                return _node_0(a, calls)
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_1
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'B':
-            v = a['event']
-            if v == 'START':
-                return _node_1(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_4
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_3
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'C':
-            return _node_2(a, calls)
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_3
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_7
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['@ABCstate']
-        if v == 'A':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_8
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_1
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'B':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_9
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'C':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_10
-            elif v == 'INTERM':
-                return _LEAF_6
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_5
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_5
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_7
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'D':
-        v = a['@ABCstate']
-        if v == 'A':
-            return _LEAF_0
-        elif v == 'B':
-            return _LEAF_3
-        elif v == 'C':
-            return _LEAF_5
-        elif v == 'IDLE':
-            return _LEAF_2
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'E':
-        v = a['event']
-        if v == 'START':
-            return _node_3(a, calls)
-        elif v == 'INTERM':
             v = a['@ABCstate']
             if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_27
-                elif v == 'F':
-                    return _LEAF_28
-                elif v == 'G':
-                    return _LEAF_29
-                elif v == 'IDLE':
-                    return _LEAF_11
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_30
-                elif v == 'F':
-                    return _LEAF_31
-                elif v == 'G':
-                    return _LEAF_32
-                elif v == 'IDLE':
-                    return _LEAF_15
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_33
-                elif v == 'F':
-                    return _LEAF_34
-                elif v == 'G':
-                    return _LEAF_35
-                elif v == 'IDLE':
-                    return _LEAF_19
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_36
-                elif v == 'F':
-                    return _LEAF_37
-                elif v == 'G':
-                    return _LEAF_38
-                elif v == 'IDLE':
-                    return _LEAF_23
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_14
-                elif v == 'F':
-                    return _LEAF_28
-                elif v == 'G':
-                    return _LEAF_29
-                elif v == 'IDLE':
-                    return _LEAF_39
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_18
-                elif v == 'F':
-                    return _LEAF_31
-                elif v == 'G':
-                    return _LEAF_32
-                elif v == 'IDLE':
-                    return _LEAF_40
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_22
-                elif v == 'F':
-                    return _LEAF_34
-                elif v == 'G':
-                    return _LEAF_35
-                elif v == 'IDLE':
-                    return _LEAF_41
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_26
-                elif v == 'F':
-                    return _LEAF_37
-                elif v == 'G':
-                    return _LEAF_38
-                elif v == 'IDLE':
-                    return _LEAF_42
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_4(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'F':
-        v = a['event']
-        if v == 'START':
-            return _node_3(a, calls)
-        elif v == 'INTERM':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_27
-                elif v == 'F':
-                    return _LEAF_28
-                elif v == 'G':
-                    return _LEAF_29
-                elif v == 'IDLE':
-                    return _LEAF_12
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_30
-                elif v == 'F':
-                    return _LEAF_31
-                elif v == 'G':
-                    return _LEAF_32
-                elif v == 'IDLE':
-                    return _LEAF_16
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_33
-                elif v == 'F':
-                    return _LEAF_34
-                elif v == 'G':
-                    return _LEAF_35
-                elif v == 'IDLE':
-                    return _LEAF_20
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_36
-                elif v == 'F':
-                    return _LEAF_37
-                elif v == 'G':
-                    return _LEAF_38
-                elif v == 'IDLE':
-                    return _LEAF_24
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_27
-                elif v == 'F':
-                    return _LEAF_14
-                elif v == 'G':
-                    return _LEAF_29
-                elif v == 'IDLE':
-                    return _LEAF_39
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_30
-                elif v == 'F':
-                    return _LEAF_18
-                elif v == 'G':
-                    return _LEAF_32
-                elif v == 'IDLE':
-                    return _LEAF_40
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_33
-                elif v == 'F':
-                    return _LEAF_22
-                elif v == 'G':
-                    return _LEAF_35
-                elif v == 'IDLE':
-                    return _LEAF_41
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_36
-                elif v == 'F':
-                    return _LEAF_26
-                elif v == 'G':
-                    return _LEAF_38
-                elif v == 'IDLE':
-                    return _LEAF_42
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_5(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'G':
-        v = a['event']
-        if v == 'START':
-            return _node_3(a, calls)
-        elif v == 'INTERM':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_27
-                elif v == 'F':
-                    return _LEAF_28
-                elif v == 'G':
-                    return _LEAF_29
-                elif v == 'IDLE':
-                    return _LEAF_13
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_30
-                elif v == 'F':
-                    return _LEAF_31
-                elif v == 'G':
-                    return _LEAF_32
-                elif v == 'IDLE':
-                    return _LEAF_17
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_33
-                elif v == 'F':
-                    return _LEAF_34
-                elif v == 'G':
-                    return _LEAF_35
-                elif v == 'IDLE':
-                    return _LEAF_21
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_36
-                elif v == 'F':
-                    return _LEAF_37
-                elif v == 'G':
-                    return _LEAF_38
-                elif v == 'IDLE':
-                    return _LEAF_25
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ABCstate']
-            if v == 'A':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_27
-                elif v == 'F':
-                    return _LEAF_28
-                elif v == 'G':
-                    return _LEAF_14
-                elif v == 'IDLE':
-                    return _LEAF_39
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'B':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_30
-                elif v == 'F':
-                    return _LEAF_31
-                elif v == 'G':
-                    return _LEAF_18
-                elif v == 'IDLE':
-                    return _LEAF_40
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'C':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_33
-                elif v == 'F':
-                    return _LEAF_34
-                elif v == 'G':
-                    return _LEAF_22
-                elif v == 'IDLE':
-                    return _LEAF_41
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@EFGstate']
-                if v == 'E':
-                    return _LEAF_36
-                elif v == 'F':
-                    return _LEAF_37
-                elif v == 'G':
-                    return _LEAF_26
-                elif v == 'IDLE':
-                    return _LEAF_42
-                else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_6(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'H':
-        v = a['@ABCstate']
-        if v == 'A':
-            v = a['event']
-            if v == 'START':
-                v = a['@EFGstate']
-                if v in ('E', 'F', 'G'):
-                    return _node_7(a, calls)
-                elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _node_0(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_1
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_0
                 else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_1
-            elif v == 'END':
-                return _LEAF_0
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['event']
+                if v == 'START':
+                    return _node_1(a, calls)
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'C':
+                return _node_2(a, calls)
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_0
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_7
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
         elif v == 'B':
-            v = a['event']
-            if v == 'START':
-                v = a['@EFGstate']
-                if v in ('E', 'F', 'G'):
-                    return _node_8(a, calls)
-                elif v == 'IDLE':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['event']
+                if v == 'START':
+                    return _node_0(a, calls)
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_1
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['event']
+                if v == 'START':
+                    return _node_1(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_4
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_3
                 else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            elif v == 'END':
-                return _LEAF_3
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'C':
+                return _node_2(a, calls)
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_3
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_7
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
         elif v == 'C':
-            v = a['event']
-            if v == 'START':
-                v = a['@EFGstate']
-                if v in ('E', 'F', 'G'):
-                    return _node_9(a, calls)
-                elif v == 'IDLE':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_8
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_1
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_9
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'C':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_10
+                elif v == 'INTERM':
+                    return _LEAF_6
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_5
                 else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_6
-            elif v == 'END':
-                return _LEAF_5
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_5
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_7
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            return _node_10(a, calls)
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'I':
-        v = a['@ABCstate']
-        if v == 'A':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_8
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_1
-            elif v == 'END':
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'D':
+            v = a['@ABCstate']
+            if v == 'A':
                 return _LEAF_0
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'B':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_9
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            elif v == 'END':
+            elif v == 'B':
                 return _LEAF_3
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'C':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_10
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_6
-            elif v == 'END':
+            elif v == 'C':
                 return _LEAF_5
+            elif v == 'IDLE':
+                return _LEAF_2
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'E':
+            v = a['event']
+            if v == 'START':
+                return _node_3(a, calls)
+            elif v == 'INTERM':
+                v = a['@ABCstate']
+                if v == 'A':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_27
+                    elif v == 'F':
+                        return _LEAF_28
+                    elif v == 'G':
+                        return _LEAF_29
+                    elif v == 'IDLE':
+                        return _LEAF_11
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'B':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_30
+                    elif v == 'F':
+                        return _LEAF_31
+                    elif v == 'G':
+                        return _LEAF_32
+                    elif v == 'IDLE':
+                        return _LEAF_15
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'C':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_33
+                    elif v == 'F':
+                        return _LEAF_34
+                    elif v == 'G':
+                        return _LEAF_35
+                    elif v == 'IDLE':
+                        return _LEAF_19
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_36
+                    elif v == 'F':
+                        return _LEAF_37
+                    elif v == 'G':
+                        return _LEAF_38
+                    elif v == 'IDLE':
+                        return _LEAF_23
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ABCstate']
+                if v == 'A':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_14
+                    elif v == 'F':
+                        return _LEAF_28
+                    elif v == 'G':
+                        return _LEAF_29
+                    elif v == 'IDLE':
+                        return _LEAF_39
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'B':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_18
+                    elif v == 'F':
+                        return _LEAF_31
+                    elif v == 'G':
+                        return _LEAF_32
+                    elif v == 'IDLE':
+                        return _LEAF_40
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'C':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_22
+                    elif v == 'F':
+                        return _LEAF_34
+                    elif v == 'G':
+                        return _LEAF_35
+                    elif v == 'IDLE':
+                        return _LEAF_41
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_26
+                    elif v == 'F':
+                        return _LEAF_37
+                    elif v == 'G':
+                        return _LEAF_38
+                    elif v == 'IDLE':
+                        return _LEAF_42
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_4(a, calls)
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            return _node_10(a, calls)
+        elif v == 'F':
+            v = a['event']
+            if v == 'START':
+                return _node_3(a, calls)
+            elif v == 'INTERM':
+                v = a['@ABCstate']
+                if v == 'A':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_27
+                    elif v == 'F':
+                        return _LEAF_28
+                    elif v == 'G':
+                        return _LEAF_29
+                    elif v == 'IDLE':
+                        return _LEAF_12
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'B':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_30
+                    elif v == 'F':
+                        return _LEAF_31
+                    elif v == 'G':
+                        return _LEAF_32
+                    elif v == 'IDLE':
+                        return _LEAF_16
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'C':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_33
+                    elif v == 'F':
+                        return _LEAF_34
+                    elif v == 'G':
+                        return _LEAF_35
+                    elif v == 'IDLE':
+                        return _LEAF_20
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_36
+                    elif v == 'F':
+                        return _LEAF_37
+                    elif v == 'G':
+                        return _LEAF_38
+                    elif v == 'IDLE':
+                        return _LEAF_24
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ABCstate']
+                if v == 'A':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_27
+                    elif v == 'F':
+                        return _LEAF_14
+                    elif v == 'G':
+                        return _LEAF_29
+                    elif v == 'IDLE':
+                        return _LEAF_39
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'B':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_30
+                    elif v == 'F':
+                        return _LEAF_18
+                    elif v == 'G':
+                        return _LEAF_32
+                    elif v == 'IDLE':
+                        return _LEAF_40
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'C':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_33
+                    elif v == 'F':
+                        return _LEAF_22
+                    elif v == 'G':
+                        return _LEAF_35
+                    elif v == 'IDLE':
+                        return _LEAF_41
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_36
+                    elif v == 'F':
+                        return _LEAF_26
+                    elif v == 'G':
+                        return _LEAF_38
+                    elif v == 'IDLE':
+                        return _LEAF_42
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_5(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'G':
+            v = a['event']
+            if v == 'START':
+                return _node_3(a, calls)
+            elif v == 'INTERM':
+                v = a['@ABCstate']
+                if v == 'A':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_27
+                    elif v == 'F':
+                        return _LEAF_28
+                    elif v == 'G':
+                        return _LEAF_29
+                    elif v == 'IDLE':
+                        return _LEAF_13
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'B':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_30
+                    elif v == 'F':
+                        return _LEAF_31
+                    elif v == 'G':
+                        return _LEAF_32
+                    elif v == 'IDLE':
+                        return _LEAF_17
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'C':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_33
+                    elif v == 'F':
+                        return _LEAF_34
+                    elif v == 'G':
+                        return _LEAF_35
+                    elif v == 'IDLE':
+                        return _LEAF_21
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_36
+                    elif v == 'F':
+                        return _LEAF_37
+                    elif v == 'G':
+                        return _LEAF_38
+                    elif v == 'IDLE':
+                        return _LEAF_25
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ABCstate']
+                if v == 'A':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_27
+                    elif v == 'F':
+                        return _LEAF_28
+                    elif v == 'G':
+                        return _LEAF_14
+                    elif v == 'IDLE':
+                        return _LEAF_39
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'B':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_30
+                    elif v == 'F':
+                        return _LEAF_31
+                    elif v == 'G':
+                        return _LEAF_18
+                    elif v == 'IDLE':
+                        return _LEAF_40
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'C':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_33
+                    elif v == 'F':
+                        return _LEAF_34
+                    elif v == 'G':
+                        return _LEAF_22
+                    elif v == 'IDLE':
+                        return _LEAF_41
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v == 'E':
+                        return _LEAF_36
+                    elif v == 'F':
+                        return _LEAF_37
+                    elif v == 'G':
+                        return _LEAF_26
+                    elif v == 'IDLE':
+                        return _LEAF_42
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_6(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'H':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['event']
+                if v == 'START':
+                    v = a['@EFGstate']
+                    if v in ('E', 'F', 'G'):
+                        return _node_7(a, calls)
+                    elif v == 'IDLE':
+                        return _LEAF_0
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_1
+                elif v == 'END':
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['event']
+                if v == 'START':
+                    v = a['@EFGstate']
+                    if v in ('E', 'F', 'G'):
+                        return _node_8(a, calls)
+                    elif v == 'IDLE':
+                        return _LEAF_3
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                elif v == 'END':
+                    return _LEAF_3
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'C':
+                v = a['event']
+                if v == 'START':
+                    v = a['@EFGstate']
+                    if v in ('E', 'F', 'G'):
+                        return _node_9(a, calls)
+                    elif v == 'IDLE':
+                        return _LEAF_5
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                elif v == 'END':
+                    return _LEAF_5
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                return _node_10(a, calls)
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'I':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_8
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_1
+                elif v == 'END':
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_9
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                elif v == 'END':
+                    return _LEAF_3
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'C':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_10
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                elif v == 'END':
+                    return _LEAF_5
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                return _node_10(a, calls)
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'J':
+            v = a['@ABCstate']
+            if v == 'A':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@ABCstate'],))
+                    calls('sendAbortRequest', (a['@ABCstate'],))
+                    return _LEAF_8
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_1
+                elif v == 'END':
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'B':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@ABCstate'],))
+                    calls('sendAbortRequest', (a['@ABCstate'],))
+                    return _LEAF_9
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                elif v == 'END':
+                    return _LEAF_3
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'C':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@ABCstate'],))
+                    calls('sendAbortRequest', (a['@ABCstate'],))
+                    return _LEAF_10
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                elif v == 'END':
+                    return _LEAF_5
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                return _node_10(a, calls)
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
         else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'J':
-        v = a['@ABCstate']
-        if v == 'A':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@ABCstate'],))
-                calls('sendAbortRequest', (a['@ABCstate'],))
-                return _LEAF_8
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_1
-            elif v == 'END':
-                return _LEAF_0
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'B':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@ABCstate'],))
-                calls('sendAbortRequest', (a['@ABCstate'],))
-                return _LEAF_9
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            elif v == 'END':
-                return _LEAF_3
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'C':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@ABCstate'],))
-                calls('sendAbortRequest', (a['@ABCstate'],))
-                return _LEAF_10
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_6
-            elif v == 'END':
-                return _LEAF_5
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            return _node_10(a, calls)
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    else:
-        raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:

@@ -2,29 +2,21 @@
 """Rule base diagnosis, compiled into a decision graph of depth 8.
 
 Inputs: pres1, pres2, deltaP, temp, drain, level, valve. Outputs: proced.
-The compiler found 52 case(s) of inputs the rules do not settle (a value
+The compiler found 13 case(s) of inputs the rules do not settle (a value
 listed as `a | b` stands for any of them):
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=]-inf, 40[, drain=off, level=*other*, difP=]-inf, 0[ | [0, 10[ (rules fired: r01, r03, r04, r10)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=]-inf, 40[, drain=*other*, level=high (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=]-inf, 40[, drain=*other*, level=low (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=]-inf, 40[, drain=*other*, level=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=[40, inf[, drain=*other*, level=high (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=[40, inf[, drain=*other*, level=low (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=open, pres2=[40, inf[, drain=*other*, level=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=off, difP=]-inf, 0[, level=*other* (rules fired: r01, r03, r04, r10)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=off, difP=[0, 10[, level=*other* (rules fired: r01, r03, r04, r10)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=*other*, level=high (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=*other*, level=low (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=*other*, level=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=[40, inf[, drain=*other*, level=high (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=[40, inf[, drain=*other*, level=low (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=]-inf, 286[, valve=*other*, pres2=[40, inf[, drain=*other*, level=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=[286, inf[, valve=open, pres2=]-inf, 40[, drain=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=[286, inf[, valve=open, pres2=[40, inf[, drain=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=[286, inf[, valve=*other*, pres2=]-inf, 40[, drain=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[, temp=[286, inf[, valve=*other*, pres2=[40, inf[, drain=*other* (rules fired: r01)
-- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=[138, 160[, temp=]-inf, 286[, valve=open, drain=*other*, pres2=]-inf, 40[, level=high (rules fired: none)
-- ... and 32 more (`specc rules` lists them all).
+- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[ | [160, inf[, temp=]-inf, 286[, valve=open, pres2=]-inf, 40[, drain=off, level=*other*, difP=]-inf, 10[ (rules fired: r01, r03, r04, r10)
+- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[ | [160, inf[, temp=]-inf, 286[, valve=open | *other*, pres2=]-inf, inf[, drain=*other*, level=high | low | *other* (rules fired: r01)
+- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[ | [160, inf[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=off, difP=]-inf, 10[, level=*other* (rules fired: r01, r03, r04, r10)
+- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=]-inf, 138[ | [160, inf[, temp=[286, inf[, valve=open | *other*, pres2=]-inf, inf[, drain=*other* (rules fired: r01)
+- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=[138, 160[, temp=]-inf, 286[, valve=open | *other*, drain=*other*, pres2=]-inf, inf[, level=high | low | *other* (rules fired: none)
+- incomplete: undetermined proced when deltaP=]-inf, 4[, pres1=[138, 160[, temp=[286, inf[, valve=open | *other*, drain=*other*, pres2=]-inf, inf[ (rules fired: none)
+- incomplete: undetermined proced when deltaP=[4, 20[, temp=]-inf, 286[, valve=open, pres2=]-inf, 40[, drain=off, level=*other*, difP=]-inf, 10[ (rules fired: r01, r03, r04, r10)
+- incomplete: undetermined proced when deltaP=[4, 20[, temp=]-inf, 286[, valve=open | *other*, pres2=]-inf, inf[, drain=*other*, level=high | low | *other* (rules fired: r01)
+- incomplete: undetermined proced when deltaP=[4, 20[, temp=]-inf, 286[, valve=*other*, pres2=]-inf, 40[, drain=off, difP=]-inf, 10[, level=*other* (rules fired: r01, r03, r04, r10)
+- incomplete: undetermined proced when deltaP=[4, 20[, temp=[286, inf[, valve=open | *other*, pres2=]-inf, inf[, drain=*other* (rules fired: r01)
+- incomplete: undetermined proced when deltaP=[20, inf[, temp=]-inf, 286[, valve=open | *other*, drain=off, level=*other* (rules fired: r01, r03, r04, r05)
+- incomplete: undetermined proced when deltaP=[20, inf[, temp=]-inf, 286[, valve=open | *other*, drain=*other*, level=high | low | *other*, pres2=]-inf, inf[ (rules fired: r01)
+- incomplete: undetermined proced when deltaP=[20, inf[, temp=[286, inf[, valve=open | *other*, drain=*other*, pres2=]-inf, inf[ (rules fired: r01)
 """
 
 from __future__ import annotations
@@ -34,12 +26,14 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["pres1", "pres2", "deltaP", "temp", "drain", "level", "valve"]
+NUMERIC_INPUTS = ["pres1", "pres2", "deltaP", "temp"]
 OUTPUTS = ["proced"]
 DEPTH = 8
-FINDINGS = 52
+FINDINGS = 13
 
 _LEAF_0 = Decision(MappingProxyType({'proced': 'a3'}), (), (), None)
 _LEAF_1 = Decision(MappingProxyType({'proced': 'a23'}), (), (), None)
@@ -55,47 +49,51 @@ _LEAF_8 = Decision(MappingProxyType({'proced': 'i3'}), (), (), None)
 def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 8 tests; `calls(name, args)` runs `do` calls."""
     a = dict(inputs)
-    v = a['deltaP']
-    if v < 4.0:
-        v = a['pres1']
-        if (v < 138.0) or (160.0 <= v):
+    try:
+        v = a['deltaP']
+        if v < 4.0:
+            v = a['pres1']
+            if (v < 138.0) or (160.0 <= v):
+                return _node_0(a, calls)
+            elif 138.0 <= v and v < 160.0:
+                v = a['drain']
+                if v == 'on':
+                    return _LEAF_0
+                elif v == 'off':
+                    return _LEAF_8
+                else:
+                    return _LEAF_4
+            else:
+                raise ValueError(f"pres1={v!r} is outside its domain")
+        elif 4.0 <= v and v < 20.0:
             return _node_0(a, calls)
-        elif 138.0 <= v and v < 160.0:
-            v = a['drain']
-            if v == 'on':
-                return _LEAF_0
-            elif v == 'off':
-                return _LEAF_8
+        elif 20.0 <= v:
+            v = a['temp']
+            if v < 286.0:
+                v = a['drain']
+                if v == 'on':
+                    return _LEAF_0
+                elif v == 'off':
+                    a['difP'] = (a['pres2'] - a['pres1'])
+                    return _node_2(a, calls)
+                else:
+                    return _LEAF_4
+            elif 286.0 <= v:
+                v = a['drain']
+                if v == 'on':
+                    return _LEAF_0
+                elif v == 'off':
+                    a['difP'] = (a['pres2'] - a['pres1'])
+                    return _LEAF_7
+                else:
+                    return _LEAF_4
             else:
-                return _LEAF_4
+                raise ValueError(f"temp={v!r} is outside its domain")
         else:
-            raise ValueError(f"pres1={v!r} is outside its domain")
-    elif 4.0 <= v and v < 20.0:
-        return _node_0(a, calls)
-    elif 20.0 <= v:
-        v = a['temp']
-        if v < 286.0:
-            v = a['drain']
-            if v == 'on':
-                return _LEAF_0
-            elif v == 'off':
-                a['difP'] = (a['pres2'] - a['pres1'])
-                return _node_2(a, calls)
-            else:
-                return _LEAF_4
-        elif 286.0 <= v:
-            v = a['drain']
-            if v == 'on':
-                return _LEAF_0
-            elif v == 'off':
-                a['difP'] = (a['pres2'] - a['pres1'])
-                return _LEAF_7
-            else:
-                return _LEAF_4
-        else:
-            raise ValueError(f"temp={v!r} is outside its domain")
-    else:
-        raise ValueError(f"deltaP={v!r} is outside its domain")
+            raise ValueError(f"deltaP={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:

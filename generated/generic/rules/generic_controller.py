@@ -2,29 +2,29 @@
 """Rule base generic_controller, compiled into a decision graph of depth 4.
 
 Inputs: service, event, @ABCstate, @EFGstate. Outputs: status, ABCstate, EFGstate.
-The compiler found 25 case(s) of inputs the rules do not settle (a value
+The compiler found 29 case(s) of inputs the rules do not settle (a value
 listed as `a | b` stands for any of them):
 - incomplete: undetermined status, ABCstate, EFGstate when service=A, @ABCstate=A, event=START | INTERM | ABORT | ZOMBIE (rules fired: none)
 - incomplete: undetermined EFGstate when service=A, @ABCstate=A, event=END (rules fired: endABC)
-- incomplete: undetermined ABCstate, EFGstate when service=A, @ABCstate=B, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined ABCstate, EFGstate when service=A, @ABCstate=C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined ABCstate, EFGstate when service=A, @ABCstate=IDLE, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined ABCstate, EFGstate when service=B, @ABCstate=A, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=A, @ABCstate=B | C | IDLE, event=START | INTERM (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=A, @ABCstate=B | C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined ABCstate, EFGstate when service=A | B | C, @ABCstate=IDLE, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=A | C, event=START | INTERM (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=B, @ABCstate=A | C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=B, event=START | INTERM | ABORT | ZOMBIE (rules fired: none)
 - incomplete: undetermined EFGstate when service=B, @ABCstate=B, event=END (rules fired: endABC)
-- incomplete: undetermined ABCstate, EFGstate when service=B, @ABCstate=C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=IDLE, event=START (rules fired: none)
 - incomplete: undetermined EFGstate when service=B, @ABCstate=IDLE, event=INTERM (rules fired: intermB)
-- incomplete: undetermined ABCstate, EFGstate when service=B, @ABCstate=IDLE, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=A, event=START (rules fired: CstartWhenNotIdle)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=A, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=B, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=A | B, event=START | END | ABORT | ZOMBIE (rules fired: CstartWhenNotIdle)
+- incomplete: undetermined status, ABCstate, EFGstate when service=C, @ABCstate=A | B | IDLE, event=INTERM (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=C | IDLE, event=START (rules fired: CstartWhenNotIdle)
+- incomplete: undetermined status, ABCstate, EFGstate when service=C, @ABCstate=C, event=INTERM | ABORT | ZOMBIE (rules fired: none)
 - incomplete: undetermined EFGstate when service=C, @ABCstate=C, event=END (rules fired: endABC)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=IDLE, event=START (rules fired: CstartWhenIdle)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=IDLE, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined ABCstate, EFGstate when service=D, event=START (rules fired: Dstart)
-- incomplete: undetermined ABCstate, EFGstate when service=D, event=INTERM | END (rules fired: replyD)
-- incomplete: undetermined ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G, event=START (rules fired: EFGHstartNotIdle)
-- incomplete: undetermined ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G, event=INTERM (rules fired: intermEFGnotIdle)
-- ... and 5 more (`specc rules` lists them all).
+- incomplete: undetermined ABCstate, EFGstate when service=D, event=START | INTERM | END (rules fired: Dstart)
+- incomplete: undetermined status, ABCstate, EFGstate when service=D, event=ABORT | ZOMBIE (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G, event=START | INTERM (rules fired: EFGHstartNotIdle)
+- incomplete: undetermined status, ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G, event=END | ABORT | ZOMBIE (rules fired: none)
+- ... and 9 more (`specc rules` lists them all).
 """
 
 from __future__ import annotations
@@ -34,12 +34,14 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@ABCstate", "@EFGstate"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "ABCstate", "EFGstate"]
 DEPTH = 4
-FINDINGS = 25
+FINDINGS = 29
 
 _LEAF_0 = Decision(MappingProxyType({'status': None, 'ABCstate': None, 'EFGstate': None}), (), ('status', 'ABCstate', 'EFGstate'), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': None}), (), ('EFGstate',), None)
@@ -52,125 +54,129 @@ _LEAF_5 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': None, 'EFGstate
 def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 4 tests; `calls(name, args)` runs `do` calls."""
     a = inputs
-    v = a['service']
-    if v == 'A':
-        v = a['@ABCstate']
+    try:
+        v = a['service']
         if v == 'A':
-            return _node_0(a, calls)
-        elif v in ('B', 'C', 'IDLE'):
-            return _node_1(a, calls)
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'B':
-        v = a['@ABCstate']
-        if v in ('A', 'C'):
-            return _node_1(a, calls)
-        elif v == 'B':
-            return _node_0(a, calls)
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_0
-            elif v == 'INTERM':
-                return _LEAF_3
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_2
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'C':
-        v = a['@ABCstate']
-        if v in ('A', 'B'):
-            return _node_2(a, calls)
-        elif v == 'C':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_4
-            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-                return _LEAF_0
-            elif v == 'END':
-                return _LEAF_1
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_5
-            elif v == 'INTERM':
-                return _LEAF_0
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_2
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@ABCstate={v!r} is outside its domain")
-    elif v == 'D':
-        v = a['event']
-        if v in ('START', 'INTERM', 'END'):
-            return _LEAF_5
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _LEAF_0
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v in ('E', 'F', 'G'):
-        return _node_3(a, calls)
-    elif v == 'H':
-        v = a['event']
-        if v == 'START':
-            v = a['@EFGstate']
-            if v in ('E', 'F', 'G'):
-                return _node_5(a, calls)
-            elif v == 'IDLE':
-                return _LEAF_5
-            else:
-                raise ValueError(f"@EFGstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            return _LEAF_2
-        elif v in ('END', 'ABORT', 'ZOMBIE'):
-            return _LEAF_0
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'I':
-        v = a['event']
-        if v == 'START':
             v = a['@ABCstate']
-            if v in ('A', 'B', 'C'):
-                return _LEAF_4
+            if v == 'A':
+                return _node_0(a, calls)
+            elif v in ('B', 'C', 'IDLE'):
+                return _node_1(a, calls)
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'B':
+            v = a['@ABCstate']
+            if v in ('A', 'C'):
+                return _node_1(a, calls)
+            elif v == 'B':
+                return _node_0(a, calls)
             elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_0
+                elif v == 'INTERM':
+                    return _LEAF_3
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_2
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'C':
+            v = a['@ABCstate']
+            if v in ('A', 'B'):
+                return _node_2(a, calls)
+            elif v == 'C':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_4
+                elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_0
+                elif v == 'END':
+                    return _LEAF_1
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_5
+                elif v == 'INTERM':
+                    return _LEAF_0
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_2
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            else:
+                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        elif v == 'D':
+            v = a['event']
+            if v in ('START', 'INTERM', 'END'):
+                return _LEAF_5
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v in ('E', 'F', 'G'):
+            return _node_3(a, calls)
+        elif v == 'H':
+            v = a['event']
+            if v == 'START':
                 v = a['@EFGstate']
                 if v in ('E', 'F', 'G'):
                     return _node_5(a, calls)
                 elif v == 'IDLE':
-                    return _LEAF_0
+                    return _LEAF_5
                 else:
                     raise ValueError(f"@EFGstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            return _LEAF_2
-        elif v in ('END', 'ABORT', 'ZOMBIE'):
-            return _LEAF_0
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'J':
-        v = a['event']
-        if v == 'START':
-            v = a['@ABCstate']
-            if v in ('A', 'B', 'C'):
-                return _node_6(a, calls)
-            elif v == 'IDLE':
+            elif v == 'INTERM':
+                return _LEAF_2
+            elif v in ('END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            return _LEAF_2
-        elif v in ('END', 'ABORT', 'ZOMBIE'):
-            return _LEAF_0
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'I':
+            v = a['event']
+            if v == 'START':
+                v = a['@ABCstate']
+                if v in ('A', 'B', 'C'):
+                    return _LEAF_4
+                elif v == 'IDLE':
+                    v = a['@EFGstate']
+                    if v in ('E', 'F', 'G'):
+                        return _node_5(a, calls)
+                    elif v == 'IDLE':
+                        return _LEAF_0
+                    else:
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                return _LEAF_2
+            elif v in ('END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'J':
+            v = a['event']
+            if v == 'START':
+                v = a['@ABCstate']
+                if v in ('A', 'B', 'C'):
+                    return _node_6(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                return _LEAF_2
+            elif v in ('END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
         else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    else:
-        raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:

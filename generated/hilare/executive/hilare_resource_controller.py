@@ -11,9 +11,11 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate", "@READ_OBST_SEARCH_OBJstate", "@ExecTrajState", "@ARM_OBJ_ARM_BACKstate", "@CALC_OBJstate", "@CALC_GOALstate"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate", "READ_OBST_SEARCH_OBJstate", "ExecTrajState", "ARM_OBJ_ARM_BACKstate", "CALC_GOALstate", "CALC_OBJstate"]
 DEPTH = 6
 FINDINGS = 0
@@ -85,530 +87,534 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
 
 def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
-    v = a['service']
-    if v in ('AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'GET-NEAR-OBJ'):
-        return _node_0(a, calls)
-    elif v == 'READ-MODEL':
-        v = a['event']
-        if v == 'START':
-            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-            if v == 'READ-MODEL':
-                calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
-                return _LEAF_2
-            elif v == 'CALC-TRAJ-GOAL':
-                return _node_1(a, calls)
-            elif v == 'CALC-TRAJ-OBJ':
-                return _node_2(a, calls)
-            elif v == 'IDLE':
-                return _LEAF_5
-            else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-            if v == 'READ-MODEL':
-                return _LEAF_6
-            elif v == 'CALC-TRAJ-GOAL':
-                return _LEAF_7
-            elif v == 'CALC-TRAJ-OBJ':
-                return _LEAF_8
-            elif v == 'IDLE':
-                return _LEAF_2
-            else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-            if v == 'READ-MODEL':
-                return _LEAF_5
-            elif v == 'CALC-TRAJ-GOAL':
-                return _LEAF_7
-            elif v == 'CALC-TRAJ-OBJ':
-                return _LEAF_8
-            elif v == 'IDLE':
-                return _LEAF_9
-            else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_3(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'INIT-MODEL':
-        v = a['event']
-        if v == 'START':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v in ('READ-OBST', 'SEARCH-OBJ'):
-                return _node_4(a, calls)
-            elif v == 'IDLE':
-                return _LEAF_0
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _LEAF_1
-        elif v == 'END':
-            return _LEAF_0
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'READ-OBST':
-        v = a['event']
-        if v == 'START':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v == 'READ-OBST':
-                calls('changeInterState', (a['@READ_OBST_SEARCH_OBJstate'],))
-                return _LEAF_10
-            elif v == 'SEARCH-OBJ':
-                return _node_5(a, calls)
-            elif v == 'IDLE':
-                return _LEAF_12
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v == 'READ-OBST':
-                return _LEAF_13
-            elif v == 'SEARCH-OBJ':
-                return _LEAF_14
-            elif v == 'IDLE':
-                return _LEAF_10
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v == 'READ-OBST':
-                return _LEAF_12
-            elif v == 'SEARCH-OBJ':
-                return _LEAF_14
-            elif v == 'IDLE':
-                return _LEAF_15
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_6(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'EXEC-TRAJ-GOAL':
-        v = a['event']
-        if v == 'START':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-                if v in ('READ-MODEL', 'CALC-TRAJ-GOAL', 'IDLE'):
-                    return _node_7(a, calls)
-                elif v == 'CALC-TRAJ-OBJ':
-                    return _LEAF_16
-                else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-            elif v == 'EXEC-TRAJ-OBJ':
-                return _LEAF_18
-            elif v == 'IDLE':
-                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-                if v in ('READ-MODEL', 'CALC-TRAJ-GOAL', 'IDLE'):
-                    return _node_9(a, calls)
-                elif v == 'CALC-TRAJ-OBJ':
-                    return _LEAF_19
-                else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                return _LEAF_21
-            elif v == 'EXEC-TRAJ-OBJ':
-                return _LEAF_22
-            elif v == 'IDLE':
-                return _LEAF_17
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                return _LEAF_20
-            elif v == 'EXEC-TRAJ-OBJ':
-                return _LEAF_22
-            elif v == 'IDLE':
-                return _LEAF_23
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_10(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'EXEC-TRAJ-OBJ':
-        v = a['event']
-        if v == 'START':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                return _node_8(a, calls)
-            elif v == 'EXEC-TRAJ-OBJ':
-                calls('changeInterState', (a['@ExecTrajState'],))
-                return _LEAF_24
-            elif v == 'IDLE':
-                return _LEAF_20
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                return _LEAF_21
-            elif v == 'EXEC-TRAJ-OBJ':
-                return _LEAF_22
-            elif v == 'IDLE':
-                return _LEAF_24
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                return _LEAF_21
-            elif v == 'EXEC-TRAJ-OBJ':
-                return _LEAF_20
-            elif v == 'IDLE':
-                return _LEAF_23
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_11(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'CALC-TRAJ-GOAL':
-        v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-        if v == 'READ-MODEL':
+    try:
+        v = a['service']
+        if v in ('AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'GET-NEAR-OBJ'):
+            return _node_0(a, calls)
+        elif v == 'READ-MODEL':
             v = a['event']
             if v == 'START':
-                return _LEAF_25
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_6
+                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                if v == 'READ-MODEL':
+                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                    return _LEAF_2
+                elif v == 'CALC-TRAJ-GOAL':
+                    return _node_1(a, calls)
+                elif v == 'CALC-TRAJ-OBJ':
+                    return _node_2(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_5
+                else:
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                if v == 'READ-MODEL':
+                    return _LEAF_6
+                elif v == 'CALC-TRAJ-GOAL':
+                    return _LEAF_7
+                elif v == 'CALC-TRAJ-OBJ':
+                    return _LEAF_8
+                elif v == 'IDLE':
+                    return _LEAF_2
+                else:
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                if v == 'READ-MODEL':
+                    return _LEAF_5
+                elif v == 'CALC-TRAJ-GOAL':
+                    return _LEAF_7
+                elif v == 'CALC-TRAJ-OBJ':
+                    return _LEAF_8
+                elif v == 'IDLE':
+                    return _LEAF_9
+                else:
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_3(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'INIT-MODEL':
+            v = a['event']
+            if v == 'START':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v in ('READ-OBST', 'SEARCH-OBJ'):
+                    return _node_4(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_1
+            elif v == 'END':
+                return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'READ-OBST':
+            v = a['event']
+            if v == 'START':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v == 'READ-OBST':
+                    calls('changeInterState', (a['@READ_OBST_SEARCH_OBJstate'],))
+                    return _LEAF_10
+                elif v == 'SEARCH-OBJ':
+                    return _node_5(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_12
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v == 'READ-OBST':
+                    return _LEAF_13
+                elif v == 'SEARCH-OBJ':
+                    return _LEAF_14
+                elif v == 'IDLE':
+                    return _LEAF_10
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v == 'READ-OBST':
+                    return _LEAF_12
+                elif v == 'SEARCH-OBJ':
+                    return _LEAF_14
+                elif v == 'IDLE':
+                    return _LEAF_15
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_6(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'EXEC-TRAJ-GOAL':
+            v = a['event']
+            if v == 'START':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                    if v in ('READ-MODEL', 'CALC-TRAJ-GOAL', 'IDLE'):
+                        return _node_7(a, calls)
+                    elif v == 'CALC-TRAJ-OBJ':
+                        return _LEAF_16
+                    else:
+                        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                elif v == 'EXEC-TRAJ-OBJ':
+                    return _LEAF_18
+                elif v == 'IDLE':
+                    v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                    if v in ('READ-MODEL', 'CALC-TRAJ-GOAL', 'IDLE'):
+                        return _node_9(a, calls)
+                    elif v == 'CALC-TRAJ-OBJ':
+                        return _LEAF_19
+                    else:
+                        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    return _LEAF_21
+                elif v == 'EXEC-TRAJ-OBJ':
+                    return _LEAF_22
+                elif v == 'IDLE':
+                    return _LEAF_17
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    return _LEAF_20
+                elif v == 'EXEC-TRAJ-OBJ':
+                    return _LEAF_22
+                elif v == 'IDLE':
+                    return _LEAF_23
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_10(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'EXEC-TRAJ-OBJ':
+            v = a['event']
+            if v == 'START':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    return _node_8(a, calls)
+                elif v == 'EXEC-TRAJ-OBJ':
+                    calls('changeInterState', (a['@ExecTrajState'],))
+                    return _LEAF_24
+                elif v == 'IDLE':
+                    return _LEAF_20
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    return _LEAF_21
+                elif v == 'EXEC-TRAJ-OBJ':
+                    return _LEAF_22
+                elif v == 'IDLE':
+                    return _LEAF_24
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    return _LEAF_21
+                elif v == 'EXEC-TRAJ-OBJ':
+                    return _LEAF_20
+                elif v == 'IDLE':
+                    return _LEAF_23
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_11(a, calls)
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         elif v == 'CALC-TRAJ-GOAL':
-            v = a['event']
-            if v == 'START':
-                return _node_1(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_7
-            elif v == 'END':
-                return _LEAF_5
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_3
+            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+            if v == 'READ-MODEL':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_25
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'CALC-TRAJ-GOAL':
+                v = a['event']
+                if v == 'START':
+                    return _node_1(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_7
+                elif v == 'END':
+                    return _LEAF_5
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_3
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'CALC-TRAJ-OBJ':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_26
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_8
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_5
+                elif v == 'INTERM':
+                    return _LEAF_3
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_9
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
         elif v == 'CALC-TRAJ-OBJ':
             v = a['event']
             if v == 'START':
-                return _LEAF_26
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_8
+                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                if v == 'READ-MODEL':
+                    return _LEAF_25
+                elif v == 'CALC-TRAJ-GOAL':
+                    v = a['@ExecTrajState']
+                    if v == 'EXEC-TRAJ-GOAL':
+                        calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                        calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                        calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                        return _LEAF_3
+                    elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                        return _node_1(a, calls)
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                elif v == 'CALC-TRAJ-OBJ':
+                    v = a['@ExecTrajState']
+                    if v == 'EXEC-TRAJ-GOAL':
+                        calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                        calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                        calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
+                        return _LEAF_4
+                    elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                        return _node_2(a, calls)
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@ExecTrajState']
+                    if v == 'EXEC-TRAJ-GOAL':
+                        calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                        calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                        return _LEAF_5
+                    elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                        return _LEAF_5
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                if v == 'READ-MODEL':
+                    return _LEAF_6
+                elif v == 'CALC-TRAJ-GOAL':
+                    return _LEAF_7
+                elif v == 'CALC-TRAJ-OBJ':
+                    return _LEAF_8
+                elif v == 'IDLE':
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
+                if v == 'READ-MODEL':
+                    return _LEAF_6
+                elif v == 'CALC-TRAJ-GOAL':
+                    return _LEAF_7
+                elif v == 'CALC-TRAJ-OBJ':
+                    return _LEAF_5
+                elif v == 'IDLE':
+                    return _LEAF_9
+                else:
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_12(a, calls)
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
+        elif v == 'ARM-OBJ':
             v = a['event']
             if v == 'START':
-                return _LEAF_5
+                v = a['@ARM_OBJ_ARM_BACKstate']
+                if v == 'ARM-OBJ':
+                    v = a['@ExecTrajState']
+                    if v == 'EXEC-TRAJ-GOAL':
+                        calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                        calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                        return _LEAF_27
+                    elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                        return _node_13(a, calls)
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                elif v == 'ARM-BACK':
+                    v = a['@ExecTrajState']
+                    if v == 'EXEC-TRAJ-GOAL':
+                        calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                        calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                        return _LEAF_29
+                    elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                        return _node_14(a, calls)
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@ExecTrajState']
+                    if v == 'EXEC-TRAJ-GOAL':
+                        calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                        calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                        return _LEAF_31
+                    elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                        return _LEAF_32
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
             elif v == 'INTERM':
-                return _LEAF_3
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_9
+                v = a['@ARM_OBJ_ARM_BACKstate']
+                if v == 'ARM-OBJ':
+                    return _LEAF_33
+                elif v == 'ARM-BACK':
+                    return _LEAF_34
+                elif v == 'IDLE':
+                    return _LEAF_28
+                else:
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ARM_OBJ_ARM_BACKstate']
+                if v == 'ARM-OBJ':
+                    return _LEAF_32
+                elif v == 'ARM-BACK':
+                    return _LEAF_34
+                elif v == 'IDLE':
+                    return _LEAF_35
+                else:
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_15(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'ARM-BACK':
+            v = a['event']
+            if v == 'START':
+                v = a['@ARM_OBJ_ARM_BACKstate']
+                if v == 'ARM-OBJ':
+                    return _LEAF_27
+                elif v == 'ARM-BACK':
+                    return _node_14(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_32
+                else:
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@ARM_OBJ_ARM_BACKstate']
+                if v == 'ARM-OBJ':
+                    return _LEAF_33
+                elif v == 'ARM-BACK':
+                    return _LEAF_34
+                elif v == 'IDLE':
+                    return _LEAF_30
+                else:
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@ARM_OBJ_ARM_BACKstate']
+                if v == 'ARM-OBJ':
+                    return _LEAF_33
+                elif v == 'ARM-BACK':
+                    return _LEAF_32
+                elif v == 'IDLE':
+                    return _LEAF_35
+                else:
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_16(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'TAKE-IMAGE':
+            v = a['event']
+            if v == 'START':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v in ('READ-OBST', 'IDLE'):
+                    return _LEAF_0
+                elif v == 'SEARCH-OBJ':
+                    return _LEAF_36
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_1
+            elif v == 'END':
+                return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'SEARCH-OBJ':
+            v = a['event']
+            if v == 'START':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v == 'READ-OBST':
+                    return _LEAF_37
+                elif v == 'SEARCH-OBJ':
+                    return _node_5(a, calls)
+                elif v == 'IDLE':
+                    return _LEAF_12
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v == 'READ-OBST':
+                    return _LEAF_13
+                elif v == 'SEARCH-OBJ':
+                    return _LEAF_14
+                elif v == 'IDLE':
+                    return _LEAF_11
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@READ_OBST_SEARCH_OBJstate']
+                if v == 'READ-OBST':
+                    return _LEAF_13
+                elif v == 'SEARCH-OBJ':
+                    return _LEAF_12
+                elif v == 'IDLE':
+                    return _LEAF_15
+                else:
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_17(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'CALC-GOAL':
+            v = a['event']
+            if v == 'START':
+                v = a['@CALC_GOALstate']
+                if v == 'CALC-GOAL':
+                    v = a['@ExecTrajState']
+                    if v in ('EXEC-TRAJ-GOAL', 'IDLE'):
+                        return _node_18(a, calls)
+                    elif v == 'EXEC-TRAJ-OBJ':
+                        return _LEAF_39
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                elif v == 'IDLE':
+                    v = a['@ExecTrajState']
+                    if v in ('EXEC-TRAJ-GOAL', 'IDLE'):
+                        return _LEAF_40
+                    elif v == 'EXEC-TRAJ-OBJ':
+                        return _LEAF_41
+                    else:
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                else:
+                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@CALC_GOALstate']
+                if v == 'CALC-GOAL':
+                    return _LEAF_42
+                elif v == 'IDLE':
+                    return _LEAF_38
+                else:
+                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@CALC_GOALstate']
+                if v == 'CALC-GOAL':
+                    return _LEAF_40
+                elif v == 'IDLE':
+                    return _LEAF_43
+                else:
+                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_19(a, calls)
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
+        elif v == 'CALC-OBJ':
+            v = a['event']
+            if v == 'START':
+                v = a['@ExecTrajState']
+                if v == 'EXEC-TRAJ-GOAL':
+                    calls('changeInterState', (a['@ExecTrajState'],))
+                    calls('sendAbortRequest', (a['@ExecTrajState'],))
+                    v = a['@CALC_OBJstate']
+                    if v == 'CALC-OBJ':
+                        return _LEAF_44
+                    elif v == 'IDLE':
+                        return _LEAF_45
+                    else:
+                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
+                    return _node_20(a, calls)
+                else:
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            elif v == 'INTERM':
+                v = a['@CALC_OBJstate']
+                if v == 'CALC-OBJ':
+                    return _LEAF_48
+                elif v == 'IDLE':
+                    return _LEAF_46
+                else:
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+            elif v == 'END':
+                v = a['@CALC_OBJstate']
+                if v == 'CALC-OBJ':
+                    return _LEAF_47
+                elif v == 'IDLE':
+                    return _LEAF_49
+                else:
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+            elif v in ('ABORT', 'ZOMBIE'):
+                return _node_21(a, calls)
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
-            raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-    elif v == 'CALC-TRAJ-OBJ':
-        v = a['event']
-        if v == 'START':
-            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-            if v == 'READ-MODEL':
-                return _LEAF_25
-            elif v == 'CALC-TRAJ-GOAL':
-                v = a['@ExecTrajState']
-                if v == 'EXEC-TRAJ-GOAL':
-                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
-                    return _LEAF_3
-                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                    return _node_1(a, calls)
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            elif v == 'CALC-TRAJ-OBJ':
-                v = a['@ExecTrajState']
-                if v == 'EXEC-TRAJ-GOAL':
-                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    calls('changeInterState', (a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate'],))
-                    return _LEAF_4
-                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                    return _node_2(a, calls)
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@ExecTrajState']
-                if v == 'EXEC-TRAJ-GOAL':
-                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _LEAF_5
-                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                    return _LEAF_5
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-            if v == 'READ-MODEL':
-                return _LEAF_6
-            elif v == 'CALC-TRAJ-GOAL':
-                return _LEAF_7
-            elif v == 'CALC-TRAJ-OBJ':
-                return _LEAF_8
-            elif v == 'IDLE':
-                return _LEAF_4
-            else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate']
-            if v == 'READ-MODEL':
-                return _LEAF_6
-            elif v == 'CALC-TRAJ-GOAL':
-                return _LEAF_7
-            elif v == 'CALC-TRAJ-OBJ':
-                return _LEAF_5
-            elif v == 'IDLE':
-                return _LEAF_9
-            else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_12(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'ARM-OBJ':
-        v = a['event']
-        if v == 'START':
-            v = a['@ARM_OBJ_ARM_BACKstate']
-            if v == 'ARM-OBJ':
-                v = a['@ExecTrajState']
-                if v == 'EXEC-TRAJ-GOAL':
-                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _LEAF_27
-                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                    return _node_13(a, calls)
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            elif v == 'ARM-BACK':
-                v = a['@ExecTrajState']
-                if v == 'EXEC-TRAJ-GOAL':
-                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _LEAF_29
-                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                    return _node_14(a, calls)
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@ExecTrajState']
-                if v == 'EXEC-TRAJ-GOAL':
-                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                    return _LEAF_31
-                elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                    return _LEAF_32
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@ARM_OBJ_ARM_BACKstate']
-            if v == 'ARM-OBJ':
-                return _LEAF_33
-            elif v == 'ARM-BACK':
-                return _LEAF_34
-            elif v == 'IDLE':
-                return _LEAF_28
-            else:
-                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ARM_OBJ_ARM_BACKstate']
-            if v == 'ARM-OBJ':
-                return _LEAF_32
-            elif v == 'ARM-BACK':
-                return _LEAF_34
-            elif v == 'IDLE':
-                return _LEAF_35
-            else:
-                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_15(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'ARM-BACK':
-        v = a['event']
-        if v == 'START':
-            v = a['@ARM_OBJ_ARM_BACKstate']
-            if v == 'ARM-OBJ':
-                return _LEAF_27
-            elif v == 'ARM-BACK':
-                return _node_14(a, calls)
-            elif v == 'IDLE':
-                return _LEAF_32
-            else:
-                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@ARM_OBJ_ARM_BACKstate']
-            if v == 'ARM-OBJ':
-                return _LEAF_33
-            elif v == 'ARM-BACK':
-                return _LEAF_34
-            elif v == 'IDLE':
-                return _LEAF_30
-            else:
-                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@ARM_OBJ_ARM_BACKstate']
-            if v == 'ARM-OBJ':
-                return _LEAF_33
-            elif v == 'ARM-BACK':
-                return _LEAF_32
-            elif v == 'IDLE':
-                return _LEAF_35
-            else:
-                raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_16(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'TAKE-IMAGE':
-        v = a['event']
-        if v == 'START':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v in ('READ-OBST', 'IDLE'):
-                return _LEAF_0
-            elif v == 'SEARCH-OBJ':
-                return _LEAF_36
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _LEAF_1
-        elif v == 'END':
-            return _LEAF_0
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'SEARCH-OBJ':
-        v = a['event']
-        if v == 'START':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v == 'READ-OBST':
-                return _LEAF_37
-            elif v == 'SEARCH-OBJ':
-                return _node_5(a, calls)
-            elif v == 'IDLE':
-                return _LEAF_12
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v == 'READ-OBST':
-                return _LEAF_13
-            elif v == 'SEARCH-OBJ':
-                return _LEAF_14
-            elif v == 'IDLE':
-                return _LEAF_11
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@READ_OBST_SEARCH_OBJstate']
-            if v == 'READ-OBST':
-                return _LEAF_13
-            elif v == 'SEARCH-OBJ':
-                return _LEAF_12
-            elif v == 'IDLE':
-                return _LEAF_15
-            else:
-                raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_17(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'CALC-GOAL':
-        v = a['event']
-        if v == 'START':
-            v = a['@CALC_GOALstate']
-            if v == 'CALC-GOAL':
-                v = a['@ExecTrajState']
-                if v in ('EXEC-TRAJ-GOAL', 'IDLE'):
-                    return _node_18(a, calls)
-                elif v == 'EXEC-TRAJ-OBJ':
-                    return _LEAF_39
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            elif v == 'IDLE':
-                v = a['@ExecTrajState']
-                if v in ('EXEC-TRAJ-GOAL', 'IDLE'):
-                    return _LEAF_40
-                elif v == 'EXEC-TRAJ-OBJ':
-                    return _LEAF_41
-                else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-            else:
-                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@CALC_GOALstate']
-            if v == 'CALC-GOAL':
-                return _LEAF_42
-            elif v == 'IDLE':
-                return _LEAF_38
-            else:
-                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@CALC_GOALstate']
-            if v == 'CALC-GOAL':
-                return _LEAF_40
-            elif v == 'IDLE':
-                return _LEAF_43
-            else:
-                raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_19(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    elif v == 'CALC-OBJ':
-        v = a['event']
-        if v == 'START':
-            v = a['@ExecTrajState']
-            if v == 'EXEC-TRAJ-GOAL':
-                calls('changeInterState', (a['@ExecTrajState'],))
-                calls('sendAbortRequest', (a['@ExecTrajState'],))
-                v = a['@CALC_OBJstate']
-                if v == 'CALC-OBJ':
-                    return _LEAF_44
-                elif v == 'IDLE':
-                    return _LEAF_45
-                else:
-                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-            elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-                return _node_20(a, calls)
-            else:
-                raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
-        elif v == 'INTERM':
-            v = a['@CALC_OBJstate']
-            if v == 'CALC-OBJ':
-                return _LEAF_48
-            elif v == 'IDLE':
-                return _LEAF_46
-            else:
-                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-        elif v == 'END':
-            v = a['@CALC_OBJstate']
-            if v == 'CALC-OBJ':
-                return _LEAF_47
-            elif v == 'IDLE':
-                return _LEAF_49
-            else:
-                raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
-        elif v in ('ABORT', 'ZOMBIE'):
-            return _node_21(a, calls)
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    else:
-        raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:

@@ -2,11 +2,12 @@
 """Rule base hilare_controller, compiled into a decision graph of depth 3.
 
 Inputs: service, event, @ExecTrajState. Outputs: status, ExecTrajState.
-The compiler found 3 case(s) of inputs the rules do not settle (a value
+The compiler found 4 case(s) of inputs the rules do not settle (a value
 listed as `a | b` stands for any of them):
 - incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-OBJ | IDLE (rules fired: none)
-- incomplete: undetermined ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=CALC-TRAJ-OBJ (rules fired: CalcTrajObjWhenExecTrajGoal)
-- incomplete: undetermined ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=ARM-OBJ (rules fired: ArmGoWhenExecTrajGoal)
+- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=AVOID-ON | SET-DYNAMIC | AUTOBOX-OFF | SET-BOX | READ-MODEL | INIT-MODEL | READ-OBST | EXEC-TRAJ-GOAL | EXEC-TRAJ-OBJ | CALC-TRAJ-GOAL | ARM-BACK | OPEN-GRIP | CLOSE-GRIP | TURN-CAMERA | TAKE-IMAGE | SEARCH-OBJ | GET-NEAR-OBJ | CALC-GOAL | CALC-OBJ (rules fired: none)
+- incomplete: undetermined ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=START, service=CALC-TRAJ-OBJ | ARM-OBJ (rules fired: CalcTrajObjWhenExecTrajGoal)
+- incomplete: undetermined status, ExecTrajState when @ExecTrajState=EXEC-TRAJ-GOAL, event=INTERM | END | ABORT | ZOMBIE (rules fired: none)
 """
 
 from __future__ import annotations
@@ -16,12 +17,14 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@ExecTrajState"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "ExecTrajState"]
 DEPTH = 3
-FINDINGS = 3
+FINDINGS = 4
 
 _LEAF_0 = Decision(MappingProxyType({'status': None, 'ExecTrajState': None}), (), ('status', 'ExecTrajState'), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ExecTrajState': None}), (), ('ExecTrajState',), None)
@@ -31,28 +34,32 @@ _LEAF_2 = Decision(MappingProxyType({'status': 'WAIT', 'ExecTrajState': None}), 
 def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 3 tests; `calls(name, args)` runs `do` calls."""
     a = inputs
-    v = a['@ExecTrajState']
-    if v in ('EXEC-TRAJ-OBJ', 'IDLE'):
-        return _LEAF_0
-    elif v == 'EXEC-TRAJ-GOAL':
-        v = a['event']
-        if v == 'START':
-            v = a['service']
-            if v in ('AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'READ-MODEL', 'INIT-MODEL', 'READ-OBST', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'CALC-TRAJ-GOAL', 'ARM-BACK', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'TAKE-IMAGE', 'SEARCH-OBJ', 'GET-NEAR-OBJ', 'CALC-GOAL', 'CALC-OBJ'):
-                return _LEAF_0
-            elif v == 'CALC-TRAJ-OBJ':
-                calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                return _LEAF_1
-            elif v == 'ARM-OBJ':
-                calls('changeInterState', ('EXEC-TRAJ-GOAL',))
-                calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
-                return _LEAF_2
-            else:
-                raise ValueError(f"service={v!r} is outside its domain")
-        elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+    try:
+        v = a['@ExecTrajState']
+        if v in ('EXEC-TRAJ-OBJ', 'IDLE'):
             return _LEAF_0
+        elif v == 'EXEC-TRAJ-GOAL':
+            v = a['event']
+            if v == 'START':
+                v = a['service']
+                if v in ('AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'READ-MODEL', 'INIT-MODEL', 'READ-OBST', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'CALC-TRAJ-GOAL', 'ARM-BACK', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'TAKE-IMAGE', 'SEARCH-OBJ', 'GET-NEAR-OBJ', 'CALC-GOAL', 'CALC-OBJ'):
+                    return _LEAF_0
+                elif v == 'CALC-TRAJ-OBJ':
+                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                    return _LEAF_1
+                elif v == 'ARM-OBJ':
+                    calls('changeInterState', ('EXEC-TRAJ-GOAL',))
+                    calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
+                    return _LEAF_2
+                else:
+                    raise ValueError(f"service={v!r} is outside its domain")
+            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                return _LEAF_0
+            else:
+                raise ValueError(f"event={v!r} is outside its domain")
         else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    else:
-        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise

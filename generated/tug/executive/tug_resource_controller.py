@@ -11,9 +11,11 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["service", "event", "@GOTO_HITCH_UNHITCHstate"]
+NUMERIC_INPUTS = []
 OUTPUTS = ["status", "GOTO_HITCH_UNHITCHstate"]
 DEPTH = 3
 FINDINGS = 0
@@ -48,132 +50,136 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
 
 def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
     a = inputs
-    v = a['service']
-    if v == 'GOTO':
-        v = a['@GOTO_HITCH_UNHITCHstate']
+    try:
+        v = a['service']
         if v == 'GOTO':
-            v = a['event']
-            if v == 'START':
-                calls('changeInterState', (a['@GOTO_HITCH_UNHITCHstate'],))
-                return _LEAF_0
-            elif v == 'INTERM':
-                return _LEAF_1
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_0
+            v = a['@GOTO_HITCH_UNHITCHstate']
+            if v == 'GOTO':
+                v = a['event']
+                if v == 'START':
+                    calls('changeInterState', (a['@GOTO_HITCH_UNHITCHstate'],))
+                    return _LEAF_0
+                elif v == 'INTERM':
+                    return _LEAF_1
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_0
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'HITCH':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_3
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'UNHITCH':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_5
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_0
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_7
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
         elif v == 'HITCH':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_3
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
+            v = a['@GOTO_HITCH_UNHITCHstate']
+            if v == 'GOTO':
+                return _node_0(a, calls)
+            elif v == 'HITCH':
+                v = a['event']
+                if v == 'START':
+                    return _node_1(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_4
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_9
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'UNHITCH':
+                v = a['event']
+                if v == 'START':
+                    return _node_2(a, calls)
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_6
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_9
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_7
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
         elif v == 'UNHITCH':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_5
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_6
+            v = a['@GOTO_HITCH_UNHITCHstate']
+            if v == 'GOTO':
+                return _node_0(a, calls)
+            elif v == 'HITCH':
+                v = a['event']
+                if v == 'START':
+                    return _node_1(a, calls)
+                elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_4
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'UNHITCH':
+                v = a['event']
+                if v == 'START':
+                    return _node_2(a, calls)
+                elif v == 'INTERM':
+                    return _LEAF_6
+                elif v == 'END':
+                    return _LEAF_2
+                elif v in ('ABORT', 'ZOMBIE'):
+                    return _LEAF_10
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
+            elif v == 'IDLE':
+                v = a['event']
+                if v == 'START':
+                    return _LEAF_2
+                elif v == 'INTERM':
+                    return _LEAF_10
+                elif v in ('END', 'ABORT', 'ZOMBIE'):
+                    return _LEAF_7
+                else:
+                    raise ValueError(f"event={v!r} is outside its domain")
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
+                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+        elif v == 'SET-LOAD':
             v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_0
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_7
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
-    elif v == 'HITCH':
-        v = a['@GOTO_HITCH_UNHITCHstate']
-        if v == 'GOTO':
-            return _node_0(a, calls)
-        elif v == 'HITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_1(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_4
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_9
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'UNHITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_2(a, calls)
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_6
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_9
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_7
+            if v in ('START', 'END'):
+                return _LEAF_11
+            elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
+                return _LEAF_12
             else:
                 raise ValueError(f"event={v!r} is outside its domain")
         else:
-            raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
-    elif v == 'UNHITCH':
-        v = a['@GOTO_HITCH_UNHITCHstate']
-        if v == 'GOTO':
-            return _node_0(a, calls)
-        elif v == 'HITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_1(a, calls)
-            elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_4
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'UNHITCH':
-            v = a['event']
-            if v == 'START':
-                return _node_2(a, calls)
-            elif v == 'INTERM':
-                return _LEAF_6
-            elif v == 'END':
-                return _LEAF_2
-            elif v in ('ABORT', 'ZOMBIE'):
-                return _LEAF_10
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        elif v == 'IDLE':
-            v = a['event']
-            if v == 'START':
-                return _LEAF_2
-            elif v == 'INTERM':
-                return _LEAF_10
-            elif v in ('END', 'ABORT', 'ZOMBIE'):
-                return _LEAF_7
-            else:
-                raise ValueError(f"event={v!r} is outside its domain")
-        else:
-            raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
-    elif v == 'SET-LOAD':
-        v = a['event']
-        if v in ('START', 'END'):
-            return _LEAF_11
-        elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
-            return _LEAF_12
-        else:
-            raise ValueError(f"event={v!r} is outside its domain")
-    else:
-        raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
 
 
 def _node_0(a: Any, calls: Calls) -> Decision:

@@ -11,9 +11,11 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
 INPUTS = ["load", "clearance"]
+NUMERIC_INPUTS = ["load", "clearance"]
 OUTPUTS = ["speed"]
 DEPTH = 2
 FINDINGS = 0
@@ -26,18 +28,22 @@ _LEAF_2 = Decision(MappingProxyType({'speed': 'fast'}), (), (), None)
 def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
     """One deduction cycle: at most 2 tests; `calls(name, args)` runs `do` calls."""
     a = inputs
-    v = a['clearance']
-    if 0.0 <= v and v < 0.6:
-        return _LEAF_0
-    elif 0.6 <= v and v < 1.5:
-        return _LEAF_1
-    elif 1.5 <= v and v <= 30.0:
-        v = a['load']
-        if 0.0 <= v and v < 100.0:
-            return _LEAF_2
-        elif 100.0 <= v and v <= 1000.0:
+    try:
+        v = a['clearance']
+        if 0.0 <= v and v < 0.6:
+            return _LEAF_0
+        elif 0.6 <= v and v < 1.5:
             return _LEAF_1
+        elif 1.5 <= v and v <= 30.0:
+            v = a['load']
+            if 0.0 <= v and v < 100.0:
+                return _LEAF_2
+            elif 100.0 <= v and v <= 1000.0:
+                return _LEAF_1
+            else:
+                raise ValueError(f"load={v!r} is outside its domain")
         else:
-            raise ValueError(f"load={v!r} is outside its domain")
-    else:
-        raise ValueError(f"clearance={v!r} is outside its domain")
+            raise ValueError(f"clearance={v!r} is outside its domain")
+    except TypeError as error:  # a numeric input given a string or None: say which
+        _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise

@@ -570,7 +570,9 @@ class FtPlan:
         return repaired
 
     def give_up(self, why: str) -> None:
-        for goal in self.state.open_goals():
+        # Only the goals still calling for action: a final goal that holds now (the robot is home)
+        # is met when the mission ends (`run`), not abandoned.
+        for goal in self.state.pending():
             self.state.missed[goal.line] = why
         self.tell_operator(f"remaining goals abandoned: {why}")
 

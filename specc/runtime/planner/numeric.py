@@ -318,7 +318,7 @@ class DurationSpec:
     low: float
     high: float
     contingent: bool
-    variables: Mapping[str, Value] = field(default_factory=dict)  # internal values the arguments decide
+    variables: Mapping[str, Value] = field(default_factory=dict)  # values the given arguments decide
 
 
 def duration_of(task: pm.Task, args: Mapping[str, Value]) -> DurationSpec:
@@ -374,9 +374,10 @@ def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> Durat
     if low > high + 1e-9:
         raise Empty(f"{task.name}: its duration would lie in [{low:g}, {high:g}]")
     known: dict[str, Value] = {}
-    for name in task.variables:
+    given = {name for name, _ in key}
+    for name in (*task.params, *task.variables):  # a parameter too (`?left =. ?b - 1`, both parameters)
         found = closure.value(name)
-        if found is not None:
+        if found is not None and name not in given:
             known[name] = found
     return DurationSpec(max(0.0, low), high, contingent, known)
 

@@ -22,7 +22,7 @@ class Action:
     contingent: bool
     preemptible: bool  # may be stopped while it runs (latePreemptive)
     window: tuple[float, float] = (0.0, 0.0)  # [earliest, latest] start the partial order allows
-    values: tuple[tuple[str, Value], ...] = ()  # the other variables the planner fixed (symbolic ones)
+    values: tuple[tuple[str, Value], ...] = ()  # the other variables the planner fixed (a symbol or a number)
 
     def text(self) -> str:
         return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
@@ -70,6 +70,11 @@ class Plan:
     def ends_by(self, action: Action) -> float:
         """The latest date the action may end, whatever nature does."""
         return self.uncontrolled.get(action.end, (0.0, action.dispatch + action.duration[1]))[1]
+
+    @property
+    def controllability_text(self) -> str:
+        """How the plan is controllable, in words (IxTeT's pseudo-controllability)."""
+        return "pseudo-controllable" if self.controllability == "pseudo" else f"{self.controllability}ly controllable"
 
     @property
     def makespan(self) -> float:

@@ -157,7 +157,7 @@ class Planner:
         alone: dict[int, Attempt] = {}  # each goal's search alone: the first of those below, if it comes to them
         for goal in goals:
             alone[goal.index] = attempt([goal], self.goal_nodes)
-            impossible = impossible_alone(alone[goal.index])
+            impossible = impossible_alone(alone[goal.index], goal, setup.problem)
             if impossible is not None:
                 outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, impossible)
             else:
@@ -176,10 +176,10 @@ class Planner:
                     kept.append(goal)
                     best = tried
                 else:
-                    higher = ", ".join(g.text for g in kept) or "none"
-                    outcomes[goal.index] = GoalOutcome(
-                        goal.text, goal.priority, goal.hold.line, False,
-                        f"cannot be met together with the goals kept before it ({higher}): {explain(tried)}")
+                    why = (f"cannot be met together with the goals kept before it ({', '.join(g.text for g in kept)})"
+                           if kept else "not met alone either (no goal was kept before it)")
+                    outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False,
+                                                       f"{why}: {explain(tried)}")
         assert best.node is not None
         plan, notes = setup.extract(best.node, self.exact)
         if self.improve:
@@ -244,7 +244,7 @@ class Planner:
             return {}
         found = {}
         for goal in setup.goals:
-            why = impossible_alone(setup.search([goal], self.goal_nodes))
+            why = impossible_alone(setup.search([goal], self.goal_nodes), goal, problem)
             if why is not None:
                 found[goal.hold.line] = why
         return found
@@ -302,15 +302,31 @@ def _push(stack: list[tuple[Node, Resolver | None, int]], node: Node, choice: li
     return cut
 
 
-def impossible_alone(alone: Attempt) -> str | None:
-    """Why a goal searched for alone is impossible (its whole search space failed), else None."""
-    return f"impossible even alone: {explain(alone)}" if alone.node is None and alone.exhausted else None
+def impossible_alone(alone: Attempt, goal: Goal, problem: pm.Problem) -> str | None:
+    """Why a goal searched for alone is impossible (its whole search space failed), else None;
+    with the problem's constraints on the goal's dates (a deadline), which the search's own words
+    (a contradiction between two timepoints) do not name."""
+    if alone.node is not None or not alone.exhausted:
+        return None
+    dated = set(pm.assertion_timepoints(goal.hold)) - {problem.start, problem.end}
+    bounds = [f"{_constraint_text(c)} (line {c.line})" for c in problem.constraints
+              if c.line and pm.timepoints_of(c) & dated]
+    return f"impossible even alone: {explain(alone)}" + (f"; the goal's dates: {', '.join(bounds)}" if bounds else "")
+
+
+def _constraint_text(c: pm.Constraint) -> str:
+    if isinstance(c, pm.Member) and isinstance(c.domain, pm.Interval):
+        return f"{pm.describe(c.expr)} in [{c.domain.low:g}, {c.domain.high:g}]"
+    if isinstance(c, pm.Relation):
+        return f"{pm.describe(c.left)} {c.op} {pm.describe(c.right)}"
+    return "a constraint"
 
 
 def explain(attempt: Attempt) -> str:
     if attempt.node is not None:
         return "planned"
-    scope = "every partial plan failed" if attempt.exhausted else f"no plan within {attempt.nodes} partial plans"
+    scope = "every partial plan failed" if attempt.exhausted else (
+        f"no plan within {attempt.nodes} partial plans (a larger search budget may find one)")
     if not attempt.failures:
         return scope
     common = ", ".join(why for why, _ in attempt.failures.most_common(2))
@@ -724,8 +740,10 @@ class Setup:
             task = instance.task
             spec = durations[instance.id]
             args = tuple(_chosen(node.bindings.value(instance.var(p))) for p in task.params)
-            values = tuple((v, _chosen(node.bindings.value(instance.var(v)))) for v in task.variables
-                           if isinstance(node.bindings.value(instance.var(v)), str))
+            # Every local variable the plan pins (a symbol, or a number such as `?b2 =. ?b - 1`
+            # once ?b is chosen): the validator evaluates the assertions that use it.
+            values = tuple((v, value) for v in task.variables
+                           if (value := node.bindings.value(instance.var(v))) is not None)
             actions.append(Action(instance.id, task.name, args, instance.start, instance.end,
                                   schedule[instance.start], (spec.low, spec.high), spec.contingent,
                                   task.preemptible, network.window(instance.start), values))

@@ -78,6 +78,7 @@ from specc.runtime.planner.model import (
     Var,
     assertion_timepoints,
     describe,
+    timepoints_of,
 )
 from specc.runtime.planner.plan import Action, Plan, Value, format_value
 
@@ -671,7 +672,11 @@ class Validator:
             dropped = a.goal is not None and a.line in self.dropped if isinstance(a, (Event, Hold)) else False
             for t in assertion_timepoints(a):
                 uses.setdefault(t, []).append(dropped)
-        self.optional = {t for t, flags in uses.items() if all(flags)}
+        # A timepoint only dropped goals use, or one nothing uses (declared and forgotten: `specc
+        # check` warns), needs no date.
+        constrained = set().union(*(timepoints_of(c) for c in p.constraints))
+        self.optional = {t for t, flags in uses.items() if all(flags)} | {
+            t for t in p.timepoints if t not in uses and t not in constrained}
         for name, date in self.plan.schedule.items():
             if name == p.start and abs(date) > TOLERANCE:
                 self.report("t_start", f"schedule: {p.start} is date 0, not {date_text(date)}")
