@@ -809,10 +809,13 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
                 raise RunError(f"{option} {value}: give a mission time in seconds")
         if start is not None and end is not None and start > end:
             raise RunError(f"--from {start:g} is after --to {end:g}: nothing between them")
-        folder, events = load_run(run_path)
+        cut: list[str] = []
+        folder, events = load_run(run_path, cut)
         note = check_kinds(events, kind or ())
     except RunError as error:
         raise _run_error(error, 2) from None
+    for said in cut:
+        err.print(f"warning: {said}", markup=False)
     if note is not None:
         err.print(f"note: {note}", markup=False)
     previous: float | None = None
@@ -893,7 +896,8 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
             configuration = f" with {row.configuration}" if row.configuration else ""
             out.print(f"{robot}'s mission {row.mission} in {row.world}{configuration}: {row.succeeded} of "
                       f"{row.seeds} seed(s) "
-                      f"succeeded ({100 * row.success_rate:.0f} %), {row.simulated_time:.0f} s per successful run",
+                      f"succeeded ({100 * row.success_rate:.0f} %)" + (
+                          f", {row.simulated_time:.0f} s per successful run" if row.simulated_time is not None else ""),
                       markup=False)
     for failure in result.failures:
         out.print(f"failed: {failure.name}: {failure.why}", markup=False)

@@ -16,10 +16,9 @@ GROUP_COLOURS = ("#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860
 
 def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title: str) -> Path:
     """Services on a circle; solid arcs interrupt, dashed arcs wait; groups share a colour."""
-    import matplotlib
+    from specc.runtime.sim.render import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from matplotlib.patches import FancyArrowPatch
 
     groups = service_groups(graph)
@@ -89,10 +88,9 @@ def draw_net(net: petri.Net, target: Path, title: str, where: Mapping[str, Any] 
     transitions touching them (one KA's net: `only=lambda p: p.startswith("KA.")`). `where`,
     place -> an object with `line` and `what`, puts the statement under the place's name.
     The same net always makes the same file."""
-    import matplotlib
+    from specc.runtime.sim.render import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from matplotlib.patches import Circle, FancyArrowPatch, Rectangle
 
     suffix = target.suffix.lower()
@@ -190,7 +188,7 @@ def draw_net(net: petri.Net, target: Path, title: str, where: Mapping[str, Any] 
         target.parent.mkdir(parents=True, exist_ok=True)
         stamp: dict[str, Any] = {".png": {"Software": None}, ".svg": {"Date": None},
                                  ".pdf": {"CreationDate": None}}[suffix]
-        with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "specc"}):
+        with plt.rc_context({"svg.fonttype": "none", "svg.hashsalt": "specc"}):
             figure.savefig(target, dpi=120, metadata=stamp)
     finally:
         plt.close(figure)
@@ -340,10 +338,9 @@ def draw_timeline(plan: Any, problem: Any, target: Path) -> Path:
     """A Gantt chart of a plan: one row per task, each action a bar from its dispatch date to its
     shortest end, then a lighter bar to its longest (what nature may add); the windows of
     contingent events (visibility windows) as bands; the goal timepoints and the mission end."""
-    import matplotlib
+    from specc.runtime.sim.render import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from specc.runtime.planner.plan import format_value
 

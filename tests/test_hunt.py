@@ -300,6 +300,18 @@ def test_reading_a_bad_log_names_the_file_and_line(tmp_path: Path) -> None:
         read_events(path)
     with pytest.raises(RunError, match="cannot read the event log"):
         read_events(tmp_path / "missing.jsonl")
+    # A last line cut off (no newline: a run killed while writing it): the events before it, and a
+    # note, when asked for; a bad line elsewhere, or a cut one without notes, is refused.
+    path.write_text('{"t": 0.0, "kind": "goal"}\n{"t": 1.0, "ki', encoding="utf-8")
+    notes: list[str] = []
+    assert read_events(path, notes) == [{"t": 0.0, "kind": "goal"}]
+    assert notes == [f"{path}:2: the last line is cut off (the run was killed while writing it): the 1 event(s) "
+                     "before it are kept"]
+    with pytest.raises(RunError, match=r"bad\.jsonl:2: not a JSON event"):
+        read_events(path)
+    path.write_text('{"t": 0.0, "ki\n{"t": 1.0, "kind": "goal"}', encoding="utf-8")
+    with pytest.raises(RunError, match=r"bad\.jsonl:1: not a JSON event"):
+        read_events(path, [])
 
 
 # ---------------------------------------------------------------- campaign scale

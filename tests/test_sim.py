@@ -55,6 +55,11 @@ def test_room_world_loads():
     ({**EMPTY, "objects": {"at": [{"x": 1.0, "y": 2.0, "z": 0.0}]}}, "objects.at[0]: unknown key 'z'"),
     ({**EMPTY, "obstacles": [{"circle": [3.0, 3.0, float("inf")]}]}, "obstacles[0]: circle must be"),
     ({**EMPTY, "obstacles": [{"polygon": [[2, 2], [3, float("nan")], [3, 3]]}]}, "obstacles[0]: polygon must"),
+    ({**EMPTY, "obstacles": [{"circle": [3.0, 3.0, 0.5]}], "targets": [{"name": "A", "x": 3.0, "y": 3.2}]},
+     "targets[0] (A) (3, 3.2) is inside an obstacle or outside the walls"),
+    ({**EMPTY, "targets": [{"name": "B", "x": 99.0, "y": 1.0}]}, "targets[0] (B) (99, 1) is inside an obstacle"),
+    ({**EMPTY, "obstacles": [{"polygon": [[2, 2], [4, 4], [4, 2], [2, 4]]}]},  # a bow tie
+     "obstacles[0]: the polygon crosses itself (its edges from corner 0 and from corner 2"),
 ])
 def test_bad_worlds_say_where_and_what(data, fragment):
     with pytest.raises(WorldError) as error:
@@ -158,6 +163,17 @@ def test_the_rover_follows_commanded_turns():
     xs, ys = sim.trace.path_array()[:, 0], sim.trace.path_array()[:, 1]
     assert max(ys) == pytest.approx(2.0, abs=0.05)  # went round the 1 m circle
     assert math.hypot(xs[-1], ys[-1]) < 1.0
+
+
+def test_a_turn_asked_beyond_the_wheels_limit_keeps_its_curvature():
+    # Ten times the wheels' top speed along a 1 m radius: both wheels slow down alike, and the robot
+    # still goes round the 1 m circle (clipped one by one, both wheels at the limit drove straight).
+    sim = Simulation(world(), HILARE, seed=0)
+    fast = 10 * HILARE.max_wheel_speed
+    sim.wheels.drive(fast, fast)
+    sim.run_for(30.0)
+    ys = sim.trace.path_array()[:, 1]
+    assert max(ys) == pytest.approx(2.0, abs=0.05)
 
 
 def test_devices_move_at_bounded_speed():

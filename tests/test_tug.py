@@ -134,3 +134,31 @@ def test_a_planned_mission_whose_problem_has_no_goal_is_refused_not_reported_a_s
     assert result.returncode == 2, result.stdout + result.stderr
     assert "plans problem 'shuttle', which has no goal" in result.stderr
     assert not (tmp_path / "runs").exists()
+
+
+def test_a_mission_stopped_at_its_horizon_counts_no_goal_a_stopped_action_was_changing(tmp_path: Path) -> None:
+    # 20 s: the first move (DOCK to A) is on its way. FTplan's facts still say the tug is at the
+    # dock, but the move was changing that: the return home is not met, and FTplan's end of
+    # mission is dated at the horizon, not at its own last date (8.25 s, its planning).
+    result = specc("run", TUG, "--mission", "shuttle", "--horizon", "20", "--runs", tmp_path, "-q")
+    folder = tmp_path / "tug-shuttle-hall-Robot1-2-s0-horizon20"
+    report = json.loads((folder / "report.json").read_text())
+    assert report["outcome"] == "horizon" and report["measures"]["planned_goals_met"] == 0, result.stderr
+    events = read_events(folder / "events.jsonl")
+    missed = [e["text"] for e in events if e["kind"] == "ftplan" and e["event"] == "goal-missed"]
+    assert any(text.startswith("AT() = DOCK") and "MOVE(DOCK, A), which changes it, was stopped" in text
+               for text in missed)
+    times = [e["t"] for e in events]
+    assert times == sorted(times)
+
+
+def test_a_mission_no_seed_of_which_succeeded_has_no_mean_time() -> None:
+    from specc.run.session import RunOutcome
+    from specc.run.sweep import SweepResult, mission_rows
+
+    failed = [RunOutcome(Path(f"run{seed}"), "tug", {"mission": "deliver", "world": "hall", "outcome": "failed",
+                                                     "simulated_time": 31.0 + seed, "measures": {"distance": 2.0}}, "")
+              for seed in range(2)]
+    (row,) = mission_rows(failed)
+    assert (row.succeeded, row.simulated_time, row.means) == (0, None, {"distance": 2.0})  # not "0 s per run"
+    assert "| 0 | 0 % | - |" in SweepResult("tug", failed, [], mission_rows(failed)).markdown()

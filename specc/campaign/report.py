@@ -270,10 +270,11 @@ def to_json(report: CampaignReport) -> dict[str, Any]:
 def draw(report: CampaignReport, path: Path) -> Path:
     """Fig 4.14: the mean quotients of each configuration, without and with injected faults,
     over every world and without W4."""
-    import matplotlib
+    from matplotlib.ticker import PercentFormatter
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from specc.runtime.sim.render import pyplot
+
+    plt = pyplot()
 
     panels = tuple(label for label, _ in world_subsets(report.description))
     shown = quotients(report)
@@ -293,7 +294,7 @@ def draw(report: CampaignReport, path: Path) -> Path:
         axis.set_xticks(range(len(shown)), [label for _, label in shown])
         axis.set_ylim(0, 1.1)
         axis.set_title(f"{{{worlds}, M*}}")
-        axis.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
+        axis.yaxis.set_major_formatter(PercentFormatter(1.0))
     # Below the panels: inside one, the legend would hide its bars.
     columns = min(4, len(series))
     handles, labels = axes[0].get_legend_handles_labels()

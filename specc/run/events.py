@@ -123,8 +123,10 @@ class EventLog:
         self.close()
 
 
-def read_events(path: str | Path) -> list[dict[str, Any]]:
-    """The events of a log file, in order (blank lines are skipped)."""
+def read_events(path: str | Path, notes: list[str] | None = None) -> list[dict[str, Any]]:
+    """The events of a log file, in order (blank lines are skipped). With `notes`, a last line
+    cut off (no newline after it: a run killed while writing it) is left out and said there,
+    instead of refusing the whole log."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -132,13 +134,18 @@ def read_events(path: str | Path) -> list[dict[str, Any]]:
         raise RunError(f"{path}: cannot read the event log ({error.strerror or error})") from None
     except UnicodeDecodeError:
         raise RunError(f"{path}: not an event log (not UTF-8 text)") from None
-    events = []
-    for number, line in enumerate(text.splitlines(), 1):
+    events: list[dict[str, Any]] = []
+    lines = text.splitlines()
+    for number, line in enumerate(lines, 1):
         if not line.strip():
             continue
         try:
             event = json.loads(line)
         except json.JSONDecodeError as error:
+            if notes is not None and number == len(lines) and not text.endswith("\n"):
+                notes.append(f"{path}:{number}: the last line is cut off (the run was killed while writing it): "
+                             f"the {len(events)} event(s) before it are kept")
+                break
             raise RunError(f"{path}:{number}: not a JSON event ({error.msg})") from None
         if not isinstance(event, dict) or not isinstance(event.get("kind"), str) \
                 or not isinstance(event.get("t"), int | float):

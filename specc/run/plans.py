@@ -158,7 +158,7 @@ class KernelExecutor(abc.ABC):
             if run.finished is None:
                 self.interrupt(run)
             self.record(run, "stopped", f"stopped: {why}")
-        raise HorizonReached(why)
+        raise HorizonReached(why, self.kernel.now)
 
     def safe_state(self, now: float) -> float:
         """Interrupt everything still running for the plan, and wait for the robot to stand and

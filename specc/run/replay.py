@@ -19,8 +19,9 @@ from specc.run.session import LOG
 QUIET_KINDS = ("pose",)  # sampled at 2 Hz: shown only when asked for by name
 
 
-def load_run(run: Path) -> tuple[Path, list[dict[str, Any]]]:
-    """The run folder and its events, from the folder or from its events.jsonl."""
+def load_run(run: Path, notes: list[str] | None = None) -> tuple[Path, list[dict[str, Any]]]:
+    """The run folder and its events, from the folder or from its events.jsonl (`notes`: see
+    `read_events`)."""
     if run.is_dir():
         folder, log = run, run / LOG
         if not log.is_file():
@@ -29,7 +30,7 @@ def load_run(run: Path) -> tuple[Path, list[dict[str, Any]]]:
         folder, log = run.parent, run
     else:
         raise RunError(f"no run folder or event log '{run}': give a folder `specc run` wrote (runs/...)")
-    events = read_events(log)
+    events = read_events(log, notes)
     if not events:
         raise RunError(f"{log}: the log is empty (the run stopped before its first event)")
     return folder, events

@@ -216,7 +216,8 @@ def run_planned(planned: PlannedRun, progress: Progress | None = None) -> RunOut
             _finish(outcome, request, plan, report, summary, log, started)
             raise RunCrashed(f"the run was {stop.why} (what it logged is in {folder / LOG}, the report in "
                              f"{folder / REPORT})", outcome, stop.exit_code) from None
-        except Exception as error:  # a failure half-way (even a RunError): keep what the log holds, say what broke
+        except (Exception, SystemExit) as error:  # a failure half-way (even a RunError, a user's sys.exit): keep what
+            # the log holds, say what broke
             report = {"outcome": "crashed", "why": f"{type(error).__name__}: {error}"}
             summary = f"the run crashed at {log.events[-1]['t'] if log.events else 0.0:.1f} s: {report['why']}"
             _finish(outcome, request, plan, report, summary, log, started)

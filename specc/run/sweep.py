@@ -48,7 +48,7 @@ class MissionRow:
     configuration: str | None  # FTplan's, for a planned mission
     seeds: int
     succeeded: int
-    simulated_time: float  # mean, s, over the successful runs
+    simulated_time: float | None  # mean, s, over the successful runs (None: none succeeded)
     means: dict[str, float]  # the mean of each figure every run measured with a number
 
     @property
@@ -81,7 +81,7 @@ class SweepResult:
                     + "| --- " * (7 + len(figures)) + "|\n")
             for row in self.missions:
                 text += (f"| {row.mission} | {row.world} | {row.configuration or '-'} | {row.seeds} | "
-                         f"{row.succeeded} | {100 * row.success_rate:.0f} % | {row.simulated_time:.1f} | "
+                         f"{row.succeeded} | {100 * row.success_rate:.0f} % | {seconds(row.simulated_time, '.1f')} | "
                          + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures) + "\n")
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
         if crashed:
@@ -153,7 +153,7 @@ def mission_rows(outcomes: Sequence[RunOutcome]) -> list[MissionRow]:
                    if measured and all(_is_number(m.get(name)) for m in measured)]
         succeeded = [o for o in group if o.succeeded]
         rows.append(MissionRow(mission, world, configuration, len(group), len(succeeded),
-                               mean([o.report["simulated_time"] for o in succeeded]),
+                               mean([o.report["simulated_time"] for o in succeeded]) if succeeded else None,
                                {name: mean([float(m[name]) for m in measured]) for name in numeric}))
     return rows
 
@@ -172,3 +172,8 @@ def write_table(result: SweepResult, path: Path) -> list[Path]:
     except OSError as error:
         raise RunError(f"cannot write the table '{path}': {error.strerror or error}") from None
     return written
+
+
+def seconds(value: float | None, spec: str = ".0f") -> str:
+    """A mean time as a table shows it: "-" when there is none (no run succeeded)."""
+    return "-" if value is None else format(value, spec)

@@ -32,6 +32,11 @@ HISTORY = 1_000  # transitions a module (and messages an executive) remembers
 # ---------------------------------------------------------------- the dictionary of Table 2.1
 
 
+# What a codel may raise and the module survives as a failure of the activity (or an incident):
+# any exception, and SystemExit too (`sys.exit()` in a codel is its bug, not the end of the run).
+CODE_ERRORS = (Exception, SystemExit)
+
+
 class Status(enum.StrEnum):
     CS_ERROR = "CS_ERROR"  # the request or a reply could not be transmitted
     WAITING = "WAITING"  # the reply asked for has not arrived yet (report: which one)
@@ -419,7 +424,7 @@ class TaskRunner:
 
     def initialise(self) -> None:
         if not self.initialised and self.spec.init is not None:
-            if self.module.call_permanent(self.spec.init):
+            if self.module.call_permanent(self.spec.init, "init"):
                 self.module.cycle_done(self.spec.init)
         self.initialised = True
 
@@ -696,7 +701,7 @@ class Module:
         """The codel's result, or None when it raised (the activity is then already ended)."""
         try:
             result = self.call_with_parent(activity, self.function(name), self.sdi, activity)
-        except Exception as exc:  # a codel's bug is the activity's extrinsic error, not the runtime's
+        except CODE_ERRORS as exc:  # a codel's bug is the activity's extrinsic error, not the runtime's
             self.extrinsic(activity, "CODEL_ERROR", f"codel '{name}' raised {self.explain(exc)}")
             return None
         if not isinstance(result, str):
@@ -712,7 +717,7 @@ class Module:
             registry.current = None
         try:
             result = self.function(name)(self.sdi, record)
-        except Exception as exc:
+        except CODE_ERRORS as exc:
             return Report("CODEL_ERROR", f"codel '{name}' raised {self.explain(exc)}")
         finally:
             if running is not None:
@@ -724,7 +729,7 @@ class Module:
         return Report("UNDECLARED_STATE", f"validate codel '{name}' returned {result!r}: accept with 'end', "
                       f"refuse with a fail message ({', '.join(spec.fail) or 'none declared'})")
 
-    def explain(self, exc: Exception) -> str:
+    def explain(self, exc: BaseException) -> str:
         """A codel's exception as the activity's report gives it; a field the SDI does not declare
         is named with the fields it has."""
         missing = f"'{type(self.sdi).__name__}' object has no attribute '"
@@ -747,13 +752,13 @@ class Module:
         finally:
             self.registry.current = previous
 
-    def call_permanent(self, name: str) -> bool:
+    def call_permanent(self, name: str, kind: str = "permanent") -> bool:
         """Run a permanent (or init) codel; False when it raised (an incident): then the posters
         named after it keep their last date, so that no reader takes stale data for fresh."""
         try:
             self.function(name)(self.sdi)
-        except Exception as exc:
-            self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: permanent codel '{name}' "
+        except CODE_ERRORS as exc:
+            self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: {kind} codel '{name}' "
                                            f"raised {self.explain(exc)}")
             return False
         return True

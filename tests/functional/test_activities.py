@@ -120,12 +120,13 @@ def test_intrinsic_failure_runs_the_end_codel_and_reports_the_fail_message(robot
 
 def test_extrinsic_failures_are_final_errors_not_crashes(robot: Robot) -> None:
     outcomes = {}
-    for script in ("raise", "none", "NOT_A_STATE", "end2"):
+    for script in ("raise", "exit", "none", "NOT_A_STATE", "end2"):
         _, replies = send(robot, "C", script)
         robot.kernel.run_for(0.05)
         outcomes[script] = (replies[-1].status, replies[-1].report.code)
-    assert outcomes == {
-        "raise": (Status.FINAL_ERROR, "CODEL_ERROR"), "none": (Status.FINAL_ERROR, "UNDECLARED_STATE"),
+    assert outcomes == {  # a codel's sys.exit() is its bug too: the run goes on
+        "raise": (Status.FINAL_ERROR, "CODEL_ERROR"), "exit": (Status.FINAL_ERROR, "CODEL_ERROR"),
+        "none": (Status.FINAL_ERROR, "UNDECLARED_STATE"),
         "NOT_A_STATE": (Status.FINAL_ERROR, "UNDECLARED_STATE"), "end2": (Status.FINAL_ERROR, "UNDECLARED_STATE")}
     _, replies = send(robot, "Checked", "end")  # declared `-> exec, ether`: `end` is not allowed
     robot.kernel.run_for(0.05)

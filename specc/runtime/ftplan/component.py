@@ -45,7 +45,7 @@ from specc.runtime.ftplan.analyzer import Violation, analyse
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
 from specc.runtime.ftplan.planners import Answer, Watchdog
-from specc.runtime.ftplan.state import Goal, SystemState, fact_list
+from specc.runtime.ftplan.state import Goal, SystemState, consequences, fact_list
 from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Plan, Repair, format_value
@@ -56,7 +56,12 @@ MISSION_FAILED = "mission failure: no valid plan found"  # Fig 3.2 line 20
 
 
 class MissionFailure(Exception):
-    """The mission exception: the redundant planners are exhausted."""
+    """The mission exception: the redundant planners are exhausted. `at`: the mission time it
+    came at, when the execution layer raised it (the run's horizon), later than FTplan's own."""
+
+    def __init__(self, why: str, at: float | None = None):
+        super().__init__(why)
+        self.at = at
 
 
 # ---------------------------------------------------------------- planners, as FTplan sees them
@@ -217,6 +222,7 @@ class FtPlan:
                 self.concurrent()
         except MissionFailure as error:
             failure = str(error)
+            self.now = max(self.now, error.at if error.at is not None else self.now)
             self.log("mission-failure", failure)
             self.tell_operator(failure)
             self.now = self.executor.safe_state(self.now)
@@ -504,6 +510,11 @@ class FtPlan:
         ended: set[str] = set()  # ids of the current plan's actions that ended
 
         def report(r: Report) -> None:
+            if r.kind == "started":  # what its end will change is uncertain until then (`SystemState.changing`)
+                for key, _ in consequences(self.config.state_rules, "ended", r.name, r.args, self.views.get(k)):
+                    self.state.changing[key] = (r.action, f"{r.name}({', '.join(format_value(a) for a in r.args)})")
+            elif r.kind in ("ended", "failed"):
+                self.state.changing = {key: by for key, by in self.state.changing.items() if by[0] != r.action}
             self.state.report(self.config.state_rules, r.kind, r.name, r.args, self.views.get(k))
             self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
                      + (f": {r.why}" if r.why else ""), k, r.time)

@@ -81,6 +81,10 @@ class SystemState:
     dates: dict[str, Dates]
     met: set[int] = field(default_factory=set)  # goal lines
     missed: dict[int, str] = field(default_factory=dict)  # goal line -> why
+    # The facts an action that started and has not ended or failed will change as it ends (what
+    # the state rules `on ended` say): their value is uncertain meanwhile, so a goal on one is not
+    # met when the mission ends there (stopped at the horizon). Fact -> (action id, its text).
+    changing: dict[FactKey, tuple[str, str]] = field(default_factory=dict)
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -123,12 +127,15 @@ class SystemState:
         newly = []
         for goal in self.open_goals():
             in_time = now <= goal.deadline + 1e-6
-            if self.holds(goal) and (mission_over if goal.final else in_time):
+            stopped = self.changing.get(goal.key) if mission_over else None
+            if self.holds(goal) and stopped is None and (mission_over if goal.final else in_time):
                 self.met.add(goal.line)
                 newly.append(goal)
             elif mission_over or not in_time:
-                self.missed[goal.line] = ("not met when the mission ended" if mission_over
-                                          else f"its deadline {goal.deadline:g} s has passed")
+                self.missed[goal.line] = (
+                    f"not known when the mission ended: {stopped[1]}, which changes it, was stopped on the way"
+                    if stopped is not None else "not met when the mission ended" if mission_over
+                    else f"its deadline {goal.deadline:g} s has passed")
         return newly
 
     def pending(self) -> list[Goal]:

@@ -215,10 +215,12 @@ def legend_beside(figure: Any, ax: Any) -> None:
 
 
 def pyplot() -> Any:
-    """matplotlib's pyplot on the Agg backend: pictures need no display."""
+    """matplotlib's pyplot on the Agg backend (pictures need no display), text taken as written:
+    a why or a goal holding `$RESULT` ... `$R` would otherwise be set as mathematics."""
     import matplotlib
 
     matplotlib.use("Agg")
+    matplotlib.rcParams["text.parse_math"] = False
     import matplotlib.pyplot as plt
 
     return plt

@@ -80,9 +80,15 @@ class Rover:
 
     # ------------------------------------------------------------ commands
     def drive(self, v: float, w: float) -> None:
-        """Ask for a forward speed v (m/s) and a turn rate w (rad/s): wheel rim speeds, clipped."""
+        """Ask for a forward speed v (m/s) and a turn rate w (rad/s): wheel rim speeds, both scaled
+        down alike when one would pass the wheels' limit, so that the robot keeps the curvature
+        asked for (clipping each wheel alone would drive straight on when both saturate)."""
         half = w * self.config.wheel_base / 2.0
-        self.wheels(v - half, v + half)
+        left, right = v - half, v + half
+        over = max(abs(left), abs(right)) / self.config.max_wheel_speed
+        if over > 1.0:
+            left, right = left / over, right / over
+        self.wheels(left, right)
 
     def forget_progress(self) -> None:
         """A new start: motion asked before now no longer counts towards being blocked."""

@@ -209,6 +209,10 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
                     isinstance(p, list) and len(p) == 2 and all(_finite(c) for c in p) for p in points):
                 raise WorldError(f"{source}: {label}: polygon must list at least 3 [x, y] corners (finite numbers)")
             polygon = tuple((float(x), float(y)) for x, y in points)
+            crossing = self_crossing(polygon)
+            if crossing is not None:
+                raise WorldError(f"{source}: {label}: the polygon crosses itself (its edges from corner {crossing[0]} "
+                                 f"and from corner {crossing[1]}, counted from 0): list its corners in order around it")
             area = signed_area(polygon)
             if abs(area) < 1e-9:
                 raise WorldError(f"{source}: {label}: the polygon has no area")
@@ -241,7 +245,10 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
         windows.append(window)
     world = World(name, bounds, start, tuple(obstacles), placed, int(count), targets, tuple(windows),
                   description, source)
-    for label, (x, y) in [("start", start[:2])] + [(f"objects.at[{k}]", p) for k, p in enumerate(placed)]:
+    # Targets too: a station a robot is sent to inside a crate or past a wall fails its every
+    # mission, far from the line that put it there.
+    for label, (x, y) in [("start", start[:2])] + [(f"objects.at[{k}]", p) for k, p in enumerate(placed)] + [
+            (f"targets[{k}] ({t.name})", (t.x, t.y)) for k, t in enumerate(targets)]:
         if world.clearance(x, y) <= 0:
             raise WorldError(f"{source}: {label} ({x:g}, {y:g}) is inside an obstacle or outside the walls")
     return world
@@ -309,6 +316,25 @@ class _Where:
 
 def _finite(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def self_crossing(points: Sequence[tuple[float, float]]) -> tuple[int, int] | None:
+    """Two edges of the polygon that cross (by the corners they start from), else None: a bow
+    tie is no obstacle the simulator can hold (its inside is not what was meant)."""
+    n = len(points)
+
+    def side(a: tuple[float, float], b: tuple[float, float], c: tuple[float, float]) -> float:
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+    for i in range(n):
+        a, b = points[i], points[(i + 1) % n]
+        for j in range(i + 2, n):
+            if (j + 1) % n == i:
+                continue  # the edge before the first one: they share a corner
+            c, d = points[j], points[(j + 1) % n]
+            if side(a, b, c) * side(a, b, d) < 0 and side(c, d, a) * side(c, d, b) < 0:
+                return i, j
+    return None
 
 
 def signed_area(points: Sequence[tuple[float, float]]) -> float:

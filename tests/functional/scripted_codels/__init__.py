@@ -1,5 +1,5 @@
 """Codels that play the script of their request: `script` is a comma-separated list of what
-the successive codel calls return. `raise` raises, `none` returns None, `send:X` sends
+the successive codel calls return. `raise` raises, `exit` calls sys.exit(3), `none` returns None, `send:X` sends
 beta.Child with script X (X's own steps separated by `;`) and continues with `exec`.
 `to:module.request:X:R` sends that request (script X, steps separated by `;`; `-` for a request
 without input) and returns R; `write:P` writes poster P by hand and continues with `exec`;
@@ -14,6 +14,10 @@ def play(state, sdi, request):
     request.step += 1
     if outcome == "raise":
         raise ValueError("scripted failure")
+    if outcome == "exit":
+        import sys
+
+        sys.exit(3)
     if outcome == "none":
         return None
     if outcome.startswith("send:"):
