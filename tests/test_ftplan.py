@@ -147,6 +147,22 @@ def test_a_crashed_or_planless_planner_counts_as_a_late_one() -> None:
     assert "scripted fault" in watchdog[0] and "no plan" in watchdog[1]
 
 
+def w2_goal(problem: pm.Problem) -> pm.Assertion:
+    """Modele1 M1's goal of communicating in window W2."""
+    return next(g for g in problem.assertions if g.goal is not None and getattr(g, "args", ()) == (pm.Sym("W2"),))
+
+
+@dataclass
+class DropsGoal:
+    """A planner that silently leaves one goal out of every problem it is given."""
+
+    goal: pm.Assertion
+
+    def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+        kept = replace(problem, assertions=tuple(a for a in problem.assertions if a is not self.goal))
+        return Planner(mission()[0]).plan(kept, now)
+
+
 @pytest.mark.parametrize("policy", ["successive", "concurrent"])
 def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner(policy: str) -> None:
     # p1's plan meets every goal but COMMUNICATION(W2) (a planner that silently drops it); the
@@ -154,14 +170,7 @@ def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner(policy: 
     # Concurrent planning asks both again, and p1, the fastest, wins with a plan that meets
     # nothing; p1 is then left out of the next round, so p2's plan runs.
     _, problem = mission()
-    w2 = next(g for g in problem.assertions if g.goal is not None and getattr(g, "args", ()) == (pm.Sym("W2"),))
-
-    @dataclass
-    class DropsW2:
-        def plan(self, problem: pm.Problem, now: float) -> PlanResult:
-            kept = replace(problem, assertions=tuple(a for a in problem.assertions if a is not w2))
-            return Planner(mission()[0]).plan(kept, now)
-
+    w2 = w2_goal(problem)
     requests: list[pm.Problem] = []
 
     @dataclass
@@ -170,7 +179,7 @@ def test_goals_a_plan_leaves_open_are_planned_again_by_the_next_planner(policy: 
             requests.append(problem)
             return Planner(mission()[0]).plan(problem, now)
 
-    result = FtPlan(config(("p1", "p2"), policy), problem, LocalPool({"p1": DropsW2(), "p2": Recording()}),
+    result = FtPlan(config(("p1", "p2"), policy), problem, LocalPool({"p1": DropsGoal(w2), "p2": Recording()}),
                     ScriptedExecutor()).run()
     assert result.success, result.missed
     assert any(e.kind == "goals-open" and "COMMUNICATION(W2)" in e.text for e in result.events)
@@ -189,15 +198,8 @@ def test_goals_abandoned_when_every_plan_leaves_them_aside_spare_the_final_goals
     # Both planners drop COMMUNICATION(W2): FTplan gives it up. The robot is home by then, so the
     # final goals of being home (X and Y) hold: they are met when the mission ends, not abandoned.
     _, problem = mission()
-    w2 = next(g for g in problem.assertions if g.goal is not None and getattr(g, "args", ()) == (pm.Sym("W2"),))
-
-    @dataclass
-    class DropsW2:
-        def plan(self, problem: pm.Problem, now: float) -> PlanResult:
-            kept = replace(problem, assertions=tuple(a for a in problem.assertions if a is not w2))
-            return Planner(mission()[0]).plan(kept, now)
-
-    result = FtPlan(config(("p1", "p2"), policy), problem, LocalPool({"p1": DropsW2(), "p2": DropsW2()}),
+    w2 = w2_goal(problem)
+    result = FtPlan(config(("p1", "p2"), policy), problem, LocalPool({"p1": DropsGoal(w2), "p2": DropsGoal(w2)}),
                     ScriptedExecutor()).run()
     goals = [g for g in problem.assertions if g.goal is not None]
     assert list(result.missed) == [next(text for text in result.missed if "COMMUNICATION(W2)" in text)]

@@ -98,6 +98,8 @@ def test_a_table_of_the_tug(tmp_path: Path) -> None:
     (("--mission", "shuttle", "--config", "Robot3"), "no robot configuration 'Robot3'"),
     (("--mission", "shuttle", "--config", "Robot1,Robot2"), "one configuration each time: repeat the option"),
     (("--mission", "fetch", "--world", "hall"), "robot 'tug' has no mission 'fetch'"),
+    (("--goal", "!(GO-PLACE E)"), "no KA of procedures 'tug_tasks' is invoked by it (they are invoked by "
+                                  "!(GO-PLACE DOCK), !(GO-PLACE A)"),  # E is no station: no run, no folder
 ])
 def test_bad_options_for_the_tug_are_one_line(tmp_path: Path, args: tuple[str, ...], message: str) -> None:
     result = specc("run", TUG, *args, "--runs", tmp_path, "-q")
@@ -162,3 +164,22 @@ def test_a_mission_no_seed_of_which_succeeded_has_no_mean_time() -> None:
     (row,) = mission_rows(failed)
     assert (row.succeeded, row.simulated_time, row.means) == (0, None, {"distance": 2.0})  # not "0 s per run"
     assert "| 0 | 0 % | - |" in SweepResult("tug", failed, [], mission_rows(failed)).markdown()
+
+
+def test_a_move_that_fails_leaves_the_tug_away_from_every_station(tmp_path: Path) -> None:
+    # A crate across the way to A: the move is BLOCKED. FTplan's state rule puts the tug AWAY (not
+    # back at the dock, as it did), so the return home is not counted met, the next plan moves
+    # from AWAY, and the run's why names the failures the goals' reasons would hide.
+    world = tmp_path / "blocked.toml"
+    world.write_text((TUG / "worlds" / "hall.toml").read_text().replace('name = "hall"', 'name = "blocked"')
+                     + "\n[[obstacles]]\npolygon = [[10.6, 6.6], [11.4, 6.6], [11.4, 9.2], [10.6, 9.2]]\n")
+    result = specc("run", TUG, "--mission", "shuttle", "--world", world, "--horizon", "60", "--runs", tmp_path,
+                   "-q", "--no-pictures")
+    folder = tmp_path / "tug-shuttle-blocked-Robot1-2-s0-horizon60"
+    report = json.loads((folder / "report.json").read_text())
+    assert report["measures"]["planned_goals_met"] == 0, result.stderr
+    assert "action failure(s); the last: MOVE(" in report["why"] and "GOTO answered BLOCKED" in report["why"]
+    events = read_events(folder / "events.jsonl")
+    started = [e["text"] for e in events if e["kind"] == "ftplan" and e["event"] == "report"
+               and e["text"].startswith("started MOVE")]
+    assert started[0] == "started MOVE(DOCK, A)" and "started MOVE(AWAY, A)" in started[1:]

@@ -411,12 +411,15 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
                            "planner_failures": result.planner_failures,
                            # the mission exception: no plan in time (not the horizon stopping the run)
                            "planning_failure": "" if stopped else result.failure}
+        # What went wrong on the way, which the goals' reasons (a plan leaving them aside) hide.
+        failed = [e.text for e in result.events if e.kind == "action-failed"]
+        failures = f" ({len(failed)} action failure(s); the last: {failed[-1]})" if failed else ""
         if stopped:
             outcome, why = "horizon", f"{result.failure}: {len(result.met)} of {len(met) + len(result.missed)} " \
-                                      "planned goal(s) met"
+                                      f"planned goal(s) met{failures}"
         elif outcome == "succeeded" and (result.failure or result.missed):
-            outcome, why = "failed", result.failure or f"{len(result.missed)} planned goal(s) missed: " + "; ".join(
-                f"{goal}: {reason}" for goal, reason in result.missed.items())
+            outcome, why = "failed", (result.failure or f"{len(result.missed)} planned goal(s) missed: " + "; ".join(
+                f"{goal}: {reason}" for goal, reason in result.missed.items())) + failures
         elif outcome == "succeeded":
             why = f"every goal achieved ({len(intentions)} posted, {len(result.met)} planned)" if intentions \
                 else f"every planned goal achieved ({len(result.met)})"

@@ -331,6 +331,13 @@ def _checked_goal(robot: Any, text: str) -> str:
                        f"{did_you_mean(head, invoked)}")
     if invoked[head] != len(goal.expr.args):
         raise RunError(f"--goal {text}: {head} takes {invoked[head]} argument(s), {len(goal.expr.args)} given")
+    from specc.runtime.supervisor import match
+
+    triggers = [ka.trigger for ka in library.kas if ka.goal_invoked and ka.trigger.head == head]
+    if not any(match(trigger, goal.expr, {}) for trigger in triggers):  # `!(GO-PLACE E)`, no KA for E
+        shown = ", ".join(f"!{trigger}" for trigger in triggers)
+        raise RunError(f"--goal {text}: no KA of procedures '{library.name}' is invoked by it (they are invoked by "
+                       f"{shown})")
     return text
 
 

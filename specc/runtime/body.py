@@ -120,6 +120,19 @@ def body_problem(key: str, value: float) -> str | None:
         return f"'{key}' is a count: give a whole number"
     if spec.is_count and value > MAX_COUNT:
         return f"'{key}' is {value:g}: at most {MAX_COUNT:,} (each is simulated at every reading)"
-    if key in ("radius", "wheel_base", "mass") and value == 0:
-        return f"'{key}' must be > 0"
+    if key in POSITIVE and value == 0:
+        return f"'{key}' must be > 0 ({spec.unit}): {POSITIVE[key]}"
+    if spec.unit == ANGLE and value > 360:
+        return f"'{key}' is {value:g} degrees: at most 360"
     return None
+
+
+# The keys a zero makes meaningless, and what it would mean.
+POSITIVE = {
+    "radius": "the footprint would be empty", "wheel_base": "the wheels would be one", "mass": "no body",
+    "max_wheel_speed": "the robot could never move", "max_wheel_accel": "the wheels could never speed up",
+    "sonar_range": "the sonars would see nothing", "laser_range": "the laser would see nothing",
+    "laser_fov": "the laser would see nothing", "camera_r_max": "the camera would see nothing",
+    "camera_open": "the camera would see nothing", "pan_speed": "the pan-tilt unit could never pan",
+    "tilt_speed": "the pan-tilt unit could never tilt", "arm_speed": "the arm could never move",
+}
