@@ -643,7 +643,8 @@ def rules_report(paths: PathsArg,
         if len(shown) < len(findings):
             out.print(f"  ... {len(findings) - len(shown)} more (--limit 0 shows all)", markup=False)
         if findings:
-            out.print(f"  {len(findings)} case(s) of inputs unsettled: {tally(findings)}", markup=False)
+            out.print(f"  {compiled.findings_count()} case(s) of inputs unsettled: {tally(findings)}"
+                      + (" (the listing stops there)" if compiled.findings_cut else ""), markup=False)
         else:
             out.print("  complete and consistent for every input", markup=False)
 

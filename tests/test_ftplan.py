@@ -278,3 +278,18 @@ def test_a_planner_s_own_problem_gets_its_goals_that_stand_for_ftplan_s_open_one
     assert FtPlan.open_planner_goals(component, "careful", None) == [51, 52, 53]  # type: ignore[arg-type]
     state.met.add(11)
     assert FtPlan.open_planner_goals(component, "careful", None) == [52, 53]  # type: ignore[arg-type]
+
+
+def test_an_action_the_safe_state_stopped_counts_as_failed_and_changes_nothing_more() -> None:
+    # A pan-tilt move runs beside a move that failed: the safe state stops it on its way. FTplan's
+    # `on failed` rule for it applies (the unit is somewhere: OTHER_POSITION), and nothing is left
+    # "changing" to be mistaken, at the mission's end, for an action stopped by the horizon.
+    from specc.runtime.ftplan.state import Running
+
+    _, problem = mission()
+    ftplan = FtPlan(config(("p1",)), problem, LocalPool({"p1": Scripted([])}), ScriptedExecutor())
+    ftplan.state.changing[("PTU_POSITION", ())] = Running("MOVE_PAN_TILT_UNIT#4", "MOVE_PAN_TILT_UNIT",
+                                                         (0.0, -30.0))
+    ftplan.stopped_as_failed("p1")
+    assert ftplan.state.changing == {} and ftplan.state.facts[("PTU_POSITION", ())] == "OTHER_POSITION"
+    assert ftplan.events[-1].text.startswith("stopped MOVE_PAN_TILT_UNIT(0, -30): counted as failed")

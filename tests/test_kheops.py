@@ -480,3 +480,14 @@ def test_a_generated_decision_refuses_what_its_inputs_cannot_be_and_names_the_in
             k.interpret(base_from(TYPED_INPUTS), {"soc": 50, "estop": wrong})
     with pytest.raises(TypeError, match=r"input soc='50': give a number"):
         guard.decide({"soc": "50", "estop": False})
+
+
+def test_a_listing_of_unsettled_inputs_cut_at_its_limit_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    base = base_from(SHARED_STATES)
+    full = k.compile_base(base)
+    assert not full.findings_cut and full.findings_count() == str(len(full.findings))
+    monkeypatch.setattr(k, "FINDINGS_LIMIT", 2)  # reached as shared states list their cases again
+    cut = k.Compiler(base).compile()  # not compile_base: it keeps what it compiled
+    assert cut.findings_cut and cut.findings_count() == f"at least {len(cut.findings)}"
+    warning = k.unsettled_warning(cut, "rule base 'bms'", base.source or m.RuleBase(name="bms"))
+    assert warning is not None and f"at least {len(cut.findings)} case(s)" in warning.message

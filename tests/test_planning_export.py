@@ -302,3 +302,18 @@ def test_numbers_a_task_computes_are_ground_too() -> None:
     assert mentions(result, "?b in {1, 2, 3}", "?left in {0, 1, 2, 3}")
     objects = {o.name for o in result.problem.all_objects}
     assert {"CHARGE_0", "CHARGE_1", "CHARGE_2", "CHARGE_3"} <= objects and "CHARGE_4" not in objects
+
+
+def test_the_numbers_reached_go_forward_only_and_a_cut_is_said() -> None:
+    from tests.test_planner import BATTERY_SPEC, from_text
+
+    text = BATTERY_SPEC.replace("[0, 3]", "[0, 100]").replace("?b in [1, 3]", "?b in [1, 100]")
+    domain, problem = from_text(text.replace("(0, 3), t_start", "(0, 50), t_start"))
+    result = export(domain, problem)
+    objects = {o.name for o in result.problem.all_objects}
+    # From 50, a hop only goes down: 49, 48, ... and never up to 51.
+    assert {"CHARGE_50", "CHARGE_49", "CHARGE_0"} <= objects and "CHARGE_51" not in objects
+    assert not any("cut at" in note for note in result.unsupported)
+    domain, problem = from_text(text.replace("(0, 3), t_start", "(0, 100), t_start"))
+    result = export(domain, problem)  # 101 numbers: more than REACHED_NUMBERS
+    assert any("the numbers the tasks' events lead to are cut at 64" in note for note in result.unsupported)

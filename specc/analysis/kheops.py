@@ -699,6 +699,11 @@ class Compiled:
     # outputs that value's decision leaves as they were (they keep their previous-cycle value `@name`).
     split: str | None = None
     kept: Mapping[Any, tuple[str, ...]] = field(default_factory=dict)
+    findings_cut: bool = False  # FINDINGS_LIMIT stopped the listing: more inputs are unsettled than listed
+
+    def findings_count(self) -> str:
+        """'16', or 'at least 10000' when the listing was cut."""
+        return f"at least {len(self.findings)}" if self.findings_cut else str(len(self.findings))
 
     @property
     def depth(self) -> int:
@@ -733,7 +738,8 @@ class Compiler:
         memory = initial_memory(self.base)
         alive = tuple(r for r in self.base.rules if r.kind != "else")
         root = self.node(memory, alive, frozenset(self.observable), (), ())
-        return Compiled(self.base, root, merged_findings(self.findings), self.tree_nodes, len(self.shared))
+        return Compiled(self.base, root, merged_findings(self.findings), self.tree_nodes, len(self.shared),
+                        findings_cut=self.findings_cut)
 
     def state(self, memory: Mapping[str, frozenset[Any]], alive: tuple[Rule, ...],
               testable: frozenset[str]) -> tuple[Any, ...]:
@@ -1012,6 +1018,7 @@ def compile_parts(base: Base, split: str, parts: Mapping[Any, tuple[Base, tuple[
     branches: list[tuple[Any, Node]] = []
     findings: list[Finding] = []
     spent = 0
+    cut = False
     for value in attribute.values:
         part, _ = parts[value]
         compiler = Compiler(part, limit, spent, shared)
@@ -1020,10 +1027,11 @@ def compile_parts(base: Base, split: str, parts: Mapping[Any, tuple[Base, tuple[
         except TooLarge as exc:
             raise TooLarge(str(exc), exc.node, exc.limit, value) from None
         spent = compiler.tree_nodes
+        cut = cut or compiled.findings_cut
         branches.append((value, compiled.root))
         findings += [Finding(f.kind, f.attributes, ((split, value), *f.witness), f.fired) for f in compiled.findings]
     return Compiled(base, Test(split, tuple(branches)), findings, spent, len(shared) + 1, split,
-                    {value: kept for value, (_, kept) in parts.items()})
+                    {value: kept for value, (_, kept) in parts.items()}, cut)
 
 
 def paths_bound(base: Base) -> tuple[int, list[tuple[str, int]]]:
@@ -1158,14 +1166,14 @@ def _elements(value: Any) -> tuple[Any, ...]:
 
 
 def describe(finding: Finding) -> str:
-    witness = ", ".join(f"{a}={' | '.join(map(str, _joined(v))) if isinstance(v, tuple) else v}"
+    witness = ", ".join(f"{a}={' | '.join(map(str, _coalesced(v))) if isinstance(v, tuple) else v}"
                         for a, v in finding.witness) or "any input"
     fired = ", ".join(finding.fired) or "none"
     what = "no value left for" if finding.kind == "inconsistent" else "undetermined"
     return f"{finding.kind}: {what} {', '.join(finding.attributes)} when {witness} (rules fired: {fired})"
 
 
-def _joined(values: tuple[Any, ...]) -> list[Any]:
+def _coalesced(values: tuple[Any, ...]) -> list[Any]:
     """A witness's values with the intervals that touch written as one (`[0, 3[ | [3, 6[` as
     `[0, 6[`): the pieces of a numeric input's partition are disjoint, so what touches adds up."""
     out: list[Any] = []
@@ -1195,6 +1203,6 @@ def unsettled_warning(compiled: Compiled, what: str, node: m.Node) -> Diagnostic
     findings = compiled.findings
     if not findings:
         return None
-    return Diagnostic("rules-unsettled", f"{what} leaves {len(findings)} case(s) of inputs unsettled "
+    return Diagnostic("rules-unsettled", f"{what} leaves {compiled.findings_count()} case(s) of inputs unsettled "
                       f"({tally(findings)}), e.g. {describe(worst_first(findings)[0])}; `specc rules` lists them",
                       node.span, "warning")

@@ -9,7 +9,7 @@ The encoding, chosen for the temporal planners of unified_planning (Aries) and f
 - symbolic sets become user types (a laminar family of the sets the parameters and the fluents
   need; a set crossing another falls back to its smallest enclosing type, or to `symbol`);
 - a numeric slot (attribute argument or value) is ground over the numbers that appear in the
-  domain and the problem, and those the tasks' constraints compute from them (`reach_numbers`,
+  domain and the problem, and those the tasks' events lead to from them (`reach_numbers`,
   within the declared domains): the slots a task variable links share one user type, with one object
   per number (`AT_ROBOT_X_4`), so Modele1's real-valued MOVE and TAKE_PICTURE become finite;
 - a task is a durative action; its variables used in assertions (`?state`) become parameters. The
@@ -85,7 +85,6 @@ ROOT_TYPE = "symbol"
 HORIZON_FLUENT = "within_horizon"
 TABLE_LIMIT = 200_000  # ground parameter tuples enumerated for one task's duration table
 REACHED_NUMBERS = 64  # numbers a numeric class may gain from the tasks' arithmetic (`reach_numbers`)
-REACH_TUPLES = 4_096  # combinations of the other variables tried for one variable there
 CHOICE_LIMIT = 4096  # combinations of symbolic variables tried to bound one ground task
 TOLERANCE = 1e-9
 
@@ -706,32 +705,40 @@ class _Exporter:
         self.reach_numbers()
 
     def reach_numbers(self) -> None:
-        """Add to each numeric class the numbers a task's constraints compute from the numbers it
-        has (`?b2 =. ?b - 1` takes a battery of 3 charges to 2, then 1, then 0), within the
-        domains its slots declare: the numbers written alone would leave such a task no ground
-        instance. Bounded: REACHED_NUMBERS per class, REACH_TUPLES combinations per variable."""
+        """Add to each numeric class the numbers a task's events lead to from the numbers it has:
+        `event(BATTERY(): (?b, ?b2))` with `?b2 =. ?b - 1` takes a battery of 3 charges to 2, then
+        1, then 0 (forward only: what a value may become, never what it may have been), within
+        the domains the slots declare. The numbers written alone would leave such a task no ground
+        instance. Bounded (REACHED_NUMBERS per class): a class it cuts is said in the notes."""
+        cut: set[str] = set()
         grown = True
         while grown:
             grown = False
             for task in self.domain.tasks:
-                numeric = [(v, c) for v in self.task_variables(task) if (c := self.numeric_class(task.name, v))]
-                for var, cls in numeric:
-                    others = [(v, c) for v, c in numeric if v != var]
-                    pools = [sorted(c.values) for _, c in others]
-                    if len(cls.values) >= REACHED_NUMBERS or math.prod(map(len, pools)) > REACH_TUPLES:
+                for a in task.assertions:
+                    if not (isinstance(a, pm.Event) and isinstance(a.before, pm.Var) and isinstance(a.after, pm.Var)):
                         continue
-                    allowed = [d for slot in self.var_slots(task, var) if isinstance(d := self.declared(slot),
-                                                                                      pm.Interval)]
-                    for combination in itertools.product(*pools):
-                        fixed: dict[Key, Dom] = {("var", v): (x, x) for (v, _), x in zip(others, combination,
-                                                                                         strict=True)}
-                        found = bounds(task.constraints, fixed, [("var", var)])
-                        value = _single(found[("var", var)]) if found is not None else None
-                        if (isinstance(value, float) and value not in cls.values
-                                and all(d.low <= value <= d.high for d in allowed)
-                                and len(cls.values) < REACHED_NUMBERS):
-                            cls.values.add(value)
-                            grown = True
+                    source, target = self.numeric_class(task.name, a.before.name), \
+                        self.numeric_class(task.name, a.after.name)
+                    if source is None or target is None:
+                        continue
+                    allowed = [d for slot in self.var_slots(task, a.after.name)
+                               if isinstance(d := self.declared(slot), pm.Interval)]
+                    for before in sorted(source.values):
+                        found = bounds(task.constraints, {("var", a.before.name): (before, before)},
+                                       [("var", a.after.name)])
+                        value = _single(found[("var", a.after.name)]) if found is not None else None
+                        if not isinstance(value, float) or value in target.values or not all(
+                                d.low <= value <= d.high for d in allowed):
+                            continue
+                        if len(target.values) >= REACHED_NUMBERS:
+                            cut.add(target.type_name)
+                            continue
+                        target.values.add(value)
+                        grown = True
+        for name in sorted(cut):
+            self.note(f"{name}: the numbers the tasks' events lead to are cut at {REACHED_NUMBERS}: the values "
+                      "past them are not exported, and a plan needing them is not found from the files.")
 
     def numeric_class(self, scope: str, var: str) -> _NumericClass | None:
         node = ("var", scope, var)
@@ -1037,7 +1044,7 @@ class _Exporter:
         if numeric:
             ground = "; ".join(f"{p.var} in {{{', '.join(_seconds(v) for v in kept[p.var])}}}" for p in numeric)
             self.note(f"{task.name}: the real-valued {', '.join(p.var for p in numeric)} are ground over the numbers "
-                      f"that appear in the domain and the problem, and those the tasks' constraints compute from them, "
+                      f"that appear in the domain and the problem, and those the tasks' events lead to from them, "
                       f"that meet its constraints ({ground}), which makes a "
                       "PDDL encoding possible; any other value the planner could choose is lost.")
         coupled_params = [p for p in params if any(("var", p.var) in _keys(c) for c in coupled)]

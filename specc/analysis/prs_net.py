@@ -808,7 +808,7 @@ class Translator:
                         changed |= len(found[var]) != before
             if bounds is None:  # the numbers given and compared with, before any arithmetic
                 bounds = {var: (min(numbers), max(numbers)) for var, values in found.items()
-                          if (numbers := [v for v in values if _is_number(v)])}
+                          if (numbers := [v for v in values if rp.is_number(v)])}
             grown = _arithmetic_closure(links, found, bounds)
         every = {v for expr in _compounds(ka) for v in variables(expr)}
         if ka.action is not None and ka.action.result is not None:
@@ -1456,14 +1456,12 @@ class Translator:
                                                  "an unbound variable: bind it before the request")
                     self.emit.fire(f"{origin} is unbound", origin, [(f"{head}.POST", colour)], [(error, petri.BLACK)])
                     continue
-                # The executive answers BAD-SERVICE and the KA goes on with that answer (§3.9); a
-                # result domain without that value gets the failure it has instead.
-                failure = next((r for r in ("BAD-SERVICE", "ERROR", "REFUSED") if r in results),
-                               next((r for r in results if not _success(r)), None))
-                answered = ("it answers BAD-SERVICE" if failure == "BAD-SERVICE" else
-                            f"it answers BAD-SERVICE, taken here as {failure}, the failure the answer's domain has"
-                            if failure is not None else "it answers BAD-SERVICE, which the answer's domain lacks: "
-                            "the request waits for ever here")
+                # The executive answers BAD-SERVICE and the KA goes on with that answer (§3.9). A
+                # result domain without that value has no colour for it: the net stops there
+                # rather than follow another answer the KA may treat otherwise.
+                failure = "BAD-SERVICE" if "BAD-SERVICE" in results else None
+                answered = ("it answers BAD-SERVICE" if failure is not None else "it answers BAD-SERVICE, which "
+                            "the answer's domain lacks (add it to follow what the KA does next): the net stops here")
                 self.result.errors[error] = ("unknown-service", f"a KA asks the executive for a service it does "
                                              f"not offer ({name}, asked through {head}): "
                                              f"{answered}; declare the service or fix the request")
@@ -1525,21 +1523,25 @@ ARITHMETIC_VALUES = 256  # the most values an arithmetic assignment may add to a
 def _arithmetic_closure(links: Sequence[tuple[str, Any]], found: dict[str, dict[Any, None]],
                         bounds: Mapping[str, tuple[float, float]]) -> bool:
     """Widen each variable assigned an arithmetic expression (`assign @I = (+ @I 1)`, a loop's
-    counter) with the values the expression takes over the domains known, kept within `bounds`,
-    the range of the numbers the variable is given or compared with, widened by the
-    expression's largest constant (the step a loop takes past its bound as it exits). True when
-    a domain grew."""
+    counter, or `(* @I 2)`) with the values the expression takes from values within `bounds`,
+    the range of the numbers each variable is given or compared with: a value past them (the one
+    a loop exits with) is kept, and never computed from. At most ARITHMETIC_VALUES values each
+    (`(/ @I 2)` never ends; the net then finds the value it has no room for). True when a domain
+    grew."""
     grown = False
+
+    def within(name: str, value: Any) -> bool:
+        low, high = bounds.get(name, (-math.inf, math.inf))
+        return not rp.is_number(value) or low <= value <= high
+
     for var, expr in links:
         if not (isinstance(expr, rp.Compound) and expr.head in ARITHMETIC) or var not in bounds:
             continue
         names = sorted(variables(expr))
         if any(name not in found for name in names):
             continue
-        step = max((abs(c) for c in _constants(expr)), default=0)
-        low, high = bounds[var][0] - step, bounds[var][1] + step
         values = found[var]
-        pool = [tuple(found[name]) for name in names]
+        pool = [tuple(v for v in found[name] if within(name, v)) for name in names]
         if math.prod(len(p) for p in pool) > ARITHMETIC_VALUES:
             continue
         for combination in itertools.product(*pool):
@@ -1547,22 +1549,12 @@ def _arithmetic_closure(links: Sequence[tuple[str, Any]], found: dict[str, dict[
                 value = evaluate(expr, dict(zip(names, combination, strict=True)))
             except (Undefined, TypeError, ArithmeticError):
                 continue
-            if (_is_number(value) and low <= value <= high and value not in values
-                    and len(values) < ARITHMETIC_VALUES):
+            if rp.is_number(value) and value not in values and len(values) < ARITHMETIC_VALUES:
                 values[value] = None
                 grown = True
     return grown
 
 
-def _constants(term: Any) -> list[float]:
-    """The numbers written in an arithmetic expression."""
-    if isinstance(term, rp.Compound):
-        return [c for a in term.args for c in _constants(a)]
-    return [term] if _is_number(term) else []
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def _success(result: Any) -> bool:

@@ -32,6 +32,7 @@ class RuleVisitor(Visitor):
         self.tested: set[str] = set()
         self.first_read: dict[str, m.AttrRef] = {}  # where each attribute is first tested
         self.first_set: dict[str, m.AttrRef] = {}  # where each attribute is first deduced
+        self.conjuncts: set[int] = set()  # the rule's condition's conjuncts (ids): what must hold for it to fire
         self.in_action = False
 
     def visit_RuleForeach(self, node: m.RuleForeach) -> None:
@@ -49,7 +50,9 @@ class RuleVisitor(Visitor):
             self.check_index(node.index, node.span)
         if node.condition is not None:
             self.in_action = False
+            self.conjuncts = {id(c) for c in conjuncts(node.condition)}
             self.visit(node.condition)
+            self.conjuncts = set()
         self.in_action = True
         for action in node.actions:
             self.visit(action)
@@ -81,6 +84,8 @@ class RuleVisitor(Visitor):
     def check_range(self, node: m.KCompare) -> None:
         """A comparison of a numeric attribute with a number it can never satisfy within its declared
         range (`x > 20` with x in [0, 10]): the rule testing it never fires, a typo the likeliest cause."""
+        if self.in_action or id(node) not in self.conjuncts:
+            return  # under `!` or `|` a comparison that never holds may leave the rule firing
         declared = self.declared.get(node.attr.name)
         domain = declared.domain if declared is not None else None
         if not (isinstance(domain, m.NumericDomain) and isinstance(node.value, m.Number)
@@ -185,6 +190,14 @@ def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> Non
         ctx.report("undefined-attribute", f"'{name}' is tested, but it is no input, has no init and no rule sets "
                    f"it: the rule can never fire (a misspelt input or constant?){did_you_mean(name, known)}",
                    ref.span)
+
+
+def conjuncts(condition: m.Node) -> list[m.Node]:
+    """The parts of a condition that must each hold: `a, b, (c, d)` gives a, b, c and d; `!a` or
+    `a | b` is one part."""
+    if isinstance(condition, m.KAnd):
+        return [part for operand in condition.operands for part in conjuncts(operand)]
+    return [condition]
 
 
 def check_set_never_read(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:

@@ -80,8 +80,9 @@ class SweepResult:
                     + "".join(f"{name} | " for name in figures) + "\n"
                     + "| --- " * (7 + len(figures)) + "|\n")
             for row in self.missions:
+                time = mean_time_text(row.simulated_time, ".1f")
                 text += (f"| {row.mission} | {row.world} | {row.configuration or '-'} | {row.seeds} | "
-                         f"{row.succeeded} | {100 * row.success_rate:.0f} % | {seconds(row.simulated_time, '.1f')} | "
+                         f"{row.succeeded} | {100 * row.success_rate:.0f} % | {time} | "
                          + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures) + "\n")
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
         if crashed:
@@ -174,6 +175,6 @@ def write_table(result: SweepResult, path: Path) -> list[Path]:
     return written
 
 
-def seconds(value: float | None, spec: str = ".0f") -> str:
+def mean_time_text(value: float | None, spec: str = ".0f") -> str:
     """A mean time as a table shows it: "-" when there is none (no run succeeded)."""
     return "-" if value is None else format(value, spec)

@@ -188,14 +188,14 @@ COMPARISONS: dict[str, Callable[[Any, Any], bool]] = {
 ARITHMETIC = ("+", "-", "*", "/")
 
 
-def _number(value: Any) -> bool:
+def is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def compute(head: str, args: tuple[Any, ...]) -> int | float:
     """`(+ a b ...)`, `(- a)`, `(- a b ...)`, `(* ...)`, `(/ a b ...)` over numbers; ValueError
     for anything else or a division by zero."""
-    if not args or not all(_number(a) for a in args):
+    if not args or not all(is_number(a) for a in args):
         raise ValueError("arithmetic on something that is not a number")
     if head == "+":
         return sum(args)
@@ -211,7 +211,7 @@ def compute(head: str, args: tuple[Any, ...]) -> int | float:
 
 def compare(head: str, left: Any, right: Any) -> bool:
     """A comparison between two numbers; ValueError for anything else."""
-    if not _number(left) or not _number(right):
+    if not is_number(left) or not is_number(right):
         raise ValueError(f"{left!r} and {right!r} cannot be compared: comparisons are between numbers")
     return COMPARISONS[head](left, right)
 

@@ -38,8 +38,10 @@ def check_numbers(numeric: tuple[str, ...], inputs: Mapping[str, Any], error: Ty
     """After a decision raised `error`: a TypeError naming the numeric input given something other
     than a number (`soc='50'`), if one was; else nothing (the caller raises `error` itself)."""
     for name in numeric:
-        value = inputs.get(name)
-        if not isinstance(value, (int, float)) or isinstance(value, bool):
+        if name not in inputs:
+            continue  # the decision did not read it (else KeyError): not the cause
+        value = inputs[name]
+        if not isinstance(value, (int, float)):  # a bool is a number to Python: True compares as 1
             raise TypeError(f"input {name}={value!r}: give a number ({error})") from None
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import difflib
 import functools
 import hashlib
 import os
@@ -15,7 +16,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 from lark.lexer import PatternStr
 
-from specc.diagnostics import Diagnostic, did_you_mean, error
+from specc.diagnostics import Diagnostic, error
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.resources import grammar_path
@@ -242,19 +243,42 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
     expected = describe_expected(exc.expected, keyword_texts())
     # A misspelt keyword reads as a name, and where the keyword was optional (a task's preemption
     # after its '}') the parser no longer expects it: say which keyword the word is close to.
-    words = [k for k in keyword_texts().values() if k.isidentifier()]
-    close = did_you_mean(str(token), words) if token.type == "NAME" and str(token) not in words else ""
-    if not close:  # an operator written a character short (`=>` where a rule wants `==>`)
-        texts = keyword_texts()
-        operators = [texts[t] for t in exc.expected if t in texts and len(texts[t]) > 1 and not texts[t].isalnum()]
-        near = [op for op in operators if any(text.startswith(op[:i] + op[i + 1:], position) for i in range(len(op)))]
-        written = text[position:position + 3]
-        near.sort(key=lambda op: (-len(os.path.commonprefix([op, written])), -len(op)))
-        close = f" (did you mean '{near[0]}'?)" if near else ""
+    close = _meant(exc, text, position, str(token), token.type == "NAME")
     return error("unexpected-token", f"unexpected {describe_token(token)}{close}; expected {expected}", span)
 
 
 UNITS = ("us", "ms", "s", "min")
+
+
+def _meant(exc: UnexpectedToken, text: str, position: int, written: str, is_name: bool) -> str:
+    """' (did you mean 'X'?)' when writing X instead makes the file parse past this point: a
+    misspelt keyword (even one the parser no longer expects: a task's optional preemption after
+    its '}') or an operator a character short (`=>` where a rule wants `==>`); else ''."""
+    texts = keyword_texts()
+    if is_name:
+        words = [k for k in texts.values() if k.isidentifier() and len(k) > 2]  # not the units s, ms, us
+        expected = [texts[t] for t in exc.expected if t in texts and texts[t] in words]
+        tried = difflib.get_close_matches(written, expected, n=3) + difflib.get_close_matches(written, words, n=3)
+        end = position + len(written)
+    else:
+        operators = [texts[t] for t in exc.expected if t in texts and len(texts[t]) > 1 and not texts[t].isalnum()]
+        tried = [op for op in operators if any(text.startswith(op[:i] + op[i + 1:], position) for i in range(len(op)))]
+        end = position + max((len(op) - 1 for op in tried), default=0)
+    for candidate in dict.fromkeys(tried):
+        if _parses_past(text[:position] + candidate + text[end:], position + len(candidate)):
+            return f" (did you mean '{candidate}'?)"
+    return ""
+
+
+def _parses_past(text: str, position: int) -> bool:
+    """Does `text` parse, or fail only after `position`?"""
+    try:
+        parser().parse(text)
+    except UnexpectedInput as exc:
+        return (getattr(exc, "pos_in_stream", None) or 0) > position
+    except Exception:  # a builder's error past the grammar: the text parsed that far
+        return True
+    return True
 
 
 def _unit_typo(text: str, position: int) -> tuple[int, str] | None:

@@ -45,7 +45,7 @@ from specc.runtime.ftplan.analyzer import Violation, analyse
 from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.execution import Execution, Executor, Report
 from specc.runtime.ftplan.planners import Answer, Watchdog
-from specc.runtime.ftplan.state import Goal, SystemState, consequences, fact_list
+from specc.runtime.ftplan.state import Goal, Running, SystemState, consequences, fact_list
 from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.plan import Plan, Repair, format_value
@@ -512,9 +512,9 @@ class FtPlan:
         def report(r: Report) -> None:
             if r.kind == "started":  # what its end will change is uncertain until then (`SystemState.changing`)
                 for key, _ in consequences(self.config.state_rules, "ended", r.name, r.args, self.views.get(k)):
-                    self.state.changing[key] = (r.action, f"{r.name}({', '.join(format_value(a) for a in r.args)})")
+                    self.state.changing[key] = Running(r.action, r.name, r.args)
             elif r.kind in ("ended", "failed"):
-                self.state.changing = {key: by for key, by in self.state.changing.items() if by[0] != r.action}
+                self.state.changing = {key: by for key, by in self.state.changing.items() if by.action != r.action}
             self.state.report(self.config.state_rules, r.kind, r.name, r.args, self.views.get(k))
             self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
                      + (f": {r.why}" if r.why else ""), k, r.time)
@@ -533,6 +533,7 @@ class FtPlan:
             self.log("action-failed", f"{outcome.why} (action {outcome.failed_action})", k)
             self.now = self.executor.safe_state(self.now)
             self.log("safe-state", "running activities stopped before recovery", k)
+            self.stopped_as_failed(k)
             repaired = self.repair(k, plan, ended, outcome.failed_action)
             if repaired is None:
                 return "failed"
@@ -579,6 +580,15 @@ class FtPlan:
         said = answer.result.notes if answer.result is not None else ()
         self.log("repaired", f"{k}: {'; '.join(n for n in said if n.startswith('repaired')) or 'plan repaired'}", k)
         return repaired
+
+    def stopped_as_failed(self, k: str) -> None:
+        """The actions the safe state stopped on their way (beside the one that failed) left the
+        world as a failure does: their `on failed` rules say what FTplan now believes, and nothing
+        is still changing (the next plan's actions have ids of their own to track)."""
+        for running in dict.fromkeys(self.state.changing.values()):
+            self.state.report(self.config.state_rules, "failed", running.name, running.args, self.views.get(k))
+            self.log("report", f"stopped {running.text()}: counted as failed (brought to the safe state)", k)
+        self.state.changing.clear()
 
     def give_up(self, why: str) -> None:
         # Only the goals still calling for action: a final goal that holds now (the robot is home)

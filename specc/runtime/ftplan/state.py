@@ -69,6 +69,18 @@ class Goal:
         return f"{self.attribute}({args}) = {format_value(self.value)} (line {self.line}, priority {self.priority:g})"
 
 
+@dataclass(frozen=True)
+class Running:
+    """An action of the plan carried out, from its start to its end or failure."""
+
+    action: str  # its id in the plan (MOVE#3)
+    name: str
+    args: tuple[Value, ...]
+
+    def text(self) -> str:
+        return f"{self.name}({', '.join(format_value(a) for a in self.args)})"
+
+
 @dataclass
 class SystemState:
     """The facts FTplan believes, the goals met, failed and still open."""
@@ -83,8 +95,8 @@ class SystemState:
     missed: dict[int, str] = field(default_factory=dict)  # goal line -> why
     # The facts an action that started and has not ended or failed will change as it ends (what
     # the state rules `on ended` say): their value is uncertain meanwhile, so a goal on one is not
-    # met when the mission ends there (stopped at the horizon). Fact -> (action id, its text).
-    changing: dict[FactKey, tuple[str, str]] = field(default_factory=dict)
+    # met when the mission ends there (stopped at the horizon). Fact -> the action.
+    changing: dict[FactKey, Running] = field(default_factory=dict)
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -127,13 +139,14 @@ class SystemState:
         newly = []
         for goal in self.open_goals():
             in_time = now <= goal.deadline + 1e-6
-            stopped = self.changing.get(goal.key) if mission_over else None
+            running = self.changing.get(goal.key) if mission_over else None
+            stopped = running.text() if running is not None else None
             if self.holds(goal) and stopped is None and (mission_over if goal.final else in_time):
                 self.met.add(goal.line)
                 newly.append(goal)
             elif mission_over or not in_time:
                 self.missed[goal.line] = (
-                    f"not known when the mission ended: {stopped[1]}, which changes it, was stopped on the way"
+                    f"not known when the mission ended: {stopped}, which changes it, was stopped on the way"
                     if stopped is not None else "not met when the mission ended" if mission_over
                     else f"its deadline {goal.deadline:g} s has passed")
         return newly
