@@ -74,7 +74,7 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
     it leaves unsettled; for each executive, the same of its resource controller (its generated
     rules joined by its own bases, compiled one decision per service: milliseconds for 21 services)."""
     from specc.analysis.controller import executive_controller
-    from specc.analysis.kheops import KheopsError, compile_base, normalise, unsettled_warning
+    from specc.analysis.kheops import KheopsError, compile_base, normalise, size_warning, unsettled_warning
 
     joined = {ref.text for e in program.items if isinstance(e, m.Executive) for ref in e.rules}
     found = []
@@ -82,8 +82,9 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
         try:
             normal = normalise(base)
             if base.name not in joined:
-                warning = unsettled_warning(compile_base(normal), f"rule base '{base.name}'", base)
-                found += [warning] if warning is not None else []
+                compiled = compile_base(normal)
+                found += [w for w in (unsettled_warning(compiled, f"rule base '{base.name}'", base),
+                                      size_warning(compiled, f"rule base '{base.name}'", base)) if w is not None]
         except KheopsError as exc:
             found.append(exc.diagnostic())
     if any(d.severity == "error" for d in found):
@@ -93,9 +94,10 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
             controller = executive_controller(program, executive)
             if controller.problems:
                 continue  # the executive's check reported them
-            warning = unsettled_warning(controller.compile(), f"the resource controller of executive "
-                                        f"'{executive.name}'", executive)
-            found += [warning] if warning is not None else []
+            compiled = controller.compile()
+            what = f"the resource controller of executive '{executive.name}'"
+            found += [w for w in (unsettled_warning(compiled, what, executive), size_warning(compiled, what, executive))
+                      if w is not None]
         except KheopsError as exc:
             found.append(exc.diagnostic())
     return found

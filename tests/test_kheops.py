@@ -491,3 +491,16 @@ def test_a_listing_of_unsettled_inputs_cut_at_its_limit_says_so(monkeypatch: pyt
     assert cut.findings_cut and cut.findings_count() == f"at least {len(cut.findings)}"
     warning = k.unsettled_warning(cut, "rule base 'bms'", base.source or m.RuleBase(name="bms"))
     assert warning is not None and f"at least {len(cut.findings)} case(s)" in warning.message
+
+
+def test_a_large_decision_graph_is_a_warning_with_its_figures(tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    # Under the work limit, 23,318 nodes made a 17 MB module (8 inputs x 50 rules): check says so.
+    spec = tmp_path / "guard.spec"
+    spec.write_text(TYPED_INPUTS)
+    assert not any(d.code == "rules-large" for d in load([spec]).diagnostics)
+    monkeypatch.setattr(k, "LARGE_DAG_NODES", 2)
+    k._COMPILED.clear()
+    (large,) = [d for d in load([spec]).diagnostics if d.code == "rules-large"]
+    assert large.severity == "warning" and "rule base 'guard' compiles into a decision graph of" in large.message
+    assert "split it into bases that each decide from fewer inputs" in large.message

@@ -2,29 +2,29 @@
 """Rule base generic_controller, compiled into a decision graph of depth 4.
 
 Inputs: service, event, @ABCstate, @EFGstate. Outputs: status, ABCstate, EFGstate.
-The compiler found 29 case(s) of inputs the rules do not settle (a value
+The compiler found 30 case(s) of inputs the rules do not settle (a value
 listed as `a | b` stands for any of them):
 - incomplete: undetermined status, ABCstate, EFGstate when service=A, @ABCstate=A, event=START | INTERM | ABORT | ZOMBIE (rules fired: none)
 - incomplete: undetermined EFGstate when service=A, @ABCstate=A, event=END (rules fired: endABC)
-- incomplete: undetermined status, ABCstate, EFGstate when service=A, @ABCstate=B | C | IDLE, event=START | INTERM (rules fired: none)
-- incomplete: undetermined ABCstate, EFGstate when service=A, @ABCstate=B | C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=A, @ABCstate=B | IDLE, event=START | INTERM (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=A | C, @ABCstate=B, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=A | B, @ABCstate=C, event=START | INTERM (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=A | B, @ABCstate=C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
 - incomplete: undetermined ABCstate, EFGstate when service=A | B | C, @ABCstate=IDLE, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
-- incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=A | C, event=START | INTERM (rules fired: none)
-- incomplete: undetermined ABCstate, EFGstate when service=B, @ABCstate=A | C, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
+- incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=A, event=START | INTERM (rules fired: none)
+- incomplete: undetermined ABCstate, EFGstate when service=B | C, @ABCstate=A, event=END | ABORT | ZOMBIE (rules fired: eventABCnotRunning)
 - incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=B, event=START | INTERM | ABORT | ZOMBIE (rules fired: none)
 - incomplete: undetermined EFGstate when service=B, @ABCstate=B, event=END (rules fired: endABC)
 - incomplete: undetermined status, ABCstate, EFGstate when service=B, @ABCstate=IDLE, event=START (rules fired: none)
 - incomplete: undetermined EFGstate when service=B, @ABCstate=IDLE, event=INTERM (rules fired: intermB)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=A | B, event=START | END | ABORT | ZOMBIE (rules fired: CstartWhenNotIdle)
+- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=A | B | C | IDLE, event=START (rules fired: CstartWhenNotIdle)
 - incomplete: undetermined status, ABCstate, EFGstate when service=C, @ABCstate=A | B | IDLE, event=INTERM (rules fired: none)
-- incomplete: undetermined ABCstate, EFGstate when service=C, @ABCstate=C | IDLE, event=START (rules fired: CstartWhenNotIdle)
 - incomplete: undetermined status, ABCstate, EFGstate when service=C, @ABCstate=C, event=INTERM | ABORT | ZOMBIE (rules fired: none)
 - incomplete: undetermined EFGstate when service=C, @ABCstate=C, event=END (rules fired: endABC)
 - incomplete: undetermined ABCstate, EFGstate when service=D, event=START | INTERM | END (rules fired: Dstart)
 - incomplete: undetermined status, ABCstate, EFGstate when service=D, event=ABORT | ZOMBIE (rules fired: none)
-- incomplete: undetermined ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G, event=START | INTERM (rules fired: EFGHstartNotIdle)
-- incomplete: undetermined status, ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G, event=END | ABORT | ZOMBIE (rules fired: none)
-- ... and 9 more (`specc rules` lists them all).
+- incomplete: undetermined ABCstate, EFGstate when service=E | F | G, @EFGstate=E | F | G | IDLE, event=START (rules fired: EFGHstartNotIdle)
+- ... and 10 more (`specc rules` lists them all).
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ INPUTS = ["service", "event", "@ABCstate", "@EFGstate"]
 NUMERIC_INPUTS = []
 OUTPUTS = ["status", "ABCstate", "EFGstate"]
 DEPTH = 4
-FINDINGS = 29
+FINDINGS = 30
 
 _LEAF_0 = Decision(MappingProxyType({'status': None, 'ABCstate': None, 'EFGstate': None}), (), ('status', 'ABCstate', 'EFGstate'), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': None}), (), ('EFGstate',), None)
