@@ -662,9 +662,11 @@ def skeleton(paths: PathsArg) -> None:
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
     # New codel modules go to the robot's folder, where `specc run` imports them from: the nearest
-    # folder above a spec (or its own) holding the system block; beside the spec when none does.
+    # folder above a spec (or its own) holding the system block; with no system block yet (step 1
+    # of docs/your-robot.md), the folder the command was given; beside the spec otherwise.
     robots = {loaded.paths[f.path].resolve().parent for f in loaded.program.files
-              if any(isinstance(item, m.System) for item in f.items)}
+              if any(isinstance(item, m.System) for item in f.items)} or {
+        path.resolve() for path in paths if path.is_dir()}
     wrote = 0
     for source in loaded.program.files:
         spec_dir = loaded.paths[source.path].resolve().parent

@@ -102,6 +102,8 @@ CODES: dict[str, Code] = {
     "missing-python-module": Code("the Python module a spec names is not next to it", 'codels: "cart_codles";'),
     "python-syntax-error": Code("a codel module has a syntax error", "cart_codels.py with `def go(sdi:`"),
     # ---------------------------------------------------------------- executive
+    "control-conflict": Code("a conflicts entry naming a service that runs a control request (it is never in EXEC)",
+                             "DOCK { conflicts { SET-SPEED: interrupt; } }  // SET-SPEED: type control"),
     "rules-large": Code("a rule base whose decision graph, under the work limit, still makes megabytes of Python",
                         "8 numeric inputs x 50 threshold rules"),
     "intermediate-never-read": Code("an undeclared attribute rules deduce and no rule tests (a misspelt output?)",

@@ -304,7 +304,8 @@ def test_an_extension_hook_that_raises_is_named_with_where_it_raised(tmp_path: P
     cart = write_robot(tmp_path, spec)
     (cart / "cart_codels" / "ext.py").write_text(f"def {hook}(*args):\n    raise KeyError('boom')\n")
     result = specc(tmp_path, "run", cart, "--folder", tmp_path / "run", "-q")
-    said = f"robot 'cart': its extension's {hook}() raised KeyError: 'boom' ({cart / 'cart_codels' / 'ext.py'}:2)"
+    # The file named relative to the working folder (the test's, where cart/ is), as a user reads it.
+    said = f"robot 'cart': its extension's {hook}() raised KeyError: 'boom' (cart/cart_codels/ext.py:2)"
     assert said in result.stderr and "internal error" not in result.stderr, result.stderr
     # prepare is the run's set-up: bad input, nothing run; measure comes at the end: the run crashed, its log kept.
     assert result.returncode == (2 if hook == "prepare" else 1)
@@ -490,6 +491,9 @@ def test_a_permanent_codel_that_raises_is_in_the_log_the_report_and_the_summary(
     assert report["measures"]["incidents"] == len(alarms) == len(report["incidents"])
     assert "permanent codel 'watch'" in (tmp_path / "run" / "summary.txt").read_text()
     assert "incident: " in result.stdout
+    # A success, but not a clean one: the why says so, with the first incident.
+    assert report["outcome"] == "succeeded" and f"; {len(alarms)} incident(s), the first: " in report["why"]
+    assert "permanent codel 'watch' raised ZeroDivisionError" in report["why"]
 
 
 LOOPING_CODEL = CODELS.replace('def step(sdi, request):\n', 'def step(sdi, request):\n    while True:\n'

@@ -507,3 +507,21 @@ def test_an_operator_written_a_character_short_is_named() -> None:
     text = 'rules q {\n  inputs x: [0, 10];\n  outputs o: {"a"};\n  q1: x < 5 => restrict o == "a";\n}\n'
     (found,) = parse_text(text, "q.spec").diagnostics
     assert found.code == "unexpected-token" and "unexpected '=' (did you mean '==>'?)" in found.message
+
+
+def test_skeleton_writes_codels_where_specc_run_imports_them(tmp_path: Path) -> None:
+    # docs/your-robot.md's step 1: a module in a subfolder, no system block yet. The stubs go to
+    # the robot's folder given to the command (not beside the module's spec), and once a system
+    # block exists, to its folder.
+    robot = tmp_path / "bot"
+    (robot / "modules").mkdir(parents=True)
+    (robot / "modules" / "drive.spec").write_text('module drive {\n  number: 1;\n  codels: "bot_codels.drive";\n'
+                                                  "  request Go { type: control; validate: check; }\n}\n")
+    first = specc("skeleton", str(robot))
+    assert first.returncode == 0 and (robot / "bot_codels" / "drive.py").is_file(), first.stdout + first.stderr
+    assert not (robot / "modules" / "bot_codels").exists()
+    (robot / "modules" / "arm.spec").write_text('module arm {\n  number: 2;\n  codels: "bot_codels.arm";\n'
+                                                "  request Lift { type: control; validate: lift; }\n}\n")
+    (robot / "system.spec").write_text("system bot {\n  modules: drive, arm;\n}\n")
+    second = specc("skeleton", str(robot / "modules"), str(robot / "system.spec"))
+    assert second.returncode == 0 and (robot / "bot_codels" / "arm.py").is_file(), second.stdout + second.stderr

@@ -183,3 +183,17 @@ def test_a_move_that_fails_leaves_the_tug_away_from_every_station(tmp_path: Path
     started = [e["text"] for e in events if e["kind"] == "ftplan" and e["event"] == "report"
                and e["text"].startswith("started MOVE")]
     assert started[0] == "started MOVE(DOCK, A)" and "started MOVE(AWAY, A)" in started[1:]
+
+
+def test_codels_beside_the_module_specs_instead_of_the_robot_s_folder_are_found_and_named(tmp_path: Path) -> None:
+    # `specc check` finds codels from a spec's folder upwards; `specc run` imports them from the
+    # robot's folder: codels put in modules/ pass the one and fail the other, which says where they are.
+    import shutil
+
+    tug = tmp_path / "tug"
+    shutil.copytree(TUG, tug, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.move(tug / "tug_codels", tug / "modules" / "tug_codels")
+    result = specc("run", tug, "--mission", "deliver", "-g", tmp_path / "gen", "--runs", tmp_path / "runs", "-q")
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "no tug_codels/ with the codels robot 'tug' names here" in result.stderr
+    assert "it is in modules/tug_codels: move tug_codels/ up into the robot's folder" in result.stderr

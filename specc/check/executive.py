@@ -122,6 +122,12 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
         for conflict in service.conflicts:
             if conflict.service not in services:
                 ctx.unknown("undefined-service", "service", conflict.service, services, conflict.span)
+                continue
+            target = ctx.symbols.service_request(services[conflict.service])
+            if target is not None and target.kind == "control":  # the incompatibility graph leaves it out
+                ctx.warn("control-conflict", f"'{conflict.service}' runs a control request, which ends as it "
+                         f"starts and is never in EXEC: nothing to {conflict.policy}, so this entry changes "
+                         "nothing; remove it, or give the conflict to the service that runs", conflict.span)
     for parameter in executive.parameters:
         if parameter.get is None and parameter.set is None:
             ctx.report("missing-property", f"parameter '{parameter.name}' needs 'get:' and/or 'set:'",

@@ -423,6 +423,8 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         elif outcome == "succeeded":
             why = f"every goal achieved ({len(intentions)} posted, {len(result.met)} planned)" if intentions \
                 else f"every planned goal achieved ({len(result.met)})"
+    if recorder.incidents:  # software trouble the robot lived on with: a success, but not a clean one
+        why += f"; {len(recorder.incidents)} incident(s), the first: {recorder.incidents[0]}"
     # What the run measured, logged before the robot's own measures and judgement read the log.
     figures = {"distance": round(sim.rover.distance, 3), "requests": recorder.requests,
                "incidents": len(recorder.incidents), **planned_figures}

@@ -219,7 +219,11 @@ def import_robot(generated: Path, folder: Path, robot: str) -> ModuleType:
                        f"run `specc compile {folder} -o {generated}` again") from None
     for codels in _codel_packages(root):
         if not ((folder / codels / "__init__.py").is_file() or (folder / f"{codels}.py").is_file()):
-            raise RunError(f"{folder}: no {codels}/ with the codels robot '{robot}' names here: give the robot's "
+            elsewhere = sorted(str(p.parent.relative_to(folder)) for p in folder.glob(f"*/**/{codels}/__init__.py"))
+            moved = (f"; it is in {', '.join(elsewhere)}: move {codels}/ up into the robot's folder, where `specc run` "
+                     "imports it from" if elsewhere else "")
+            raise RunError(f"{folder}: no {codels}/ with the codels robot '{robot}' names here (looked for "
+                           f"{folder / codels}/__init__.py and {folder / codels}.py){moved}; or give the robot's "
                            "folder (the one holding its specs and codels)")
         forget_unless_from(codels, folder)
     return root

@@ -19,6 +19,7 @@ import enum
 import functools
 import itertools
 import math
+import os
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -742,7 +743,7 @@ class Module:
             hint = f"did you mean '{close[0]}'? " if close else ""
             return (f"AttributeError: module {self.name}'s SDI has no field '{name}' ({hint}its fields: "
                     f"{', '.join(fields) or 'none'}; declare it in the module's internal_data)")
-        return f"{type(exc).__name__}: {text}"
+        return f"{type(exc).__name__}: {text}{where_raised(exc)}"
 
     def call_with_parent(self, activity: Activity, function: Callable[..., Any], *args: Any) -> Any:
         previous = self.registry.current
@@ -1196,5 +1197,11 @@ def where_raised(exc: BaseException) -> str:
 
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if not f.filename.startswith("<")]
     if isinstance(exc, SyntaxError) and exc.filename:
-        return f" ({exc.filename}:{exc.lineno})"
-    return f" ({frames[-1].filename}:{frames[-1].lineno})" if frames else ""
+        return f" ({_shown(exc.filename)}:{exc.lineno})"
+    return f" ({_shown(frames[-1].filename)}:{frames[-1].lineno})" if frames else ""
+
+
+def _shown(path: str) -> str:
+    """A file as a message names it: relative to the working folder when it is below it."""
+    relative = os.path.relpath(path) if os.path.isabs(path) else path
+    return path if relative.startswith("..") else relative

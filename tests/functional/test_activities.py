@@ -3,6 +3,8 @@ Fig. 2.4, and every status of Table 2.1, on a generated module whose codels play
 
 from __future__ import annotations
 
+import re
+
 from specc.runtime import functional as rt
 from specc.runtime.functional import State, Status
 from tests.functional.conftest import Robot
@@ -128,6 +130,10 @@ def test_extrinsic_failures_are_final_errors_not_crashes(robot: Robot) -> None:
         "raise": (Status.FINAL_ERROR, "CODEL_ERROR"), "exit": (Status.FINAL_ERROR, "CODEL_ERROR"),
         "none": (Status.FINAL_ERROR, "UNDECLARED_STATE"),
         "NOT_A_STATE": (Status.FINAL_ERROR, "UNDECLARED_STATE"), "end2": (Status.FINAL_ERROR, "UNDECLARED_STATE")}
+    _, replies = send(robot, "C", "raise")  # where the codel raised, as file:line
+    robot.kernel.run_for(0.05)
+    assert re.search(r"raised ValueError: scripted failure \(.*scripted_codels/__init__\.py:\d+\)$",
+                     replies[-1].report.detail), replies[-1].report.detail
     _, replies = send(robot, "Checked", "end")  # declared `-> exec, ether`: `end` is not allowed
     robot.kernel.run_for(0.05)
     assert (replies[-1].status, replies[-1].report.code) == (Status.FINAL_ERROR, "UNDECLARED_STATE")
