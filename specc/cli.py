@@ -203,8 +203,9 @@ def graph(paths: PathsArg,
 
     Example: specc graph --incompat examples/tug -o tug-incompat.png
 
-    Example: specc graph --net ROBOT --goal '!(G ...)' --ka K -o net.png (procedures whose variables have
-    finite domains, as for specc verify --goal)
+    Example: specc graph --net <robot folder> --goal '!(<GOAL> <args>)' --ka <KA> -o net.png (the
+    procedures' variables need finite domains, as for specc verify --goal; docs/language.md has one to
+    run as it is)
     """
     from specc.analysis.incompat import build_graph, service_groups, state_count
     from specc.pictures import draw_incompatibility_graph
@@ -528,6 +529,7 @@ def plan(paths: PathsArg,
             sys.stdout.write(text)
         else:
             try:
+                json_path.parent.mkdir(parents=True, exist_ok=True)  # as -o does for the picture
                 json_path.write_text(text, encoding="utf-8")
             except OSError as exc:
                 err.print(f"error: cannot write '{json_path}': {exc} [unwritable-file]", markup=False)
@@ -722,7 +724,9 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
                                                 "first when stale).")] = Path("generated"),
         runs: Annotated[Path, typer.Option(help="Where run folders go.")] = Path("runs"),
         folder: Annotated[Optional[Path], typer.Option("--folder", "-o", help="The run folder (default: "
-                                                       "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>).")] = None,
+                                                       "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>; with "
+                                                       "--goal, 'goal' for the mission and the goals and a digest "
+                                                       "of them after the seed).")] = None,
         timing: Annotated[str, typer.Option(help="FTplan's planning time: model (deterministic) or wall "
                                                  "(measured).")] = "model",
         horizon: Annotated[Optional[float], typer.Option(help="Simulated seconds before the run stops (default: "
@@ -738,8 +742,12 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
     planners) and write a run folder: events.jsonl, report.json, summary.txt, map.png, timeline.png.
     Exits 0 when the mission succeeded, 1 when it failed (the report says why), 2 on bad input.
 
-    Examples: specc run examples/tug --mission deliver; specc run examples/tug --goal '!(FETCH B C)' --seed 3;
-    specc run examples/tug --mission shuttle --world crowded --config Robot2."""
+    Example: specc run examples/tug --mission deliver
+
+    Example: specc run examples/tug --goal '!(FETCH B C)' --seed 3
+
+    Example: specc run examples/tug --mission shuttle --world crowded --config Robot2
+    """
     from specc.run import RunError
     from specc.run.session import RunCrashed, RunRequest, run_in_folder
 
@@ -847,8 +855,9 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
           world: Annotated[Optional[list[str]], typer.Option(help="A world (repeatable; default: each mission's "
                                                                   "own).")] = None,
           config: Annotated[Optional[list[str]], typer.Option(help="FTplan's configuration of the planned missions "
-                                                                   "(repeatable; default: the ftplan block's "
-                                                                   "own).")] = None,
+                                                                   "(repeatable; without --mission, only the "
+                                                                   "planned missions run; default: the ftplan "
+                                                                   "block's own).")] = None,
           seeds: Annotated[int, typer.Option(min=1, help="Seeds 0..N-1 for every combination.")] = 1,
           generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
           = Path("generated"),
@@ -861,8 +870,10 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
     their measures: per mission and world, the success rate and the means of the runs' figures (the
     means of seed 004 §4.1.4 when the robot's extension measures them, as the rover's does).
 
-    Examples: specc table examples/tug --seeds 10; specc table examples/tug --mission shuttle --world hall
-    --config Robot1 --config Robot1/2."""
+    Example: specc table examples/tug --seeds 10
+
+    Example: specc table examples/tug --mission shuttle --config Robot1 --config Robot1/2
+    """
     from specc.run import RunError, writable_folder
     from specc.run.measures import rich_table
     from specc.run.session import RunCrashed, RunRequest, compile_robot
@@ -1057,8 +1068,9 @@ def campaign(
     of activities (with and without the worlds set apart), per mutant, the mutants set aside, the bar
     charts of Fig 4.14 and the headline.
 
-    Examples: specc campaign examples/tug --mutants 5 --runs 1;
-    specc campaign examples/tug --mutants 40 --runs 3 --configs Robot1,Robot1/2 --set-apart crowded
+    Example: specc campaign examples/tug --mutants 5 --runs 1
+
+    Example: specc campaign examples/tug --mutants 40 --runs 3 --configs Robot1,Robot1/2 --set-apart crowded
     """
     from specc.campaign.campaign import Campaign, CampaignPlan, campaign_defaults, check_names, select_mutants
     from specc.campaign.engines import DaskEngine, LocalEngine

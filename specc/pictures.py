@@ -52,7 +52,8 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
         axes.scatter([x], [y], s=420, color=shade, edgecolors="black", zorder=3)
         axes.annotate(service + kind, (x, y), xytext=(x * 1.18, y * 1.18), ha="center", va="center", fontsize=9)
     legend = [f"{g.name}: {' | '.join(g.states)}" for g in groups]
-    axes.set_title(f"{title}\n{len(groups)} service groups, {state_count(groups)} controller states "
+    plural = "" if len(groups) == 1 else "s"
+    axes.set_title(f"{title}\n{len(groups)} service group{plural}, {state_count(groups)} controller states "
                    "(solid: interrupt, dashed: wait)", fontsize=11)
     for i, line in enumerate(legend):
         axes.text(-1.45, -1.35 - 0.09 * i, line, fontsize=9, color=GROUP_COLOURS[i % len(GROUP_COLOURS)])

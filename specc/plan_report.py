@@ -103,7 +103,7 @@ def print_result(outcome: Outcome, out: Console) -> None:
              ", ".join(f"{name}={date:.2f}" for name, date in sorted(plan.assumed.items(), key=lambda kv: kv[1])))
     table = Table(title=f"plan ({len(plan.actions)} actions, {plan.controllability_text}: the dates hold "
                         f"{holds})", title_justify="left", show_edge=False)
-    for column in ("start", "action", "duration", "ends by", "may start", ""):
+    for column in ("start", "action", "duration", "ends by", "may start", "preemption"):
         table.add_column(column, justify="right" if column in ("start", "ends by") else "left", no_wrap=True)
     for a in plan.ordered():
         low, high = a.duration

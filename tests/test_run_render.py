@@ -257,3 +257,25 @@ def test_a_log_without_the_world_or_the_body_cannot_be_drawn(hunt: MissionRun, t
     with pytest.raises(RunError, match="the log cannot be drawn.*KeyError.*'y'") as error:
         render_run(edited, tmp_path / "edited")
     assert "\n" not in str(error.value)
+
+
+def test_the_reflexes_that_fired_have_their_row_on_the_timeline(hunt: MissionRun, tmp_path: Path,
+                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    from specc.run import pictures
+    from specc.run.render import draw_service_timeline
+
+    rows: list[list[str]] = []
+    real = pictures.save
+
+    def save(figure: Any, path: Any) -> Path:
+        rows.append([label.get_text() for label in figure.axes[0].get_yticklabels()])
+        return real(figure, path)
+
+    monkeypatch.setattr(pictures, "save", save)
+    draw_service_timeline(list(hunt.events), tmp_path / "plain.png")
+    fired = {"t": 5.0, "kind": "reflex", "reflex": "stop", "on": "reply us.watchObstacle", "code": "OBSTACLE",
+             "actions": ["request loco.Stop"]}
+    draw_service_timeline([*hunt.events, fired], tmp_path / "reflex.png")
+    had_reflexes = any(e["kind"] == "reflex" for e in hunt.events)
+    assert ("reflexes" in rows[0]) == had_reflexes and "reflexes" in rows[1]
+    assert rows[1].index("reflexes") == rows[1].index("alarms") - 1

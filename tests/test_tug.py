@@ -197,3 +197,14 @@ def test_codels_beside_the_module_specs_instead_of_the_robot_s_folder_are_found_
     assert result.returncode == 2, result.stdout + result.stderr
     assert "no tug_codels/ with the codels robot 'tug' names here" in result.stderr
     assert "it is in modules/tug_codels: move tug_codels/ up into the robot's folder" in result.stderr
+
+
+def test_a_table_for_one_configuration_runs_the_planned_missions_alone(tmp_path: Path) -> None:
+    # --config is FTplan's: without --mission, the missions it plans (not `deliver`, which only
+    # posts a goal and used to stop the table with "mission deliver is not planned").
+    result = specc("table", TUG, "--config", "Robot1", "--runs", tmp_path, "--quiet")
+    assert result.returncode == 0, result.stderr
+    data = json.loads((tmp_path / "tug-table.json").read_text())
+    assert [(row["mission"], row["configuration"]) for row in data["missions"]] == [
+        ("shuttle", "Robot1"), ("fetch_b", "Robot1")]
+    assert all(not line.endswith(" ") for line in (tmp_path / "tug-table.md").read_text().splitlines())

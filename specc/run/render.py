@@ -556,9 +556,10 @@ def draw_service_timeline(events: Events, path: str | Path) -> Path:
     PNG at `path`."""
     bars = service_bars(events)
     services = list(dict.fromkeys(bar.service for bar in bars))
-    motions, objects, alarms = "robot motion", "objects", "alarms"
+    motions, objects, alarms, reflexes = "robot motion", "objects", "alarms", "reflexes"
     arm = motion_stretches(events, "arm-motion")
-    rows = [*services, motions, *(["arm motion"] if arm else []), objects, alarms]
+    fired = [e for e in events if e.get("kind") == "reflex"]
+    rows = [*services, motions, *(["arm motion"] if arm else []), objects, *([reflexes] if fired else []), alarms]
     row = {name: k for k, name in enumerate(rows)}
     end = max(last_time(events), SHORTEST_AXIS)
     plt = pyplot()
@@ -593,6 +594,10 @@ def draw_service_timeline(events: Events, path: str | Path) -> Path:
             if times:
                 ax.plot(times, [row[objects]] * len(times), marker="o", ls="", ms=6, mfc=colour, mec="#111827",
                         mew=0.5, label=label, zorder=5)
+        for reflex in fired:  # the executive's own reactions (§3.5): what it did without the task level
+            ax.plot(reflex["t"], row[reflexes], marker="v", ms=7, color="#7c3aed", zorder=5)
+            ax.annotate(str(reflex.get("reflex") or reflex.get("on", "")), (reflex["t"], row[reflexes]),
+                        textcoords="offset points", xytext=(4, 4), fontsize=6, color="#7c3aed")
         for alarm in (e for e in events if e.get("kind") == "alarm"):
             ax.plot(alarm["t"], row[alarms], marker="X", ms=8, color="#dc2626", zorder=5)
             ax.annotate(str(alarm.get("what", "")), (alarm["t"], row[alarms]), textcoords="offset points",

@@ -77,13 +77,14 @@ class SweepResult:
         else:
             figures = list(dict.fromkeys(name for row in self.missions for name in row.means))
             text = ("| mission | world | configuration | seeds | succeeded | success rate | time (s) | "
-                    + "".join(f"{name} | " for name in figures) + "\n"
+                    + "".join(f"{name} | " for name in figures)).rstrip() + ("\n"
                     + "| --- " * (7 + len(figures)) + "|\n")
             for row in self.missions:
                 time = mean_time_text(row.simulated_time, ".1f")
                 text += (f"| {row.mission} | {row.world} | {row.configuration or '-'} | {row.seeds} | "
                          f"{row.succeeded} | {100 * row.success_rate:.0f} % | {time} | "
-                         + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures) + "\n")
+                         + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures)).rstrip() \
+                    + "\n"
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
         if crashed:
             text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
@@ -102,10 +103,16 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
           configurations: Sequence[str] = (), seeds: Sequence[int] = (0,), step: Step | None = None) -> SweepResult:
     """Run `robot` (compiled into base.generated) on every combination, each run as `base` says
     otherwise (its folder under base.runs). Names are checked before the first run. No missions:
-    every mission of the system; no worlds: each in its own; no configurations: FTplan's default."""
+    every mission of the system (with configurations: every planned one); no worlds: each in its own;
+    no configurations: FTplan's default."""
     if not seeds:
         raise RunError("no seed to run: give at least one")
-    every = missions or tuple(load_robot(base.generated, base.specs, robot).system.missions)
+    declared = load_robot(base.generated, base.specs, robot).system.missions if not missions else {}
+    # With configurations of FTplan and no mission named: the planned missions, which they are for.
+    every = missions or tuple(name for name, mission in declared.items()
+                              if not configurations or mission.plan is not None)
+    if configurations and not every:
+        raise RunError(f"--config: robot '{robot}' has no planned mission (a mission with 'plan:') to run it on")
     requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
                 for c, m, w, s in itertools.product(configurations or (None,), every, worlds or (None,), seeds)]
     if not requests:
