@@ -5,9 +5,7 @@ reference interpreter runs every rule, frame rules included)."""
 
 from __future__ import annotations
 
-import importlib
 import random
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +16,7 @@ from specc.analysis.controller import Controller, executive_controller
 from specc.analysis.incompat import state_count
 from specc.model import nodes as m
 from specc.pipeline import load
-from tests.functional.conftest import compile_robot
+from tests.functional.conftest import compiled_module
 from tests.scale import write_robot
 
 
@@ -60,12 +58,7 @@ def test_the_split_controller_decides_as_the_whole_base(tmp_path: Path) -> None:
 
 def test_the_generated_split_controller_decides_as_the_whole_base(tmp_path: Path) -> None:
     folder = write_robot(tmp_path / "robot", 15, seed=5)
-    package = compile_robot(folder, tmp_path / "out")
-    sys.path.insert(0, str(tmp_path / "out"))
-    try:
-        module = importlib.import_module(f"{package}.executive.scale15_resource_controller")
-    finally:
-        sys.path.remove(str(tmp_path / "out"))
+    module = compiled_module(folder, tmp_path / "out", "executive.scale15_resource_controller")
     base = controller(tmp_path / "again", 15, seed=5).base
     assert module.SPLIT == "service" and set(module.KEPT) == set(base.attributes["service"].values)
     rng = random.Random(13)

@@ -458,19 +458,11 @@ rules guard {
 
 
 def test_a_generated_decision_refuses_what_its_inputs_cannot_be_and_names_the_input(tmp_path: Path) -> None:
-    import importlib
-    import sys
-
-    from tests.functional.conftest import compile_robot
+    from tests.functional.conftest import compiled_module
 
     spec = tmp_path / "guard.spec"
     spec.write_text(TYPED_INPUTS)
-    name = compile_robot(spec, tmp_path / "out")
-    sys.path.insert(0, str(tmp_path / "out"))
-    try:
-        guard = importlib.import_module(f"{name}.rules.guard")
-    finally:
-        sys.path.remove(str(tmp_path / "out"))
+    guard = compiled_module(spec, tmp_path / "out", "rules.guard")
     assert guard.decide({"soc": 50, "estop": False}).outputs == {"action": "go"}
     assert guard.decide({"soc": 50, "estop": 1}).outputs == {"action": "stop"}  # as the interpreter: 1 == True
     for wrong in ("no", None, 2):  # a truthy string used to read as True

@@ -25,6 +25,17 @@ def compile_robot(spec: Path | list[Path], target: Path, name: str | None = None
     return name
 
 
+def compiled_module(spec: Path | list[Path], target: Path, part: str) -> ModuleType:
+    """One module of the package the specs compile to in `target` (`part`: `rules.guard`,
+    `executive.x_resource_controller`), imported with `target` on the path only meanwhile."""
+    name = compile_robot(spec, target)
+    sys.path.insert(0, str(target))
+    try:
+        return importlib.import_module(f"{name}.{part}")
+    finally:
+        sys.path.remove(str(target))
+
+
 @pytest.fixture(scope="session")
 def scripted_package(tmp_path_factory: pytest.TempPathFactory) -> ModuleType:
     target = tmp_path_factory.mktemp("generated")
