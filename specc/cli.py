@@ -655,6 +655,9 @@ def rules_report(paths: PathsArg,
 def skeleton(paths: PathsArg) -> None:
     """Write stubs for the Python functions the specs name but their modules lack (module codels,
     executive input/output functions, PRS actions and evaluable predicates); never rewrites code.
+    A function is added to the Python module the spec names (`codels: "cart_codels.drive"`), in the
+    robot's folder where `specc run` imports it from (the folder holding the system block, else the
+    folder given), created with its package when missing.
 
     Example: specc skeleton examples/tug
     """
@@ -932,7 +935,8 @@ def mutants_command(
                                                                  "with --seed, stratified by class.")] = None,
         seed: Annotated[int, typer.Option(help="Draws the --sample.")] = 0,
         show: Annotated[Optional[str], typer.Option(help="Print this mutant's description, verdict and diff "
-                                                         "(e.g. model1-0042).")] = None,
+                                                         "(its id, as the listing gives it: "
+                                                         "<domain>-NNNN, e.g. warehouse-0020).")] = None,
         output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write each kept (or sampled) "
                                                        "mutant's spec file and diff into this folder.")] = None,
         workers: Annotated[Optional[int], typer.Option(min=1, help="Processes checking mutants (default: one "
