@@ -63,9 +63,12 @@ def _controller_naming_diagnostics(program: m.Program) -> list[Diagnostic]:
     so reported here, after the check passes, and before anything is compiled)."""
     from specc.analysis.controller import naming, rules_waits_override
 
-    executives = [e for e in program.items if isinstance(e, m.Executive)]
-    return [error(p.code, p.message, p.node.span) for e in executives for p in naming(program, e).problems] + [
-        warning(p.code, p.message, p.node.span) for e in executives for p in rules_waits_override(program, e)]
+    found = []
+    for executive in (e for e in program.items if isinstance(e, m.Executive)):
+        named = naming(program, executive)
+        found += [error(p.code, p.message, p.node.span) for p in named.problems]
+        found += [warning(p.code, p.message, p.node.span) for p in rules_waits_override(executive, named)]
+    return found
 
 
 def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
@@ -74,7 +77,7 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
     it leaves unsettled; for each executive, the same of its resource controller (its generated
     rules joined by its own bases, compiled one decision per service: milliseconds for 21 services)."""
     from specc.analysis.controller import executive_controller
-    from specc.analysis.kheops import KheopsError, compile_base, normalise, size_warning, unsettled_warning
+    from specc.analysis.kheops import KheopsError, compile_base, compiled_warnings, normalise
 
     joined = {ref.text for e in program.items if isinstance(e, m.Executive) for ref in e.rules}
     found = []
@@ -82,9 +85,7 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
         try:
             normal = normalise(base)
             if base.name not in joined:
-                compiled = compile_base(normal)
-                found += [w for w in (unsettled_warning(compiled, f"rule base '{base.name}'", base),
-                                      size_warning(compiled, f"rule base '{base.name}'", base)) if w is not None]
+                found += compiled_warnings(compile_base(normal), f"rule base '{base.name}'", base)
         except KheopsError as exc:
             found.append(exc.diagnostic())
     if any(d.severity == "error" for d in found):
@@ -94,10 +95,8 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
             controller = executive_controller(program, executive)
             if controller.problems:
                 continue  # the executive's check reported them
-            compiled = controller.compile()
-            what = f"the resource controller of executive '{executive.name}'"
-            found += [w for w in (unsettled_warning(compiled, what, executive), size_warning(compiled, what, executive))
-                      if w is not None]
+            found += compiled_warnings(controller.compile(), f"the resource controller of executive "
+                                       f"'{executive.name}'", executive)
         except KheopsError as exc:
             found.append(exc.diagnostic())
     return found

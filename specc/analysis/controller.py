@@ -423,12 +423,12 @@ def fixed_values(condition: k.Cond) -> dict[str, Any]:
     return {a.attribute: a.value for a in atoms if isinstance(a, k.Atom) and a.op == "=="}
 
 
-def rules_waits_override(program: m.Program, executive: m.Executive) -> list[Problem]:
+def rules_waits_override(executive: m.Executive, named: Naming) -> list[Problem]:
     """The executive's hand-written rules that a wait always overrides: whenever one applies, so
     does the generated rule making its service WAIT (a declared `wait`, or one a `sends:` adds),
-    which no hand-written rule takes over (`take_over`), so the rule never decides anything."""
-    named = naming(program, executive)
-    if named.problems:
+    which no hand-written rule takes over (`take_over`), so the rule never decides anything.
+    `named`: the executive's `naming`, which its caller has already."""
+    if named.problems or not named.hand:
         return []
     generated = k.normalise(controller_rules(controller_name(executive), named.graph, named.groups, named.names))
     waits = wait_rules(named.graph, named.groups)

@@ -727,6 +727,7 @@ class Compiler:
         # Per explored state: the path and rules fired that first reached it, and the slice of
         # `findings` its subgraph gave; a path reaching it again gets those findings too.
         self.reached_first: dict[tuple[Any, ...], tuple[int, int, int, int]] = {}
+        self.findings_cut = False  # FINDINGS_LIMIT was reached
         self.reads: dict[int, tuple[str, ...]] = {}
         self.rule_atoms: dict[int, tuple[Atom, ...]] = {}
         self.restricting: dict[int, frozenset[str]] = {}
@@ -943,8 +944,6 @@ class Compiler:
             child_of.update(dict.fromkeys(values, child))
         branches = tuple((value, child_of[value]) for value in self.ordered(chosen, memory[chosen]))
         return self.wrap(procedural, self.intern(Test(chosen, branches)))
-
-    findings_cut = False  # FINDINGS_LIMIT was reached
 
     def too_large(self) -> TooLarge:
         bound, largest = paths_bound_text(self.base)
@@ -1166,7 +1165,6 @@ def _elements(value: Any) -> tuple[Any, ...]:
     return value if isinstance(value, tuple) else (value,)
 
 
-
 def describe(finding: Finding) -> str:
     witness = ", ".join(f"{a}={' | '.join(map(str, _coalesced(v))) if isinstance(v, tuple) else v}"
                         for a, v in finding.witness) or "any input"
@@ -1213,6 +1211,11 @@ def size_warning(compiled: Compiled, what: str, node: m.Node) -> Diagnostic | No
                       f"({compiled.tree_nodes:,} explored): about {megabytes:.0f} MB of generated Python, seconds to "
                       "import; split it into bases that each decide from fewer inputs, or compare each numeric "
                       "input with fewer thresholds", node.span, "warning")
+
+
+def compiled_warnings(compiled: Compiled, what: str, node: m.Node) -> list[Diagnostic]:
+    """What check and compile say of a compiled base: the inputs it leaves unsettled, its size."""
+    return [w for w in (unsettled_warning(compiled, what, node), size_warning(compiled, what, node)) if w is not None]
 
 
 def unsettled_warning(compiled: Compiled, what: str, node: m.Node) -> Diagnostic | None:

@@ -711,6 +711,7 @@ class _Exporter:
         the domains the slots declare. The numbers written alone would leave such a task no ground
         instance. Bounded (REACHED_NUMBERS per class): a class it cuts is said in the notes."""
         cut: set[str] = set()
+        tried: set[tuple[int, float]] = set()  # (event, value before): each worked out once, not at every sweep
         grown = True
         while grown:
             grown = False
@@ -725,6 +726,9 @@ class _Exporter:
                     allowed = [d for slot in self.var_slots(task, a.after.name)
                                if isinstance(d := self.declared(slot), pm.Interval)]
                     for before in sorted(source.values):
+                        if (id(a), before) in tried:
+                            continue
+                        tried.add((id(a), before))
                         found = bounds(task.constraints, {("var", a.before.name): (before, before)},
                                        [("var", a.after.name)])
                         value = _single(found[("var", a.after.name)]) if found is not None else None

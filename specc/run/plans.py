@@ -37,7 +37,7 @@ from specc.runtime.ftplan.execution import OVERRUN_TOLERANCE, Execution, Precede
 from specc.runtime.ftplan.facts import FactKey, match, substitute
 from specc.runtime.ftplan.state import consequences
 from specc.runtime.ftplan.view import View
-from specc.runtime.planner.plan import Action, Plan, Value, format_value
+from specc.runtime.planner.plan import Action, Plan, Value, format_call, format_value
 from specc.runtime.planner.validate import normalise, same
 from specc.runtime.system import BindingSpec, StateCondition, StateValue
 
@@ -293,7 +293,7 @@ class Call:
         args = " ".join(format_value(a) for a in self.args)
         if self.kind == "goal":
             return f"!({self.target}{' ' + args if args else ''})"
-        return f"{self.target}({', '.join(format_value(a) for a in self.args)})"
+        return format_call(self.target, self.args)
 
 
 def bound_call(binding: BindingSpec, action: Action, after: Callable[[], Mapping[FactKey, Value]]) -> Call:

@@ -43,7 +43,7 @@ import numpy as np
 
 from specc.run import RunError, pictures
 from specc.runtime.body import RobotConfig
-from specc.runtime.planner.plan import Value, format_value
+from specc.runtime.planner.plan import Value, format_call, format_value
 from specc.runtime.sim import Target, Window, World, WorldError, parse_world
 from specc.runtime.sim.render import (
     OBJECT_COLOURS,
@@ -241,7 +241,7 @@ class ActionBar:
         return found.group(1) if found else self.task
 
     def text(self) -> str:
-        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+        return format_call(self.task, self.args)
 
 
 def action_bars(events: Events) -> list[ActionBar]:

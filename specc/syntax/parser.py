@@ -258,14 +258,14 @@ def _meant(exc: UnexpectedToken, text: str, position: int, written: str, is_name
     if is_name:
         words = [k for k in texts.values() if k.isidentifier() and len(k) > 2]  # not the units s, ms, us
         expected = [texts[t] for t in exc.expected if t in texts and texts[t] in words]
-        tried = difflib.get_close_matches(written, expected, n=3) + difflib.get_close_matches(written, words, n=3)
-        end = position + len(written)
+        close = difflib.get_close_matches(written, expected, n=3) + difflib.get_close_matches(written, words, n=3)
+        tried = [(word, len(written)) for word in close]  # (what to write, the length it replaces)
     else:
         operators = [texts[t] for t in exc.expected if t in texts and len(texts[t]) > 1 and not texts[t].isalnum()]
-        tried = [op for op in operators if any(text.startswith(op[:i] + op[i + 1:], position) for i in range(len(op)))]
-        end = position + max((len(op) - 1 for op in tried), default=0)
-    for candidate in dict.fromkeys(tried):
-        if _parses_past(text[:position] + candidate + text[end:], position + len(candidate)):
+        tried = [(op, len(op) - 1) for op in operators
+                 if any(text.startswith(op[:i] + op[i + 1:], position) for i in range(len(op)))]
+    for candidate, replaced in dict.fromkeys(tried):
+        if _parses_past(text[:position] + candidate + text[position + replaced:], position + len(candidate)):
             return f" (did you mean '{candidate}'?)"
     return ""
 

@@ -29,7 +29,7 @@ from specc.runtime.ftplan.facts import FactKey, match, substitute
 from specc.runtime.ftplan.state import Dates, SystemState, consequences, constant, constant_key
 from specc.runtime.ftplan.view import View
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.plan import Action, Plan, Value, format_value
+from specc.runtime.planner.plan import Action, Plan, Value, format_call, format_value
 from specc.runtime.planner.validate import same
 
 # Dates computed by the planner's solver differ in their last digits from the same date reached
@@ -188,7 +188,7 @@ def _requirement(rule: Requirement, plan: Plan, projection: Projection) -> list[
         found = possible_values(projection.timeline(key), span, action.id)
         if all(_same_value(p.value, required) for p in found):
             continue
-        attribute = f"{key[0]}({', '.join(format_value(a) for a in key[1])})"
+        attribute = format_call(key[0], key[1])
         if len(found) == 1:
             what = f"{attribute} is {_possibility(found[0])}, not {format_value(required)}"
         else:

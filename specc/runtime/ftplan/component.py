@@ -48,7 +48,7 @@ from specc.runtime.ftplan.planners import Answer, Watchdog
 from specc.runtime.ftplan.state import Goal, Running, SystemState, consequences, fact_list
 from specc.runtime.ftplan.view import View, same_fact
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.plan import Plan, Repair, format_value
+from specc.runtime.planner.plan import Plan, Repair, format_call
 from specc.runtime.planner.replan import replanning_problem
 
 MISSION_FAILED_IN_TIME = "mission failure: no valid plan found in time"  # Fig 3.1 line 24, Fig 3.2 line 24
@@ -516,7 +516,7 @@ class FtPlan:
             elif r.kind in ("ended", "failed"):
                 self.state.changing = {key: by for key, by in self.state.changing.items() if by.action != r.action}
             self.state.report(self.config.state_rules, r.kind, r.name, r.args, self.views.get(k))
-            self.log("report", f"{r.kind} {r.name}({', '.join(format_value(a) for a in r.args)})"
+            self.log("report", f"{r.kind} {format_call(r.name, r.args)}"
                      + (f": {r.why}" if r.why else ""), k, r.time)
             if r.kind == "ended":
                 ended.add(r.action)

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from specc.runtime.ftplan.config import FactUpdate, StateRule, Value
 from specc.runtime.ftplan.facts import FactKey, match, substitute
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.plan import format_value
+from specc.runtime.planner.plan import format_call, format_value
 from specc.runtime.planner.replan import Fact
 from specc.runtime.planner.validate import normalise, same
 
@@ -78,7 +78,7 @@ class Running:
     args: tuple[Value, ...]
 
     def text(self) -> str:
-        return f"{self.name}({', '.join(format_value(a) for a in self.args)})"
+        return format_call(self.name, self.args)
 
 
 @dataclass

@@ -3,6 +3,7 @@ schedule, the goals kept and dropped, or no plan and why (seed 004 §3.2.1.2).""
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 Value = float | str
@@ -25,7 +26,7 @@ class Action:
     values: tuple[tuple[str, Value], ...] = ()  # the other variables the planner fixed (a symbol or a number)
 
     def text(self) -> str:
-        return f"{self.task}({', '.join(format_value(a) for a in self.args)})"
+        return format_call(self.task, self.args)
 
 
 @dataclass(frozen=True)
@@ -125,3 +126,8 @@ def format_value(value: Value) -> str:
     if isinstance(value, float):
         return f"{value:g}"
     return str(value)
+
+
+def format_call(name: str, args: Iterable[Value]) -> str:
+    """`MOVE(DOCK, A)`: a task (or an attribute) with its arguments, as messages and logs write it."""
+    return f"{name}({', '.join(format_value(a) for a in args)})"
