@@ -41,6 +41,30 @@ PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders sea
                                                 show_default=False, readable=False)]
 
 
+def refuse_unwritable(path: Path | None, what: str, example: str, picture: bool = False) -> None:
+    """Exit at once, before any planning or drawing, when the file `path` cannot be written: a
+    folder, a picture format matplotlib does not write, or a folder that cannot be made or written
+    in ('-' is the standard output)."""
+    if path is None or str(path) == "-":
+        return
+    from specc.run import RunError, writable_folder
+
+    try:
+        if path.is_dir():
+            raise RunError(f"{what} '{path}' is a folder: give a file name, e.g. {path / example}")
+        if picture and path.suffix:
+            from matplotlib.backend_bases import FigureCanvasBase
+
+            formats = FigureCanvasBase.get_supported_filetypes()
+            if path.suffix[1:].lower() not in formats:
+                raise RunError(f"{what} '{path}': matplotlib writes no '{path.suffix}' picture; end the name "
+                               f"with .png, .svg or .pdf (or {', '.join('.' + f for f in sorted(formats))})")
+        writable_folder(path.parent, f"the folder of {what}")
+    except RunError as error:
+        err.print(f"error: {error}", markup=False)
+        raise typer.Exit(1) from None
+
+
 def report(loaded: Loaded) -> int:
     """Print every diagnostic; the exit code is 1 when any is an error."""
     for diagnostic in loaded.diagnostics:
@@ -213,6 +237,7 @@ def graph(paths: PathsArg,
     if incompat == net:
         err.print("error: say what to draw: --incompat or --net", markup=False)
         raise typer.Exit(1)
+    refuse_unwritable(output, "the picture (-o)", "net.png" if net else "incompat.png", picture=True)
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
@@ -509,6 +534,8 @@ def plan(paths: PathsArg,
     Example: specc plan examples/tug --problem shuttle -o build/shuttle.png --json build/shuttle.json"""
     from specc.plan_report import print_result, solve
 
+    refuse_unwritable(picture, "the picture (-o)", "plan.png", picture=True)
+    refuse_unwritable(json_path, "the JSON file (--json)", "plan.json")
     loaded = load(paths)
     if report(loaded):
         raise typer.Exit(1)

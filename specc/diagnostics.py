@@ -24,6 +24,8 @@ class SpeccError(Exception):
 
 @dataclass(frozen=True)
 class Diagnostic:
+    """One message of `specc check`: code, text, where, and notes at other places."""
+
     code: str
     message: str
     span: Span

@@ -5,20 +5,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lark import Token
-
 from specc.check import check_program
 from specc.diagnostics import Diagnostic, error, sort_key, warning
 from specc.model import nodes as m
+from specc.syntax.parsed import Comment
 from specc.syntax.parser import display_path, parse_text, read_source, spec_files
 
 
 @dataclass
 class Loaded:
+    """A robot's specs loaded: the program, every diagnostic, and the files' texts."""
+
     program: m.Program | None
     diagnostics: list[Diagnostic]
     sources: dict[str, str] = field(default_factory=dict)  # file as shown in spans -> its text
-    comments: dict[str, list[Token]] = field(default_factory=dict)
+    comments: dict[str, list[Comment]] = field(default_factory=dict)
     paths: dict[str, Path] = field(default_factory=dict)  # file as shown in spans -> its path
 
     @property

@@ -22,6 +22,8 @@ from specc.runtime.planner.validate import validate
 
 @dataclass
 class Outcome:
+    """A planning problem solved for `specc plan`, and what the validator says of the plan."""
+
     domain: pm.PlanningDomain
     problem: pm.Problem
     result: PlanResult

@@ -11,6 +11,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from specc import disk_cache
+
 
 def python_name(base: str) -> str:
     """The Python name a spec name becomes in the generated package (`a-b` -> `a_b`)."""
@@ -103,19 +105,62 @@ class _Imported:
     name: str
 
 
-@functools.lru_cache(maxsize=256)
+PYTHON_NAMES = "python"  # the disk cache's kind of entry: a module's top-level names
+
+
 def _top_level(path: Path) -> Mapping[str, FunctionShape | _Imported | None] | SyntaxError:
     """The names a module defines at top level: a plain function's shape, where a `from ... import`
-    takes a name from, or None (an assignment, a decorated function); or why it cannot be read."""
+    takes a name from, or None (an assignment, a decorated function); or why it cannot be read.
+    Read back from the disk cache when this code read the same file before: parsing the codels is
+    most of a `specc check` of a robot whose specs are cached."""
     try:
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-    except SyntaxError as exc:
-        exc.lineno = exc.lineno or 1  # a NUL byte is a SyntaxError of no line
-        return exc
-    except (OSError, UnicodeDecodeError, ValueError) as exc:  # unreadable, not UTF-8, a NUL byte
-        unreadable = SyntaxError(f"cannot read it as Python source: {exc}")
-        unreadable.lineno = 1
-        return unreadable
+        data = path.read_bytes()
+    except OSError as exc:
+        return _unreadable(path, exc).error()
+    return _names_in(data, str(path))
+
+
+@functools.lru_cache(maxsize=256)
+def _names_in(data: bytes, filename: str) -> Mapping[str, FunctionShape | _Imported | None] | SyntaxError:
+    key = disk_cache.key(_own_digest(), filename, data)
+    kept = disk_cache.read(PYTHON_NAMES, key, (dict, _Unreadable))
+    found = _read_names(data, filename) if kept is disk_cache.MISSING else kept
+    if kept is disk_cache.MISSING:
+        disk_cache.keep(PYTHON_NAMES, key, found)
+    return found.error() if isinstance(found, _Unreadable) else found
+
+
+@functools.lru_cache(maxsize=1)
+def _own_digest() -> str:
+    return disk_cache.source_digest([Path(__file__)])
+
+
+@dataclass(frozen=True)
+class _Unreadable:
+    """Why a module cannot be read, as kept on disk (plain data: an exception's attributes do not all
+    survive pickling once a library has changed how exceptions pickle)."""
+
+    message: str
+    filename: str
+    line: int
+    offset: int = 1
+    text: str | None = None
+
+    def error(self) -> SyntaxError:
+        return SyntaxError(self.message, (self.filename, self.line, self.offset, self.text))
+
+
+def _unreadable(path: Path | str, exc: Exception) -> _Unreadable:
+    return _Unreadable(f"cannot read it as Python source: {exc}", str(path), 1)
+
+
+def _read_names(data: bytes, filename: str) -> dict[str, FunctionShape | _Imported | None] | _Unreadable:
+    try:
+        tree = ast.parse(data.decode("utf-8"), filename=filename)
+    except SyntaxError as exc:  # a NUL byte is a SyntaxError of no line
+        return _Unreadable(exc.msg, filename, exc.lineno or 1, exc.offset or 1, exc.text)
+    except (UnicodeDecodeError, ValueError) as exc:  # not UTF-8, a NUL byte
+        return _unreadable(filename, exc)
     names: dict[str, FunctionShape | _Imported | None] = {}
     for node in tree.body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -177,8 +222,3 @@ def _follow(entry: FunctionShape | _Imported | None, path: Path, depth: int) -> 
     if found is None or found.defined_in:
         return found
     return dataclasses.replace(found, defined_in=f"{source.parent.name}/{source.name}")
-
-
-def clear_caches() -> None:
-    """Forget what was read (a file just written, e.g. by `specc skeleton`)."""
-    _top_level.cache_clear()

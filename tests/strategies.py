@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import strategies as st
 
 from specc.model import nodes as m
-from specc.syntax.parser import keyword_texts
+from specc.syntax.grammar import keyword_texts
 
 KEYWORDS = {text for text in keyword_texts().values() if text.isidentifier()} | {"oo"}
 

@@ -528,3 +528,17 @@ def test_a_run_stopped_by_sigterm_leaves_its_report(tmp_path: Path) -> None:
     assert run.returncode == 130 and "Traceback" not in stderr, stderr
     report = json.loads((tmp_path / "run" / "report.json").read_text())
     assert report["outcome"] == "interrupted" and report["why"] == "stopped by SIGTERM"
+
+
+def test_a_start_where_the_body_overlaps_an_obstacle_is_refused_before_the_run(cart: Path) -> None:
+    """The start's centre is clear (0.4 m from the crate's centre, outside its 0.3 m) but the cart's
+    0.25 m body reaches into the crate: the physics would shove it out at once."""
+    work = cart.parent
+    tight = WORLD.replace("x = 1.0\ny = 1.0", "x = 4.5\ny = 1.1")
+    (cart / "worlds" / "tight.toml").write_text(tight)
+    folder = work / "never-tight"
+    result = specc(work, "run", cart, "--goal", "!(GO 3 4)", "--world", cart / "worlds" / "tight.toml",
+                   "--folder", folder, "-q")
+    assert result.returncode == 2, result.stderr
+    assert "the robot's body (its 0.25 m radius) at its start (4.5, 1.1, heading 0 rad) overlaps" in result.stderr
+    assert "Traceback" not in result.stderr and not folder.exists()

@@ -525,3 +525,21 @@ def test_skeleton_writes_codels_where_specc_run_imports_them(tmp_path: Path) -> 
     (robot / "system.spec").write_text("system bot {\n  modules: drive, arm;\n}\n")
     second = specc("skeleton", str(robot / "modules"), str(robot / "system.spec"))
     assert second.returncode == 0 and (robot / "bot_codels" / "arm.py").is_file(), second.stdout + second.stderr
+
+
+def test_an_output_that_cannot_be_written_stops_plan_and_graph_before_any_work(tmp_path: Path) -> None:
+    """A picture format matplotlib does not write, or a folder given for a file, is said at once:
+    nothing is planned or drawn first (the plan's text, printed after planning, never appears)."""
+    tug = str(EXAMPLES / "tug")
+    (tmp_path / "taken").mkdir()
+    cases = [
+        (("plan", tug, "--problem", "shuttle", "-o", str(tmp_path / "plan.txt")), "matplotlib writes no '.txt'"),
+        (("plan", tug, "--problem", "shuttle", "--json", str(tmp_path / "taken")), "is a folder: give a file name"),
+        (("graph", "--incompat", tug, "-o", str(tmp_path / "graph.docx")), "end the name with .png, .svg or .pdf"),
+    ]
+    for arguments, said in cases:
+        result = specc(*arguments)
+        assert result.returncode == 1 and said in result.stderr, result.stderr
+        assert "Traceback" not in result.stderr and "partial plans" not in result.stdout + result.stderr
+        assert "group(s)" not in result.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]

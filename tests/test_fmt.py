@@ -23,7 +23,7 @@ PIECE = re.compile(r'"(?:[^"\\\n]|\\.)*"|//[^\n]*|/\*.*?\*/|\s+|[^\s"/]+|/', re.
 def parsed(text: str) -> tuple[m.SourceFile, list[str]]:
     result = parse_text(text, "case.spec")
     assert result.source is not None, [d.headline() for d in result.diagnostics]
-    return result.source, [" ".join(str(c).split()) for c in result.comments]
+    return result.source, [" ".join(c.text.split()) for c in result.comments]
 
 
 def fmt(text: str) -> str:

@@ -1,5 +1,6 @@
-"""Parsed files are kept (specc.syntax.parser.parsed_cache): a file parsed before by the same front
-end is read back instead of parsed again, and what is read back is what a parse gives."""
+"""Parsed files are kept (specc.disk_cache): a file parsed before by the same front end is read back
+instead of parsed again, and what is read back is what a parse gives; so are the top-level
+functions of a codel module (specc.pysource), and a command on files seen before loads no lark."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from specc.syntax import parser
+from specc import disk_cache
+from specc.syntax import grammar, parser
+from specc.syntax.parsed import ParseResult
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = (ROOT / "examples" / "tug" / "modules" / "drive.spec").read_text()
@@ -21,15 +24,15 @@ BROKEN = "module arm {\n  request Grab { type: control }\n}\n"
 @pytest.fixture()
 def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    parser.parsed_cache.cache_clear()
-    folder = parser.parsed_cache()
+    disk_cache.folder.cache_clear()
+    folder = disk_cache.folder(parser.PARSED)
     assert folder is not None and str(folder).startswith(str(tmp_path))
     yield folder
-    parser.parsed_cache.cache_clear()
+    disk_cache.folder.cache_clear()
 
 
-def fresh(text: str, path: str) -> parser.ParseResult:
-    return parser._parse_text(text, path)  # the parse the cache stands for
+def fresh(text: str, path: str) -> ParseResult:
+    return grammar.parse_uncached(text, path)  # the parse the cache stands for
 
 
 def test_a_file_parsed_again_is_read_back_and_equal_to_a_parse(cache: Path) -> None:
@@ -38,7 +41,7 @@ def test_a_file_parsed_again_is_read_back_and_equal_to_a_parse(cache: Path) -> N
     again = parser.parse_text(SPEC, "drive.spec")
     assert again is not first  # read back, not the same object
     assert again.source == fresh(SPEC, "drive.spec").source == first.source
-    assert [str(t) for t in again.comments] == [str(t) for t in first.comments]
+    assert again.comments == first.comments == fresh(SPEC, "drive.spec").comments != []
 
 
 def test_a_changed_text_or_path_is_parsed_anew(cache: Path) -> None:
@@ -76,4 +79,50 @@ def test_the_cache_can_be_turned_off(tmp_path: Path) -> None:
     done = subprocess.run([sys.executable, "-m", "specc.cli", "check", "examples/tug"], cwd=ROOT,
                           capture_output=True, text=True, env=environment, timeout=300)
     assert done.returncode == 0, done.stderr
-    assert len(list(tmp_path.rglob("*.pickle"))) == len(list((ROOT / "examples" / "tug").rglob("*.spec")))
+    parsed = list((tmp_path / "specc" / parser.PARSED).glob("*.pickle"))
+    assert len(parsed) == len(list((ROOT / "examples" / "tug").rglob("*.spec")))
+
+
+CODELS = "def start(sdi):\n    return 'ok'\n\n\ndef step(sdi, x, y=1):\n    return 'done'\n"
+
+
+def test_a_codel_module_read_again_is_read_back_and_an_edit_is_read_anew(cache: Path, tmp_path: Path) -> None:
+    from specc.pysource import PYTHON_NAMES, _names_in, top_level_functions
+
+    module = tmp_path / "arm_codels.py"
+    module.write_text(CODELS)
+    first = top_level_functions(module)
+    assert not isinstance(first, SyntaxError) and set(first) == {"start", "step"}
+    (entry,) = (cache.parent / PYTHON_NAMES).glob("*.pickle")
+    _names_in.cache_clear()  # what a new process sees: only the disk
+    again = top_level_functions(module)
+    assert again == first and again is not first
+    module.write_text(CODELS.replace("def step(sdi, x, y=1)", "def step(sdi)"))
+    edited = top_level_functions(module)
+    assert not isinstance(edited, SyntaxError)
+    shape = edited["step"]
+    assert shape is not None and (shape.least, shape.most) == (1, 1)
+
+
+def test_a_codel_syntax_error_keeps_its_line_through_the_cache(cache: Path, tmp_path: Path) -> None:
+    from specc.pysource import _names_in, top_level_functions
+
+    module = tmp_path / "broken_codels.py"
+    module.write_text("def start(sdi):\n    return 'ok'\n\ndef step(sdi:\n")
+    first = top_level_functions(module)
+    _names_in.cache_clear()
+    again = top_level_functions(module)
+    assert isinstance(first, SyntaxError) and isinstance(again, SyntaxError)
+    assert again.lineno == first.lineno == 4 and again.msg == first.msg
+
+
+def test_a_check_of_specs_seen_before_does_not_load_lark(tmp_path: Path) -> None:
+    """Parsing is lark's, but a file read back from the cache needs none of it (a cold command on
+    a robot seen before saves lark's import)."""
+    environment = {**os.environ, "XDG_CACHE_HOME": str(tmp_path)}
+    probe = ("import sys; from pathlib import Path; from specc.pipeline import load; "
+             "loaded = load([Path('examples/tug')]); assert not loaded.errors; "
+             "print('lark' in sys.modules)")
+    runs = [subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True,
+                           env=environment, timeout=300) for _ in range(2)]
+    assert [r.stdout.strip() for r in runs] == ["True", "False"], [r.stderr for r in runs]

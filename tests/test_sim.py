@@ -354,3 +354,18 @@ def test_a_body_built_from_python_is_checked_as_a_body_block_is():
     with pytest.raises(ValueError, match="body 'x': 'radius' must be a finite number >= 0"):
         RobotConfig.from_spec("x", {"radius": -1})
     assert RobotConfig.from_spec("x", {"radius": 0.3, "mass": 20}).mass == 20.0
+
+
+def test_a_box_footprint_overlaps_where_its_corner_reaches_and_not_where_its_side_is_clear() -> None:
+    """A 1 x 0.4 m box 0.45 m from a wall: clear lying along the wall (its half-width is 0.2 m),
+    overlapping across it (its half-length is 0.5 m); turned by 45 degrees its corner reaches
+    0.54 m, so it overlaps too. A disc of 0.3 m there is clear by 0.15 m."""
+    room = world()
+    xmin = room.bounds[0]
+    y = 0.0
+    along = room.footprint_clearance((xmin + 0.45, y, math.pi / 2), 0.0, 1.0, 0.4)
+    across = room.footprint_clearance((xmin + 0.45, y, 0.0), 0.0, 1.0, 0.4)
+    turned = room.footprint_clearance((xmin + 0.45, y, math.pi / 4), 0.0, 1.0, 0.4)
+    assert along == pytest.approx(0.25, abs=1e-6)
+    assert across <= 0 and turned <= 0
+    assert room.footprint_clearance((xmin + 0.45, y, 0.0), 0.3) == pytest.approx(0.15)

@@ -28,6 +28,8 @@ from specc.model import nodes as m
 
 @dataclass(frozen=True)
 class Arc:
+    """An incompatibility between two services: the policy the source applies to the target."""
+
     source: str
     target: str
     policy: str  # interrupt | wait
@@ -36,6 +38,8 @@ class Arc:
 
 @dataclass(frozen=True)
 class IncompatibilityGraph:
+    """The services of an executive and their incompatibilities (seed 000 §3.3)."""
+
     services: tuple[str, ...]
     arcs: tuple[Arc, ...]
     modules: dict[str, str]  # service -> module of its request
@@ -50,6 +54,8 @@ class IncompatibilityGraph:
 
 @dataclass(frozen=True)
 class Group:
+    """Services that share a controller state: a connected part of the graph."""
+
     services: tuple[str, ...]
 
     @property

@@ -92,16 +92,22 @@ class Atom:
 
 @dataclass(frozen=True)
 class Not:
+    """A condition that holds when its operand does not."""
+
     operand: Cond
 
 
 @dataclass(frozen=True)
 class All:
+    """Conditions that must all hold."""
+
     operands: tuple[Cond, ...]
 
 
 @dataclass(frozen=True)
 class Any_:
+    """Conditions of which one must hold."""
+
     operands: tuple[Cond, ...]
 
 
@@ -153,17 +159,23 @@ class Expr:
 
 @dataclass(frozen=True)
 class Restrict:
+    """A rule's action narrowing an output to the values its atom allows."""
+
     atom: Atom
 
 
 @dataclass(frozen=True)
 class Assign:
+    """A rule's `do` action giving an attribute the value of an expression."""
+
     target: str
     expr: Expr
 
 
 @dataclass(frozen=True)
 class Call:
+    """A rule's `do` action calling a function of the user's with arguments."""
+
     function: str
     args: tuple[Expr, ...]
 
@@ -173,6 +185,8 @@ Action = Union[Restrict, Assign, Call]
 
 @dataclass(frozen=True)
 class Rule:
+    """A rule of a normalised base: `when` (condition ==> actions), `impossible` or `else`."""
+
     name: str
     kind: str  # when | impossible | else
     condition: Cond | None
@@ -214,6 +228,8 @@ class Piece:
 
 @dataclass
 class Attribute:
+    """An attribute of a normalised base: its role, kind and the values (or pieces) it takes."""
+
     name: str
     role: str  # inputs | outputs | intermediate | previous
     kind: str = "symbol"  # symbol | bool | number
@@ -580,6 +596,8 @@ def restrict(memory: dict[str, frozenset[Any]], atom: Atom) -> None:
 
 @dataclass
 class Outcome:
+    """What the reference interpreter decides for one set of inputs, and which rules fired."""
+
     outputs: dict[str, Any]  # determined outputs; None for an undetermined one
     fired: list[str]
     calls: list[tuple[str, tuple[Any, ...]]]
@@ -657,6 +675,8 @@ def finish(base: Base, memory: Mapping[str, frozenset[Any]], outcome: Outcome) -
 
 @dataclass(frozen=True)
 class Leaf:
+    """The end of a path of the compiled decision: each output's value, and what went wrong."""
+
     outputs: tuple[tuple[str, Any], ...]  # every output of the base compiled: (name, value or None)
     inconsistent: tuple[str, ...] = ()
     incomplete: tuple[str, ...] = ()
@@ -665,6 +685,8 @@ class Leaf:
 
 @dataclass(frozen=True)
 class Test:
+    """A node of the compiled decision: one branch per value (or piece) of an attribute."""
+
     attribute: str
     branches: tuple[tuple[Any, Node], ...]  # (domain element, subgraph)
 
@@ -682,6 +704,8 @@ Node = Union[Leaf, Test, Do]
 
 @dataclass(frozen=True)
 class Finding:
+    """An inconsistency or incompleteness of a base, with the inputs that lead to it."""
+
     kind: str  # inconsistent | incomplete
     attributes: tuple[str, ...]
     witness: tuple[tuple[str, Any], ...]  # the tests on the path: attribute, domain element (a tuple: any of them)
@@ -690,6 +714,8 @@ class Finding:
 
 @dataclass
 class Compiled:
+    """A rule base compiled into a decision graph of bounded depth (seed 000 §3.7)."""
+
     base: Base
     root: Node
     findings: list[Finding]

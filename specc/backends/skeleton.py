@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from specc.model import nodes as m
-from specc.pysource import clear_caches, find_module, top_level_functions
+from specc.pysource import find_module, top_level_functions
 
 FIRST_NEXT_STATE = {"start": "exec", "exec": "ether", "end": "ether", "inter": "ether"}
 
@@ -149,7 +149,6 @@ def write_stubs(wanted: Needs, spec_dir: Path, robot_dir: Path | None = None) ->
         if path.parent != base and not package_init.exists():
             package_init.write_text("")
         path.write_text(f'"""Functions of {wanted.owner} (stubs written by `specc skeleton`)."""\n')
-        clear_caches()
     existing = top_level_functions(path)
     if isinstance(existing, SyntaxError):
         raise SyntaxError(f"{path}:{existing.lineno}: cannot add functions to a file with a syntax error: "
@@ -163,5 +162,4 @@ def write_stubs(wanted: Needs, spec_dir: Path, robot_dir: Path | None = None) ->
     with path.open("a", encoding="utf-8") as handle:
         for stub in stubs.values():
             handle.write(stub.text)
-    clear_caches()
     return Change(path, created, tuple(stubs))

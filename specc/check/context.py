@@ -18,6 +18,8 @@ KNOWN_SHOWN = 12  # known names an unknown name's message lists when none is clo
 
 @dataclass
 class Context:
+    """What a check works on: the program, where its files are, and the diagnostics so far."""
+
     program: m.Program
     base_dirs: dict[str, Path] = field(default_factory=dict)  # file (as in spans) -> its folder
     diagnostics: list[Diagnostic] = field(default_factory=list)

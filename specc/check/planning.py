@@ -112,6 +112,8 @@ def tables(ctx: Context, members: Iterable[Any], base: DomainTables | None = Non
 
 @dataclass
 class Scope:
+    """The names visible in a task, macro, attribute, problem or fragment being checked."""
+
     kind: str  # task | macro | attribute | problem | fragment
     variables: set[str] = field(default_factory=set)
     timepoints: set[str] = field(default_factory=set)

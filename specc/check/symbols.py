@@ -37,6 +37,8 @@ Named = TypeVar("Named", bound=_HasName)
 
 @dataclass(frozen=True)
 class Symbols:
+    """The names a program defines, by kind, for the checks to look up."""
+
     blocks: Mapping[type, Mapping[str, Any]]  # kind -> name -> the block (its first definition)
     requests: Mapping[str, Mapping[str, m.Request]]  # module -> request name -> request
     posters: Mapping[str, Mapping[str, m.Poster]]  # module -> poster name -> poster

@@ -35,6 +35,8 @@ def property_fields(node_type: type) -> list[Any]:
 
 @dataclass(frozen=True, kw_only=True)
 class Node:
+    """The base of every construct: where it was written (spans never take part in equality)."""
+
     span: Span = span_field()
 
 
@@ -70,11 +72,15 @@ class Ref(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Number(Node):
+    """A number as written (`3`, `0.25`)."""
+
     value: int | float
 
 
 @dataclass(frozen=True, kw_only=True)
 class Duration(Node):
+    """A number with its unit of time (`50 ms`, `2 min`)."""
+
     value: int | float
     unit: str
 
@@ -87,17 +93,23 @@ class Duration(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class String(Node):
+    """A double-quoted string (`"tug_codels"`)."""
+
     value: str
 
 
 @dataclass(frozen=True, kw_only=True)
 class TypeRef(Node):
+    """A GenoM type (`double`, `char[32]`, a struct or enum of the module)."""
+
     name: str
     size: int | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
 class TypedName(Node):
+    """`name: type`, in a request's `input:` or `output:`."""
+
     name: str
     type: TypeRef
 
@@ -110,18 +122,24 @@ PropValue = Union[Ref, Number, Duration, String, TypedName]
 
 @dataclass(frozen=True, kw_only=True)
 class Field(Node):
+    """A field of a struct or of a module's internal data (`x: double;`)."""
+
     name: str
     type: TypeRef
 
 
 @dataclass(frozen=True, kw_only=True)
 class StructDecl(Node):
+    """`struct NAME { field: type; ... }` in a module."""
+
     name: str
     fields: tuple[Field, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
 class EnumDecl(Node):
+    """`enum NAME { A, B, ... }` in a module."""
+
     name: str
     values: tuple[str, ...] = ()
 
@@ -137,6 +155,8 @@ class Codel(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Request(Node):
+    """`request NAME { type: control|exec; ... }`: what a module offers (GenoM), with its codels."""
+
     name: str
     kind: str | None = prop("type", "symbol", choices=("control", "exec"))
     activity: Ref | None = prop("activity", "ref", doc="activity kind, e.g. filter")
@@ -153,6 +173,8 @@ class Request(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class ExecTask(Node):
+    """`exec_task NAME { period: ...; }`: the periodic task that runs a module's activities."""
+
     name: str
     period: Duration | None = prop("period", "duration")
     delay: Duration | None = prop("delay", "duration")
@@ -165,6 +187,8 @@ class ExecTask(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Poster(Node):
+    """`poster NAME { data: ...; }`: data a module publishes for others to read."""
+
     name: str
     update: str | None = prop("update", "symbol", choices=("auto", "manual"))
     data: tuple[Ref, ...] = prop("data", "refs", doc="internal data fields exported")
@@ -174,6 +198,8 @@ class Poster(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Module(Node):
+    """`module NAME { ... }`: a GenoM functional module (seed 000 ch. 2)."""
+
     name: str
     number: Number | None = prop("number", "int")
     codel_module: String | None = prop("codels", "string", doc="Python module holding the codels")
@@ -191,6 +217,8 @@ class Module(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Timeouts(Node):
+    """`timeout { start: ...; interm: ...; final: ...; }` of a service: how long each reply may take."""
+
     start: Duration | None = prop("start", "duration")
     interm: Duration | None = prop("interm", "duration")
     final: Duration | None = prop("final", "duration")
@@ -198,6 +226,8 @@ class Timeouts(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Conflict(Node):
+    """`SERVICE: interrupt;` or `SERVICE: wait;` in a service's `conflicts { }`: what happens when both are asked."""
+
     service: str
     policy: str  # "interrupt" | "wait"
 
@@ -212,6 +242,8 @@ class Argument(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Service(Node):
+    """`service NAME { request: module.REQUEST; ... }`: a request the executive runs for the task level."""
+
     name: str
     request: Ref | None = prop("request", "ref", doc="module.request the service runs")
     input: Ref | None = prop("input", "ref", doc="input function or poster giving the request's input")
@@ -225,18 +257,25 @@ class Service(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Comparison(Node):
+    """`OP value` in a reflex's trigger (`> 0.5`)."""
+
     op: str
     value: PropValue
 
 
 @dataclass(frozen=True, kw_only=True)
 class ReflexAction(Node):
+    """`request|abort|start TARGET` in a reflex: what it does when triggered."""
+
     verb: str  # request | abort | start
     target: Ref
 
 
 @dataclass(frozen=True, kw_only=True)
 class Reflex(Node):
+    """`reflex [NAME] on reply|warning|interm SOURCE [OP value] => actions;`: the executive's own
+    reaction."""
+
     name: str | None
     trigger: str  # reply | warning | interm
     source: Ref
@@ -256,6 +295,8 @@ class Parameter(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Executive(Node):
+    """`executive NAME { service ...; reflex ...; }`: the services and their incompatibilities (seed 000 ch. 3)."""
+
     name: str
     rules: tuple[Ref, ...] = prop("rules", "refs", doc="rule bases added to the generated controller")
     codel_module: String | None = prop("codels", "string", doc="Python module of input/output functions")
@@ -270,6 +311,8 @@ class Executive(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class AttrRef(Node):
+    """An attribute of a rule base as a rule reads it (`speed`; `@speed`, its previous value; `range[i]`)."""
+
     name: str
     previous: bool = False
     index: str | None = None
@@ -277,6 +320,8 @@ class AttrRef(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class KBinary(Node):
+    """`left OP right`: arithmetic in a rule base."""
+
     op: str
     left: KExpr
     right: KExpr
@@ -284,6 +329,8 @@ class KBinary(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class KNegate(Node):
+    """`-operand` in a rule base."""
+
     operand: KExpr
 
 
@@ -292,6 +339,8 @@ KExpr = Union[Number, String, AttrRef, KBinary, KNegate]
 
 @dataclass(frozen=True, kw_only=True)
 class KRange(Node):
+    """`low..high` in a rule base's list of values."""
+
     low: KItem
     high: KItem
 
@@ -301,18 +350,22 @@ KItem = Union[String, Number, Ref, KRange]
 
 @dataclass(frozen=True, kw_only=True)
 class SymbolDomain(Node):
+    """`{"fast", "slow"}`: the symbols an attribute of a rule base takes."""
+
     values: tuple[KItem, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class NumericDomain(Node):
+    """`[low, high]` or `number`: the numbers an attribute of a rule base takes."""
+
     low: KExpr | None = None
     high: KExpr | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
 class BoolDomain(Node):
-    pass
+    """`bool`: a true/false attribute of a rule base."""
 
 
 AttrDomain = Union[SymbolDomain, NumericDomain, BoolDomain]
@@ -320,6 +373,8 @@ AttrDomain = Union[SymbolDomain, NumericDomain, BoolDomain]
 
 @dataclass(frozen=True, kw_only=True)
 class AttrDecl(Node):
+    """`inputs|outputs|intermediate name: domain, ...;` in a rule base."""
+
     role: str  # inputs | outputs | intermediate
     name: str
     domain: AttrDomain | None = None
@@ -327,18 +382,24 @@ class AttrDecl(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class ConstDecl(Node):
+    """`const NAME = value;` in a rule base."""
+
     name: str
     value: KExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class InitDecl(Node):
+    """`init @NAME = value;` in a rule base: an attribute's previous value at the first decision."""
+
     name: str
     value: KExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class KCompare(Node):
+    """`attr OP value` in a rule's condition."""
+
     attr: AttrRef
     op: str
     value: KExpr
@@ -346,6 +407,8 @@ class KCompare(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class KMember(Node):
+    """`attr oneof|noneof [items]` in a rule's condition."""
+
     attr: AttrRef
     op: str  # oneof | noneof
     items: tuple[KItem, ...]
@@ -353,31 +416,43 @@ class KMember(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class KTrue(Node):
+    """`attr` alone in a rule's condition or restriction: a bool attribute that holds."""
+
     attr: AttrRef
 
 
 @dataclass(frozen=True, kw_only=True)
 class KFalse(Node):
+    """`!attr` in a restriction: a bool attribute that does not hold."""
+
     attr: AttrRef
 
 
 @dataclass(frozen=True, kw_only=True)
 class KNot(Node):
+    """`!condition` in a rule's condition."""
+
     operand: Cond
 
 
 @dataclass(frozen=True, kw_only=True)
 class KAnd(Node):
+    """Conditions that must all hold (`a, b`)."""
+
     operands: tuple[Cond, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class KOr(Node):
+    """Conditions of which one must hold (`a | b`)."""
+
     operands: tuple[Cond, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class KForeach(Node):
+    """`foreach VAR in [items] (condition)`: the condition for each item."""
+
     var: str
     items: tuple[KItem, ...]
     body: Cond
@@ -389,23 +464,31 @@ Restriction = Union[KCompare, KMember, KTrue, KFalse]
 
 @dataclass(frozen=True, kw_only=True)
 class Restrict(Node):
+    """`restrict RESTRICTION` in a rule's actions: it narrows an output's values."""
+
     restriction: Restriction
 
 
 @dataclass(frozen=True, kw_only=True)
 class DoAssign(Node):
+    """`target = value` in a rule's `do { }`."""
+
     target: str
     value: KExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class DoCall(Node):
+    """`function(args)` in a rule's `do { }`."""
+
     function: str
     args: tuple[KExpr, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
 class DoAction(Node):
+    """`do { target = value; function(args) }` in a rule's actions."""
+
     statements: tuple[DoAssign | DoCall, ...]
 
 
@@ -414,6 +497,8 @@ Action = Union[Restrict, DoAction]
 
 @dataclass(frozen=True, kw_only=True)
 class Rule(Node):
+    """`NAME: condition ==> actions;` in a rule base (or an `impossible` / `else` rule)."""
+
     name: str
     index: str | None = None
     kind: str = "when"  # when | impossible | else
@@ -423,6 +508,8 @@ class Rule(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class RuleForeach(Node):
+    """`foreach VAR in [items] { rules }`: rules written once for each item."""
+
     var: str
     items: tuple[KItem, ...]
     rules: tuple[Rule, ...]
@@ -430,6 +517,8 @@ class RuleForeach(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class RuleBase(Node):
+    """`rules NAME { ... }`: a Kheops rule base (seed 000 §3.7), compiled to a decision of bounded depth."""
+
     name: str
     constants: tuple[ConstDecl, ...] = ()
     attributes: tuple[AttrDecl, ...] = ()
@@ -442,11 +531,15 @@ class RuleBase(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class SymbolSet(Node):
+    """`{A, B, C}`: the values of a PRS type or parameter."""
+
     values: tuple[str, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class DomainRef(Node):
+    """A named PRS type used as a domain."""
+
     name: str
 
 
@@ -463,18 +556,24 @@ PDomain = Union[SymbolSet, IntRange, DomainRef]
 
 @dataclass(frozen=True, kw_only=True)
 class TypeDecl(Node):
+    """`type NAME = domain;` in procedures."""
+
     name: str
     domain: PDomain
 
 
 @dataclass(frozen=True, kw_only=True)
 class PParam(Node):
+    """`name: domain`, a parameter of a PRS predicate or action."""
+
     name: str
     domain: PDomain
 
 
 @dataclass(frozen=True, kw_only=True)
 class PredicateDecl(Node):
+    """`predicate [kinds] NAME(params) [-> result];` in procedures: a fact of the database."""
+
     name: str
     kinds: tuple[str, ...] = ()  # closed | functional | event | evaluable
     params: tuple[PParam, ...] = ()
@@ -492,6 +591,8 @@ class ServiceBinding(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class ActionDecl(Node):
+    """`action NAME(params) [-> result] = ...;` in procedures: what a primitive KA may do."""
+
     name: str
     params: tuple[PParam, ...] = ()
     result: PDomain | None = None
@@ -500,16 +601,22 @@ class ActionDecl(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class LogicVar(Node):
+    """`$X`: a PRS logical variable."""
+
     name: str  # with its leading $
 
 
 @dataclass(frozen=True, kw_only=True)
 class ProgramVar(Node):
+    """`@X`: a PRS program variable."""
+
     name: str  # with its leading @
 
 
 @dataclass(frozen=True, kw_only=True)
 class SExp(Node):
+    """`(HEAD args...)`: a PRS expression, fact or call."""
+
     head: str
     args: tuple[SArg, ...] = ()
 
@@ -519,22 +626,31 @@ SArg = Union[LogicVar, ProgramVar, Ref, Number, String, SExp]
 
 @dataclass(frozen=True, kw_only=True)
 class Goal(Node):
+    """`!(...)`, `?(...)`, `^(...)`, `=>(...)`, `~>(...)`, `#(...)` or `%(...)`: a PRS goal (achieve,
+    test, wait, conclude, retract, preserve, maintain)."""
+
     op: str  # ! ? ^ => ~> # %
     body: SExp
 
 
 @dataclass(frozen=True, kw_only=True)
 class Block(Node):
+    """`{ statements }` in a KA's body."""
+
     statements: tuple[Stmt, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
 class GoalStmt(Node):
+    """A goal as a statement of a KA's body (`!(GO 2 5);`)."""
+
     goal: Goal
 
 
 @dataclass(frozen=True, kw_only=True)
 class IfStmt(Node):
+    """`if (goal) { ... } else { ... }` in a KA's body."""
+
     condition: Goal
     then: Block
     orelse: Block | IfStmt | None = None
@@ -542,29 +658,37 @@ class IfStmt(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class WhileStmt(Node):
+    """`while (goal) { ... }` in a KA's body."""
+
     condition: Goal
     body: Block
 
 
 @dataclass(frozen=True, kw_only=True)
 class ParallelStmt(Node):
+    """`parallel { ... } { ... }` in a KA's body: branches run together."""
+
     branches: tuple[Block, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class ChooseStmt(Node):
+    """`choose { ... } { ... }` in a KA's body: the first branch that succeeds."""
+
     branches: tuple[Block, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class AssignStmt(Node):
+    """`assign @X = value;` in a KA's body."""
+
     var: str
     value: SArg
 
 
 @dataclass(frozen=True, kw_only=True)
 class FailStmt(Node):
-    pass
+    """`fail;` in a KA's body: the KA fails here."""
 
 
 Stmt = Union[GoalStmt, IfStmt, WhileStmt, ParallelStmt, ChooseStmt, AssignStmt, FailStmt]
@@ -572,12 +696,16 @@ Stmt = Union[GoalStmt, IfStmt, WhileStmt, ParallelStmt, ChooseStmt, AssignStmt, 
 
 @dataclass(frozen=True, kw_only=True)
 class KAAction(Node):
+    """`action: (CALL args) [-> $RESULT];`: a primitive KA's action."""
+
     call: SExp
     result: LogicVar | ProgramVar | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
 class KA(Node):
+    """`ka NAME { invocation: ...; body { } }`: a PRS knowledge area (seed 000 ch. 4)."""
+
     name: str
     invocation: Goal | SExp | None = None
     context: Goal | SExp | None = None
@@ -590,6 +718,8 @@ class KA(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Procedures(Node):
+    """`procedures NAME { ... }`: a PRS database's types, predicates and actions, and its KAs."""
+
     name: str
     types: tuple[TypeDecl, ...] = ()
     predicates: tuple[PredicateDecl, ...] = ()
@@ -602,27 +732,35 @@ class Procedures(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Infinity(Node):
-    pass
+    """`oo`: an unbounded end of an IxTeT interval."""
 
 
 @dataclass(frozen=True, kw_only=True)
 class IxVar(Node):
+    """`?x`: an IxTeT variable."""
+
     name: str  # with its leading ?
 
 
 @dataclass(frozen=True, kw_only=True)
 class IxName(Node):
+    """A constant symbol or a timepoint in IxTeT (`DOCK`, `t_start`)."""
+
     name: str
 
 
 @dataclass(frozen=True, kw_only=True)
 class IxCall(Node):
+    """`FUNCTION(args)` in an IxTeT expression."""
+
     function: str
     args: tuple[IxExpr, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
 class IxBinary(Node):
+    """`left OP right` in an IxTeT expression."""
+
     op: str
     left: IxExpr
     right: IxExpr
@@ -630,6 +768,8 @@ class IxBinary(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class IxUnary(Node):
+    """`-operand` (or another prefix operator) in an IxTeT expression."""
+
     op: str
     operand: IxExpr
 
@@ -639,22 +779,30 @@ IxExpr = Union[Number, Infinity, IxVar, IxName, IxCall, IxBinary, IxUnary]
 
 @dataclass(frozen=True, kw_only=True)
 class Interval(Node):
+    """`[low, high]` in IxTeT."""
+
     low: IxExpr
     high: IxExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class SetLiteral(Node):
+    """`{A, B}` in IxTeT."""
+
     values: tuple[str, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class SetRef(Node):
+    """A named constant set in IxTeT (`PLACES`)."""
+
     name: str
 
 
 @dataclass(frozen=True, kw_only=True)
 class SetUnion(Node):
+    """Sets joined with `|`, or one set, in IxTeT."""
+
     parts: tuple[SetLiteral | SetRef, ...]
 
 
@@ -663,12 +811,16 @@ DomainValue = Union[Interval, SetUnion]
 
 @dataclass(frozen=True, kw_only=True)
 class Transition(Node):
+    """`(before, after)`: the value an event changes an attribute from and to."""
+
     before: IxExpr
     after: IxExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class AttrValue(Node):
+    """`ATTRIBUTE(args): value` in IxTeT, the value a transition or a single value."""
+
     attribute: str
     args: tuple[IxExpr, ...] = ()
     value: IxExpr | Transition
@@ -676,12 +828,16 @@ class AttrValue(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class GoalMark(Node):
+    """`goal(priority, weight)` after an assertion of a problem: it is a goal to meet."""
+
     priority: IxExpr
     weight: IxExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class Hold(Node):
+    """`hold(ATTR(args): value, (start, end))`: the attribute keeps its value over the interval."""
+
     attr: AttrValue
     start: IxExpr
     end: IxExpr
@@ -690,6 +846,8 @@ class Hold(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Event(Node):
+    """`event(ATTR(args): (before, after), time)`: the attribute changes at that time."""
+
     kind: str | None  # explained | contingent | None
     attr: AttrValue
     time: IxExpr
@@ -698,12 +856,16 @@ class Event(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Window(Node):
+    """`(start, end)`: the interval a resource is used over."""
+
     start: IxExpr
     end: IxExpr
 
 
 @dataclass(frozen=True, kw_only=True)
 class ResourceUse(Node):
+    """`use|consume|produce(RESOURCE(args): amount, when)`."""
+
     verb: str  # use | consume | produce
     attr: AttrValue
     when: IxExpr | Window
@@ -712,16 +874,22 @@ class ResourceUse(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class VariableDecl(Node):
+    """`variable ?a, ?b;` in an IxTeT task."""
+
     names: tuple[IxVar, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class TimepointDecl(Node):
+    """`timepoint t1, t2;` in an IxTeT task or problem."""
+
     names: tuple[str, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class InConstraint(Node):
+    """`expr in domain;` (possibly `contingent`): an IxTeT constraint."""
+
     expr: IxExpr
     domain: DomainValue
     contingent: bool = False
@@ -729,6 +897,8 @@ class InConstraint(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class RelConstraint(Node):
+    """`left OP right;` (possibly `contingent`): an IxTeT constraint."""
+
     left: IxExpr
     op: str
     right: IxExpr
@@ -737,18 +907,24 @@ class RelConstraint(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Implication(Node):
+    """`condition => consequence;`: a constraint that holds only when the condition does."""
+
     condition: InConstraint
     consequence: InConstraint | RelConstraint
 
 
 @dataclass(frozen=True, kw_only=True)
 class MacroCall(Node):
+    """`NAME(args);`: a macro's statements written in place."""
+
     name: str
     args: tuple[IxExpr, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
 class Include(Node):
+    """`include NAME;`: a fragment's statements written in place."""
+
     name: str
 
 
@@ -760,12 +936,16 @@ TStmt = Union[
 
 @dataclass(frozen=True, kw_only=True)
 class Constant(Node):
+    """`constant NAME = set;` in a planning domain."""
+
     name: str
     value: SetUnion
 
 
 @dataclass(frozen=True, kw_only=True)
 class Attribute(Node):
+    """`attribute NAME(?params) { ... }`: a state variable of a planning domain."""
+
     name: str
     params: tuple[IxVar, ...] = ()
     body: tuple[TStmt, ...] = ()
@@ -773,6 +953,8 @@ class Attribute(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Resource(Node):
+    """`resource NAME(?params) { ... }`: a shared resource of a planning domain."""
+
     name: str
     params: tuple[IxVar, ...] = ()
     body: tuple[TStmt, ...] = ()
@@ -780,6 +962,8 @@ class Resource(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Macro(Node):
+    """`macro NAME(params) { ... }`: statements written once and used in tasks."""
+
     name: str
     params: tuple[str, ...] = ()
     body: tuple[TStmt, ...] = ()
@@ -787,6 +971,8 @@ class Macro(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Task(Node):
+    """`task NAME(?params) (t_start, t_end) { ... }`: an action a plan may hold (IxTeT's chronicle)."""
+
     name: str
     params: tuple[IxVar, ...] = ()
     start: str = "t_start"
@@ -800,12 +986,16 @@ DomainMember = Union[Include, Constant, Attribute, Resource, Macro, Task]
 
 @dataclass(frozen=True, kw_only=True)
 class Domain(Node):
+    """`domain NAME { ... }`: an IxTeT planning domain (seed 004 annex A)."""
+
     name: str
     members: tuple[DomainMember, ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
 class Problem(Node):
+    """`problem NAME for DOMAIN { ... }`: the initial state, goals and deadlines of a planning problem."""
+
     name: str
     domain: Ref
     body: tuple[TStmt | Include, ...] = ()
@@ -814,6 +1004,8 @@ class Problem(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Fragment(Node):
+    """`fragment NAME { ... }`: statements shared by domains and problems (`include NAME;`)."""
+
     name: str
     members: tuple[DomainMember | TStmt, ...] = ()
 
@@ -840,6 +1032,8 @@ class Correspondence(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Planner(Node):
+    """`planner NAME { domain: ...; }` in an ftplan block: one of FTplan's diverse planners."""
+
     name: str
     domain: Ref | None = prop("domain", "ref", doc="planning domain the planner uses")
     heuristic: Ref | None = prop("heuristic", "ref", doc="resolver ordering heuristic")
@@ -871,6 +1065,8 @@ class MissionView(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Mission(Node):
+    """`mission NAME { planner: problem; ... }` in an ftplan block: the problem each planner plans."""
+
     name: str
     problems: tuple[MissionProblem, ...] = ()
     views: tuple[MissionView, ...] = ()
@@ -878,6 +1074,8 @@ class Mission(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class AnalyzerCondition(Node):
+    """`during|at_start|at_end TASK(args) requires ATTR: value;`: a condition FTplan's plan analyser checks."""
+
     kind: str  # during | at_start | at_end
     task: str
     args: tuple[IxExpr, ...]
@@ -886,11 +1084,15 @@ class AnalyzerCondition(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class AnalyzerNoOverlap(Node):
+    """`no_overlap TASK, TASK;`: tasks FTplan's plan analyser forbids to overlap."""
+
     tasks: tuple[str, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
 class AnalyzerMaxDuration(Node):
+    """`max_duration TASK duration;`: a duration FTplan's plan analyser bounds."""
+
     task: str
     limit: Duration
 
@@ -900,6 +1102,8 @@ AnalyzerRule = Union[AnalyzerCondition, AnalyzerNoOverlap, AnalyzerMaxDuration]
 
 @dataclass(frozen=True, kw_only=True)
 class FactUpdate(Node):
+    """`ATTR(args) := value` in a state update."""
+
     attribute: str
     args: tuple[IxExpr, ...]
     value: IxExpr
@@ -907,6 +1111,8 @@ class FactUpdate(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class StateUpdate(Node):
+    """`on ended|failed|report TASK(args) => updates;`: how an action's outcome changes FTplan's state."""
+
     report: str  # ended | failed | report
     task: str
     args: tuple[IxExpr, ...]
@@ -915,6 +1121,8 @@ class StateUpdate(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class FtPlan(Node):
+    """`ftplan NAME { ... }`: the fault-tolerant planning component (seed 004 ch. 3) and its planners."""
+
     name: str
     order: tuple[Ref, ...] = prop("planners", "refs", doc="planners in the order successive planning tries them")
     policy: str | None = prop("policy", "symbol", choices=("successive", "concurrent"))
@@ -954,6 +1162,8 @@ class DeviceGrant(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class DeviceGrants(Node):
+    """A system's `devices { }` section."""
+
     entries: tuple[DeviceGrant, ...] = ()
 
 
@@ -991,6 +1201,8 @@ class BindingReport(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Bindings(Node):
+    """A system's `bindings { }` section."""
+
     entries: tuple[Binding, ...] = ()
 
 
@@ -1008,6 +1220,8 @@ class SystemMission(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class System(Node):
+    """`system NAME { ... }`: how a robot runs: its modules, executive, supervisor, body, worlds, missions."""
+
     name: str
     modules: tuple[Ref, ...] = prop("modules", "refs")
     executive: Ref | None = prop("executive", "ref")
@@ -1028,6 +1242,8 @@ Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment,
 
 @dataclass(frozen=True, kw_only=True)
 class SourceFile(Node):
+    """One spec file and the blocks it holds."""
+
     path: str
     items: tuple[Item, ...] = ()
 

@@ -16,8 +16,6 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any, Literal, Union
 
-from lark import Token
-
 from specc.analysis.planning import PlanningError, domain_model
 from specc.check import check_program
 from specc.diagnostics import Diagnostic
@@ -27,6 +25,7 @@ from specc.mutation.edits import CLASSES, Edit, MutationClass, domain_edits
 from specc.mutation.tree import replace_at
 from specc.pipeline import Loaded, load
 from specc.runtime.planner import model as pm
+from specc.syntax.parsed import Comment
 from specc.syntax.parser import parse_text
 from specc.syntax.printer import format_source, print_source
 
@@ -54,7 +53,7 @@ class MutationTarget:
     # The file as written and its comments, so that a mutant keeps them (`specc fmt`'s printing);
     # without them (a Program whose file cannot be read again), files are printed without comments.
     written: str = field(default="", repr=False)
-    comments: tuple[Token, ...] = field(default=(), repr=False)
+    comments: tuple[Comment, ...] = field(default=(), repr=False)
 
     @property
     def source(self) -> m.SourceFile:
@@ -214,7 +213,7 @@ def mutation_target(robot: Robot, domain: str | None = None, base_dirs: dict[str
     `Program` (its files found again from the paths its spans name, for the codel checks, unless
     `base_dirs` says where each file is)."""
     sources: dict[str, str] = {}
-    comments: dict[str, list[Token]] = {}
+    comments: dict[str, list[Comment]] = {}
     if isinstance(robot, m.Program):
         program = robot
         dirs = base_dirs if base_dirs is not None else {
@@ -257,7 +256,7 @@ def default_domain(program: m.Program) -> str:
     return domains[0]
 
 
-def _written(source: m.SourceFile) -> tuple[dict[str, str], dict[str, list[Token]]]:
+def _written(source: m.SourceFile) -> tuple[dict[str, str], dict[str, list[Comment]]]:
     """The text and comments of a Program's file, read again from the path its spans name when
     that file still holds the same model (so mutants keep their comments whichever way the robot
     was given); nothing otherwise."""

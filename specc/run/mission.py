@@ -319,6 +319,14 @@ def prepared_world(robot: Robot, mission: MissionSpec, seed: int, world_file: Pa
             ground = prepare(ground, RunSetup(robot, mission, seed, planning))
         except WorldError as error:  # what the world asks cannot be drawn
             raise RunError(str(error)) from None
+    body = robot.system.body
+    # The physics would push a body that starts in an obstacle out of it at once (or wedge it):
+    # the run would go on from somewhere the world file never said.
+    if ground.footprint_clearance(ground.start, body.radius, body.length, body.width) <= 0:
+        x, y, theta = ground.start
+        shape = f"its {body.length:g} x {body.width:g} m box" if body.length > 0 else f"its {body.radius:g} m radius"
+        raise RunError(f"{world_file}: the robot's body ({shape}) at its start ({x:g}, {y:g}, heading {theta:g} "
+                       "rad) overlaps an obstacle or a wall: move [start] in the world file, or the obstacle")
     return ground
 
 

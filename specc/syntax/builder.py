@@ -23,6 +23,8 @@ from specc.model.span import Span
 
 @dataclass(frozen=True)
 class Prop:
+    """A `key: value;` property as written, before the block it belongs to reads it."""
+
     key: str
     key_span: Span
     values: tuple[m.PropValue, ...]
@@ -31,6 +33,8 @@ class Prop:
 
 @dataclass(frozen=True)
 class Section:
+    """A `name { key: value; ... }` section of properties."""
+
     name: str
     props: tuple[Prop, ...]
     span: Span
@@ -979,26 +983,36 @@ class Builder(Transformer[Token, Any]):
 
 @dataclass(frozen=True)
 class AttrIndex:
+    """The `[i]` of an indexed attribute of a rule base."""
+
     text: str
 
 
 @dataclass(frozen=True)
 class InternalData:
+    """A module's `internal_data { }` fields, before the module gathers them."""
+
     fields: tuple[m.Field, ...]
 
 
 @dataclass(frozen=True)
 class AnalyzerBlock:
+    """An ftplan block's `analyzer { }` rules, before the block gathers them."""
+
     rules: tuple[Any, ...]
 
 
 @dataclass(frozen=True)
 class StateBlock:
+    """An ftplan block's `state { }` updates, before the block gathers them."""
+
     updates: tuple[Any, ...]
 
 
 @dataclass(frozen=True)
 class ViewBlock:
+    """A planner's `view { }` correspondences, before the planner gathers them."""
+
     correspondences: tuple[Any, ...]
 
 

@@ -12,11 +12,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from lark import Token
-
 from specc.model import nodes as m
 from specc.model.nodes import property_fields
 from specc.model.span import Span
+from specc.syntax.parsed import Comment
 
 INDENT = "  "
 WRAP_AT = 100
@@ -281,45 +280,26 @@ def tstmt(s: Any) -> str:
 # ---------------------------------------------------------------- layout with comments
 
 
-@dataclass(frozen=True)
-class _Comment:
-    text: str
-    line: int
-    column: int
-
-    def lines(self, pad: str) -> list[str]:
-        """The comment at indentation `pad`. A block comment's later lines keep their indentation
-        relative to its first line, so re-indenting twice gives the same text."""
-        first, *more = self.text.split("\n")
-        shown = [pad + first]
-        for part in more:
-            part = part.rstrip()
-            indent = len(part) - len(part.lstrip())
-            shown.append(pad + part[min(indent, self.column - 1):] if part else "")
-        return shown
-
-
 @dataclass
 class _Comments:
     """Which comment goes where: before the first element after it, or at the end of a line."""
 
-    leading: dict[tuple[int, int], list[_Comment]]
+    leading: dict[tuple[int, int], list[Comment]]
     trailing: dict[tuple[int, int], list[str]]
-    rest: list[_Comment]
+    rest: list[Comment]
     line_starts: set[tuple[int, int]]  # the first anchor of each source line
 
 
-def _place_comments(comments: list[Token], anchors: list[tuple[int, int]], text: str) -> _Comments:
+def _place_comments(comments: list[Comment], anchors: list[tuple[int, int]], text: str) -> _Comments:
     """Anchors are where printed lines start in the source, including each block's closing
     brace, so a comment written last in a block stays inside it."""
     ordered = sorted(set(anchors))
     source_lines = text.split("\n")
     starts = {key for i, key in enumerate(ordered) if i == 0 or ordered[i - 1][0] != key[0]}
     placed = _Comments({}, {}, [], starts)
-    for c in comments:
-        position = (c.line or 1, c.column or 1)
+    for comment in comments:
+        position = (comment.line, comment.column)
         before = source_lines[position[0] - 1][: position[1] - 1] if position[0] <= len(source_lines) else ""
-        comment = _Comment(str(c).replace("\r\n", "\n").rstrip(), *position)
         if before.strip() and "\n" not in comment.text:
             # At the end of a line: it stays there if an element starts on that line.
             i = bisect.bisect_right(ordered, position) - 1
@@ -362,7 +342,7 @@ class Printer:
             self.leading_comments(self.comments.leading.pop(key, []), INDENT * (self.depth + 1))
         self.out.append(INDENT * self.depth + text + self._trailing(key))
 
-    def leading_comments(self, comments: list[_Comment], pad: str) -> None:
+    def leading_comments(self, comments: list[Comment], pad: str) -> None:
         for comment in comments:
             if self._source_blank(comment.line - 1):
                 self.blank()
@@ -737,7 +717,7 @@ def print_source(source: m.SourceFile) -> str:
     return "\n".join(printer.out) + "\n"
 
 
-def format_source(source: m.SourceFile, text: str, comments: list[Token]) -> str:
+def format_source(source: m.SourceFile, text: str, comments: list[Comment]) -> str:
     """Canonical text of one file, keeping its comments (what `specc fmt` writes)."""
     dry = Printer()
     dry.source_file(source)

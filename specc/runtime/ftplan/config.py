@@ -53,6 +53,8 @@ class Correspondence:
 
 @dataclass(frozen=True)
 class PlannerConfig:
+    """One of FTplan's planners as the runtime runs it: its domain and search settings."""
+
     name: str
     domain: str  # the planning domain's name (a module of the generated `planner` package)
     heuristic: str | None = None
@@ -100,6 +102,8 @@ class NoOverlap:
 
 @dataclass(frozen=True)
 class MaxDuration:
+    """An analyser rule: the task must not last longer than `seconds`."""
+
     task: str
     seconds: float
     line: int = 0
@@ -110,6 +114,8 @@ AnalyzerRule = Requirement | NoOverlap | MaxDuration
 
 @dataclass(frozen=True)
 class FactUpdate:
+    """A change of FTplan's state that an action's outcome makes."""
+
     attribute: str
     args: tuple[Term, ...]
     value: Term
@@ -128,6 +134,8 @@ class StateRule:
 
 @dataclass(frozen=True)
 class MissionProblem:
+    """The problem a planner plans for a mission."""
+
     planner: str
     problem: str  # the planner's statement of the mission
     domain: str  # the problem's domain: the one the planner plans it in
@@ -148,6 +156,8 @@ class Mission:
 
 @dataclass(frozen=True)
 class FtPlanConfig:
+    """The whole FTplan component as the runtime runs it."""
+
     name: str
     planners: tuple[PlannerConfig, ...]  # in the order successive planning tries them
     policy: str = "successive"  # successive | concurrent

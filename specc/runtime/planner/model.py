@@ -30,6 +30,8 @@ INF = float("inf")
 
 @dataclass(frozen=True)
 class Num:
+    """A number in a planning expression."""
+
     value: float
 
 
@@ -97,12 +99,16 @@ def describe(e: Expr) -> str:
 
 @dataclass(frozen=True)
 class Interval:
+    """The numbers from `low` to `high`: a variable's domain."""
+
     low: float
     high: float
 
 
 @dataclass(frozen=True)
 class Symbols:
+    """A finite set of symbols: a variable's domain."""
+
     values: tuple[str, ...]  # sorted
 
 
@@ -150,12 +156,16 @@ Constraint = Union[Member, Relation, Implies]
 
 @dataclass(frozen=True)
 class GoalMark:
+    """The priority and weight of a problem's goal."""
+
     priority: float
     weight: float
 
 
 @dataclass(frozen=True)
 class Event:
+    """A change of an attribute's value, from `before` to `after`, at a timepoint."""
+
     attribute: str
     args: tuple[Expr, ...]
     before: Expr
@@ -168,6 +178,8 @@ class Event:
 
 @dataclass(frozen=True)
 class Hold:
+    """An attribute keeping a value from one timepoint to another."""
+
     attribute: str
     args: tuple[Expr, ...]
     value: Expr
@@ -208,6 +220,8 @@ def assertion_timepoints(a: Assertion) -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class Attribute:
+    """A state variable of the domain, with the domains of its parameters and value."""
+
     name: str
     params: tuple[str, ...] = ()
     param_domains: tuple[Values | None, ...] = ()
@@ -216,6 +230,8 @@ class Attribute:
 
 @dataclass(frozen=True)
 class Resource:
+    """A shared resource of the domain and its capacity."""
+
     name: str
     params: tuple[str, ...] = ()
     param_domains: tuple[Values | None, ...] = ()
@@ -224,6 +240,8 @@ class Resource:
 
 @dataclass(frozen=True)
 class Task:
+    """An action a plan may hold: its parameters, timepoints, assertions and constraints."""
+
     name: str
     params: tuple[str, ...]
     start: str = "t_start"
@@ -243,6 +261,8 @@ class Task:
 
 @dataclass(frozen=True)
 class PlanningDomain:
+    """Everything a planner plans with: attributes, resources and tasks."""
+
     name: str
     attributes: tuple[Attribute, ...] = ()
     resources: tuple[Resource, ...] = ()

@@ -41,6 +41,8 @@ class Link:
 
 @dataclass(frozen=True)
 class GoalOutcome:
+    """A goal of the problem, and whether the plan keeps it (and why not)."""
+
     description: str  # "hold(COMMUNICATION(W1): DONE) at line 37"
     priority: float
     line: int
@@ -50,6 +52,8 @@ class GoalOutcome:
 
 @dataclass(frozen=True)
 class Plan:
+    """A plan: its actions with their dates and durations, and the goals it meets."""
+
     domain: str
     problem: str
     actions: tuple[Action, ...]
@@ -106,6 +110,8 @@ class Repair:
 
 @dataclass(frozen=True)
 class PlanResult:
+    """What a planning call gives: the plan (or none), each goal's outcome, and its cost."""
+
     plan: Plan | None
     goals: tuple[GoalOutcome, ...] = ()
     reason: str = ""  # why there is no plan

@@ -71,6 +71,8 @@ class PlanningInputError(ValueError):
 
 @dataclass(frozen=True)
 class Goal:
+    """A goal of the problem as the search pursues it."""
+
     index: int  # position among the problem's assertions
     hold: pm.Hold | pm.Event
     priority: float
@@ -85,6 +87,9 @@ class Goal:
 
 @dataclass
 class Attempt:
+    """One search: the plan found (or none), the partial plans expanded, whether every branch was
+    tried, and its dead ends."""
+
     node: Node | None
     nodes: int
     exhausted: bool  # the whole search space was explored
@@ -837,6 +842,8 @@ def pseudo_network(node: Node, ends: Links, instants: Links) -> tuple[STN, str]:
 
 @dataclass(frozen=True)
 class Resolver:
+    """One way to resolve a flaw: a link, an insertion, an ordering, a separation or a binding."""
+
     kind: str  # link | insert | order | apart | bind
     need: int = -1
     producer: int = -1

@@ -277,6 +277,8 @@ class Bindings:
 
 @dataclass(frozen=True)
 class Assertion:
+    """An assertion of a partial plan: an event, hold or resource use, with its timepoints."""
+
     id: int
     kind: str  # event | hold | use
     attribute: str
@@ -307,6 +309,8 @@ class Assertion:
 
 @dataclass(frozen=True)
 class Instance:
+    """A task put in the partial plan, with its arguments."""
+
     id: str
     task: pm.Task
     variables: tuple[str, ...]  # plan variables, in the order params + task.variables
@@ -328,6 +332,8 @@ class Instance:
 
 @dataclass(frozen=True)
 class Link:
+    """A causal link: the producer assertion gives the consumer the value it needs."""
+
     producer: int
     consumer: int
 

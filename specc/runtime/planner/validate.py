@@ -544,6 +544,8 @@ def instance_text(instance: Instance) -> str:
 
 @dataclass
 class GroundEvent:
+    """An event of the plan with its values known."""
+
     instance: Instance
     before: Value
     after: Value
@@ -557,6 +559,8 @@ class GroundEvent:
 
 @dataclass
 class GroundHold:
+    """A hold of the plan with its value known (or its choices)."""
+
     instance: Instance
     value: Value | None  # None: any of `choices` (a symbolic variable the plan left unbound)
     start: str
@@ -573,6 +577,8 @@ class GroundHold:
 
 @dataclass
 class GroundUse:
+    """A resource use of the plan with its amount known."""
+
     instance: Instance
     amount: float
     start: str
@@ -582,6 +588,8 @@ class GroundUse:
 
 @dataclass
 class TemporalCheck:
+    """A temporal constraint of the plan, and which action or problem states it."""
+
     constraint: Constraint
     owner: str
     env: Mapping[str, Value]
@@ -590,6 +598,8 @@ class TemporalCheck:
 
 @dataclass
 class Nature:
+    """A contingent duration or date: the range nature picks it from."""
+
     key: str
     low: float
     high: float

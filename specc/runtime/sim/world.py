@@ -49,6 +49,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+FOOTPRINT_STEP = 0.02  # m between the points of a box footprint's outline that are checked
+
 
 class WorldError(ValueError):
     """A world file that cannot be used, with where and why."""
@@ -56,6 +58,8 @@ class WorldError(ValueError):
 
 @dataclass(frozen=True)
 class Polygon:
+    """An obstacle whose outline is a polygon."""
+
     points: tuple[tuple[float, float], ...]  # counter-clockwise
 
     def edges(self) -> list[tuple[float, float, float, float]]:
@@ -80,6 +84,8 @@ class Polygon:
 
 @dataclass(frozen=True)
 class Circle:
+    """A round obstacle."""
+
     x: float
     y: float
     radius: float
@@ -102,6 +108,8 @@ Obstacle = Polygon | Circle
 
 @dataclass(frozen=True)
 class Target:
+    """A named place of the world (a photo's object, a station)."""
+
     name: str
     x: float
     y: float
@@ -109,6 +117,8 @@ class Target:
 
 @dataclass(frozen=True)
 class Window:
+    """A named period of the mission (a communication window)."""
+
     name: str
     start: float
     end: float
@@ -116,6 +126,8 @@ class Window:
 
 @dataclass(frozen=True)
 class World:
+    """A simulated world: its walls, obstacles, targets and windows (a world file)."""
+
     name: str
     bounds: tuple[float, float, float, float]  # xmin, xmax, ymin, ymax: walls all around
     start: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -134,6 +146,24 @@ class World:
         if walls <= 0:
             return 0.0
         return min([walls] + [o.distance(x, y) for o in self.obstacles])
+
+    def footprint_clearance(self, pose: tuple[float, float, float], radius: float, length: float = 0.0,
+                            width: float = 0.0) -> float:
+        """How far a body at `pose` stands from the nearest obstacle or wall (0 or less: they
+        overlap): a disc of `radius`, or a `length` x `width` box turned by the pose's heading, whose
+        outline is sampled every FOOTPRINT_STEP."""
+        x, y, theta = pose
+        if length <= 0:
+            return self.clearance(x, y) - radius
+        cos, sin = math.cos(theta), math.sin(theta)
+        corners = [(sx * length / 2, sy * width / 2) for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+        points = [(x, y)]
+        for (ax, ay), (bx, by) in zip(corners, corners[1:] + corners[:1], strict=True):
+            steps = max(1, math.ceil(math.hypot(bx - ax, by - ay) / FOOTPRINT_STEP))
+            for k in range(steps):
+                u, v = ax + (bx - ax) * k / steps, ay + (by - ay) * k / steps
+                points.append((x + u * cos - v * sin, y + u * sin + v * cos))
+        return min(self.clearance(px, py) for px, py in points)
 
     def segments(self) -> list[tuple[float, float, float, float]]:
         """Every straight edge: the polygons' and the four walls'."""
