@@ -7,11 +7,8 @@ A block's name also names a file of the generated package (`executive/tug.py`, i
 
 from __future__ import annotations
 
-import math
-
 from specc.check.context import KIND_WORDS, Context
 from specc.model import nodes as m
-from specc.model.visitor import walk
 from specc.pysource import python_name, python_name_problem, shadowed_by_the_standard_library
 
 # The generated package's folder each kind's blocks are written into (problems and fragments
@@ -29,7 +26,6 @@ CONTROLLER_SUFFIX = "_resource_controller"  # specc.analysis.controller's name f
 def check(ctx: Context) -> None:
     for kind, word in KIND_WORDS.items():
         ctx.duplicates(list(ctx.items(kind)), word)
-    check_numbers(ctx)
     files: dict[tuple[str, str], tuple[str, m.Node]] = {}  # (folder, file stem) -> (what, block)
     for kind, folder in FOLDERS.items():
         item: m.Node
@@ -62,12 +58,3 @@ def check(ctx: Context) -> None:
                    "instead; rename it", systems[0].span)
 
 
-def check_numbers(ctx: Context) -> None:
-    """Every duration of a spec is a finite number of seconds (the parser refuses a number past
-    the largest float; `1e308 min` is one, but not in seconds): no generated literal holds an
-    infinity and no clock waits one."""
-    for source in ctx.program.files:
-        for node in walk(source):
-            if isinstance(node, m.Duration) and not math.isfinite(node.seconds):
-                ctx.report("bad-duration", f"{node.value:g} {node.unit} is too long to be a number of seconds",
-                           node.span)

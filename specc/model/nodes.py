@@ -33,11 +33,42 @@ def property_fields(node_type: type) -> list[Any]:
     return [f for f in fields(node_type) if "key" in f.metadata]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Node:
     """The base of every construct: where it was written (spans never take part in equality)."""
 
     span: Span = span_field()
+
+    # Equality, hash and repr are written once here, from each class's fields, where `dataclass`
+    # would generate them for every class (eq=False, repr=False on each): generating them for the
+    # model's 129 classes was 20 ms of every command's start. They mean what the generated ones
+    # do: same class and same compared fields; a hash of those; the repr fields by name.
+    def __eq__(self, other: object) -> bool:
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return _compared_values(self) == _compared_values(other)
+
+    def __hash__(self) -> int:
+        return hash(_compared_values(self))
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{name}={getattr(self, name)!r}" for name in _field_names(type(self), "repr"))
+        return f"{type(self).__name__}({shown})"
+
+
+def _field_names(node_type: type, flag: str) -> tuple[str, ...]:
+    """The names of the fields of `node_type` whose `flag` ("compare" or "repr") is set."""
+    names = _FIELD_NAMES.get((node_type, flag))
+    if names is None:
+        names = _FIELD_NAMES[node_type, flag] = tuple(f.name for f in fields(node_type) if getattr(f, flag))
+    return names
+
+
+_FIELD_NAMES: dict[tuple[type, str], tuple[str, ...]] = {}
+
+
+def _compared_values(node: Node) -> tuple[Any, ...]:
+    return tuple([getattr(node, name) for name in _field_names(type(node), "compare")])
 
 
 # ---------------------------------------------------------------- values
@@ -59,7 +90,7 @@ class Word(str):
         return word
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Ref(Node):
     """A name, possibly dotted (`pilo.execPosterTraj`)."""
 
@@ -70,14 +101,14 @@ class Ref(Node):
         return ".".join(self.parts)
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Number(Node):
     """A number as written (`3`, `0.25`)."""
 
     value: int | float
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Duration(Node):
     """A number with its unit of time (`50 ms`, `2 min`)."""
 
@@ -91,14 +122,14 @@ class Duration(Node):
         return float(self.value) * self.SCALE[self.unit]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class String(Node):
     """A double-quoted string (`"tug_codels"`)."""
 
     value: str
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class TypeRef(Node):
     """A GenoM type (`double`, `char[32]`, a struct or enum of the module)."""
 
@@ -106,7 +137,7 @@ class TypeRef(Node):
     size: int | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class TypedName(Node):
     """`name: type`, in a request's `input:` or `output:`."""
 
@@ -120,7 +151,7 @@ PropValue = Union[Ref, Number, Duration, String, TypedName]
 # ---------------------------------------------------------------- module (GenoM)
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Field(Node):
     """A field of a struct or of a module's internal data (`x: double;`)."""
 
@@ -128,7 +159,7 @@ class Field(Node):
     type: TypeRef
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class StructDecl(Node):
     """`struct NAME { field: type; ... }` in a module."""
 
@@ -136,7 +167,7 @@ class StructDecl(Node):
     fields: tuple[Field, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class EnumDecl(Node):
     """`enum NAME { A, B, ... }` in a module."""
 
@@ -144,7 +175,7 @@ class EnumDecl(Node):
     values: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Codel(Node):
     """`codel <state>: <function> [-> next, states];` — the codel run in that activity state."""
 
@@ -153,7 +184,7 @@ class Codel(Node):
     yields: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Request(Node):
     """`request NAME { type: control|exec; ... }`: what a module offers (GenoM), with its codels."""
 
@@ -171,7 +202,7 @@ class Request(Node):
     codels: tuple[Codel, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ExecTask(Node):
     """`exec_task NAME { period: ...; }`: the periodic task that runs a module's activities."""
 
@@ -185,7 +216,7 @@ class ExecTask(Node):
     codels: tuple[Codel, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Poster(Node):
     """`poster NAME { data: ...; }`: data a module publishes for others to read."""
 
@@ -196,7 +227,7 @@ class Poster(Node):
     doc: String | None = prop("doc", "string")
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Module(Node):
     """`module NAME { ... }`: a GenoM functional module (seed 000 ch. 2)."""
 
@@ -215,7 +246,7 @@ class Module(Node):
 # ---------------------------------------------------------------- executive
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Timeouts(Node):
     """`timeout { start: ...; interm: ...; final: ...; }` of a service: how long each reply may take."""
 
@@ -224,7 +255,7 @@ class Timeouts(Node):
     final: Duration | None = prop("final", "duration")
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Conflict(Node):
     """`SERVICE: interrupt;` or `SERVICE: wait;` in a service's `conflicts { }`: what happens when both are asked."""
 
@@ -232,7 +263,7 @@ class Conflict(Node):
     policy: str  # "interrupt" | "wait"
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Argument(Node):
     """A constant input of the service's request (`args { speed: 0.3; }`)."""
 
@@ -240,7 +271,7 @@ class Argument(Node):
     value: PropValue
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Service(Node):
     """`service NAME { request: module.REQUEST; ... }`: a request the executive runs for the task level."""
 
@@ -255,7 +286,7 @@ class Service(Node):
     conflicts: tuple[Conflict, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Comparison(Node):
     """`OP value` in a reflex's trigger (`> 0.5`)."""
 
@@ -263,7 +294,7 @@ class Comparison(Node):
     value: PropValue
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ReflexAction(Node):
     """`request|abort|start TARGET` in a reflex: what it does when triggered."""
 
@@ -271,7 +302,7 @@ class ReflexAction(Node):
     target: Ref
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Reflex(Node):
     """`reflex [NAME] on reply|warning|interm SOURCE [OP value] => actions;`: the executive's own
     reaction."""
@@ -283,7 +314,7 @@ class Reflex(Node):
     actions: tuple[ReflexAction, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Parameter(Node):
     """A GET-PARAM / SET-PARAM parameter of the executive (seed 000 §4.2.2)."""
 
@@ -293,7 +324,7 @@ class Parameter(Node):
     doc: String | None = prop("doc", "string")
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Executive(Node):
     """`executive NAME { service ...; reflex ...; }`: the services and their incompatibilities (seed 000 ch. 3)."""
 
@@ -309,7 +340,7 @@ class Executive(Node):
 # ---------------------------------------------------------------- rules (Kheops)
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AttrRef(Node):
     """An attribute of a rule base as a rule reads it (`speed`; `@speed`, its previous value; `range[i]`)."""
 
@@ -318,7 +349,7 @@ class AttrRef(Node):
     index: str | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KBinary(Node):
     """`left OP right`: arithmetic in a rule base."""
 
@@ -327,7 +358,7 @@ class KBinary(Node):
     right: KExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KNegate(Node):
     """`-operand` in a rule base."""
 
@@ -337,7 +368,7 @@ class KNegate(Node):
 KExpr = Union[Number, String, AttrRef, KBinary, KNegate]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KRange(Node):
     """`low..high` in a rule base's list of values."""
 
@@ -348,14 +379,14 @@ class KRange(Node):
 KItem = Union[String, Number, Ref, KRange]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SymbolDomain(Node):
     """`{"fast", "slow"}`: the symbols an attribute of a rule base takes."""
 
     values: tuple[KItem, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class NumericDomain(Node):
     """`[low, high]` or `number`: the numbers an attribute of a rule base takes."""
 
@@ -363,7 +394,7 @@ class NumericDomain(Node):
     high: KExpr | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class BoolDomain(Node):
     """`bool`: a true/false attribute of a rule base."""
 
@@ -371,7 +402,7 @@ class BoolDomain(Node):
 AttrDomain = Union[SymbolDomain, NumericDomain, BoolDomain]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AttrDecl(Node):
     """`inputs|outputs|intermediate name: domain, ...;` in a rule base."""
 
@@ -380,7 +411,7 @@ class AttrDecl(Node):
     domain: AttrDomain | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ConstDecl(Node):
     """`const NAME = value;` in a rule base."""
 
@@ -388,7 +419,7 @@ class ConstDecl(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class InitDecl(Node):
     """`init @NAME = value;` in a rule base: an attribute's previous value at the first decision."""
 
@@ -396,7 +427,7 @@ class InitDecl(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KCompare(Node):
     """`attr OP value` in a rule's condition."""
 
@@ -405,7 +436,7 @@ class KCompare(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KMember(Node):
     """`attr oneof|noneof [items]` in a rule's condition."""
 
@@ -414,42 +445,42 @@ class KMember(Node):
     items: tuple[KItem, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KTrue(Node):
     """`attr` alone in a rule's condition or restriction: a bool attribute that holds."""
 
     attr: AttrRef
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KFalse(Node):
     """`!attr` in a restriction: a bool attribute that does not hold."""
 
     attr: AttrRef
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KNot(Node):
     """`!condition` in a rule's condition."""
 
     operand: Cond
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KAnd(Node):
     """Conditions that must all hold (`a, b`)."""
 
     operands: tuple[Cond, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KOr(Node):
     """Conditions of which one must hold (`a | b`)."""
 
     operands: tuple[Cond, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KForeach(Node):
     """`foreach VAR in [items] (condition)`: the condition for each item."""
 
@@ -462,14 +493,14 @@ Cond = Union[KCompare, KMember, KTrue, KNot, KAnd, KOr, KForeach]
 Restriction = Union[KCompare, KMember, KTrue, KFalse]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Restrict(Node):
     """`restrict RESTRICTION` in a rule's actions: it narrows an output's values."""
 
     restriction: Restriction
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class DoAssign(Node):
     """`target = value` in a rule's `do { }`."""
 
@@ -477,7 +508,7 @@ class DoAssign(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class DoCall(Node):
     """`function(args)` in a rule's `do { }`."""
 
@@ -485,7 +516,7 @@ class DoCall(Node):
     args: tuple[KExpr, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class DoAction(Node):
     """`do { target = value; function(args) }` in a rule's actions."""
 
@@ -495,7 +526,7 @@ class DoAction(Node):
 Action = Union[Restrict, DoAction]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Rule(Node):
     """`NAME: condition ==> actions;` in a rule base (or an `impossible` / `else` rule)."""
 
@@ -506,7 +537,7 @@ class Rule(Node):
     actions: tuple[Action, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class RuleForeach(Node):
     """`foreach VAR in [items] { rules }`: rules written once for each item."""
 
@@ -515,7 +546,7 @@ class RuleForeach(Node):
     rules: tuple[Rule, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class RuleBase(Node):
     """`rules NAME { ... }`: a Kheops rule base (seed 000 §3.7), compiled to a decision of bounded depth."""
 
@@ -529,21 +560,21 @@ class RuleBase(Node):
 # ---------------------------------------------------------------- procedures (PRS)
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SymbolSet(Node):
     """`{A, B, C}`: the values of a PRS type or parameter."""
 
     values: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class DomainRef(Node):
     """A named PRS type used as a domain."""
 
     name: str
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IntRange(Node):
     """`low..high`: the bounded integers a Petri-net translation can enumerate (§4.4.10)."""
 
@@ -554,7 +585,7 @@ class IntRange(Node):
 PDomain = Union[SymbolSet, IntRange, DomainRef]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class TypeDecl(Node):
     """`type NAME = domain;` in procedures."""
 
@@ -562,7 +593,7 @@ class TypeDecl(Node):
     domain: PDomain
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class PParam(Node):
     """`name: domain`, a parameter of a PRS predicate or action."""
 
@@ -570,7 +601,7 @@ class PParam(Node):
     domain: PDomain
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class PredicateDecl(Node):
     """`predicate [kinds] NAME(params) [-> result];` in procedures: a fact of the database."""
 
@@ -581,7 +612,7 @@ class PredicateDecl(Node):
     binding: String | None = None  # the Python function an evaluable predicate calls
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ServiceBinding(Node):
     """`action GOTO(x: float, y: float) -> int = service GOTO;`: the action requests the executive's
     service with its arguments (the service's `takes:` inputs) and its value is the request's id."""
@@ -589,7 +620,7 @@ class ServiceBinding(Node):
     service: str
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ActionDecl(Node):
     """`action NAME(params) [-> result] = ...;` in procedures: what a primitive KA may do."""
 
@@ -599,21 +630,21 @@ class ActionDecl(Node):
     binding: String | ServiceBinding
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class LogicVar(Node):
     """`$X`: a PRS logical variable."""
 
     name: str  # with its leading $
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ProgramVar(Node):
     """`@X`: a PRS program variable."""
 
     name: str  # with its leading @
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SExp(Node):
     """`(HEAD args...)`: a PRS expression, fact or call."""
 
@@ -624,7 +655,7 @@ class SExp(Node):
 SArg = Union[LogicVar, ProgramVar, Ref, Number, String, SExp]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Goal(Node):
     """`!(...)`, `?(...)`, `^(...)`, `=>(...)`, `~>(...)`, `#(...)` or `%(...)`: a PRS goal (achieve,
     test, wait, conclude, retract, preserve, maintain)."""
@@ -633,21 +664,21 @@ class Goal(Node):
     body: SExp
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Block(Node):
     """`{ statements }` in a KA's body."""
 
     statements: tuple[Stmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class GoalStmt(Node):
     """A goal as a statement of a KA's body (`!(GO 2 5);`)."""
 
     goal: Goal
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IfStmt(Node):
     """`if (goal) { ... } else { ... }` in a KA's body."""
 
@@ -656,7 +687,7 @@ class IfStmt(Node):
     orelse: Block | IfStmt | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class WhileStmt(Node):
     """`while (goal) { ... }` in a KA's body."""
 
@@ -664,21 +695,21 @@ class WhileStmt(Node):
     body: Block
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ParallelStmt(Node):
     """`parallel { ... } { ... }` in a KA's body: branches run together."""
 
     branches: tuple[Block, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ChooseStmt(Node):
     """`choose { ... } { ... }` in a KA's body: the first branch that succeeds."""
 
     branches: tuple[Block, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AssignStmt(Node):
     """`assign @X = value;` in a KA's body."""
 
@@ -686,7 +717,7 @@ class AssignStmt(Node):
     value: SArg
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class FailStmt(Node):
     """`fail;` in a KA's body: the KA fails here."""
 
@@ -694,7 +725,7 @@ class FailStmt(Node):
 Stmt = Union[GoalStmt, IfStmt, WhileStmt, ParallelStmt, ChooseStmt, AssignStmt, FailStmt]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KAAction(Node):
     """`action: (CALL args) [-> $RESULT];`: a primitive KA's action."""
 
@@ -702,7 +733,7 @@ class KAAction(Node):
     result: LogicVar | ProgramVar | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class KA(Node):
     """`ka NAME { invocation: ...; body { } }`: a PRS knowledge area (seed 000 ch. 4)."""
 
@@ -716,7 +747,7 @@ class KA(Node):
     properties: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Procedures(Node):
     """`procedures NAME { ... }`: a PRS database's types, predicates and actions, and its KAs."""
 
@@ -730,26 +761,26 @@ class Procedures(Node):
 # ---------------------------------------------------------------- domain / problem (IxTeT)
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Infinity(Node):
     """`oo`: an unbounded end of an IxTeT interval."""
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IxVar(Node):
     """`?x`: an IxTeT variable."""
 
     name: str  # with its leading ?
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IxName(Node):
     """A constant symbol or a timepoint in IxTeT (`DOCK`, `t_start`)."""
 
     name: str
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IxCall(Node):
     """`FUNCTION(args)` in an IxTeT expression."""
 
@@ -757,7 +788,7 @@ class IxCall(Node):
     args: tuple[IxExpr, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IxBinary(Node):
     """`left OP right` in an IxTeT expression."""
 
@@ -766,7 +797,7 @@ class IxBinary(Node):
     right: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class IxUnary(Node):
     """`-operand` (or another prefix operator) in an IxTeT expression."""
 
@@ -777,7 +808,7 @@ class IxUnary(Node):
 IxExpr = Union[Number, Infinity, IxVar, IxName, IxCall, IxBinary, IxUnary]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Interval(Node):
     """`[low, high]` in IxTeT."""
 
@@ -785,21 +816,21 @@ class Interval(Node):
     high: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SetLiteral(Node):
     """`{A, B}` in IxTeT."""
 
     values: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SetRef(Node):
     """A named constant set in IxTeT (`PLACES`)."""
 
     name: str
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SetUnion(Node):
     """Sets joined with `|`, or one set, in IxTeT."""
 
@@ -809,7 +840,7 @@ class SetUnion(Node):
 DomainValue = Union[Interval, SetUnion]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Transition(Node):
     """`(before, after)`: the value an event changes an attribute from and to."""
 
@@ -817,7 +848,7 @@ class Transition(Node):
     after: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AttrValue(Node):
     """`ATTRIBUTE(args): value` in IxTeT, the value a transition or a single value."""
 
@@ -826,7 +857,7 @@ class AttrValue(Node):
     value: IxExpr | Transition
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class GoalMark(Node):
     """`goal(priority, weight)` after an assertion of a problem: it is a goal to meet."""
 
@@ -834,7 +865,7 @@ class GoalMark(Node):
     weight: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Hold(Node):
     """`hold(ATTR(args): value, (start, end))`: the attribute keeps its value over the interval."""
 
@@ -844,7 +875,7 @@ class Hold(Node):
     goal: GoalMark | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Event(Node):
     """`event(ATTR(args): (before, after), time)`: the attribute changes at that time."""
 
@@ -854,7 +885,7 @@ class Event(Node):
     goal: GoalMark | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Window(Node):
     """`(start, end)`: the interval a resource is used over."""
 
@@ -862,7 +893,7 @@ class Window(Node):
     end: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ResourceUse(Node):
     """`use|consume|produce(RESOURCE(args): amount, when)`."""
 
@@ -872,21 +903,21 @@ class ResourceUse(Node):
     goal: GoalMark | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class VariableDecl(Node):
     """`variable ?a, ?b;` in an IxTeT task."""
 
     names: tuple[IxVar, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class TimepointDecl(Node):
     """`timepoint t1, t2;` in an IxTeT task or problem."""
 
     names: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class InConstraint(Node):
     """`expr in domain;` (possibly `contingent`): an IxTeT constraint."""
 
@@ -895,7 +926,7 @@ class InConstraint(Node):
     contingent: bool = False
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class RelConstraint(Node):
     """`left OP right;` (possibly `contingent`): an IxTeT constraint."""
 
@@ -905,7 +936,7 @@ class RelConstraint(Node):
     contingent: bool = False
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Implication(Node):
     """`condition => consequence;`: a constraint that holds only when the condition does."""
 
@@ -913,7 +944,7 @@ class Implication(Node):
     consequence: InConstraint | RelConstraint
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class MacroCall(Node):
     """`NAME(args);`: a macro's statements written in place."""
 
@@ -921,7 +952,7 @@ class MacroCall(Node):
     args: tuple[IxExpr, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Include(Node):
     """`include NAME;`: a fragment's statements written in place."""
 
@@ -934,7 +965,7 @@ TStmt = Union[
 ]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Constant(Node):
     """`constant NAME = set;` in a planning domain."""
 
@@ -942,7 +973,7 @@ class Constant(Node):
     value: SetUnion
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Attribute(Node):
     """`attribute NAME(?params) { ... }`: a state variable of a planning domain."""
 
@@ -951,7 +982,7 @@ class Attribute(Node):
     body: tuple[TStmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Resource(Node):
     """`resource NAME(?params) { ... }`: a shared resource of a planning domain."""
 
@@ -960,7 +991,7 @@ class Resource(Node):
     body: tuple[TStmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Macro(Node):
     """`macro NAME(params) { ... }`: statements written once and used in tasks."""
 
@@ -969,7 +1000,7 @@ class Macro(Node):
     body: tuple[TStmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Task(Node):
     """`task NAME(?params) (t_start, t_end) { ... }`: an action a plan may hold (IxTeT's chronicle)."""
 
@@ -984,7 +1015,7 @@ class Task(Node):
 DomainMember = Union[Include, Constant, Attribute, Resource, Macro, Task]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Domain(Node):
     """`domain NAME { ... }`: an IxTeT planning domain (seed 004 annex A)."""
 
@@ -992,7 +1023,7 @@ class Domain(Node):
     members: tuple[DomainMember, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Problem(Node):
     """`problem NAME for DOMAIN { ... }`: the initial state, goals and deadlines of a planning problem."""
 
@@ -1002,7 +1033,7 @@ class Problem(Node):
     preemption: str | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Fragment(Node):
     """`fragment NAME { ... }`: statements shared by domains and problems (`include NAME;`)."""
 
@@ -1013,7 +1044,7 @@ class Fragment(Node):
 # ---------------------------------------------------------------- ftplan
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class ViewFact(Node):
     """`ATTRIBUTE(args): value` in a correspondence; on FTplan's side the value may be an interval."""
 
@@ -1022,7 +1053,7 @@ class ViewFact(Node):
     value: IxExpr | Interval
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Correspondence(Node):
     """`planner facts <=> FTplan's facts`: how a planner's vocabulary reads FTplan's state."""
 
@@ -1030,7 +1061,7 @@ class Correspondence(Node):
     state_facts: tuple[ViewFact, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Planner(Node):
     """`planner NAME { domain: ...; }` in an ftplan block: one of FTplan's diverse planners."""
 
@@ -1047,7 +1078,7 @@ class Planner(Node):
     view: tuple[Correspondence, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class MissionProblem(Node):
     """`planner: problem;` in a mission: the planner's statement of the mission."""
 
@@ -1055,7 +1086,7 @@ class MissionProblem(Node):
     problem: Ref
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class MissionView(Node):
     """`view planner { ... }` in a mission: correspondences that hold for this mission only."""
 
@@ -1063,7 +1094,7 @@ class MissionView(Node):
     correspondences: tuple[Correspondence, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Mission(Node):
     """`mission NAME { planner: problem; ... }` in an ftplan block: the problem each planner plans."""
 
@@ -1072,7 +1103,7 @@ class Mission(Node):
     views: tuple[MissionView, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AnalyzerCondition(Node):
     """`during|at_start|at_end TASK(args) requires ATTR: value;`: a condition FTplan's plan analyser checks."""
 
@@ -1082,14 +1113,14 @@ class AnalyzerCondition(Node):
     requirement: AttrValue
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AnalyzerNoOverlap(Node):
     """`no_overlap TASK, TASK;`: tasks FTplan's plan analyser forbids to overlap."""
 
     tasks: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class AnalyzerMaxDuration(Node):
     """`max_duration TASK duration;`: a duration FTplan's plan analyser bounds."""
 
@@ -1100,7 +1131,7 @@ class AnalyzerMaxDuration(Node):
 AnalyzerRule = Union[AnalyzerCondition, AnalyzerNoOverlap, AnalyzerMaxDuration]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class FactUpdate(Node):
     """`ATTR(args) := value` in a state update."""
 
@@ -1109,7 +1140,7 @@ class FactUpdate(Node):
     value: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class StateUpdate(Node):
     """`on ended|failed|report TASK(args) => updates;`: how an action's outcome changes FTplan's state."""
 
@@ -1119,7 +1150,7 @@ class StateUpdate(Node):
     updates: tuple[FactUpdate, ...]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class FtPlan(Node):
     """`ftplan NAME { ... }`: the fault-tolerant planning component (seed 004 ch. 3) and its planners."""
 
@@ -1137,7 +1168,7 @@ class FtPlan(Node):
 # ---------------------------------------------------------------- system
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Setting(Node):
     """One `name: value;` entry of a system's `body { }` or `worlds { }`."""
 
@@ -1145,14 +1176,14 @@ class Setting(Node):
     value: PropValue
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Settings(Node):
     """A system's `body { }` or `worlds { }` section."""
 
     entries: tuple[Setting, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class DeviceGrant(Node):
     """`module: device, ...;` in a system's `devices { }`: what the module's codels may drive."""
 
@@ -1160,14 +1191,14 @@ class DeviceGrant(Node):
     devices: tuple[Ref, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class DeviceGrants(Node):
     """A system's `devices { }` section."""
 
     entries: tuple[DeviceGrant, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Binding(Node):
     """`TASK(?a, ?b) => goal G(?a);`: how a planning task is carried out (kind: goal, service or
     request), with the target's arguments made from the task's."""
@@ -1181,7 +1212,7 @@ class Binding(Node):
     report: BindingReport | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class BindingWhere(Node):
     """`where ATTR(?o, ...) := VALUE`: ?variables bound by the first of FTplan's state changes at
     the action's end that reads so."""
@@ -1191,7 +1222,7 @@ class BindingWhere(Node):
     value: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class BindingReport(Node):
     """`report NAME(module.Poster.field, ...)`: posters read when the action is over, reported to FTplan."""
 
@@ -1199,14 +1230,14 @@ class BindingReport(Node):
     values: tuple[Ref, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Bindings(Node):
     """A system's `bindings { }` section."""
 
     entries: tuple[Binding, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SystemMission(Node):
     """A mission of the robot: the goals its supervisor is given, in one of its worlds."""
 
@@ -1218,7 +1249,7 @@ class SystemMission(Node):
     goals: tuple[Goal, ...] = ()  # `goal: !(...);`, posted together at the start
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class System(Node):
     """`system NAME { ... }`: how a robot runs: its modules, executive, supervisor, body, worlds, missions."""
 
@@ -1240,7 +1271,7 @@ class System(Node):
 Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment, FtPlan, System]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class SourceFile(Node):
     """One spec file and the blocks it holds."""
 
@@ -1248,7 +1279,7 @@ class SourceFile(Node):
     items: tuple[Item, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
 class Program(Node):
     """Every file of one robot, in the order they were given."""
 

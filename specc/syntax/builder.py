@@ -98,7 +98,13 @@ class Builder(Transformer[Token, Any]):
 
     def duration(self, meta: Meta, children: list[Any]) -> m.Duration:
         number, unit = children
-        return m.Duration(value=self.number_value(number), unit=unit, span=self.span(meta))
+        duration = m.Duration(value=self.number_value(number), unit=unit, span=self.span(meta))
+        if math.isfinite(duration.value) and not math.isfinite(duration.seconds):
+            # A number, but not in seconds (`1e308 min`): no generated literal may hold an infinity,
+            # and no clock wait one.
+            self.diagnostics.append(error("bad-duration", f"{duration.value:g} {unit} is too long to be a number "
+                                          "of seconds", duration.span))
+        return duration
 
     def number_value(self, token: Token) -> int | float:
         value = parse_number(str(token))

@@ -16,6 +16,7 @@ Two solvers, for two jobs:
 
 from __future__ import annotations
 
+import collections
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -120,6 +121,7 @@ class Closure:
 
     domains: dict[str, Dom] = field(default_factory=dict)
     constraints: tuple[pm.Constraint, ...] = ()
+    narrowed: list[str] = field(default_factory=list, repr=False)  # variables narrowed, in order
 
     def value(self, name: str) -> Value | None:
         d = self.domains.get(name)
@@ -163,6 +165,7 @@ class Closure:
             current = self.domains.get(e.name)
             if current is None:
                 self.domains[e.name] = target
+                self.narrowed.append(e.name)
                 return True
             if isinstance(current, frozenset) or isinstance(target, frozenset):
                 if not (isinstance(current, frozenset) and isinstance(target, frozenset)):
@@ -172,11 +175,13 @@ class Closure:
                     raise Empty(f"{e.name} in {show(current)} cannot be in {show(target)}")
                 if narrowed != current:
                     self.domains[e.name] = narrowed
+                    self.narrowed.append(e.name)
                     return True
                 return False
             narrowed_iv = intersect(current, target)
             if narrowed_iv[0] > current[0] + TOLERANCE or narrowed_iv[1] < current[1] - TOLERANCE:
                 self.domains[e.name] = narrowed_iv
+                self.narrowed.append(e.name)
                 return True
             return False
         goal = self.numeric(target)
@@ -284,16 +289,64 @@ class Closure:
         return False if d[1] < c.domain.low or d[0] > c.domain.high else None
 
     def propagate(self, rounds: int = 30) -> None:
-        for _ in range(rounds):
-            changed = False
-            for c in self.constraints:
-                changed |= self.apply(c)
-            if not changed:
-                return
+        """Apply the constraints until none narrows a domain: each one first in order, then again
+        only when a variable it reads has narrowed since (AC-3's queue; sweeping every constraint
+        until a sweep changes nothing re-applied most of them for nothing). Each is applied at most
+        `rounds` times: interval narrowing may converge only in the limit."""
+        readers = _readers(self.constraints)
+        queue = collections.deque(range(len(self.constraints)))
+        queued = [True] * len(self.constraints)
+        applied = [0] * len(self.constraints)
+        while queue:
+            index = queue.popleft()
+            queued[index] = False
+            if applied[index] >= rounds:
+                continue
+            applied[index] += 1
+            self.narrowed.clear()
+            self.apply(self.constraints[index])
+            for name in self.narrowed:
+                for other in readers.get(name, ()):
+                    if not queued[other]:
+                        queued[other] = True
+                        queue.append(other)
 
 
 def _empty(e: pm.Expr, excluded: frozenset[str]) -> bool:
     raise Empty(f"{describe(e)} cannot avoid {sorted(excluded)}")
+
+
+def _readers(constraints: tuple[pm.Constraint, ...]) -> dict[str, tuple[int, ...]]:
+    """Variable name -> the positions of the constraints that read it (cached by the tuple's
+    identity, which it keeps: a task's constraints are propagated again and again)."""
+    found = _READERS.get(id(constraints))
+    if found is None or found[0] is not constraints:
+        positions: dict[str, list[int]] = {}
+        for index, c in enumerate(constraints):
+            for name in sorted(_variables(c)):
+                positions.setdefault(name, []).append(index)
+        if len(_READERS) >= IDENTITY_CACHE_LIMIT:
+            _READERS.clear()
+        found = _READERS[id(constraints)] = (constraints, {k: tuple(v) for k, v in positions.items()})
+    return found[1]
+
+
+_READERS: dict[int, tuple[tuple[pm.Constraint, ...], dict[str, tuple[int, ...]]]] = {}
+
+
+def _variables(c: pm.Constraint | pm.Expr) -> set[str]:
+    """The names of the variables a constraint or an expression reads."""
+    if isinstance(c, pm.Var):
+        return {c.name}
+    if isinstance(c, pm.Op):
+        return set().union(*(_variables(a) for a in c.args))
+    if isinstance(c, pm.Member):
+        return _variables(c.expr)
+    if isinstance(c, pm.Relation):
+        return _variables(c.left) | _variables(c.right)
+    if isinstance(c, pm.Implies):
+        return _variables(c.condition) | _variables(c.consequence)
+    return set()
 
 
 def has_time(e: pm.Expr) -> bool:
@@ -347,9 +400,36 @@ _DURATIONS: dict[tuple[int, tuple[tuple[str, Value], ...]], tuple[pm.Task, Durat
 IDENTITY_CACHE_LIMIT = 4096
 
 
+@dataclass(frozen=True)
+class _TaskConstraints:
+    """A task's constraints sorted once for its duration computations: those the numeric
+    propagation applies (neither a bound on its duration nor a relation of timepoints, which the
+    propagation leaves to the temporal network), and the bounds on its duration with their range."""
+
+    task: pm.Task  # kept so that its id stays its own
+    propagated: tuple[pm.Constraint, ...]
+    durations: tuple[tuple[pm.Constraint, Interval], ...]
+
+
+def _task_constraints(task: pm.Task) -> _TaskConstraints:
+    found = _TASK_CONSTRAINTS.get(id(task))
+    if found is None:
+        durations = tuple((c, span) for c in task.constraints
+                          if (span := _duration_constraint(c, task)) is not None)
+        propagated = tuple(c for c in task.constraints if _duration_constraint(c, task) is None
+                           and not (isinstance(c, pm.Relation) and (has_time(c.left) or has_time(c.right))))
+        if len(_TASK_CONSTRAINTS) >= IDENTITY_CACHE_LIMIT:
+            _TASK_CONSTRAINTS.clear()
+        found = _TASK_CONSTRAINTS[id(task)] = _TaskConstraints(task, propagated, durations)
+    return found
+
+
+_TASK_CONSTRAINTS: dict[int, _TaskConstraints] = {}
+
+
 def _propagated(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> Closure:
     """The task's numeric constraints propagated with its parameters bound (Empty: inconsistent)."""
-    closure = Closure(constraints=tuple(c for c in task.constraints if not is_duration(c, task)))
+    closure = Closure(constraints=_task_constraints(task).propagated)
     for name, value in key:
         closure.domains[name] = frozenset((value,)) if isinstance(value, str) else (float(value), float(value))
     closure.propagate()
@@ -359,9 +439,8 @@ def _propagated(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> Closure:
 def _duration_cached(task: pm.Task, key: tuple[tuple[str, Value], ...]) -> DurationSpec:
     closure = _propagated(task, key)
     low, high, contingent = 0.0, INF, False
-    for c in task.constraints:
-        span = _duration_constraint(c, task)
-        if span is None or isinstance(c, pm.Implies):
+    for c, span in _task_constraints(task).durations:
+        if isinstance(c, pm.Implies):
             continue
         if isinstance(c, pm.Relation):
             assert isinstance(c.left, pm.Var) or isinstance(c.right, pm.Var)

@@ -50,6 +50,7 @@ Comparisons use an absolute tolerance of 1e-6 (`<` and `>` are strict).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import random
@@ -570,6 +571,11 @@ class GroundHold:
     choices: tuple[str, ...] = ()
     variable: str = ""  # "<action id>.<variable>" when value is None
 
+    @functools.cached_property
+    def key(self) -> tuple[str, tuple[Value, ...]]:
+        """Its attribute instance, as the validator's timelines group events."""
+        return instance_key(self.instance)
+
     def describe(self) -> str:
         value = text(self.value) if self.value is not None else "{" + ", ".join(self.choices) + "}"
         return f"{self.what}({instance_text(self.instance)}: {value})"
@@ -899,11 +905,20 @@ class Validator:
                     add(("late", action.id), f"{action.id}: may end at {date_text(dates[key])}, after "
                                              f"{self.problem.end} ({date_text(end)})")
 
+    @functools.cached_property
+    def _events_by_instance(self) -> dict[object, list[tuple[int, GroundEvent]]]:
+        """The events of each attribute instance (the same in every realisation: only dates change)."""
+        grouped: dict[object, list[tuple[int, GroundEvent]]] = {}
+        for i, e in enumerate(self.events):
+            grouped.setdefault(instance_key(e.instance), []).append((i, e))
+        return grouped
+
     def timelines(self, dates: Mapping[str, float], add: Callable[[object, str], None]) -> None:
         by_instance: dict[object, list[tuple[float, int, GroundEvent]]] = {}
-        for i, e in enumerate(self.events):
-            if e.time in dates:
-                by_instance.setdefault(instance_key(e.instance), []).append((dates[e.time], i, e))
+        for instance, events in self._events_by_instance.items():
+            dated = [(dates[e.time], i, e) for i, e in events if e.time in dates]
+            if dated:
+                by_instance[instance] = dated
         for timeline in by_instance.values():
             timeline.sort(key=lambda x: (x[0], x[1]))
             for (t1, i, a), (t2, j, b) in itertools.pairwise(timeline):
@@ -926,7 +941,7 @@ class Validator:
             if h.start not in dates or h.end not in dates:
                 continue
             t1, t2 = dates[h.start], dates[h.end]
-            timeline = by_instance.get(instance_key(h.instance), [])
+            timeline = by_instance.get(h.key, [])
             if t1 > t2 + TOLERANCE:
                 add(("hold-order", k), f"{h.owner}: {h.describe()} ends at {date_text(t2)}, before it starts "
                                        f"at {date_text(t1)}")
