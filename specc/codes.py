@@ -128,6 +128,7 @@ CODES: dict[str, Code] = {
     "missing-init": Code("a rule reads the previous cycle (@x) of an attribute with no init", '@status == "OK"'),
     "init-undeclared": Code("an init for an attribute the base does not declare (warning)", "init @nope = 1;"),
     "output-never-set": Code("an output no rule deduces", "outputs status, never;"),
+    "empty-rule-base": Code("a rule base with no rules: it decides nothing (warning)", "rules speed { }"),
     "input-never-read": Code("an input no rule tests: it changes no decision (warning)", "inputs battery: [0, 100];"),
     "empty-domain": Code("a domain holding no value", "inputs load: [1, 0];"),
     "rules-too-large": Code("a rule base or resource controller whose decision graph is too large to build",

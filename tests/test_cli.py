@@ -509,6 +509,17 @@ def test_an_operator_written_a_character_short_is_named() -> None:
     assert found.code == "unexpected-token" and "unexpected '=' (did you mean '==>'?)" in found.message
 
 
+
+def test_a_negative_number_where_none_has_a_meaning_is_said_so() -> None:
+    from specc.syntax.parser import parse_text
+
+    text = "system s {\n  body {\n    wheel_base: -0.5;\n  }\n}\n"
+    (found,) = parse_text(text, "s.spec").diagnostics
+    assert found.code == "unexpected-token" and (found.span.line, found.span.column) == (3, 17)
+    assert "unexpected '-' (a negative number has no meaning here: this value must be 0 or more)" in found.message
+    (other,) = parse_text(text.replace("-0.5", "-x"), "s.spec").diagnostics  # a name: no such hint
+    assert "negative number" not in other.message
+
 def test_skeleton_writes_codels_where_specc_run_imports_them(tmp_path: Path) -> None:
     # docs/your-robot.md's step 1: a module in a subfolder, no system block yet. The stubs go to
     # the robot's folder given to the command (not beside the module's spec), and once a system

@@ -227,6 +227,9 @@ def check(ctx: Context) -> None:
         ctx.duplicates(base.attributes, "attribute")
         ctx.duplicates(base.constants, "constant")
         ctx.duplicates([r for r in base.rules if isinstance(r, m.Rule)], "rule")
+        if not base.rules:
+            ctx.warn("empty-rule-base", f"rule base '{base.name}' has no rules: it decides nothing; add one, e.g. "
+                     "`slow: load > 100 ==> restrict speed == \"slow\";`", base.span)
         visitor = RuleVisitor(ctx, base)
         visitor.visit(base)
         if base.name not in completed:  # an executive's own rules read the controller's attributes

@@ -143,6 +143,9 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
     # A misspelt keyword reads as a name, and where the keyword was optional (a task's preemption
     # after its '}') the parser no longer expects it: say which keyword the word is close to.
     close = _meant(exc, text, position, str(token), token.type == "NAME")
+    if str(token) == "-" and "NUMBER" in exc.expected and text[position + 1:position + 2].isdigit():
+        # `wheel_base: -0.5;`: the value is a number, but no negative one has a meaning here.
+        close = " (a negative number has no meaning here: this value must be 0 or more)"
     return error("unexpected-token", f"unexpected {describe_token(token)}{close}; expected {expected}", span)
 
 
