@@ -279,3 +279,19 @@ def test_the_reflexes_that_fired_have_their_row_on_the_timeline(hunt: MissionRun
     had_reflexes = any(e["kind"] == "reflex" for e in hunt.events)
     assert ("reflexes" in rows[0]) == had_reflexes and "reflexes" in rows[1]
     assert rows[1].index("reflexes") == rows[1].index("alarms") - 1
+
+
+def test_a_box_footprint_is_drawn_to_its_whole_extent_with_its_front_marked() -> None:
+    """The picture's outline reaches the box's four corners (where it hits things), turned with its
+    heading; the front is marked by a notch cut inward, not by cutting the corners off."""
+    from specc.runtime.body import RobotConfig
+    from specc.runtime.sim.render import outline
+
+    box = RobotConfig(length=0.9, width=0.6)
+    points = outline(box, (1.0, 2.0, 0.0))
+    assert points[:, 0].min() == pytest.approx(0.55) and points[:, 0].max() == pytest.approx(1.45)
+    assert points[:, 1].min() == pytest.approx(1.7) and points[:, 1].max() == pytest.approx(2.3)
+    front = points[points[:, 0] < 1.45 - 1e-9]  # the notch's inner point lies behind the front edge
+    assert any(abs(y - 2.0) < 1e-9 and x > 1.0 for x, y in front)
+    turned = outline(box, (0.0, 0.0, math.pi / 2))  # facing +y: the length lies along y
+    assert turned[:, 1].max() == pytest.approx(0.45) and turned[:, 0].max() == pytest.approx(0.3)

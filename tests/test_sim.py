@@ -369,3 +369,17 @@ def test_a_box_footprint_overlaps_where_its_corner_reaches_and_not_where_its_sid
     assert along == pytest.approx(0.25, abs=1e-6)
     assert across <= 0 and turned <= 0
     assert room.footprint_clearance((xmin + 0.45, y, 0.0), 0.3) == pytest.approx(0.15)
+
+
+def test_every_problem_of_a_world_file_is_said_at_once():
+    """A misspelt key, a malformed circle and a window that ends before it starts: all three, each
+    on its line, not one per attempt."""
+    data = {**EMPTY, "start": {"x": 1.0, "thetaa": 1.0}, "obstacles": [{"circle": [3.0, 3.0, -1.0]}],
+            "windows": [{"start": 10.0, "end": 5.0}]}
+    with pytest.raises(WorldError) as error:
+        parse_world(data, "bad.toml")
+    assert len(error.value.problems) == 3
+    assert str(error.value).splitlines() == list(error.value.problems)
+    for fragment, line in zip(("[start]: unknown key 'thetaa'", "obstacles[0]: circle must be", "windows[0]: needs"),
+                              error.value.problems, strict=True):
+        assert line.startswith("bad.toml: ") and fragment in line

@@ -156,8 +156,9 @@ def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
             continue
         try:
             load_world(path)
-        except WorldError as problem:  # named as the spec names it, not by this machine's folders
-            ctx.report("bad-world", str(problem).replace(str(path), entry.value.value), entry.value.span)
+        except WorldError as error:  # each problem, named as the spec names the file, not by this machine's folders
+            for problem in error.problems:
+                ctx.report("bad-world", problem.replace(str(path), entry.value.value), entry.value.span)
     return worlds
 
 

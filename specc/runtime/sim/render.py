@@ -363,10 +363,14 @@ def draw_footprint(ax: Any, robot: RobotConfig, pose: np.ndarray | Sequence[floa
 
 
 def outline(robot: RobotConfig, pose: np.ndarray | Sequence[float]) -> np.ndarray:
-    """The robot's footprint with a notch at the front, at `pose` (x, y, theta)."""
+    """The robot's footprint with a notch at the front, at `pose` (x, y, theta). The notch is cut
+    into the front edge, so that the outline keeps the body's whole extent (its corners are where
+    it hits things)."""
     if robot.length > 0:
         hl, hw = robot.length / 2, robot.width / 2
-        local = np.array([(hl, 0.0), (hl * 0.7, hw), (-hl, hw), (-hl, -hw), (hl * 0.7, -hw)])
+        depth = min(0.3 * hl, 0.5 * hw)
+        local = np.array([(hl, hw), (-hl, hw), (-hl, -hw), (hl, -hw), (hl, -0.4 * hw), (hl - depth, 0.0),
+                          (hl, 0.4 * hw)])
     else:
         angles = np.linspace(0.25, math.tau - 0.25, 24)
         local = np.vstack([[robot.radius, 0.0], np.c_[np.cos(angles), np.sin(angles)] * robot.radius])

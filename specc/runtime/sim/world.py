@@ -47,13 +47,18 @@ import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 FOOTPRINT_STEP = 0.02  # m between the points of a box footprint's outline that are checked
 
 
 class WorldError(ValueError):
-    """A world file that cannot be used, with where and why."""
+    """A world file that cannot be used, with where and why: every problem found in it, one per
+    line (`problems`), so that a file is fixed in one go."""
+
+    def __init__(self, *problems: str) -> None:
+        super().__init__("\n".join(problems))
+        self.problems = problems
 
 
 @dataclass(frozen=True)
@@ -199,89 +204,112 @@ def load_world(path: str | Path) -> World:
 
 
 def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: str = "world") -> World:
+    """The world `data` (a world file's TOML) describes; a WorldError listing every problem found."""
     where = _Where(source)
     known = {"world", "room", "bounds", "start", "obstacles", "objects", "targets", "windows"}
     for key in data:
         if key not in known:
-            raise WorldError(f"{source}: unknown section [{key}] (known: {', '.join(sorted(known))})")
+            where.problem(f"unknown section [{key}] (known: {', '.join(sorted(known))})")
     header = where.table(data, "world", ("name", "description"))
     name = where.text(header, "name", "world", default_name)
     description = where.text(header, "description", "world", "")
+    bounds: tuple[float, float, float, float] | None = None
     if "room" in data and "bounds" in data:
-        raise WorldError(f"{source}: give [room] or [bounds], not both")
-    if "room" in data:
+        where.problem("give [room] or [bounds], not both")
+    elif "room" in data:
         room = where.table(data, "room", ("width", "height"))
-        width, height = where.number(room, "width", "room"), where.number(room, "height", "room")
-        if width <= 0 or height <= 0:
-            raise WorldError(f"{source}: [room] width and height must be positive")
-        bounds = (0.0, width, 0.0, height)
+        width, height = where.number(room, "width", "room", None), where.number(room, "height", "room", None)
+        if width is not None and height is not None:
+            if width <= 0 or height <= 0:
+                where.problem("[room] width and height must be positive")
+            else:
+                bounds = (0.0, width, 0.0, height)
     elif "bounds" in data:
         corners = ("xmin", "xmax", "ymin", "ymax")
         box = where.table(data, "bounds", corners)
-        bounds = tuple(where.number(box, k, "bounds") for k in corners)  # type: ignore[assignment]
-        if not (bounds[0] < bounds[1] and bounds[2] < bounds[3]):
-            raise WorldError(f"{source}: [bounds] needs xmin < xmax and ymin < ymax")
+        given = [where.number(box, k, "bounds", None) for k in corners]
+        if all(b is not None for b in given):
+            xmin, xmax, ymin, ymax = (float(b) for b in given if b is not None)
+            if not (xmin < xmax and ymin < ymax):
+                where.problem("[bounds] needs xmin < xmax and ymin < ymax")
+            else:
+                bounds = (xmin, xmax, ymin, ymax)
     else:
-        raise WorldError(f"{source}: the world needs walls: a [room] (width, height) or [bounds] "
-                         "(xmin, xmax, ymin, ymax)")
-    if max(abs(b) for b in bounds) > MAX_EXTENT:
-        raise WorldError(f"{source}: the walls reach {max(abs(b) for b in bounds):g} m from the origin: at most "
-                         f"{MAX_EXTENT:g} m (the physics and the pictures lose precision beyond)")
+        where.problem("the world needs walls: a [room] (width, height) or [bounds] (xmin, xmax, ymin, ymax)")
+    if bounds is not None and max(abs(b) for b in bounds) > MAX_EXTENT:
+        where.problem(f"the walls reach {max(abs(b) for b in bounds):g} m from the origin: at most {MAX_EXTENT:g} m "
+                      "(the physics and the pictures lose precision beyond)")
+        bounds = None
     start_table = where.table(data, "start", ("x", "y", "theta"))
     start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
              where.number(start_table, "theta", "start", 0.0))
     obstacles: list[Obstacle] = []
     for k, entry in enumerate(where.array(data, "obstacles", ("polygon", "circle"))):
-        label = f"obstacles[{k}]"
-        if "polygon" in entry and "circle" not in entry:
-            points = entry["polygon"]
-            if not isinstance(points, list) or len(points) < 3 or not all(
-                    isinstance(p, list) and len(p) == 2 and all(_finite(c) for c in p) for p in points):
-                raise WorldError(f"{source}: {label}: polygon must list at least 3 [x, y] corners (finite numbers)")
-            polygon = tuple((float(x), float(y)) for x, y in points)
-            crossing = self_crossing(polygon)
-            if crossing is not None:
-                raise WorldError(f"{source}: {label}: the polygon crosses itself (its edges from corner {crossing[0]} "
-                                 f"and from corner {crossing[1]}, counted from 0): list its corners in order around it")
-            area = signed_area(polygon)
-            if abs(area) < 1e-9:
-                raise WorldError(f"{source}: {label}: the polygon has no area")
-            if area < 0:
-                polygon = polygon[::-1]  # the rest of the simulator wants counter-clockwise corners
-            obstacles.append(Polygon(polygon))
-        elif "circle" in entry and "polygon" not in entry:
-            c = entry["circle"]
-            if not (isinstance(c, list) and len(c) == 3 and all(_finite(v) for v in c) and c[2] > 0):
-                raise WorldError(f"{source}: {label}: circle must be [x, y, radius] (finite numbers) with radius > 0")
-            obstacles.append(Circle(float(c[0]), float(c[1]), float(c[2])))
-        else:
-            raise WorldError(f"{source}: {label}: give either polygon = [[x, y], ...] or circle = [x, y, r]")
+        obstacle = _obstacle(where, f"obstacles[{k}]", entry)
+        if obstacle is not None:
+            obstacles.append(obstacle)
     objects_table = where.table(data, "objects", ("count", "at"))
     count = where.number(objects_table, "count", "objects", 0.0)
     if count < 0 or count != int(count):
-        raise WorldError(f"{source}: [objects] count must be a whole number >= 0")
-    placed = tuple((where.number(o, "x", f"objects.at[{k}]"), where.number(o, "y", f"objects.at[{k}]"))
+        where.problem("[objects] count must be a whole number >= 0")
+        count = 0.0
+    placed = tuple((where.number(o, "x", f"objects.at[{k}]", None), where.number(o, "y", f"objects.at[{k}]", None))
                    for k, o in enumerate(where.array(objects_table, "at", ("x", "y"), "objects.at")))
-    targets = tuple(Target(where.text(t, "name", f"targets[{k}]", f"T{k + 1}"),
-                           where.number(t, "x", f"targets[{k}]"), where.number(t, "y", f"targets[{k}]"))
+    targets = tuple((where.text(t, "name", f"targets[{k}]", f"T{k + 1}"), where.number(t, "x", f"targets[{k}]", None),
+                     where.number(t, "y", f"targets[{k}]", None))
                     for k, t in enumerate(where.array(data, "targets", ("name", "x", "y"))))
     windows = []
     for k, w in enumerate(where.array(data, "windows", ("name", "start", "end"))):
         label = f"windows[{k}]"
-        window = Window(where.text(w, "name", label, f"W{k + 1}"), where.number(w, "start", label),
-                        where.number(w, "end", label))
-        if not 0 <= window.start < window.end:
-            raise WorldError(f"{source}: {label}: needs 0 <= start < end")
-        windows.append(window)
-    world = World(name, bounds, start, tuple(obstacles), placed, int(count), targets, tuple(windows),
-                  description, source)
+        opens, closes = where.number(w, "start", label, None), where.number(w, "end", label, None)
+        if opens is not None and closes is not None:
+            if not 0 <= opens < closes:
+                where.problem(f"{label}: needs 0 <= start < end")
+            windows.append(Window(where.text(w, "name", label, f"W{k + 1}"), opens, closes))
+    if where.problems or bounds is None:
+        raise WorldError(*where.problems)
+    world = World(name, bounds, start, tuple(obstacles), tuple((x, y) for x, y in placed if x is not None
+                                                               and y is not None),
+                  int(count), tuple(Target(n, x, y) for n, x, y in targets if x is not None and y is not None),
+                  tuple(windows), description, source)
     # Targets too: a station a robot is sent to inside a crate or past a wall fails its every
     # mission, far from the line that put it there.
-    for label, (x, y) in [("start", start[:2])] + [(f"objects.at[{k}]", p) for k, p in enumerate(placed)] + [
-            (f"targets[{k}] ({t.name})", (t.x, t.y)) for k, t in enumerate(targets)]:
+    for label, (x, y) in [("start", start[:2])] + [(f"objects.at[{k}]", p) for k, p in enumerate(world.objects)] + [
+            (f"targets[{k}] ({t.name})", (t.x, t.y)) for k, t in enumerate(world.targets)]:
         if world.clearance(x, y) <= 0:
-            raise WorldError(f"{source}: {label} ({x:g}, {y:g}) is inside an obstacle or outside the walls")
+            where.problem(f"{label} ({x:g}, {y:g}) is inside an obstacle or outside the walls")
+    if where.problems:
+        raise WorldError(*where.problems)
     return world
+
+
+def _obstacle(where: _Where, label: str, entry: Mapping[str, Any]) -> Obstacle | None:
+    """One `[[obstacles]]` entry, or None (the problem recorded)."""
+    if "polygon" in entry and "circle" not in entry:
+        points = entry["polygon"]
+        if not isinstance(points, list) or len(points) < 3 or not all(
+                isinstance(p, list) and len(p) == 2 and all(_finite(c) for c in p) for p in points):
+            where.problem(f"{label}: polygon must list at least 3 [x, y] corners (finite numbers)")
+            return None
+        polygon = tuple((float(x), float(y)) for x, y in points)
+        crossing = self_crossing(polygon)
+        if crossing is not None:
+            where.problem(f"{label}: the polygon crosses itself (its edges from corner {crossing[0]} and from corner "
+                          f"{crossing[1]}, counted from 0): list its corners in order around it")
+            return None
+        area = signed_area(polygon)
+        if abs(area) < 1e-9:
+            where.problem(f"{label}: the polygon has no area")
+            return None
+        return Polygon(polygon[::-1] if area < 0 else polygon)  # the simulator wants counter-clockwise corners
+    if "circle" in entry and "polygon" not in entry:
+        c = entry["circle"]
+        if not (isinstance(c, list) and len(c) == 3 and all(_finite(v) for v in c) and c[2] > 0):
+            where.problem(f"{label}: circle must be [x, y, radius] (finite numbers) with radius > 0")
+            return None
+        return Circle(float(c[0]), float(c[1]), float(c[2]))
+    where.problem(f"{label}: give either polygon = [[x, y], ...] or circle = [x, y, r]")
+    return None
 
 
 def world_data(world: World) -> dict[str, Any]:
@@ -301,19 +329,27 @@ def world_data(world: World) -> dict[str, Any]:
 
 
 class _Where:
+    """Reads a world file's tables, recording each problem (`problems`) and going on with a
+    stand-in value, so that one reading finds them all."""
+
     def __init__(self, source: str) -> None:
         self.source = source
+        self.problems: list[str] = []
+
+    def problem(self, message: str) -> None:
+        self.problems.append(f"{self.source}: {message}")
 
     def only(self, table: Mapping[str, Any], label: str, known: tuple[str, ...]) -> None:
         """A misspelt key would otherwise be ignored silently (`thetaa` leaving theta at 0)."""
         for key in table:
             if key not in known:
-                raise WorldError(f"{self.source}: {label}: unknown key '{key}' (known: {', '.join(known)})")
+                self.problem(f"{label}: unknown key '{key}' (known: {', '.join(known)})")
 
     def table(self, data: Mapping[str, Any], key: str, known: tuple[str, ...]) -> Mapping[str, Any]:
         value = data.get(key, {})
         if not isinstance(value, dict):
-            raise WorldError(f"{self.source}: [{key}] must be a table")
+            self.problem(f"[{key}] must be a table")
+            return {}
         self.only(value, f"[{key}]", known)
         return value
 
@@ -322,25 +358,35 @@ class _Where:
         label = label or key
         value = data.get(key, [])
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-            raise WorldError(f"{self.source}: {label} must be an array of tables ([[{label}]])")
+            self.problem(f"{label} must be an array of tables ([[{label}]])")
+            return []
         for k, entry in enumerate(value):
             self.only(entry, f"{label}[{k}]", known)
         return value
 
-    def number(self, table: Mapping[str, Any], key: str, label: str, default: float | None = None) -> float:
+    @overload
+    def number(self, table: Mapping[str, Any], key: str, label: str, default: float) -> float: ...
+
+    @overload
+    def number(self, table: Mapping[str, Any], key: str, label: str, default: None) -> float | None: ...
+
+    def number(self, table: Mapping[str, Any], key: str, label: str, default: float | None) -> float | None:
+        """The number at `key`; `default` when absent (None: it must be given) or malformed."""
         if key not in table:
             if default is None:
-                raise WorldError(f"{self.source}: {label}: missing '{key}' (a number)")
+                self.problem(f"{label}: missing '{key}' (a number)")
             return default
         value = table[key]
         if not _finite(value):
-            raise WorldError(f"{self.source}: {label}: '{key}' must be a finite number, not {value!r}")
+            self.problem(f"{label}: '{key}' must be a finite number, not {value!r}")
+            return default
         return float(value)
 
     def text(self, table: Mapping[str, Any], key: str, label: str, default: str) -> str:
         value = table.get(key, default)
         if not isinstance(value, str):
-            raise WorldError(f"{self.source}: {label}: '{key}' must be a string")
+            self.problem(f"{label}: '{key}' must be a string")
+            return default
         return value
 
 
