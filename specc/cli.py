@@ -41,7 +41,7 @@ PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders sea
                                                 show_default=False, readable=False)]
 
 
-def refuse_unwritable(path: Path | None, what: str, example: str, picture: bool = False) -> None:
+def refuse_unwritable(path: Path | None, what: str, option: str, example: str, picture: bool = False) -> None:
     """Exit at once, before any planning or drawing, when the file `path` cannot be written: a
     folder, a picture format matplotlib does not write, or a folder that cannot be made or written
     in ('-' is the standard output)."""
@@ -51,15 +51,15 @@ def refuse_unwritable(path: Path | None, what: str, example: str, picture: bool 
 
     try:
         if path.is_dir():
-            raise RunError(f"{what} '{path}' is a folder: give a file name, e.g. {path / example}")
+            raise RunError(f"{what} ({option}) '{path}' is a folder: give a file name, e.g. {path / example}")
         if picture and path.suffix:
             from matplotlib.backend_bases import FigureCanvasBase
 
             formats = FigureCanvasBase.get_supported_filetypes()
             if path.suffix[1:].lower() not in formats:
-                raise RunError(f"{what} '{path}': matplotlib writes no '{path.suffix}' picture; end the name "
-                               f"with .png, .svg or .pdf (or {', '.join('.' + f for f in sorted(formats))})")
-        writable_folder(path.parent, f"the folder of {what}")
+                raise RunError(f"{what} ({option}) '{path}': matplotlib writes no '{path.suffix}' picture; end the "
+                               f"name with .png, .svg or .pdf (or {', '.join('.' + f for f in sorted(formats))})")
+        writable_folder(path.parent, f"the folder of {what}", option)
     except RunError as error:
         err.print(f"error: {error}", markup=False)
         raise typer.Exit(1) from None
@@ -237,7 +237,7 @@ def graph(paths: PathsArg,
     if incompat == net:
         err.print("error: say what to draw: --incompat or --net", markup=False)
         raise typer.Exit(1)
-    refuse_unwritable(output, "the picture (-o)", "net.png" if net else "incompat.png", picture=True)
+    refuse_unwritable(output, "the picture", "-o", "net.png" if net else "incompat.png", picture=True)
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
         raise typer.Exit(1)
@@ -534,8 +534,8 @@ def plan(paths: PathsArg,
     Example: specc plan examples/tug --problem shuttle -o build/shuttle.png --json build/shuttle.json"""
     from specc.plan_report import print_result, solve
 
-    refuse_unwritable(picture, "the picture (-o)", "plan.png", picture=True)
-    refuse_unwritable(json_path, "the JSON file (--json)", "plan.json")
+    refuse_unwritable(picture, "the picture", "-o", "plan.png", picture=True)
+    refuse_unwritable(json_path, "the JSON file", "--json", "plan.json")
     loaded = load(paths)
     if report(loaded):
         raise typer.Exit(1)
@@ -562,7 +562,8 @@ def plan(paths: PathsArg,
                 err.print(f"error: cannot write '{json_path}': {exc} [unwritable-file]", markup=False)
                 raise typer.Exit(1) from None
     if str(json_path) != "-":
-        print_result(outcome, out)
+        # A file or pipe gets the whole tables, not ones squeezed into 80 columns.
+        print_result(outcome, table_out())
         if json_path is not None:
             out.print(f"wrote {json_path}", markup=False)
     if picture is not None and outcome.useful:
@@ -718,7 +719,13 @@ def skeleton(paths: PathsArg) -> None:
         out.print("every function named by the specs already exists", markup=False)
 
 
-TABLE_WIDTH = 140  # columns of `specc table` when it does not print to a terminal
+TABLE_WIDTH = 140  # columns of a table printed to a file or a pipe
+
+
+def table_out() -> Console:
+    """Where a table goes: the terminal as it is, or a file or pipe whole (not squeezed into 80
+    columns, which cuts its cells)."""
+    return out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)
 
 
 def _run_error(error: Exception, code: int = 1) -> typer.Exit:
@@ -934,7 +941,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
         raise _run_error(error, 2) from None
     if result.rows:
         # A file or pipe gets the whole table, not one squeezed into 80 columns.
-        (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(rich_table(result.rows))
+        table_out().print(rich_table(result.rows))
     else:
         for row in result.missions:
             configuration = f" with {row.configuration}" if row.configuration else ""
@@ -1027,7 +1034,7 @@ def mutants_command(
         table.add_row(kind, *cells(counts))
     table.add_row("total", *cells(result.total()), style="bold")
     # A file or pipe gets the whole table, not one squeezed into 80 columns.
-    (out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)).print(table)
+    table_out().print(table)
     out.print(f"enumerated in {enumerated:.1f} s, re-parsed and checked in {result.seconds:.1f} s "
               f"({count} process(es))", markup=False)
     listed = result.sample(sample, seed) if sample is not None else result.kept

@@ -6,12 +6,11 @@ Tests assert `code`, never the wording.
 
 from __future__ import annotations
 
-import difflib
 import re
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from specc.model.span import Span
+from specc.runtime.hints import did_you_mean as did_you_mean  # re-exported: the checks name it here
 
 
 class SpeccError(Exception):
@@ -42,17 +41,6 @@ def error(code: str, message: str, span: Span, *notes: tuple[Span, str]) -> Diag
 
 def warning(code: str, message: str, span: Span) -> Diagnostic:
     return Diagnostic(code, message, span, "warning")
-
-
-def did_you_mean(name: str, candidates: Iterable[str]) -> str:
-    """' (did you mean 'X'?)' when a close candidate exists, else ''."""
-    pool = sorted(set(candidates))
-    match = difflib.get_close_matches(name, pool, n=1, cutoff=0.6)
-    if not match:
-        lowered = {c.lower(): c for c in pool}
-        if name.lower() in lowered:
-            match = [lowered[name.lower()]]
-    return f" (did you mean '{match[0]}'?)" if match else ""
 
 
 def render(diagnostic: Diagnostic, sources: dict[str, str]) -> str:

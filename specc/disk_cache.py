@@ -24,23 +24,34 @@ ENTRIES_KEPT = 2000  # per kind; past it, the older half goes
 MISSING = object()  # what `read` gives when nothing usable is kept
 
 
-def root() -> Path:
-    """specc's cache folder: $XDG_CACHE_HOME/specc (default ~/.cache/specc), or the temporary
-    folder when that cannot be made."""
-    folder = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "specc"
+def root() -> Path | None:
+    """specc's cache folder: $XDG_CACHE_HOME/specc (default ~/.cache/specc); when that cannot be
+    made, a folder of this user's own in the temporary folder; None when neither can (no cache).
+    An entry is a pickle, which runs code as it loads: a folder others may write in is refused."""
     try:
+        folder = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "specc"
         folder.mkdir(parents=True, exist_ok=True)
+        return folder
+    except (OSError, RuntimeError):  # RuntimeError: a user without a home folder
+        pass
+    private = Path(tempfile.gettempdir()) / f"specc-{os.getuid()}" if hasattr(os, "getuid") else None
+    if private is None:
+        return None
+    try:
+        private.mkdir(mode=0o700, exist_ok=True)
+        status = private.stat()
     except OSError:
-        folder = Path(tempfile.gettempdir())
-    return folder
+        return None
+    return private if status.st_uid == os.getuid() and not status.st_mode & 0o022 else None
 
 
 @functools.cache
 def folder(kind: str) -> Path | None:
     """Where entries of `kind` are kept, or None: SPECC_PARSE_CACHE=0, or no folder can be made."""
-    if os.environ.get("SPECC_PARSE_CACHE", "1") == "0":
+    base = root()
+    if os.environ.get("SPECC_PARSE_CACHE", "1") == "0" or base is None:
         return None
-    place = root() / kind
+    place = base / kind
     try:
         place.mkdir(parents=True, exist_ok=True)
     except OSError:
@@ -75,7 +86,7 @@ def read(kind: str, name: str, expected: type | tuple[type, ...]) -> Any:
     try:
         with (place / (name + ENTRY_SUFFIX)).open("rb") as stream:
             value = pickle.load(stream)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError, ValueError):
+    except Exception:  # absent or damaged (a damaged pickle raises almost anything): computed again
         return MISSING
     return value if isinstance(value, expected) else MISSING
 

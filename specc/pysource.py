@@ -132,7 +132,9 @@ def _names_in(data: bytes, filename: str) -> Mapping[str, FunctionShape | _Impor
 
 @functools.lru_cache(maxsize=1)
 def _own_digest() -> str:
-    return disk_cache.source_digest([Path(__file__)])
+    """This code's digest and the interpreter's version: what `ast.parse` accepts is the
+    interpreter's (3.12's `type X = ...` is a syntax error to 3.11), and the cache is shared."""
+    return disk_cache.source_digest([Path(__file__)]) + sys.implementation.cache_tag + sys.version
 
 
 @dataclass(frozen=True)

@@ -542,3 +542,39 @@ def test_a_start_where_the_body_overlaps_an_obstacle_is_refused_before_the_run(c
     assert result.returncode == 2, result.stderr
     assert "the robot's body (its 0.25 m radius) at its start (4.5, 1.1, heading 0 rad) overlaps" in result.stderr
     assert "Traceback" not in result.stderr and not folder.exists()
+
+
+def test_a_goal_from_the_command_line_is_held_to_its_predicate_s_domains(tmp_path: Path) -> None:
+    """`--goal` is checked as a mission's goal is: a value outside the domain the goal's predicate
+    declares is refused before anything runs (not found out 17 s into the run)."""
+    declared = SPEC.replace("  action GOTO(x: float, y: float)", "  predicate GO(x: 0..5, y: 0..5);\n"
+                            "  action GOTO(x: float, y: float)")
+    cart = write_robot(tmp_path, declared)
+    folder = tmp_path / "never"
+    result = specc(tmp_path, "run", cart, "--goal", "!(GO 9 4)", "--folder", folder, "-q")
+    assert result.returncode == 2, result.stderr
+    assert "--goal !(GO 9 4): 9 is not in the domain of 'x' of GO (0, 1, 2, 3, 4, 5)" in result.stderr
+    assert "Traceback" not in result.stderr and not folder.exists()
+
+
+def test_check_refuses_a_world_whose_start_the_body_overlaps(tmp_path: Path) -> None:
+    """`specc check` holds the system's worlds to its body, as the run does: the cart's 0.25 m disc
+    at (4.5, 1.1) reaches into the crate centred 0.4 m away."""
+    cart = write_robot(tmp_path)
+    (cart / "worlds" / "shop.toml").write_text(WORLD.replace("x = 1.0\ny = 1.0", "x = 4.5\ny = 1.1"))
+    result = specc(tmp_path, "check", cart)
+    assert result.returncode == 1, result.stderr
+    assert "worlds/shop.toml: the robot's body (its 0.25 m radius) at its start (4.5, 1.1, heading 0 rad) " \
+           "overlaps an obstacle or a wall" in result.stderr and "[bad-world]" in result.stderr
+
+
+def test_a_misspelt_device_is_named_with_a_hint_at_the_codel_s_line(tmp_path: Path) -> None:
+    """`sim.wheelz` in a codel: the run's why names the device it meant and the codel's own line,
+    not the simulator's line that refused the name."""
+    cart = write_robot(tmp_path, codels=CODELS.replace("    if sim.wheels.blocked:", "    if sim.wheelz.blocked:"))
+    result = specc(tmp_path, "run", cart, "--goal", "!(GO 3 4)", "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 1, result.stderr
+    why = json.loads((tmp_path / "run" / "report.json").read_text())["why"]
+    line = CODELS.splitlines().index("    if sim.wheels.blocked:") + 1
+    assert "has no device 'wheelz' (did you mean 'wheels'?)" in why, why
+    assert f"cart_codels/drive.py:{line})" in why and "simulation.py" not in why, why

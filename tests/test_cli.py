@@ -519,6 +519,8 @@ def test_a_negative_number_where_none_has_a_meaning_is_said_so() -> None:
     assert "unexpected '-' (a negative number has no meaning here: this value must be 0 or more)" in found.message
     (other,) = parse_text(text.replace("-0.5", "-x"), "s.spec").diagnostics  # a name: no such hint
     assert "negative number" not in other.message
+    listed = "procedures p {\n  type LEVEL = {-1, 0, 1};\n}\n"  # in a list a negative value may mean something
+    assert all("negative number" not in d.message for d in parse_text(listed, "p.spec").diagnostics)
 
 def test_skeleton_writes_codels_where_specc_run_imports_them(tmp_path: Path) -> None:
     # docs/your-robot.md's step 1: a module in a subfolder, no system block yet. The stubs go to
@@ -554,3 +556,13 @@ def test_an_output_that_cannot_be_written_stops_plan_and_graph_before_any_work(t
         assert "Traceback" not in result.stderr and "partial plans" not in result.stdout + result.stderr
         assert "group(s)" not in result.stdout
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
+
+
+def test_plan_printed_to_a_pipe_keeps_its_tables_whole() -> None:
+    """Captured output is not a terminal: the plan's tables are not squeezed into 80 columns (no
+    cell cut with an ellipsis, every column heading whole)."""
+    result = specc("plan", str(EXAMPLES / "atrv"), "--problem", "M1", "--domain", "model1")
+    assert result.returncode == 0, result.stderr
+    assert "…" not in result.stdout
+    assert all(heading in result.stdout for heading in ("start", "action", "duration", "ends by", "may start",
+                                                         "preemption"))

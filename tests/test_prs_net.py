@@ -93,6 +93,25 @@ def test_the_handshake_in_the_right_order_ends_with_the_goal_achieved(tmp_path: 
     assert report.findings == [] and report.succeeded >= 1 and report.failed == 0
 
 
+REAL_VALUES = """
+procedures docking {
+  type XS = {1.5, 10};
+  predicate GO(x: XS);
+  predicate TOP();
+  predicate functional DONE(v: {YES});
+  ka Top { invocation: !(TOP); body { !(GO 1.5); } }
+  ka Go { invocation: !(GO $X); body { =>(DONE YES); } }
+}
+"""
+
+
+@pytest.mark.parametrize("value", ["1.5", "10"])
+def test_a_type_of_real_numbers_holds_the_numbers_goals_write(tmp_path: Path, value: str) -> None:
+    """`{1.5, 10}` holds the number 1.5 a goal writes (not the symbol "1.5"): the goal is achieved,
+    whichever value it names, and check finds 1.5 in the domain of GO's argument."""
+    report = check(REAL_VALUES.replace("!(GO 1.5)", f"!(GO {value})"), "!(TOP)", tmp_path)
+    assert report.findings == [] and report.succeeded >= 1 and report.failed == 0
+
 RECURSION = """
 procedures digging {
   predicate DIG();
@@ -483,3 +502,11 @@ def test_a_loop_counter_takes_every_value_its_steps_reach(tmp_path: Path, test: 
     # GoRow:19 retracts AT-ROW with $OLD never bound: it changes nothing, and the KA goes on.
     assert finding(report, "changes-nothing").startswith("GoRow:19 ~>(AT-ROW $OLD) only ever runs with an unbound")
     assert "never-succeeds" not in report.kinds()
+
+
+def test_what_keeps_procedures_from_a_net_is_said_in_the_files_order() -> None:
+    from specc.diagnostics import error
+    from specc.model.span import Span
+
+    late, early = (error("unbounded-variable", f"line {n}", Span("p.spec", n, 1, n, 2)) for n in (51, 18))
+    assert [d.message for d in TranslationError([late, early]).diagnostics] == ["line 18", "line 51"]

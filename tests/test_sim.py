@@ -383,3 +383,32 @@ def test_every_problem_of_a_world_file_is_said_at_once():
     for fragment, line in zip(("[start]: unknown key 'thetaa'", "obstacles[0]: circle must be", "windows[0]: needs"),
                               error.value.problems, strict=True):
         assert line.startswith("bad.toml: ") and fragment in line
+
+
+@pytest.mark.parametrize("data, problems", [
+    ({"room": "x"}, ["[room] must be a table"]),  # not also each of its keys missing
+    ({"bounds": 5}, ["[bounds] must be a table"]),
+    ({"room": {"width": 10, "height": 8}, "start": {"x": 1, "y": 1},
+      "objects": {"count": -1, "at": [{"x": 20, "y": 1}]}},
+     ["[objects] count must be", "objects.at[0] (20, 1) is inside an obstacle or outside the walls"]),
+    ({"room": {"width": 10, "height": 8}, "start": {"x": 5, "y": 5},
+      "obstacles": [{"circle": [5, 5, 1]}, {"circle": "bad"}]},
+     ["obstacles[1]: circle must be", "start (5, 5) is inside an obstacle"]),
+])
+def test_a_world_s_problems_are_said_once_each_and_together(data, problems):
+    with pytest.raises(WorldError) as error:
+        parse_world(data, "w.toml")
+    assert len(error.value.problems) == len(problems), error.value.problems
+    for said, fragment in zip(error.value.problems, problems, strict=True):
+        assert fragment in said
+
+
+def test_a_box_footprint_meets_an_obstacle_wholly_under_it_or_a_wall_thinner_than_anything():
+    """A post under the middle of a 1 x 0.8 m box, and a 1 cm wall across it, both with no corner
+    of either inside the other: they overlap all the same. A post just clear of the box is clear."""
+    room = world(obstacles=[{"circle": [5.25, 5.2, 0.1]}])
+    assert room.footprint_clearance((5.0, 5.0, 0.0), 0.0, 1.0, 0.8) <= 0
+    wall = world(obstacles=[{"polygon": [[5.005, 0.5], [5.015, 0.5], [5.015, 9.5], [5.005, 9.5]]}])
+    assert wall.footprint_clearance((5.0, 5.0, 0.0), 0.0, 1.0, 0.8) <= 0
+    clear = world(obstacles=[{"circle": [5.0, 5.6, 0.1]}])  # 0.2 m above the box's top edge, less its radius
+    assert clear.footprint_clearance((5.0, 5.0, 0.0), 0.0, 1.0, 0.8) == pytest.approx(0.1)

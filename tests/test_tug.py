@@ -56,6 +56,11 @@ def test_a_planned_mission_shows_each_action_s_goal_service_and_module_request(t
         ("UNHITCH", "!(HITCH-OFF)", [("UNHITCH", "lift.Unhitch"), ("SET-LOAD", "drive.SetLoad")]),
         ("MOVE", "!(GO-PLACE DOCK)", [("GOTO", "drive.Goto")]),
     ]
+    # What a procedure concludes last (the hook's state) is logged before the action it carries
+    # out ends, at its own time: not when the next action's request is logged.
+    ends = {e["task"]: e for e in events if e["kind"] == "action" and e["status"] == "ended"}
+    hooked = [e for e in events if e["kind"] == "fact" and e["fact"] == "(HOOK BUSY)" and e["change"] == "concluded"]
+    assert hooked and hooked[0]["t"] <= ends["HITCH"]["t"] and events.index(hooked[0]) < events.index(ends["HITCH"])
 
 
 

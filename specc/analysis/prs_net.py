@@ -40,7 +40,7 @@ from typing import Any
 from specc.analysis import petri
 from specc.analysis.procedures import library
 from specc.check.procedures import Domains
-from specc.diagnostics import Diagnostic, did_you_mean
+from specc.diagnostics import Diagnostic, did_you_mean, sort_key
 from specc.model import nodes as m
 from specc.model.visitor import walk
 from specc.runtime import procedures as rp
@@ -145,6 +145,7 @@ class Translation:
 
 class TranslationError(Exception):
     def __init__(self, diagnostics: list[Diagnostic]):
+        diagnostics = sorted(diagnostics, key=sort_key)  # in the order of the files, as check reports
         super().__init__("; ".join(d.message for d in diagnostics))
         self.diagnostics = diagnostics
 

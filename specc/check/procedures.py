@@ -8,6 +8,7 @@ from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import Visitor
+from specc.runtime.procedures import literal
 
 # Heads PRS evaluates itself: connectives, comparisons and arithmetic.
 BUILTIN_HEADS = frozenset("& | ~ < <= > >= = + - * / BOUNDP".split())
@@ -208,9 +209,10 @@ class Domains:
         self.types = {t.name: t.domain for t in node.types}
         self.params = {p.name: p.params for p in node.predicates}
 
-    def values(self, domain: m.PDomain, seen: frozenset[str] = frozenset()) -> tuple[str | int, ...] | None:
+    def values(self, domain: m.PDomain, seen: frozenset[str] = frozenset()
+               ) -> tuple[str | int | float, ...] | None:
         if isinstance(domain, m.SymbolSet):
-            return tuple(int(v) if v.isdigit() else v for v in domain.values)
+            return tuple(literal(v) for v in domain.values)
         if isinstance(domain, m.IntRange):
             return tuple(range(domain.low, domain.high + 1))
         declared = self.types.get(domain.name)
@@ -218,7 +220,7 @@ class Domains:
             return None
         return self.values(declared, seen | {domain.name})
 
-    def argument(self, predicate: str, index: int) -> tuple[str | int, ...] | None:
+    def argument(self, predicate: str, index: int) -> tuple[str | int | float, ...] | None:
         params = self.params.get(predicate)
         if params is None or index >= len(params):
             return None

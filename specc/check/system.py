@@ -12,11 +12,12 @@ from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.check.executive import resolve_poster, resolve_request
 from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks
+from specc.check.procedures import Domains
 from specc.check.symbols import first_by_name
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import walk
-from specc.runtime.body import BODY_KEYS, DEVICES, body_problem
+from specc.runtime.body import BODY_KEYS, DEVICES, RobotConfig, body_problem
 from specc.runtime.sim.world import WorldError, load_world
 
 # The PRS domains a request input of each type accepts (seed 000 §4.2: the task level passes
@@ -135,6 +136,17 @@ def check_body(ctx: Context, system: m.System) -> None:
                    f"(or neither, for the disc of 'radius')", entry.span)
 
 
+def footprint(system: m.System) -> tuple[float, float, float]:
+    """The body's radius, length and width as its `body { }` gives them (the simulator's defaults
+    for those it does not, or gives wrong: check_body reports those)."""
+    given = {e.name: float(e.value.value) for e in (system.body.entries if system.body is not None else ())
+             if e.name in ("radius", "length", "width") and isinstance(e.value, m.Number)
+             and body_problem(e.name, float(e.value.value)) is None}
+    default = RobotConfig()
+    return (given.get("radius", default.radius), given.get("length", default.length),
+            given.get("width", default.width))
+
+
 def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
     """The system's worlds by name; each a TOML world file the simulator can load."""
     entries = system.worlds.entries if system.worlds is not None else ()
@@ -155,7 +167,9 @@ def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
                        entry.value.span)
             continue
         try:
-            load_world(path)
+            overlap = load_world(path).start_overlap(*footprint(system))
+            if overlap is not None:
+                ctx.report("bad-world", f"{entry.value.value}: {overlap}", entry.value.span)
         except WorldError as error:  # each problem, named as the spec names the file, not by this machine's folders
             for problem in error.problems:
                 ctx.report("bad-world", problem.replace(str(path), entry.value.value), entry.value.span)
@@ -327,13 +341,26 @@ def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures,
     declared = next((p for p in procedures.predicates if p.name == goal.body.head), None)
     if declared is None or len(declared.params) != len(goal.body.args):
         return
-    for param, arg in zip(declared.params, goal.body.args, strict=True):
-        allowed = finite_values(procedures, param.domain)
+    for position, arg in enumerate(goal.body.args):
         value = arg.value if isinstance(arg, m.Number) else arg.text if isinstance(arg, m.Ref) else None
-        if allowed is not None and value is not None and value not in allowed:
-            shown = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
-            ctx.report("bad-argument", f"{value} is not in the domain of '{param.name}' of {declared.name} "
-                       f"({shown})", arg.span)
+        outside = argument_outside(procedures, goal.body.head, position, value)
+        if outside is not None:
+            ctx.report("bad-argument", outside, arg.span)
+
+
+def argument_outside(procedures: m.Procedures, head: str, position: int, value: object) -> str | None:
+    """Why `value`, at `position` among the arguments of a goal `head`, lies outside the finite
+    domain the predicate declares there (None when it lies inside, or nothing says): for a
+    mission's goal and for `specc run --goal` alike."""
+    declared = next((p for p in procedures.predicates if p.name == head), None)
+    if declared is None or position >= len(declared.params) or value is None:
+        return None
+    param = declared.params[position]
+    allowed = finite_values(procedures, param.domain)
+    if allowed is None or value in allowed:
+        return None
+    shown = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
+    return f"{value} is not in the domain of '{param.name}' of {declared.name} ({shown})"
 
 
 def check_numeric_arguments(ctx: Context, goal: m.SExp, needs: Mapping[tuple[str, int], str]) -> None:
@@ -394,17 +421,9 @@ def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], str]:
     return found
 
 
-def finite_values(procedures: m.Procedures, domain: m.PDomain, seen: frozenset[str] = frozenset()
-                  ) -> tuple[str | int, ...] | None:
+def finite_values(procedures: m.Procedures, domain: m.PDomain) -> tuple[str | int | float, ...] | None:
     """The values of a finite domain (a set, a range, a type naming one); None when unbounded."""
-    if isinstance(domain, m.SymbolSet):
-        return tuple(int(v) if v.lstrip("-").isdigit() else v for v in domain.values)
-    if isinstance(domain, m.IntRange):
-        return tuple(range(domain.low, domain.high + 1))
-    declared = next((t.domain for t in procedures.types if t.name == domain.name), None)
-    if declared is None or domain.name in seen:
-        return None
-    return finite_values(procedures, declared, seen | {domain.name})
+    return Domains(procedures).values(domain)
 
 
 def check_service_actions(ctx: Context, procedures: m.Procedures, executives: list[m.Executive],

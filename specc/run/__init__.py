@@ -25,7 +25,7 @@ class RunError(ValueError):
     """A run that cannot start or a log that cannot be read: the message says why and what to do."""
 
 
-def writable_folder(folder: Path, what: str) -> None:
+def writable_folder(folder: Path, what: str, option: str = "--output") -> None:
     """RunError unless `folder` is, or can be made, a folder this process may write in: checked
     before long work (a table's runs, a campaign's experiments) whose results would otherwise
     have nowhere to go at the end."""
@@ -36,4 +36,4 @@ def writable_folder(folder: Path, what: str) -> None:
     except OSError as error:
         raise RunError(f"cannot make {what} '{folder}': {error.strerror or error}") from None
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise RunError(f"{what} '{folder}' is not writable: give another (--output)")
+        raise RunError(f"{what} '{folder}' is not writable: give another ({option})")

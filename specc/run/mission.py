@@ -320,13 +320,11 @@ def prepared_world(robot: Robot, mission: MissionSpec, seed: int, world_file: Pa
         except WorldError as error:  # what the world asks cannot be drawn
             raise RunError(str(error)) from None
     body = robot.system.body
-    # The physics would push a body that starts in an obstacle out of it at once (or wedge it):
-    # the run would go on from somewhere the world file never said.
-    if ground.footprint_clearance(ground.start, body.radius, body.length, body.width) <= 0:
-        x, y, theta = ground.start
-        shape = f"its {body.length:g} x {body.width:g} m box" if body.length > 0 else f"its {body.radius:g} m radius"
-        raise RunError(f"{world_file}: the robot's body ({shape}) at its start ({x:g}, {y:g}, heading {theta:g} "
-                       "rad) overlaps an obstacle or a wall: move [start] in the world file, or the obstacle")
+    # The run would go on from somewhere the world file never said (after the draws too: `specc
+    # check` sees the file's start, before any).
+    overlap = ground.start_overlap(body.radius, body.length, body.width)
+    if overlap is not None:
+        raise RunError(f"{world_file}: {overlap}")
     return ground
 
 
@@ -558,7 +556,6 @@ class Recorder:
 
     # ------------------------------------------------------------ the executive
     def _activity(self, activity: rx.Activity, source: rx.Phase, target: rx.Phase) -> None:
-        self.poll_facts()  # what the procedures concluded before sending this request comes first
         service = activity.service.name
         if source is rx.Phase.ETHER and target is rx.Phase.WAIT:
             self.requests += 1
@@ -569,13 +566,11 @@ class Recorder:
                           to=target.value)
 
     def _reflex(self, reflex: rx.ReflexSpec, code: str) -> None:
-        self.poll_facts()
         self.log.emit(self.kernel.now, "reflex", reflex=reflex.name, on=f"{reflex.trigger} {reflex.source}",
                       code=str(code), actions=[f"{verb} {target}" for verb, target in reflex.actions])
 
     def _message(self, message: rx.Message) -> None:
         now = self.kernel.now
-        self.poll_facts()
         if message.kind == "WARNING":
             self.log.emit(now, "warning", service=message.service, id=message.id, type=str(message.result),
                           detail=message.detail)
@@ -592,10 +587,12 @@ class Recorder:
 
     def watch_facts(self, database: Any) -> None:
         """The facts the procedures share (closed and functional predicates): the supervisor has
-        no listener for its database, so it is compared after each kernel event and before each
-        executive event is logged, when its count of changes says it changed."""
+        no listener for its database, so it is compared after each kernel event and before any
+        other event is logged (an action's end, a request...), when its count of changes says it
+        changed."""
         self._database = database
         self._facts = {p.name: [] for p in database.predicates.values() if p.kind in ("closed", "functional")}
+        self.log.before_each.append(self.poll_facts)
 
     def poll_facts(self) -> None:
         if self._database is None or self._database.changes == self._facts_seen:

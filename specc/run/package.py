@@ -15,13 +15,13 @@ import functools
 import hashlib
 import importlib
 import json
-import os
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 
+from specc import disk_cache
 from specc.diagnostics import render
 from specc.run import RunError
 
@@ -115,15 +115,10 @@ class _Stamp:
 
 
 def stamps_folder() -> Path | None:
-    """The user's cache (XDG), not the output folder: that one holds the package and nothing else.
-    None when the user has no home: every run then compiles, slower but right."""
-    cache = os.environ.get("XDG_CACHE_HOME")
-    if not cache:
-        try:
-            cache = str(Path.home() / ".cache")
-        except RuntimeError:
-            return None
-    return Path(cache) / "specc" / "stamps"
+    """In specc's cache folder (`specc.disk_cache.root`), not the output folder: that one holds the
+    package and nothing else. None without a cache folder: every run then compiles, slower but right."""
+    base = disk_cache.root()
+    return None if base is None else base / "stamps"
 
 
 _COMPILER = Path(__file__).resolve().parents[1]  # the specc package: its sources, grammar and templates

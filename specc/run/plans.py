@@ -242,6 +242,9 @@ class FtplanJournal:
         self.log = log  # an EventLog
         self.ftplan: Any = None  # the FtPlan whose events are forwarded, once it exists
         self._forwarded = 0
+        # Called before each event is logged: what changed unseen (the procedures' facts) is logged
+        # first, at its time, whoever logs next (an action's end, a request, a pose sample).
+        self.before_each: list[Callable[[], None]] = []
 
     @property
     def events(self) -> list[dict[str, Any]]:
@@ -249,6 +252,8 @@ class FtplanJournal:
         return events
 
     def emit(self, time_: float, kind: str, **fields: Any) -> dict[str, Any]:
+        for before in self.before_each:
+            before()
         self.catch_up(time_)
         event: dict[str, Any] = self.log.emit(time_, kind, **fields)
         return event

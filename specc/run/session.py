@@ -272,7 +272,8 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         if request.world is None and not worlds:
             raise RunError(f"--goal needs --world: robot '{robot.name}' names no world (give a .toml file)")
         # Without --world, the first world the system block names.
-        mission = MissionSpec("goal", request.world or worlds[0], tuple(_checked_goal(robot, g) for g in request.goals))
+        goals = tuple(_checked_goal(robot, g, request.specs) for g in request.goals)
+        mission = MissionSpec("goal", request.world or worlds[0], goals)
     elif request.mission is None:
         missions = list(robot.system.missions)
         if len(missions) != 1:
@@ -308,7 +309,7 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
     return _Plan((mission.name, world_name, configuration), run)
 
 
-def _checked_goal(robot: Any, text: str) -> str:
+def _checked_goal(robot: Any, text: str, specs: Path) -> str:
     """A goal given on the command line: PRS syntax, for a goal some KA of the supervisor is invoked by."""
     from specc.runtime.procedures import parse_goal
 
@@ -338,7 +339,25 @@ def _checked_goal(robot: Any, text: str) -> str:
         shown = ", ".join(f"!{trigger}" for trigger in triggers)
         raise RunError(f"--goal {text}: no KA of procedures '{library.name}' is invoked by it (they are invoked by "
                        f"{shown})")
+    procedures = _procedures_of(specs, library.name)
+    if procedures is not None:  # the domains the predicate declares, as check holds a mission's goals to
+        from specc.check.system import argument_outside
+
+        for position, value in enumerate(goal.expr.args):
+            outside = argument_outside(procedures, head, position, value)
+            if outside is not None:
+                raise RunError(f"--goal {text}: {outside}")
     return text
+
+
+def _procedures_of(specs: Path, name: str) -> Any:
+    """The procedures block `name` of the robot's specs (read back from the parse cache), or None."""
+    from specc.model import nodes as m
+    from specc.pipeline import load
+
+    loaded = load([specs], check=False)
+    items = loaded.program.items if loaded.program is not None else ()
+    return next((i for i in items if isinstance(i, m.Procedures) and i.name == name), None)
 
 
 def _has_variables(term: Any) -> bool:

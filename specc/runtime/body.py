@@ -22,6 +22,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, NamedTuple
 
+from specc.runtime.hints import did_you_mean
+
 COUNT, LENGTH, MASS, SPEED, ACCEL, RATIO, ANGLE, TURN_RATE = "", "m", "kg", "m/s", "m/s²", "ratio", "deg", "deg/s"
 # The devices of the simulated body (`specc.runtime.sim.simulation`) a module's codels may own.
 DEVICES = ("wheels", "encoders", "sonars", "laser", "camera", "pan_tilt", "arm", "antenna", "pose", "objects")
@@ -70,11 +72,8 @@ class RobotConfig:
         for key, value in values.items():
             spec = BODY_KEYS.get(key)
             if spec is None:
-                from difflib import get_close_matches
-
-                close = get_close_matches(key, BODY_KEYS, n=1)
-                raise ValueError(f"body '{name}': no key '{key}'" + (f" (did you mean '{close[0]}'?)" if close else
-                                                                     f"; keys: {', '.join(BODY_KEYS)}"))
+                close = did_you_mean(key, BODY_KEYS)
+                raise ValueError(f"body '{name}': no key '{key}'" + (close or f"; keys: {', '.join(BODY_KEYS)}"))
             problem = body_problem(key, float(value))
             if problem is not None:
                 raise ValueError(f"body '{name}': {problem}")

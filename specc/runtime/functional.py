@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import difflib
 import enum
 import functools
 import itertools
@@ -26,6 +25,7 @@ from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any, Generic, TypeVar
 
+from specc.runtime.hints import did_you_mean
 from specc.runtime.kernel import Kernel, Timer
 
 HISTORY = 1_000  # transitions a module (and messages an executive) remembers
@@ -739,10 +739,8 @@ class Module:
         if isinstance(exc, AttributeError) and text.startswith(missing) and text.endswith("'"):
             name = text[len(missing):-1]
             fields = [f.name for f in dataclasses.fields(self.sdi)]
-            close = difflib.get_close_matches(name, fields, n=1)
-            hint = f"did you mean '{close[0]}'? " if close else ""
-            return (f"AttributeError: module {self.name}'s SDI has no field '{name}' ({hint}its fields: "
-                    f"{', '.join(fields) or 'none'}; declare it in the module's internal_data)")
+            return (f"AttributeError: module {self.name}'s SDI has no field '{name}'{did_you_mean(name, fields)} "
+                    f"(its fields: {', '.join(fields) or 'none'}; declare it in the module's internal_data)")
         return f"{type(exc).__name__}: {text}{where_raised(exc)}"
 
     def call_with_parent(self, activity: Activity, function: Callable[..., Any], *args: Any) -> Any:
@@ -1191,14 +1189,20 @@ def import_user_module(dotted: str, owner: str, what: str, instead: str) -> Any:
 
 
 def where_raised(exc: BaseException) -> str:
-    """` (file:line)`: the last place the exception went through, the user's code that raised it
-    (not the import machinery's frozen frames); empty when there is none."""
+    """` (file:line)`: the last place of the user's code the exception went through (a codel's
+    line, not specc's device that refused its misspelt name, nor the import machinery's frozen
+    frames); specc's own last place when none is the user's; empty when there is none."""
     import traceback
 
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if not f.filename.startswith("<")]
     if isinstance(exc, SyntaxError) and exc.filename:
         return f" ({_shown(exc.filename)}:{exc.lineno})"
-    return f" ({_shown(frames[-1].filename)}:{frames[-1].lineno})" if frames else ""
+    users = [f for f in frames if not os.path.abspath(f.filename).startswith(_SPECC_FOLDER)]
+    shown = (users or frames)[-1:]
+    return f" ({_shown(shown[0].filename)}:{shown[0].lineno})" if shown else ""
+
+
+_SPECC_FOLDER = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep  # specc/, with its separator
 
 
 def _shown(path: str) -> str:

@@ -319,6 +319,13 @@ def _atom(token: str) -> Term:
         return re.sub(r"\\(.)", r"\1", token[1:-1])
     if token[0] in "$@" and len(token) > 1:
         return Var(token)
+    return literal(token)
+
+
+def literal(token: str) -> str | int | float:
+    """The value a constant written `token` stands for: a whole number, a real number (2.5, 1e9),
+    or else a symbol. One reading for goals, facts and the values of a type (`{1.5, 10}`), so that
+    a goal's 1.5 is the type's 1.5."""
     if _INTEGER.fullmatch(token):
         return int(token)
     if _REAL.fullmatch(token):

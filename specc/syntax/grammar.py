@@ -42,14 +42,18 @@ def parser() -> Lark:
         propagate_positions=True,
         maybe_placeholders=True,
         lexer_callbacks={"COMMENT": _COMMENTS.append, "BLOCK_COMMENT": _COMMENTS.append},
-        cache=str(cache_file()),
+        cache=str(kept) if (kept := cache_file()) is not None else False,
     )
 
 
-def cache_file() -> Path:
-    """Where lark keeps the analysed grammar (keyed by its text): loading it is ~5x faster."""
+def cache_file() -> Path | None:
+    """Where lark keeps the analysed grammar (keyed by its text): loading it is ~5x faster. None
+    when specc has no cache folder (`specc.disk_cache.root`)."""
+    base = disk_cache.root()
+    if base is None:
+        return None
     digest = hashlib.sha256(grammar_path().read_bytes()).hexdigest()[:16]
-    return disk_cache.root() / f"grammar-{digest}.lark.cache"
+    return base / f"grammar-{digest}.lark.cache"
 
 
 @functools.lru_cache(maxsize=1)
@@ -143,8 +147,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
     # A misspelt keyword reads as a name, and where the keyword was optional (a task's preemption
     # after its '}') the parser no longer expects it: say which keyword the word is close to.
     close = _meant(exc, text, position, str(token), token.type == "NAME")
-    if str(token) == "-" and "NUMBER" in exc.expected and text[position + 1:position + 2].isdigit():
-        # `wheel_base: -0.5;`: the value is a number, but no negative one has a meaning here.
+    if str(token) == "-" and "NUMBER" in exc.expected and text[position + 1:position + 2].isdigit() \
+            and text[:position].rstrip().endswith(":"):
+        # `wheel_base: -0.5;`: a property's value is a count, a length or a duration, never below 0.
+        # (In a list, `[-5, 0]` or `{-1, 0}`, a negative value may mean something: no such hint.)
         close = " (a negative number has no meaning here: this value must be 0 or more)"
     return error("unexpected-token", f"unexpected {describe_token(token)}{close}; expected {expected}", span)
 

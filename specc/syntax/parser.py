@@ -5,6 +5,7 @@ is `specc.syntax.grammar`: a command on files seen before does not load lark).""
 from __future__ import annotations
 
 import functools
+import importlib.util
 import os
 from pathlib import Path
 
@@ -41,9 +42,14 @@ _FRONT_END_FILES = ("diagnostics.py", "codes.py", "resources.py")
 
 @functools.lru_cache(maxsize=1)
 def _front_end_digest() -> str:
+    """The front end's sources, and lark's version (its `__init__`, found without importing it: a
+    parse read back needs no lark), since another lark may parse or place errors otherwise."""
     package = Path(__file__).resolve().parents[1]
     files = sorted(f for folder in _FRONT_END for f in (package / folder).glob("*.py"))
-    return disk_cache.source_digest([grammar_path(), *files, *(package / name for name in _FRONT_END_FILES)])
+    lark = importlib.util.find_spec("lark")
+    parser_library = [Path(lark.origin)] if lark is not None and lark.origin else []
+    return disk_cache.source_digest([grammar_path(), *files, *(package / name for name in _FRONT_END_FILES),
+                                     *parser_library])
 
 
 def spec_files(paths: list[Path]) -> tuple[list[Path], list[Diagnostic]]:

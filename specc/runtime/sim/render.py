@@ -17,6 +17,7 @@ matplotlib is imported here only, when drawing, so simulating needs no display a
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -170,9 +171,14 @@ def map_figure(scene: Scene, title: str) -> Any:
     else:
         ax = figure.add_subplot(1, 1, 1)
     draw_scene(ax, scene)
-    ax.set_title(title, fontsize=10)
+    # Wrapped to the map's own width: a long title (robot, mission, world, outcome) would otherwise
+    # run under the colour bar beside it.
+    ax.set_title(textwrap.fill(title, MAP_TITLE_WIDTH), fontsize=10)
     legend_beside(figure, ax)
     return figure
+
+
+MAP_TITLE_WIDTH = 80  # characters of a map title's line at its font size
 
 
 def animate(sim: Simulation, path: str | Path, *, frames: int = 80, title: str = "") -> Path:

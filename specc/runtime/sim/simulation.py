@@ -16,11 +16,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from specc.runtime.body import DEVICES as DEVICES  # re-exported: the devices a body has
+from specc.runtime.hints import did_you_mean
 from specc.runtime.kernel import Kernel
 from specc.runtime.sim.devices import Antenna, Arm, Camera, Encoders, PanTilt, RangeSensor, Wheels
 from specc.runtime.sim.rays import RayCaster
@@ -49,8 +50,9 @@ class DeviceView:
     def __getattr__(self, name: str) -> Any:
         if name not in self._allowed:
             given = ", ".join(sorted(self._allowed - frozenset(COMMON))) or "none"
-            raise AttributeError(f"module '{self._module}' has no device '{name}': the system gives it {given} "
-                                 f"(add it to the system's devices {{ {self._module}: ...; }})")
+            raise AttributeError(f"module '{self._module}' has no device '{name}'{did_you_mean(name, self._allowed)}: "
+                                 f"the system gives it {given} (add it to the system's devices "
+                                 f"{{ {self._module}: ...; }})")
         return getattr(self._sim, name)
 
     def __setattr__(self, name: str, value: Any) -> None:
@@ -90,6 +92,14 @@ class Trace:
 
 
 class Simulation:
+    if not TYPE_CHECKING:  # hidden from mypy, which would otherwise accept any attribute of specc's own code
+        def __getattr__(self, name: str) -> Any:
+            """Only for a name the simulation lacks: a codel's misspelt device, named with a hint."""
+            if name.startswith("_"):  # Python's own lookups (copying, pickling): the usual error
+                raise AttributeError(name)
+            known = [n for n in (*dir(type(self)), *vars(self)) if not n.startswith("_")]
+            raise AttributeError(f"the simulation has no device '{name}'{did_you_mean(name, known)}")
+
     def __init__(self, world: World, robot: RobotConfig | None = None, *, seed: int = 0, kernel: Kernel | None = None,
                  physics_period: float = 0.025, trace_period: float = 0.1) -> None:
         self.world = world

@@ -36,8 +36,8 @@ start = 60.0
 end = 90.0
 ```
 
-Units are metres, radians and seconds. Every mistake is reported as a `WorldError` naming the
-file, the entry and what to write instead.
+Units are metres, radians and seconds. Every mistake of a file is reported in one `WorldError`
+(a line each) naming the file, the entry and what to write instead.
 """
 
 from __future__ import annotations
@@ -48,8 +48,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, overload
-
-FOOTPRINT_STEP = 0.02  # m between the points of a box footprint's outline that are checked
 
 
 class WorldError(ValueError):
@@ -112,6 +110,41 @@ Obstacle = Polygon | Circle
 
 
 @dataclass(frozen=True)
+class _Box:
+    """A body's box footprint at a pose: centre, heading, half-length and half-width."""
+
+    x: float
+    y: float
+    theta: float
+    half_length: float
+    half_width: float
+
+    @property
+    def corners(self) -> list[tuple[float, float]]:
+        cos, sin = math.cos(self.theta), math.sin(self.theta)
+        return [(self.x + u * cos - v * sin, self.y + u * sin + v * cos)
+                for u, v in ((self.half_length, self.half_width), (-self.half_length, self.half_width),
+                             (-self.half_length, -self.half_width), (self.half_length, -self.half_width))]
+
+    def distance(self, x: float, y: float) -> float:
+        """0 inside, else the distance from (x, y) to the box."""
+        cos, sin = math.cos(self.theta), math.sin(self.theta)
+        u, v = (x - self.x) * cos + (y - self.y) * sin, -(x - self.x) * sin + (y - self.y) * cos
+        return math.hypot(max(abs(u) - self.half_length, 0.0), max(abs(v) - self.half_width, 0.0))
+
+    def meets(self, polygon: Polygon) -> bool:
+        """Do the box and the polygon overlap: a corner of one inside the other, or edges that cross
+        (a thin wall across the box has neither corner inside)?"""
+        corners = self.corners
+        if any(polygon.contains(cx, cy) for cx, cy in corners) or any(self.distance(px, py) == 0
+                                                                      for px, py in polygon.points):
+            return True
+        sides = list(zip(corners, corners[1:] + corners[:1], strict=True))
+        edges = [((ax, ay), (bx, by)) for ax, ay, bx, by in polygon.edges()]
+        return any(_segments_cross(a, b, c, d) for a, b in sides for c, d in edges)
+
+
+@dataclass(frozen=True)
 class Target:
     """A named place of the world (a photo's object, a station)."""
 
@@ -155,20 +188,34 @@ class World:
     def footprint_clearance(self, pose: tuple[float, float, float], radius: float, length: float = 0.0,
                             width: float = 0.0) -> float:
         """How far a body at `pose` stands from the nearest obstacle or wall (0 or less: they
-        overlap): a disc of `radius`, or a `length` x `width` box turned by the pose's heading, whose
-        outline is sampled every FOOTPRINT_STEP."""
+        overlap): a disc of `radius`, or a `length` x `width` box turned by the pose's heading."""
         x, y, theta = pose
         if length <= 0:
             return self.clearance(x, y) - radius
-        cos, sin = math.cos(theta), math.sin(theta)
-        corners = [(sx * length / 2, sy * width / 2) for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
-        points = [(x, y)]
-        for (ax, ay), (bx, by) in zip(corners, corners[1:] + corners[:1], strict=True):
-            steps = max(1, math.ceil(math.hypot(bx - ax, by - ay) / FOOTPRINT_STEP))
-            for k in range(steps):
-                u, v = ax + (bx - ax) * k / steps, ay + (by - ay) * k / steps
-                points.append((x + u * cos - v * sin, y + u * sin + v * cos))
-        return min(self.clearance(px, py) for px, py in points)
+        box = _Box(x, y, theta, length / 2, width / 2)
+        xmin, xmax, ymin, ymax = self.bounds
+        # A box is convex: its corners come nearest the walls.
+        found = min(min(cx - xmin, xmax - cx, cy - ymin, ymax - cy) for cx, cy in box.corners)
+        for obstacle in self.obstacles:
+            if isinstance(obstacle, Circle):
+                found = min(found, box.distance(obstacle.x, obstacle.y) - obstacle.radius)
+            elif box.meets(obstacle):
+                return 0.0
+            else:
+                found = min(found, *(obstacle.distance(cx, cy) for cx, cy in box.corners),
+                            *(box.distance(px, py) for px, py in obstacle.points))
+        return found
+
+    def start_overlap(self, radius: float, length: float = 0.0, width: float = 0.0) -> str | None:
+        """Why a body (a disc of `radius`, or a `length` x `width` box) cannot start at the world's
+        start: it overlaps an obstacle or a wall (the physics would shove it out at once, or wedge
+        it); None when it stands clear."""
+        if self.footprint_clearance(self.start, radius, length, width) > 0:
+            return None
+        x, y, theta = self.start
+        shape = f"its {length:g} x {width:g} m box" if length > 0 else f"its {radius:g} m radius"
+        return (f"the robot's body ({shape}) at its start ({x:g}, {y:g}, heading {theta:g} rad) overlaps an "
+                "obstacle or a wall: move [start] in the world file, or the obstacle")
 
     def segments(self) -> list[tuple[float, float, float, float]]:
         """Every straight edge: the polygons' and the four walls'."""
@@ -210,7 +257,7 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     for key in data:
         if key not in known:
             where.problem(f"unknown section [{key}] (known: {', '.join(sorted(known))})")
-    header = where.table(data, "world", ("name", "description"))
+    header = where.table(data, "world", ("name", "description")) or {}
     name = where.text(header, "name", "world", default_name)
     description = where.text(header, "description", "world", "")
     bounds: tuple[float, float, float, float] | None = None
@@ -218,7 +265,8 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
         where.problem("give [room] or [bounds], not both")
     elif "room" in data:
         room = where.table(data, "room", ("width", "height"))
-        width, height = where.number(room, "width", "room", None), where.number(room, "height", "room", None)
+        width, height = (where.number(room, "width", "room", None), where.number(room, "height", "room", None)) \
+            if room is not None else (None, None)
         if width is not None and height is not None:
             if width <= 0 or height <= 0:
                 where.problem("[room] width and height must be positive")
@@ -227,7 +275,7 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     elif "bounds" in data:
         corners = ("xmin", "xmax", "ymin", "ymax")
         box = where.table(data, "bounds", corners)
-        given = [where.number(box, k, "bounds", None) for k in corners]
+        given = [where.number(box, k, "bounds", None) for k in corners] if box is not None else [None]
         if all(b is not None for b in given):
             xmin, xmax, ymin, ymax = (float(b) for b in given if b is not None)
             if not (xmin < xmax and ymin < ymax):
@@ -240,7 +288,7 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
         where.problem(f"the walls reach {max(abs(b) for b in bounds):g} m from the origin: at most {MAX_EXTENT:g} m "
                       "(the physics and the pictures lose precision beyond)")
         bounds = None
-    start_table = where.table(data, "start", ("x", "y", "theta"))
+    start_table = where.table(data, "start", ("x", "y", "theta")) or {}
     start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
              where.number(start_table, "theta", "start", 0.0))
     obstacles: list[Obstacle] = []
@@ -248,7 +296,7 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
         obstacle = _obstacle(where, f"obstacles[{k}]", entry)
         if obstacle is not None:
             obstacles.append(obstacle)
-    objects_table = where.table(data, "objects", ("count", "at"))
+    objects_table = where.table(data, "objects", ("count", "at")) or {}
     count = where.number(objects_table, "count", "objects", 0.0)
     if count < 0 or count != int(count):
         where.problem("[objects] count must be a whole number >= 0")
@@ -266,17 +314,19 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
             if not 0 <= opens < closes:
                 where.problem(f"{label}: needs 0 <= start < end")
             windows.append(Window(where.text(w, "name", label, f"W{k + 1}"), opens, closes))
-    if where.problems or bounds is None:
+    if bounds is None:  # nothing can be placed without walls
         raise WorldError(*where.problems)
+    # Built from what could be read, so that what stands in the way is said with the rest.
     world = World(name, bounds, start, tuple(obstacles), tuple((x, y) for x, y in placed if x is not None
                                                                and y is not None),
                   int(count), tuple(Target(n, x, y) for n, x, y in targets if x is not None and y is not None),
                   tuple(windows), description, source)
     # Targets too: a station a robot is sent to inside a crate or past a wall fails its every
     # mission, far from the line that put it there.
-    for label, (x, y) in [("start", start[:2])] + [(f"objects.at[{k}]", p) for k, p in enumerate(world.objects)] + [
-            (f"targets[{k}] ({t.name})", (t.x, t.y)) for k, t in enumerate(world.targets)]:
-        if world.clearance(x, y) <= 0:
+    spots = [("start", start[:2])] + [(f"objects.at[{k}]", (x, y)) for k, (x, y) in enumerate(placed)] + [
+        (f"targets[{k}] ({n})", (x, y)) for k, (n, x, y) in enumerate(targets)]
+    for label, (x, y) in spots:
+        if x is not None and y is not None and world.clearance(x, y) <= 0:
             where.problem(f"{label} ({x:g}, {y:g}) is inside an obstacle or outside the walls")
     if where.problems:
         raise WorldError(*where.problems)
@@ -345,11 +395,13 @@ class _Where:
             if key not in known:
                 self.problem(f"{label}: unknown key '{key}' (known: {', '.join(known)})")
 
-    def table(self, data: Mapping[str, Any], key: str, known: tuple[str, ...]) -> Mapping[str, Any]:
+    def table(self, data: Mapping[str, Any], key: str, known: tuple[str, ...]) -> Mapping[str, Any] | None:
+        """The table `[key]` (empty when absent); None when it is something else (said once: what
+        its keys would be missing is not said again)."""
         value = data.get(key, {})
         if not isinstance(value, dict):
             self.problem(f"[{key}] must be a table")
-            return {}
+            return None
         self.only(value, f"[{key}]", known)
         return value
 
@@ -398,19 +450,23 @@ def self_crossing(points: Sequence[tuple[float, float]]) -> tuple[int, int] | No
     """Two edges of the polygon that cross (by the corners they start from), else None: a bow
     tie is no obstacle the simulator can hold (its inside is not what was meant)."""
     n = len(points)
-
-    def side(a: tuple[float, float], b: tuple[float, float], c: tuple[float, float]) -> float:
-        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-
     for i in range(n):
         a, b = points[i], points[(i + 1) % n]
         for j in range(i + 2, n):
             if (j + 1) % n == i:
                 continue  # the edge before the first one: they share a corner
-            c, d = points[j], points[(j + 1) % n]
-            if side(a, b, c) * side(a, b, d) < 0 and side(c, d, a) * side(c, d, b) < 0:
+            if _segments_cross(a, b, points[j], points[(j + 1) % n]):
                 return i, j
     return None
+
+
+def _segments_cross(a: tuple[float, float], b: tuple[float, float], c: tuple[float, float],
+                    d: tuple[float, float]) -> bool:
+    """Do the segments ab and cd cross (each one's ends strictly on both sides of the other)?"""
+    def side(p: tuple[float, float], q: tuple[float, float], r: tuple[float, float]) -> float:
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+    return side(a, b, c) * side(a, b, d) < 0 and side(c, d, a) * side(c, d, b) < 0
 
 
 def signed_area(points: Sequence[tuple[float, float]]) -> float:
