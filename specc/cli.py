@@ -725,7 +725,7 @@ TABLE_WIDTH = 140  # columns of a table printed to a file or a pipe
 def table_out() -> Console:
     """Where a table goes: the terminal as it is, or a file or pipe whole (not squeezed into 80
     columns, which cuts its cells)."""
-    return out if out.is_terminal else Console(highlight=False, width=TABLE_WIDTH)
+    return out if out.is_terminal else Console(highlight=False, soft_wrap=True, width=TABLE_WIDTH)
 
 
 def _run_error(error: Exception, code: int = 1) -> typer.Exit:

@@ -151,6 +151,24 @@ class Implies:
 Constraint = Union[Member, Relation, Implies]
 
 
+def names_in(expr: Expr, kind: type) -> set[str]:
+    """The names of the variables (kind Var) or timepoints (kind Time) an expression reads."""
+    if isinstance(expr, kind) and isinstance(expr, (Var, Time)):
+        return {expr.name}
+    if isinstance(expr, Op):
+        return set().union(*(names_in(a, kind) for a in expr.args))
+    return set()
+
+
+def constraint_names(c: Constraint, kind: type) -> set[str]:
+    """The names of the variables (kind Var) or timepoints (kind Time) a constraint reads."""
+    if isinstance(c, Member):
+        return names_in(c.expr, kind)
+    if isinstance(c, Relation):
+        return names_in(c.left, kind) | names_in(c.right, kind)
+    return constraint_names(c.condition, kind) | constraint_names(c.consequence, kind)
+
+
 # ---------------------------------------------------------------- assertions
 
 

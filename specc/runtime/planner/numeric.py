@@ -323,7 +323,7 @@ def _readers(constraints: tuple[pm.Constraint, ...]) -> dict[str, tuple[int, ...
     if found is None or found[0] is not constraints:
         positions: dict[str, list[int]] = {}
         for index, c in enumerate(constraints):
-            for name in sorted(_variables(c)):
+            for name in sorted(pm.constraint_names(c, pm.Var)):
                 positions.setdefault(name, []).append(index)
         if len(_READERS) >= IDENTITY_CACHE_LIMIT:
             _READERS.clear()
@@ -332,21 +332,6 @@ def _readers(constraints: tuple[pm.Constraint, ...]) -> dict[str, tuple[int, ...
 
 
 _READERS: dict[int, tuple[tuple[pm.Constraint, ...], dict[str, tuple[int, ...]]]] = {}
-
-
-def _variables(c: pm.Constraint | pm.Expr) -> set[str]:
-    """The names of the variables a constraint or an expression reads."""
-    if isinstance(c, pm.Var):
-        return {c.name}
-    if isinstance(c, pm.Op):
-        return set().union(*(_variables(a) for a in c.args))
-    if isinstance(c, pm.Member):
-        return _variables(c.expr)
-    if isinstance(c, pm.Relation):
-        return _variables(c.left) | _variables(c.right)
-    if isinstance(c, pm.Implies):
-        return _variables(c.condition) | _variables(c.consequence)
-    return set()
 
 
 def has_time(e: pm.Expr) -> bool:

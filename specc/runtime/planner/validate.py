@@ -78,6 +78,7 @@ from specc.runtime.planner.model import (
     Use,
     Var,
     assertion_timepoints,
+    constraint_names,
     describe,
     timepoints_of,
 )
@@ -197,22 +198,6 @@ def decide(c: Constraint, env: Mapping[str, Value], time_of: Callable[[str], flo
         return False
     return {"<": left < right, "<=": left <= right + TOLERANCE,
             ">": left > right, ">=": left >= right - TOLERANCE}.get(c.op, False)
-
-
-def names_in(expr: Expr, kind: type) -> set[str]:
-    if isinstance(expr, kind) and isinstance(expr, (Var, Time)):
-        return {expr.name}
-    if isinstance(expr, Op):
-        return set().union(*(names_in(a, kind) for a in expr.args))
-    return set()
-
-
-def constraint_names(c: Constraint, kind: type) -> set[str]:
-    if isinstance(c, Member):
-        return names_in(c.expr, kind)
-    if isinstance(c, Relation):
-        return names_in(c.left, kind) | names_in(c.right, kind)
-    return constraint_names(c.condition, kind) | constraint_names(c.consequence, kind)
 
 
 # ================================================================ interval propagation (durations)
