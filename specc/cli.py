@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import math
 import os
 import sys
@@ -1247,8 +1248,15 @@ class CampaignProgress:
             err.print(f"{done}/{total} experiments, {rate:,.0f}/h", markup=False)
 
 
+# A command's start allocates its long-lived objects in bursts (the modules imported, the model read
+# back): the collector, traversing them every 700 allocations, was 0.02 s of a cold `specc plan`. A
+# larger first threshold still collects cycles, 70x less often; a simulation's run is as fast.
+GC_THRESHOLDS = (50_000, 20, 20)
+
+
 def main() -> None:
     """The `specc` command: runs one subcommand, then ends the process at once."""
+    gc.set_threshold(*GC_THRESHOLDS)
     try:
         app()
     except KeyboardInterrupt:
