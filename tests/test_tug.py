@@ -6,6 +6,8 @@ executive for services, which run module requests."""
 from __future__ import annotations
 
 import json
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -213,3 +215,21 @@ def test_a_table_for_one_configuration_runs_the_planned_missions_alone(tmp_path:
     assert [(row["mission"], row["configuration"]) for row in data["missions"]] == [
         ("shuttle", "Robot1"), ("fetch_b", "Robot1")]
     assert all(not line.endswith(" ") for line in (tmp_path / "tug-table.md").read_text().splitlines())
+
+
+def test_the_guide_s_verifiable_procedures_verify_and_run_the_delivery(tmp_path: Path) -> None:
+    """docs/your-robot.md's procedures written for `specc verify` (the request protocol in
+    `property: executive` KAs, goals of finite domains), in place of the tug's own: the delivery
+    is proven free of deadlocks (one end with the goal achieved) and still runs to success."""
+    guide = (ROOT / "docs" / "your-robot.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"^```[a-z]*\n(.*?)^```$", guide, flags=re.S | re.M)  # each fenced block's text
+    (block,) = [b for b in blocks if "property: executive" in b]
+    robot = tmp_path / "tug"
+    shutil.copytree(TUG, robot)
+    (robot / "procedures.spec").write_text(block, encoding="utf-8")
+    proven = specc("verify", robot, "--goal", "!(FETCH A C)")
+    assert proven.returncode == 0, proven.stdout + proven.stderr
+    assert "ends: 1 with the goal achieved, 0 with it failed" in proven.stdout and "\ndeadlock:" not in proven.stdout
+    ran = specc("run", robot, "--mission", "deliver", "--world", "crowded", "--runs", tmp_path / "runs", "-q",
+                "--no-pictures")
+    assert ran.returncode == 0, ran.stderr
