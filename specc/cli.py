@@ -721,6 +721,7 @@ def skeleton(paths: PathsArg) -> None:
 
 
 TABLE_WIDTH = 140  # columns of a table printed to a file or a pipe
+MISSION_COLUMNS = 7  # mission, world, configuration, seeds, succeeded, success rate, time: what `table` prints
 
 
 def table_out() -> Console:
@@ -944,13 +945,16 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
         # A file or pipe gets the whole table, not one squeezed into 80 columns.
         table_out().print(rich_table(result.rows))
     else:
-        for row in result.missions:
-            configuration = f" with {row.configuration}" if row.configuration else ""
-            out.print(f"{robot}'s mission {row.mission} in {row.world}{configuration}: {row.succeeded} of "
-                      f"{row.seeds} seed(s) "
-                      f"succeeded ({100 * row.success_rate:.0f} %)" + (
-                          f", {row.simulated_time:.0f} s per successful run" if row.simulated_time is not None else ""),
-                      markup=False)
+        from rich.table import Table
+
+        headings, cells = result.mission_cells()
+        table = Table(show_edge=False)
+        shown = MISSION_COLUMNS  # the figures' means, as many as the runs measured, are in the files written
+        for k, heading in enumerate(headings[:shown]):
+            table.add_column(heading, justify="left" if k < 3 else "right")
+        for row in cells:
+            table.add_row(*row[:shown])
+        table_out().print(table)
     for failure in result.failures:
         out.print(f"failed: {failure.name}: {failure.why}", markup=False)
     for path in written:

@@ -18,7 +18,7 @@ from specc.runtime.ftplan.config import FtPlanConfig, PlannerConfig
 from specc.runtime.ftplan.execution import Execution, nominal
 from specc.runtime.planner import Planner, PlanResult
 from specc.runtime.planner import model as pm
-from specc.runtime.planner.plan import Action, Plan
+from specc.runtime.planner.plan import Action, GoalOutcome, Plan
 from tests.atrv import atrv_models, mutation_1_592
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -205,6 +205,32 @@ def test_goals_abandoned_when_every_plan_leaves_them_aside_spare_the_final_goals
     assert list(result.missed) == [next(text for text in result.missed if "COMMUNICATION(W2)" in text)]
     assert len(result.met) == len(goals) - 1 and any("AT_ROBOT_X" in text for text in result.met)
     assert any(e.kind == "operator" and "abandoned" in e.text for e in result.events)
+
+
+
+@dataclass
+class DropsGoalSaying(DropsGoal):
+    """A planner that leaves one goal out and says why, as a planner whose search ran out does."""
+
+    def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+        result = super().plan(problem, now)
+        said = GoalOutcome("COMMUNICATION(W2) = DONE", 3, self.goal.line, False,
+                           "no plan within 300 partial plans (a larger search budget may find one)")
+        return replace(result, goals=(*result.goals, said))
+
+
+@pytest.mark.parametrize("policy", ["successive", "concurrent"])
+def test_goals_given_up_say_why_each_planner_dropped_them(policy: str) -> None:
+    """"Every planner's plan left them aside" says what each plan dropped and why (a search that
+    ran out, not a choice), in the operator's message and in the goals missed."""
+    _, problem = mission()
+    w2 = w2_goal(problem)
+    result = FtPlan(config(("p1", "p2"), policy), problem,
+                    LocalPool({"p1": DropsGoalSaying(w2), "p2": DropsGoalSaying(w2)}), ScriptedExecutor()).run()
+    (why,) = result.missed.values()
+    assert why.startswith("every planner's plan left them aside (p1: COMMUNICATION(W2) = DONE: no plan within 300")
+    assert "; p2: COMMUNICATION(W2) = DONE: no plan within 300 partial plans" in why
+    assert any(e.kind == "operator" and "no plan within 300" in e.text for e in result.events)
 
 
 # ---------------------------------------------------------------- Fig 3.2

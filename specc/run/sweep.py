@@ -75,16 +75,9 @@ class SweepResult:
         if self.rows:
             text = markdown_table(self.rows)
         else:
-            figures = list(dict.fromkeys(name for row in self.missions for name in row.means))
-            text = ("| mission | world | configuration | seeds | succeeded | success rate | time (s) | "
-                    + "".join(f"{name} | " for name in figures)).rstrip() + ("\n"
-                    + "| --- " * (7 + len(figures)) + "|\n")
-            for row in self.missions:
-                time = mean_time_text(row.simulated_time, ".1f")
-                text += (f"| {row.mission} | {row.world} | {row.configuration or '-'} | {row.seeds} | "
-                         f"{row.succeeded} | {100 * row.success_rate:.0f} % | {time} | "
-                         + "".join(f"{row.means[n]:.4g} | " if n in row.means else "| " for n in figures)).rstrip() \
-                    + "\n"
+            headings, cells = self.mission_cells()
+            text = ("| " + " | ".join(headings) + " |\n" + "| --- " * len(headings) + "|\n"
+                    + "".join(("| " + " | ".join(row) + " |").replace("|  |", "| |") + "\n" for row in cells))
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
         if crashed:
             text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
@@ -92,6 +85,17 @@ class SweepResult:
             text += "\nFailures (each run's log is in its folder):\n\n" + "".join(
                 f"- {f.name}: {f.why}\n" for f in self.failures)
         return text
+
+    def mission_cells(self) -> tuple[list[str], list[list[str]]]:
+        """The missions' table when the runs measured no seed 004 means: its headings, and each
+        mission's cells (the mean of every figure a run measured with a number), for the Markdown
+        file and the terminal alike."""
+        figures = list(dict.fromkeys(name for row in self.missions for name in row.means))
+        headings = ["mission", "world", "configuration", "seeds", "succeeded", "success rate", "time (s)", *figures]
+        cells = [[row.mission, row.world, row.configuration or "-", str(row.seeds), str(row.succeeded),
+                  f"{100 * row.success_rate:.0f} %", mean_time_text(row.simulated_time, ".1f"),
+                  *(f"{row.means[n]:.4g}" if n in row.means else "" for n in figures)] for row in self.missions]
+        return headings, cells
 
     def to_json(self) -> dict[str, Any]:
         return {"robot": self.robot, "runs": [dict(o.report, folder=str(o.folder)) for o in self.outcomes],

@@ -37,7 +37,7 @@ Two departures from the figures, both where they are silent:
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Collection, Generator, Mapping
+from collections.abc import Callable, Collection, Generator, Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Protocol
 
@@ -209,6 +209,7 @@ class FtPlan:
         self.plannings = 0
         self.rounds = 0
         self.planner_failures = 0
+        self.dropped_by: dict[str, str] = {}  # planner -> the goals its last plan dropped, with why
         self.repairs = 0
         self.repaired = 0
 
@@ -294,7 +295,7 @@ class FtPlan:
                     self.step(24, MISSION_FAILED_IN_TIME)
                     raise MissionFailure(MISSION_FAILED_IN_TIME)
             if outcomes and set(outcomes) == {"idle"} and self.objectives():
-                self.give_up("every planner's plan left them aside")
+                self.give_up(self.left_aside(planners))
                 return
 
     # ------------------------------------------------------------ Fig 3.2
@@ -358,7 +359,7 @@ class FtPlan:
             elif outcome == "met":
                 idle.clear()
             if len(idle) == len(planners) and self.objectives():
-                self.give_up("every planner's plan left them aside")
+                self.give_up(self.left_aside(planners))
                 return
 
     def arrivals(self, candidates: list[str]) -> Generator[Answer, None, None]:
@@ -476,6 +477,7 @@ class FtPlan:
             self.planner_failed(k, f"{k} found no plan: {result.reason}")
             return None
         dropped = "; ".join(f"{g.description}: {g.reason}" for g in result.dropped)
+        self.dropped_by[k] = dropped
         improved = "".join(f"; {note}" for note in result.notes if note.startswith("improvement"))
         self.log("plan", f"{k}: {len(result.plan.actions)} actions" + (f", dropped {dropped}" if dropped else "")
                  + improved, k)
@@ -589,6 +591,13 @@ class FtPlan:
             self.state.report(self.config.state_rules, "failed", running.name, running.args, self.views.get(k))
             self.log("report", f"stopped {running.text()}: counted as failed (brought to the safe state)", k)
         self.state.changing.clear()
+
+    def left_aside(self, planners: Iterable[str]) -> str:
+        """Why the goals are given up when every planner's plan leaves them aside: what each plan
+        dropped, and why (a search budget too small, a deadline that cannot be met...), not only
+        that it did."""
+        said = [f"{k}: {self.dropped_by[k]}" for k in planners if self.dropped_by.get(k)]
+        return "every planner's plan left them aside" + (f" ({'; '.join(said)})" if said else "")
 
     def give_up(self, why: str) -> None:
         # Only the goals still calling for action: a final goal that holds now (the robot is home)
