@@ -1001,6 +1001,8 @@ def mutants_command(
     if not specs.exists():
         raise _run_error(ValueError(f"no such file or folder: '{specs}'"), 2)
     started = time.perf_counter()
+    if show is not None and domain is None and "-" in show:
+        domain = show.rsplit("-", 1)[0]  # an id names its domain: warehouse_slow-0001
     try:
         target = mutation_target(specs, domain)
         # --show finds a mutant by id whatever --class says: ids are given over every class.

@@ -38,7 +38,7 @@ from specc.run.mission import check_mission, load_robot
 from specc.runtime.planner import Planner
 from specc.syntax.parser import parse_text
 from tests.atrv import ATRV, atrv_models, mutation_1_592, program
-from tests.conftest import ROOT
+from tests.conftest import EXAMPLES, ROOT
 
 # A domain small enough to count its mutants by hand: one attribute with numeric bounds, one
 # task with symbolic, numeric and temporal variables, a constant expression and a contingent
@@ -441,6 +441,9 @@ def test_the_command_samples_and_shows_a_mutant(tiny: Path) -> None:
     assert shown.returncode == 0, shown.stderr
     assert "numeric 0.0 -> " in shown.stdout and "passes the checks" in shown.stdout
     assert "-    ?x1 in [0.0 - 10.0, 10.0];" in shown.stdout
+    other = specc("mutants", EXAMPLES / "tug", "--show", "warehouse_slow-0001")  # the id names its domain
+    assert other.returncode == 0, other.stderr
+    assert other.stdout.startswith("warehouse_slow-0001 ")
 
 
 @pytest.mark.parametrize(("args", "message"), [

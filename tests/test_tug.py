@@ -103,6 +103,7 @@ def test_a_table_of_the_tug(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("args, message", [
     (("--mission", "shuttle", "--config", "Robot3"), "no robot configuration 'Robot3'"),
+    (("--mission", "shuttle", "--config", "robot1"), "no robot configuration 'robot1' (did you mean 'Robot1'?)"),
     (("--mission", "shuttle", "--config", "Robot1,Robot2"), "one configuration each time: repeat the option"),
     (("--mission", "fetch", "--world", "hall"), "robot 'tug' has no mission 'fetch'"),
     (("--goal", "!(GO-PLACE E)"), "no KA of procedures 'tug_tasks' is invoked by it (they are invoked by "
@@ -231,5 +232,5 @@ def test_the_guide_s_verifiable_procedures_verify_and_run_the_delivery(tmp_path:
     assert proven.returncode == 0, proven.stdout + proven.stderr
     assert "ends: 1 with the goal achieved, 0 with it failed" in proven.stdout and "\ndeadlock:" not in proven.stdout
     ran = specc("run", robot, "--mission", "deliver", "--world", "crowded", "--runs", tmp_path / "runs", "-q",
-                "--no-pictures")
+                "--no-pictures", "-g", tmp_path / "generated")  # not the repository's generated/: a copy's
     assert ran.returncode == 0, ran.stderr

@@ -3,15 +3,15 @@
 
 ROBOT = "tug"
 SOURCES = (
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/executive.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/ftplan.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/modules/drive.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/modules/lift.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/modules/scanner.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/planning.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/procedures.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/rules.spec",
-    "/tmp/pytest-of-root/pytest-677/test_the_guide_s_verifiable_pr0/tug/tug.spec",
+    "examples/tug/executive.spec",
+    "examples/tug/ftplan.spec",
+    "examples/tug/modules/drive.spec",
+    "examples/tug/modules/lift.spec",
+    "examples/tug/modules/scanner.spec",
+    "examples/tug/planning.spec",
+    "examples/tug/procedures.spec",
+    "examples/tug/rules.spec",
+    "examples/tug/tug.spec",
 )
 MODULES = ("drive", "lift", "scanner")
 EXECUTIVES = ("tug",)

@@ -43,8 +43,11 @@ def mission_setup(configurations: Mapping[str, FtPlanConfig], configuration: str
         known = ", ".join(f"{key} ({config.planners[0].name} alone)" if len(config.planners) == 1 else key
                           for key, config in configurations.items())
         several = "; one configuration each time: repeat the option for more" if "," in configuration else ""
-        raise UnknownName(f"no robot configuration '{configuration}' (known: {known}, or a planner's name for it "
-                          f"alone; {VARIANTS_HELP}){several}") from None
+        # Only a difference of case is hinted at: Robot3 is not a misspelt Robot2, robot1 is Robot1.
+        folded = {key.lower(): key for key in configurations}
+        hint = f" (did you mean '{folded[configuration.lower()]}'?)" if configuration.lower() in folded else ""
+        raise UnknownName(f"no robot configuration '{configuration}'{hint} (known: {known}, or a planner's name "
+                          f"for it alone; {VARIANTS_HELP}){several}") from None
     except ValueError as error:
         raise UnknownName(str(error)) from None
     try:
