@@ -43,24 +43,14 @@ PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders sea
 
 
 def refuse_unwritable(path: Path | None, what: str, option: str, example: str, picture: bool = False) -> None:
-    """Exit at once, before any planning or drawing, when the file `path` cannot be written: a
-    folder, a picture format matplotlib does not write, or a folder that cannot be made or written
-    in ('-' is the standard output)."""
+    """Exit at once, before any planning or drawing, when the file `path` cannot be written
+    (`specc.run.writable_file`; '-' is the standard output)."""
     if path is None or str(path) == "-":
         return
-    from specc.run import RunError, writable_folder
+    from specc.run import RunError, writable_file
 
     try:
-        if path.is_dir():
-            raise RunError(f"{what} ({option}) '{path}' is a folder: give a file name, e.g. {path / example}")
-        if picture and path.suffix:
-            from matplotlib.backend_bases import FigureCanvasBase
-
-            formats = FigureCanvasBase.get_supported_filetypes()
-            if path.suffix[1:].lower() not in formats:
-                raise RunError(f"{what} ({option}) '{path}': matplotlib writes no '{path.suffix}' picture; end the "
-                               f"name with .png, .svg or .pdf (or {', '.join('.' + f for f in sorted(formats))})")
-        writable_folder(path.parent, f"the folder of {what}", option)
+        writable_file(path, option, "a file name", f"the folder of {what}", example, picture)
     except RunError as error:
         err.print(f"error: {error}", markup=False)
         raise typer.Exit(1) from None
@@ -913,16 +903,14 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
 
     Example: specc table examples/tug --mission shuttle --config Robot1 --config Robot1/2
     """
-    from specc.run import RunError, writable_folder
+    from specc.run import RunError, writable_file
     from specc.run.measures import rich_table
     from specc.run.session import RunCrashed, RunRequest, compile_robot
     from specc.run.sweep import sweep, write_table
 
     try:
         if output is not None:
-            if output.is_dir():
-                raise RunError(f"--output '{output}' is a folder: give the table's file, e.g. {output / 'table.md'}")
-            writable_folder(output.parent, "the table's folder")
+            writable_file(output, "--output", "the table's file", "the table's folder", "table.md")
         robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
         base = RunRequest(specs, generated=generated, runs=runs, pictures=pictures)
         with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} run(s) done") as progress:

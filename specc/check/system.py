@@ -136,15 +136,13 @@ def check_body(ctx: Context, system: m.System) -> None:
                    f"(or neither, for the disc of 'radius')", entry.span)
 
 
-def footprint(system: m.System) -> tuple[float, float, float]:
-    """The body's radius, length and width as its `body { }` gives them (the simulator's defaults
-    for those it does not, or gives wrong: check_body reports those)."""
-    given = {e.name: float(e.value.value) for e in (system.body.entries if system.body is not None else ())
-             if e.name in ("radius", "length", "width") and isinstance(e.value, m.Number)
-             and body_problem(e.name, float(e.value.value)) is None}
-    default = RobotConfig()
-    return (given.get("radius", default.radius), given.get("length", default.length),
-            given.get("width", default.width))
+def footprint(system: m.System) -> RobotConfig:
+    """The body its `body { }` block declares, from the values check_body accepts (the others, which
+    it reports, at the simulator's defaults)."""
+    values = {e.name: e.value.value for e in (system.body.entries if system.body is not None else ())
+              if e.name in BODY_KEYS and isinstance(e.value, m.Number)
+              and body_problem(e.name, float(e.value.value)) is None}
+    return RobotConfig.from_spec(system.name, values)
 
 
 def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
@@ -167,7 +165,8 @@ def check_worlds(ctx: Context, system: m.System) -> dict[str, m.Setting]:
                        entry.value.span)
             continue
         try:
-            overlap = load_world(path).start_overlap(*footprint(system))
+            body = footprint(system)
+            overlap = load_world(path).start_overlap(body.radius, body.length, body.width)
             if overlap is not None:
                 ctx.report("bad-world", f"{entry.value.value}: {overlap}", entry.value.span)
         except WorldError as error:  # each problem, named as the spec names the file, not by this machine's folders
@@ -356,7 +355,7 @@ def argument_outside(procedures: m.Procedures, head: str, position: int, value: 
     if declared is None or position >= len(declared.params) or value is None:
         return None
     param = declared.params[position]
-    allowed = finite_values(procedures, param.domain)
+    allowed = Domains(procedures).values(param.domain)
     if allowed is None or value in allowed:
         return None
     shown = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
@@ -419,11 +418,6 @@ def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], str]:
                     found[(head, position)] = reasons[0]
                     changed = True
     return found
-
-
-def finite_values(procedures: m.Procedures, domain: m.PDomain) -> tuple[str | int | float, ...] | None:
-    """The values of a finite domain (a set, a range, a type naming one); None when unbounded."""
-    return Domains(procedures).values(domain)
 
 
 def check_service_actions(ctx: Context, procedures: m.Procedures, executives: list[m.Executive],

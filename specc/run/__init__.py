@@ -37,3 +37,20 @@ def writable_folder(folder: Path, what: str, option: str = "--output") -> None:
         raise RunError(f"cannot make {what} '{folder}': {error.strerror or error}") from None
     if not os.access(folder, os.W_OK | os.X_OK):
         raise RunError(f"{what} '{folder}' is not writable: give another ({option})")
+
+
+def writable_file(path: Path, option: str, file: str, folder: str, example: str, picture: bool = False) -> None:
+    """RunError unless the file `path` (given by `option`) can be written: not a folder, a picture
+    format matplotlib writes when `picture`, in a folder that can be made and written in. Checked
+    before the work whose result it receives (a plan, a table's runs). `file` and `folder` name
+    what is asked for ("the table's file", "the table's folder"); `example` a file name to give."""
+    if path.is_dir():
+        raise RunError(f"{option} '{path}' is a folder: give {file}, e.g. {path / example}")
+    if picture and path.suffix:
+        from matplotlib.backend_bases import FigureCanvasBase
+
+        formats = FigureCanvasBase.get_supported_filetypes()
+        if path.suffix[1:].lower() not in formats:
+            raise RunError(f"{option} '{path}': matplotlib writes no '{path.suffix}' picture; end the name with "
+                           f".png, .svg or .pdf (or {', '.join('.' + f for f in sorted(formats))})")
+    writable_folder(path.parent, folder, option)

@@ -146,7 +146,7 @@ def _compiler_digest() -> str:
 
     sources = sorted(p for p in _COMPILER.rglob("*.py") if p.is_file())
     sources += [grammar_path(), *sorted(p for p in templates_dir().rglob("*") if p.is_file())]
-    return _digest([f"{p.name}:{_file_digest(p)}" for p in sources])
+    return disk_cache.source_digest(sources)
 
 
 def _reads(path: Path) -> str | None:
