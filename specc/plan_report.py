@@ -4,7 +4,7 @@ validator and print it all."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from rich.console import Console
@@ -62,9 +62,11 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
     chosen = choose_problem(program, name, domain_name)
     model = domain_model(program, domain_block(program, chosen))
     problem = problem_model(program, chosen)
+    own = math.inf
     if horizon is not None:
         if not (math.isfinite(horizon) and horizon > 0):
             raise ValueError(f"--horizon must be a positive number of seconds, not {horizon:g}")
+        own = pm.latest_end(problem)
         problem = pm.with_horizon(problem, horizon)
     if not (math.isfinite(now) and now >= 0):
         raise ValueError(f"--now must be a mission time of 0 s or more, not {now:g}")
@@ -78,6 +80,9 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
         problem = replanning_problem(problem, parsed, lines if goals is None else goals, now)
     result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability,
                      improve=improve).plan(problem, now=now)
+    if horizon is not None and horizon > own:
+        result = replace(result, notes=(*result.notes, f"--horizon {horizon:g} s is later than the problem's own end "
+                                        f"(at most {own:g} s after its start): the problem's bound stays"))
     violations = []
     if result.plan is not None:
         violations = validate(model, problem, result.plan, dropped_lines={g.line for g in result.dropped})

@@ -405,6 +405,16 @@ def test_bad_input_is_one_clear_error(tiny: Path, tmp_path: Path) -> None:
         mutation_target(tmp_path, "tiny")
 
 
+def test_a_domain_whose_members_are_all_in_fragments_says_why_it_has_no_mutant(tmp_path: Path) -> None:
+    # A campaign of no mutant would run and report empty fault rows: the fragments a domain
+    # includes are never mutated (the problems include them too), and the user is told so.
+    body = TINY.split("{", 1)[1].rsplit("}", 1)[0]
+    (tmp_path / "parts.spec").write_text(f"fragment tiny_parts {{{body}}}\ndomain tiny {{\n  include tiny_parts;\n}}\n",
+                                         encoding="utf-8")
+    with pytest.raises(MutationError, match=r"'tiny' has nothing of its own to mutate.*\(tiny_parts\).*domain block"):
+        enumerate_mutants(tmp_path, "tiny")
+
+
 # ---------------------------------------------------------------- specc mutants
 
 

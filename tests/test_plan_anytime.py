@@ -83,7 +83,10 @@ def test_the_node_limit_caps_the_improvement() -> None:
     capped = Planner(domain, improve=10_000, node_limit=first.nodes + 20).plan(problem)
     checked(domain, problem, capped)
     assert capped.nodes <= first.nodes + 20
-    assert capped.notes[-1].startswith("improvement: 20 partial plan(s)")
+    # A twentieth of the budget is kept for merging waypoints driven through: M1 has none, and
+    # that partial plan goes unspent.
+    spent = int(capped.notes[-1].removeprefix("improvement: ").split(" ")[0])
+    assert 19 <= spent <= 20 and capped.nodes == first.nodes + spent
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])

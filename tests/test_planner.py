@@ -522,3 +522,52 @@ def test_a_goal_impossible_alone_names_the_constraints_on_its_dates() -> None:
     line = next(c.line for c in problem.constraints if "ta" in pm.timepoints_of(c))
     assert not goal.kept and goal.reason.startswith("impossible even alone")
     assert goal.reason.endswith(f"the goal's dates: (ta - t_start) in [0, 3] (line {line})")
+
+
+EUCLIDEAN_SPEC = """
+domain flat {
+  attribute POS_X() { ?value in [-oo, +oo]; }
+  attribute POS_Y() { ?value in [-oo, +oo]; }
+  task MOVE(?x1, ?y1, ?x2, ?y2) (t_start, t_end) {
+    ?x1 in [0, 50]; ?x2 in [0, 50]; ?y1 in [0, 50]; ?y2 in [0, 50];
+    variable ?d, ?speed, ?duration;
+    ?d >= 0.5;
+    ?d *. ?d =. (?x2 -. ?x1) *. (?x2 -. ?x1) +. (?y2 -. ?y1) *. (?y2 -. ?y1);
+    ?speed in [0.4, 0.6];
+    ?d =. ?speed *. ?duration;
+    event(POS_X(): (?x1, ?x2), t_end);
+    event(POS_Y(): (?y1, ?y2), t_end);
+    contingent ?duration =. t_end - t_start;
+  } latePreemptive
+}
+problem go for flat {
+  timepoint t_g;
+  explained event(POS_X(): (0, 0), t_start);
+  explained event(POS_Y(): (0, 0), t_start);
+  hold(POS_X(): 3, (t_g, t_end)) goal(1, 0);
+  hold(POS_Y(): 4, (t_g, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 600];
+}
+"""
+
+
+@pytest.mark.parametrize("exact", [False, True])
+def test_a_euclidean_distance_written_with_squares_gives_the_move_its_true_duration(exact: bool) -> None:
+    # ?d * ?d: the search's enclosure, CasADi and the validator's own propagation all read it as a
+    # square (d = 5 from (0, 0) to (3, 4)), which the validator accepts.
+    domain, problem = from_text(EUCLIDEAN_SPEC)
+    result = Planner(domain, exact=exact).plan(problem)
+    checked(domain, problem, result)
+    assert result.plan is not None
+    (move,) = result.plan.actions
+    assert move.args == (0.0, 0.0, 3.0, 4.0)
+    assert move.duration == pytest.approx((5 / 0.6, 5 / 0.4), abs=1e-5)
+
+
+def test_a_horizon_later_than_the_problems_own_end_is_said_not_silently_ignored() -> None:
+    from specc.plan_report import solve
+
+    later = solve(program(), "M1_model1", None, 1000.0, 0.0, [], None, 300, False)
+    assert any("--horizon 1000 s is later than the problem's own end (at most 800 s" in n for n in later.result.notes)
+    earlier = solve(program(), "M1_model1", None, 500.0, 0.0, [], None, 300, False)
+    assert not any("--horizon" in n for n in earlier.result.notes)

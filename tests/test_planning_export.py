@@ -317,3 +317,23 @@ def test_the_numbers_reached_go_forward_only_and_a_cut_is_said() -> None:
     domain, problem = from_text(text.replace("(0, 3), t_start", "(0, 100), t_start"))
     result = export(domain, problem)  # 101 numbers: more than REACHED_NUMBERS
     assert any("the numbers the tasks' events lead to are cut at 64" in note for note in result.unsupported)
+
+
+def test_a_square_is_propagated_as_a_square_not_as_a_product_of_two_ranges() -> None:
+    # A Euclidean distance written with squares: d * d = 3 * 3 + 4 * 4, so d = 5; 5 m at 0.4-0.6 m/s
+    # take 8.33-12.5 s. Dividing 25 by d's own range [0.5, 50] would never tighten it (125 s).
+    d, speed, duration = pm.Var("?d"), pm.Var("?speed"), pm.Var("?duration")
+    constraints: list[pm.Constraint] = [
+        pm.Relation(">=", d, pm.Num(0.5)),
+        pm.Relation("=", pm.Op("*", (d, d)), pm.Op("+", (pm.Num(9.0), pm.Num(16.0)))),
+        pm.Member(speed, pm.Interval(0.4, 0.6)),
+        pm.Relation("=", d, pm.Op("*", (speed, duration))),
+        pm.Relation("=", duration, pm.Op("-", (pm.Time("t_end"), pm.Time("t_start"))), contingent=True),
+    ]
+    found = bounds(constraints, {("time", "t_start"): (0.0, 0.0)}, [("time", "t_end"), ("var", "?d")])
+    assert found is not None
+    assert found[("var", "?d")] == pytest.approx((5.0, 5.0))
+    assert found[("time", "t_end")] == pytest.approx((5 / 0.6, 5 / 0.4))
+    # A square is never negative: d * d = -1 has no solution.
+    negative = [pm.Relation("=", pm.Op("*", (d, d)), pm.Num(-1.0))]
+    assert bounds(negative, {}, [("var", "?d")]) is None

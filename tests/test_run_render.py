@@ -141,6 +141,19 @@ def test_the_rover_run_folder_holds_its_map_and_timeline(robot: Any, rover: Miss
         draw_map(rover.events, tmp_path / "m3w3.jpg")
 
 
+def test_a_failure_reason_of_a_page_keeps_the_pictures_title_to_three_lines() -> None:
+    from specc.run.render import RunInfo
+
+    why = "; ".join(f"goal {k} given up: no plan within 300 partial plans (a larger search budget may find one)"
+                    for k in range(20))
+    title = RunInfo("scout", "Robot1/2", "morning", "orchard", 0, "failed", why, 500.0).title()
+    lines = title.splitlines()
+    assert len(lines) == 3 and lines[0].startswith("scout Robot1/2, mission morning")
+    assert lines[-1].endswith("(the whole of it: summary.txt)")
+    short = RunInfo("scout", "", "morning", "orchard", 0, "succeeded", "every goal met", 500.0).title()
+    assert short == "scout, mission morning, world orchard, seed 0 — succeeded: every goal met"
+
+
 def test_a_rover_log_cut_inside_an_action_still_draws(rover: MissionRun, tmp_path: Path) -> None:
     failing = next(b for b in action_bars(rover.events) if b.outcome == "failed")
     middle = (failing.start + failing.end) / 2

@@ -77,7 +77,7 @@ from specc.analysis.planning import Lowering
 from specc.model import nodes as m
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.model import describe
-from specc.runtime.planner.numeric import div, evaluate, mul
+from specc.runtime.planner.numeric import Empty, div, evaluate, mul, square, square_root
 from specc.runtime.planner.replan import replanning_problem
 
 VALUE = -1  # the position of an attribute's value, next to its argument positions 0, 1, ...
@@ -314,6 +314,8 @@ class _Box:
             key = _key(e)
             assert key is not None
             return self.get(key)
+        if e.op == "*" and e.args[0] == e.args[1]:
+            return square(self.span(e.args[0]))
         return _apply(e.op, [self.span(a) for a in e.args])
 
     def span(self, e: pm.Expr) -> Span:
@@ -337,9 +339,14 @@ class _Box:
         if not isinstance(target, tuple):
             return False
         spans = [self.span(a) for a in e.args]
-        _meet(_apply(e.op, spans), target)
+        _meet(self.span(e), target)
         args, op, changed = e.args, e.op, False
-        if op == "+":
+        if op == "*" and args[0] == args[1]:
+            try:
+                changed |= self.project(args[0], square_root(target, spans[0]))
+            except Empty:
+                raise _Infeasible from None
+        elif op == "+":
             changed |= self.project(args[0], _apply("-", [target, spans[1]]))
             changed |= self.project(args[1], _apply("-", [target, spans[0]]))
         elif op == "-":

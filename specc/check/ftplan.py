@@ -41,6 +41,7 @@ def check(ctx: Context) -> None:
                 else:
                     known.tasks.update(found.tasks)
                     known.attributes.update(found.attributes)
+                    known.constants.update(found.constants)
         everything = DomainTables()
         for found in (known, *own.values()):
             everything.tasks.update(found.tasks)
@@ -79,6 +80,7 @@ def check(ctx: Context) -> None:
             for fact in update.updates:
                 check_attribute(ctx, vocabulary, fact.attribute, len(fact.args), fact.span)
                 check_terms(ctx, (*fact.args, fact.value))
+                check_value(ctx, vocabulary, fact.attribute, fact.value)
                 check_bound(ctx, update.args, (*fact.args, fact.value), f"{update.report} '{update.task}'")
             check_terms(ctx, update.args)
         for planner in ftplan.planners:
@@ -215,6 +217,16 @@ def check_attribute(ctx: Context, known: DomainTables, name: str, arity: int, sp
         ctx.unknown("undefined-attribute", "attribute", name, known.attributes, span, " in the planners' domains")
     elif len(attribute.params) != arity:
         ctx.report("arity-mismatch", f"'{name}' takes {len(attribute.params)} argument(s), {arity} given", span)
+
+
+def check_value(ctx: Context, known: DomainTables, attribute_name: str, value: m.IxExpr) -> None:
+    """A symbol a state rule writes is a value of the attribute (else the planner refuses the
+    facts at the first replanning, and the run ends in a planning failure)."""
+    attribute = known.attributes.get(attribute_name)
+    allowed = known.value_domain(attribute) if attribute is not None else None
+    if allowed is not None and isinstance(value, m.IxName) and value.name not in allowed:
+        ctx.report("value-outside-domain",
+                   f"'{value.name}' is not a value of {attribute_name} ({', '.join(sorted(allowed))})", value.span)
 
 
 def viewed_planners(ftplan: m.FtPlan) -> set[str]:

@@ -37,6 +37,30 @@ class DomainTables:
             found.update(v for n in walk(node) if isinstance(n, m.SetLiteral) for v in n.values)
         return found
 
+    def value_domain(self, attribute: m.Attribute | m.Resource, variable: str = VALUE_VAR) -> set[str] | None:
+        """The symbolic values `?value` (or another of the attribute's variables, one of its
+        parameters) may take, when its domain is a set of symbols."""
+        for statement in attribute.body:
+            if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
+                    and statement.expr.name == variable and isinstance(statement.domain, m.SetUnion)):
+                return self.set_values(statement.domain)
+        return None
+
+    def set_values(self, union: m.SetUnion) -> set[str] | None:
+        values: set[str] = set()
+        for part in union.parts:
+            if isinstance(part, m.SetLiteral):
+                values.update(part.values)
+                continue
+            constant = self.constants.get(part.name)
+            if constant is None:
+                return None
+            inner = self.set_values(constant.value)
+            if inner is None:
+                return None
+            values |= inner
+        return values
+
 
 def expand(ctx: Context, members: Iterable[Any], chain: tuple[str, ...] = ()) -> Iterator[Any]:
     """Members with every `include` replaced by the fragment's own (expanded) members.
@@ -221,10 +245,18 @@ class ScopeChecker(Visitor):
 
     def attr_value(self, a: m.AttrValue, scope: Scope, resource: bool = False) -> None:
         attribute = self.domain.attributes.get(a.attribute)
-        for arg in a.args:
-            self.expr(arg, scope)
+        for k, arg in enumerate(a.args):
+            allowed_arg = (self.domain.value_domain(attribute, attribute.params[k].name)
+                           if attribute is not None and k < len(attribute.params) else None)
+            if allowed_arg is None or not isinstance(arg, m.IxName) or arg.name in scope.macro_params:
+                self.expr(arg, scope)
+            elif arg.name not in allowed_arg:
+                assert attribute is not None
+                self.ctx.report("value-outside-domain",
+                                f"'{arg.name}' is not a value of {a.attribute}'s {attribute.params[k].name} "
+                                f"({', '.join(sorted(allowed_arg))})", arg.span)
         values = (a.value.before, a.value.after) if isinstance(a.value, m.Transition) else (a.value,)
-        allowed = self.value_domain(attribute) if attribute is not None else None
+        allowed = self.domain.value_domain(attribute) if attribute is not None else None
         for value in values:
             if not (allowed is not None and isinstance(value, m.IxName)):
                 self.expr(value, scope)  # symbols of a known domain are checked against it below
@@ -242,29 +274,6 @@ class ScopeChecker(Visitor):
                 self.ctx.report("value-outside-domain",
                                 f"'{value.name}' is not a value of {a.attribute} ({', '.join(sorted(allowed))})",
                                 value.span)
-
-    def value_domain(self, attribute: m.Attribute | m.Resource) -> set[str] | None:
-        """The symbolic values `?value` may take, when its domain is a set of symbols."""
-        for statement in attribute.body:
-            if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
-                    and statement.expr.name == VALUE_VAR and isinstance(statement.domain, m.SetUnion)):
-                return self.set_values(statement.domain)
-        return None
-
-    def set_values(self, union: m.SetUnion) -> set[str] | None:
-        values: set[str] = set()
-        for part in union.parts:
-            if isinstance(part, m.SetLiteral):
-                values.update(part.values)
-                continue
-            constant = self.domain.constants.get(part.name)
-            if constant is None:
-                return None
-            inner = self.set_values(constant.value)
-            if inner is None:
-                return None
-            values |= inner
-        return values
 
     def domain_value(self, d: m.DomainValue, scope: Scope) -> None:
         if isinstance(d, m.Interval):

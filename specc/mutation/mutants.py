@@ -292,6 +292,12 @@ def enumerate_mutants(robot: Robot | MutationTarget, domain: str | None = None, 
                             f"(classes: {', '.join(CLASSES)})")
     edits = domain_edits(target.program, target.file_index, target.item_index, random_values=random_values,
                          seed=seed)
+    if not edits:
+        included = [member.name for member in target.domain.members if isinstance(member, m.Include)]
+        where = (f": its members are in the fragments it includes ({', '.join(included)}), which are never "
+                 "mutated since the problems include them too; write the tasks in the domain block itself to "
+                 "mutate them") if included else ""
+        raise MutationError(f"domain '{target.domain.name}' has nothing of its own to mutate{where}")
     width = max(4, len(str(len(edits))))
     return [mutant(target, edit, f"{target.domain.name}-{rank:0{width}d}")
             for rank, edit in enumerate(edits, start=1) if edit.kind in wanted]

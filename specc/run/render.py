@@ -61,6 +61,7 @@ Events = Sequence[Mapping[str, Any]]
 
 MAP, TIMELINE, STATE = "map.png", "timeline.png", "state.png"
 TITLE_WIDTH = 130  # characters of a title line before it wraps
+TITLE_LINES = 3  # lines of a title at most
 SHORTEST_AXIS = 1.0  # s: a timeline's time axis spans at least this (a log cut at its start)
 
 # An action's outcome (specc.run.rover's ExecutedAction.outcome; running: the log ends first).
@@ -146,8 +147,10 @@ class RunInfo:
         what = f"{self.outcome}: {self.why}" if self.outcome else f"no mission-end: the log stops at {self.end:.1f} s"
         if self.distance is not None:
             what += f", {self.distance:.1f} m travelled"
+        # A failure's reason may run to a page (every goal given up, with why): the picture keeps
+        # its first lines, the run's summary has it whole.
         return textwrap.fill(f"{who}, mission {self.mission}, world {self.world}, seed {self.seed} — {what}",
-                             TITLE_WIDTH)
+                             TITLE_WIDTH, max_lines=TITLE_LINES, placeholder=" … (the whole of it: summary.txt)")
 
 
 def run_info(events: Events) -> RunInfo:

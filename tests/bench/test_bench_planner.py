@@ -16,9 +16,10 @@ What is compared, exactly:
   fixed cost, printed apart (a one-action problem).
 - The makespans: both are the latest any action may end under the slowest durations. specc's
   first plan and its plan after the anytime improvement (`improve=IMPROVE`, 30,000 partial plans,
-  its extra time printed: 1-11 s);
-  Aries' first plan, and the best plan of its anytime mode minimising the makespan within
-  ARIES_ANYTIME seconds (it stops earlier when it proves its plan optimal).
+  its extra time printed);
+  Aries' first plan, and the best plan of its anytime mode minimising the makespan within as
+  much time as specc's improvement took on that mission, ARIES_ANYTIME seconds at least (it stops
+  earlier when it proves its plan optimal).
 The issue's goals are printed per mission, met or not: specc at least 5x faster than Aries'
 first plan, and specc's improved makespan no longer than Aries' anytime best."""
 
@@ -50,7 +51,7 @@ pytestmark = pytest.mark.bench
 RUNS = 5
 ARIES_RUNS = 3
 ARIES_TIMEOUT = 60.0
-ARIES_ANYTIME = 10.0  # s for Aries' anytime mode per mission
+ARIES_ANYTIME = 10.0  # s at least for Aries' anytime mode per mission (as long as specc's improvement took)
 SPEED_GOAL = 5.0  # issue #25: specc at least 5x faster than Aries
 IMPROVE = 30_000  # partial plans for specc's improvement: a few seconds, as Aries' anytime mode has ARIES_ANYTIME
 
@@ -79,6 +80,7 @@ class AriesRow:
     status: str
     makespan: float | None  # of its first plan
     best: float | None  # the best makespan of its anytime mode
+    anytime: float = 0.0  # s its anytime mode had
 
 
 def worst_case_makespan(plan: Any) -> float:
@@ -86,7 +88,8 @@ def worst_case_makespan(plan: Any) -> float:
     return max(float(start) + float(duration) for start, _, duration in plan.timed_actions)
 
 
-def aries_on_the_compact_encoding(domain: pm.PlanningDomain, problem: pm.Problem) -> AriesRow:
+def aries_on_the_compact_encoding(domain: pm.PlanningDomain, problem: pm.Problem, anytime: float) -> AriesRow:
+    """Aries' first plan (median time of ARIES_RUNS) and its anytime mode's best within `anytime` s."""
     import unified_planning.shortcuts as up
     from unified_planning.engines import PlanGenerationResultStatus as Status
 
@@ -113,13 +116,13 @@ def aries_on_the_compact_encoding(domain: pm.PlanningDomain, problem: pm.Problem
     best: float | None = None
     try:
         with up.AnytimePlanner(name="aries") as planner:
-            for result in planner.get_solutions(optimised, timeout=ARIES_ANYTIME):
+            for result in planner.get_solutions(optimised, timeout=anytime):
                 if result.plan is not None:
                     makespan = worst_case_makespan(result.plan)
                     best = makespan if best is None else min(best, makespan)
     except Exception as error:  # its stream sometimes ends in a closed socket at the deadline: keep what came
         print(f"\n  (Aries' anytime mode stopped on {problem.name}: {type(error).__name__}; best so far kept)")
-    return AriesRow(seconds, outcome[-1], makespans[-1], best)
+    return AriesRow(seconds, outcome[-1], makespans[-1], best, anytime)
 
 
 def aries_fixed_cost() -> float:
@@ -148,7 +151,7 @@ def test_planning_time_per_mission_against_aries() -> None:
 
     up.get_environment().credits_stream = None
     lines = [f"{'mission':12} {'specc (s)':>9} {'Aries (s)':>9} {'ratio':>6}   {'specc makespan':>14} "
-             f"{'improved':>8} {'+time (s)':>9}   {'Aries first':>11} {'anytime best':>12}   goals (#25)"]
+             f"{'improved':>8} {'+time (s)':>9}   {'Aries first':>11} {'anytime best':>18}   goals (#25)"]
     fast = short = 0
     for model in ("model1", "model2"):
         for k in (1, 2, 3, 4):
@@ -162,7 +165,7 @@ def test_planning_time_per_mission_against_aries() -> None:
             assert improved.plan is not None and improved.plan.makespan <= result.plan.makespan + 1e-6
             assert validate(domain, problem, improved.plan, dropped_lines={g.line for g in improved.dropped}) == []
             more = improve_seconds - ours
-            theirs = aries_on_the_compact_encoding(domain, problem)
+            theirs = aries_on_the_compact_encoding(domain, problem, max(ARIES_ANYTIME, improve_seconds))
             row = f"{name:12} {ours:9.3f} "
             tail = f"{result.plan.makespan:14.1f} {improved.plan.makespan:8.1f} {max(more, 0.0):9.3f}   "
             if theirs.seconds is None or theirs.makespan is None:
@@ -172,11 +175,11 @@ def test_planning_time_per_mission_against_aries() -> None:
             as_short = theirs.best is not None and improved.plan.makespan <= theirs.best + 1e-6
             fast += ratio >= SPEED_GOAL
             short += as_short
-            best = "-" if theirs.best is None else f"{theirs.best:.1f}"
+            best = "-" if theirs.best is None else f"{theirs.best:.1f} ({theirs.anytime:.0f} s)"
             quality = "no anytime plan to compare" if theirs.best is None else "as short" if as_short else "LONGER"
             verdicts = f"{'faster' if ratio >= SPEED_GOAL else 'NOT 5x faster'}, {quality}"
             lines.append(row + f"{theirs.seconds:9.3f} {ratio:5.1f}x   " + tail
-                         + f"{theirs.makespan:11.1f} {best:>12}   {verdicts}")
+                         + f"{theirs.makespan:11.1f} {best:>18}   {verdicts}")
     domain, problem = atrv_models("M4_model1")
     short_horizon = pm.with_horizon(problem, 300.0)
     result = Planner(domain).plan(short_horizon)
@@ -185,7 +188,8 @@ def test_planning_time_per_mission_against_aries() -> None:
     print(f"\nspecc's planner vs Aries on the compact encoding of the same missions, same run (see the docstring); "
           f"times: specc warm, median of {RUNS}; Aries' OneshotPlanner, median of {ARIES_RUNS} (its fixed cost, "
           f"a one-action problem: {aries_fixed_cost():.3f} s); makespans (s): worst case; Aries' anytime mode "
-          f"minimising the makespan for up to {ARIES_ANYTIME:g} s:\n  " + "\n  ".join(lines)
+          f"minimising the makespan for as long as specc's improvement took, {ARIES_ANYTIME:g} s at least (in "
+          f"brackets):\n  " + "\n  ".join(lines)
           + f"\n  issue #25: specc >= {SPEED_GOAL:g}x faster on {fast} of 8 missions, makespan <= Aries' anytime "
             f"best on {short} of 8"
           + f"\n  M4_model1 with a 300 s horizon: {cut:.3f} s, drops {len(result.dropped)} goals (goal: within 1 s)")

@@ -326,6 +326,13 @@ def timepoints_of(e: Expr | Constraint) -> set[str]:
     return set()
 
 
+def latest_end(problem: Problem) -> float:
+    """The latest end its own bounds on `t_end - t_start` allow the mission (inf: none)."""
+    span = Op("-", (Time(problem.end), Time(problem.start)))
+    return min((c.domain.high for c in problem.constraints
+                if isinstance(c, Member) and c.expr == span and isinstance(c.domain, Interval)), default=INF)
+
+
 def with_horizon(problem: Problem, seconds: float) -> Problem:
     """The problem with its mission ending by `seconds` after its start: the bounds written on
     `t_end - t_start` are cut to it (a lower bound beyond it comes down with it)."""

@@ -71,6 +71,29 @@ def div(a: Interval, b: Interval) -> Interval:
     return mul(a, (1 / b[1], 1 / b[0]))
 
 
+def square(a: Interval) -> Interval:
+    """`x * x`: never negative, which the product of two independent factors in the same interval
+    may be (a Euclidean distance written `?d * ?d = dx * dx + dy * dy`)."""
+    low, high = a
+    if low >= 0:
+        return low * low, high * high
+    if high <= 0:
+        return high * high, low * low
+    return 0.0, max(low * low, high * high)
+
+
+def square_root(goal: Interval, current: Interval) -> Interval:
+    """The values of `x` in `current` whose square lies in `goal` (their hull)."""
+    if goal[1] < 0:
+        raise Empty(f"a square cannot be in {show(goal)}")
+    low, high = math.sqrt(max(goal[0], 0.0)), math.sqrt(goal[1])
+    parts = [(max(a, current[0]), min(b, current[1])) for a, b in ((low, high), (-high, -low))]
+    parts = [p for p in parts if p[0] <= p[1] + TOLERANCE]
+    if not parts:
+        raise Empty(f"no value in {show(current)} has its square in {show(goal)}")
+    return min(p[0] for p in parts), max(p[1] for p in parts)
+
+
 def evaluate(op: str, args: list[Interval]) -> Interval:
     """The interval an operator (`+ - * / neg max min abs`) gives its argument intervals."""
     if op == "+":
@@ -141,6 +164,8 @@ class Closure:
             return self.domains.setdefault(e.name, (-INF, INF))
         if isinstance(e, pm.Time):
             return (-INF, INF)  # timepoints are the temporal network's business
+        if e.op == "*" and e.args[0] == e.args[1]:
+            return square(self.numeric(self.forward(e.args[0])))
         return evaluate(e.op, [self.numeric(self.forward(a)) for a in e.args])
 
     @staticmethod
@@ -193,6 +218,8 @@ class Closure:
         elif e.op == "-":
             changed |= self.narrow(e.args[0], add(goal, args[1]))
             changed |= self.narrow(e.args[1], sub(args[0], goal))
+        elif e.op == "*" and e.args[0] == e.args[1]:
+            changed |= self.narrow(e.args[0], square_root(goal, args[0]))
         elif e.op == "*":
             changed |= self.narrow(e.args[0], div(goal, args[1]))
             changed |= self.narrow(e.args[1], div(goal, args[0]))

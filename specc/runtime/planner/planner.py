@@ -9,16 +9,18 @@ so that a run is deterministic), so the planner never searches forever on an imp
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import random
 import re
 import time
 from collections import Counter
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
+from specc.runtime.planner import waypoints as wp
 from specc.runtime.planner.heuristics import (
     FLAW_ORDERS,
     HEURISTICS,
@@ -54,6 +56,7 @@ from specc.runtime.stn import STN, Inconsistent
 INF = math.inf
 IMPROVEMENT = 0.5  # s: a plan must end this much earlier to count as better (not a rounding's worth)
 REORDER_TRIAL = 400  # partial plans at most for one goal order tried by the improvement (Setup.reorder)
+WAYPOINT_TRIAL = 300  # partial plans at most for one move split at one waypoint (Setup.waypoints)
 
 
 class NodeLimitReached(Exception):
@@ -202,13 +205,14 @@ class Planner:
         """Anytime improvement of a first plan within `budget` partial plans (#25: the time the
         watchdog leaves, under FTplan's cost model): first the goals it dropped that are not
         impossible alone, highest priority first, each tried again with the budget left (more
-        priority-weighted goals kept is the better plan); then the worst-case makespan, by branch
-        and bound near the first plan's choices (`Setup.improve`, half the budget left), then by
-        other orders of taking the goals up (`Setup.reorder`: another tour of the photos). A plan
-        replaces the first only when it keeps every goal it
-        kept and ends earlier at worst (`Plan.makespan`, the measure the plans are compared by),
-        so the result is never worse. Returns the plan, its notes, the goals kept and the partial
-        plans spent."""
+        priority-weighted goals kept is the better plan); then the worst-case makespan: by
+        waypoints in the first plan's idle times (`Setup.waypoints`: a move split so that the robot
+        goes part of the way while it would wait), by branch and bound near the first plan's
+        choices (`Setup.improve`), by other orders of taking the goals up (`Setup.reorder`:
+        another tour of the photos), then by other orders each with its waypoints. A plan
+        replaces the first only when it keeps every goal it kept and ends earlier at worst
+        (`Plan.makespan`, the measure the plans are compared by), so the result is never worse.
+        Returns the plan, its notes, the goals kept and the partial plans spent."""
         spent = 0
         gained: list[str] = []
         for goal in sorted((g for g in candidates if g not in kept), key=lambda g: (-g.priority, g.index)):
@@ -222,19 +226,40 @@ class Planner:
                 gained.append(goal.text)
         first = plan.makespan
         bound = node.worst_end()
-        # Branch and bound near the heuristic's choices (half the budget left), then other orders
-        # of taking the goals up (the rest).
-        for search, share in ((setup.improve, 2), (setup.reorder, 1)):
+        best = node
+        # A twentieth kept for merging back the waypoints the best plan drives through.
+        reserve = (budget - spent) // 20
+        budget -= reserve
+        ways: list[str] = []
+        # Each phase has a share of the budget still left (1/4, 1/6, 1/2, all the rest) and
+        # leaves what it does not spend to the next: waypoints in the first plan's idle times
+        # (they seldom need their share), branch and bound near the heuristic's choices, other
+        # orders of taking the goals up, then other orders each with its own waypoints (a tour
+        # that waits more may end sooner once the robot goes on during the waits: M3's best).
+        phases: tuple[tuple[str, Callable[[list[Goal], float, int], tuple[list[Node], int]], int], ...] = (
+            ("waypoints", lambda active, limit, share: setup.waypoints(active, node, limit, share), 4),
+            ("branch and bound", setup.improve, 6),
+            ("other goal orders", setup.reorder, 2),
+            ("other goal orders with waypoints", functools.partial(setup.reorder, waypoints=True), 1))
+        for name, search, share in phases:
             found, used = search(kept, bound, (budget - spent) // share) if spent < budget else ([], 0)
             spent += used
             for better in reversed(found):  # the best by the search's measure first
                 candidate, candidate_notes = setup.extract(better, self.exact)
                 if candidate.makespan < plan.makespan - 1e-6:
-                    plan, notes = candidate, candidate_notes
+                    plan, notes, best = candidate, candidate_notes, better
                     bound = min(bound, better.worst_end())
+                    ways.append(name)
                     break
+        budget += reserve
+        merged, used = setup.merge_drive_throughs(kept, best, budget - spent)
+        spent += used
+        if merged is not best:
+            candidate, candidate_notes = setup.extract(merged, self.exact)
+            if candidate.makespan < plan.makespan + 1e-6:
+                plan, notes = candidate, candidate_notes
         said = ([f"goal(s) kept by the improvement: {'; '.join(gained)}"] if gained else []) + (
-            [f"worst-case makespan improved from {first:.1f} s to {plan.makespan:.1f} s"]
+            [f"worst-case makespan improved from {first:.1f} s to {plan.makespan:.1f} s ({', '.join(ways)})"]
             if plan.makespan < first - 1e-6 else [])
         note = f"improvement: {spent} partial plan(s); " + ("; ".join(said) or "no better plan found")
         return plan, (*notes, note), kept, spent
@@ -290,6 +315,12 @@ class Planner:
                          for g in setup.goals)
         return PlanResult(plan, outcomes, nodes=attempt.nodes, seconds=time.perf_counter() - started,
                           notes=(*notes, note))
+
+
+def _sooner(late: tuple[float, float], than: tuple[float, float]) -> bool:
+    """Is a plan of `late` (`Setup._lateness`) better than one of `than`? An earlier worst-case
+    end, or the same one with its goals met sooner."""
+    return late[0] < than[0] - 1e-6 or (late[0] < than[0] + 1e-6 and late[1] < than[1] - 1e-6)
 
 
 def _push(stack: list[tuple[Node, Resolver | None, int]], node: Node, choice: list[Resolver], used: int,
@@ -617,7 +648,7 @@ class Setup:
             cut = _push(stack, node, choice, used, allowed) or cut
         return nodes, "cut" if cut else "done", found
 
-    def reorder(self, active: list[Goal], bound: float, budget: int) -> tuple[list[Node], int]:
+    def reorder(self, active: list[Goal], bound: float, budget: int, waypoints: bool = False) -> tuple[list[Node], int]:
         """Plans for the `active` goals whose worst-case makespan beats `bound`, each better than
         the one before, found by taking the goals up in other orders within `budget` partial
         plans. The search plans first for the goal that may come earliest; among goals that may
@@ -625,17 +656,21 @@ class Setup:
         the tour. An iterated local search over that order: first improvement over every segment
         reversed (2-opt), then every goal moved elsewhere, each order searched depth first within
         REORDER_TRIAL partial plans; at a local optimum, a seeded random reversal of the current
-        order and on from there (the same problem gives the same plans)."""
+        order and on from there (the same problem gives the same plans). With `waypoints`, each
+        order's plan is measured once its waits are used (`waypoints`, within REORDER_TRIAL more)."""
         found: list[Node] = []
         try:
             root = self.root(active)
         except DeadEnd:
             return found, 1
-        ties: dict[float, list[int]] = {}
+        # The goals that may all come as early, in the order the search takes them up when no
+        # order is given (the lower priority first: the photos before the communications).
+        ties: dict[float, list[tuple[float, int]]] = {}
         for a in root.assertions:
             if a.owner == "problem" and a.goal is not None:
-                ties.setdefault(round(root.bounds("origin", a.start)[0], 6), []).append(a.line)
-        tour = max(ties.values(), key=len, default=[])
+                ties.setdefault(round(root.bounds("origin", a.start)[0], 6), []).append((a.goal.priority, a.line))
+        largest: list[tuple[float, int]] = max(ties.values(), key=len) if ties else []
+        tour = [line for _, line in sorted(largest)]
         if len(tour) < 2:
             return found, 1
         context = self.context
@@ -651,9 +686,13 @@ class Setup:
             nodes += tried.nodes
             if tried.node is None:
                 return INF
-            end = tried.node.worst_end()
+            ways, used = self.waypoints(active, tried.node, INF, min(REORDER_TRIAL, max(0, budget - nodes))) if (
+                waypoints) else ([], 0)
+            nodes += used
+            best = ways[-1] if ways else tried.node
+            end = best.worst_end()
             if end < bound - IMPROVEMENT:
-                found.append(tried.node)
+                found.append(best)
                 bound = end
             return end
 
@@ -683,6 +722,86 @@ class Setup:
         finally:
             self.context = context
         return found, nodes
+
+    def waypoints(self, active: list[Goal], node: Node, bound: float, budget: int) -> tuple[list[Node], int]:
+        """Plans for the `active` goals made from `node`'s by splitting its moves at waypoints
+        (`waypoints`: where the robot waits, it goes part of the way to its next place), each
+        better than the one before, within `budget` partial plans; and the partial plans spent.
+        Better (`_sooner`): the goals met no later and some sooner, the worst-case makespan no
+        longer (the time a wait saves comes out at the end only once the waits after it are used
+        too); the last plan's makespan beats `bound` or it is not returned. First improvement: a
+        split that makes the plan better is kept, and the moves are looked at again."""
+        found: list[Node] = []
+        nodes = 0
+        kept_ids = set(self.kept_ids)  # a repair's, which the splits' searches would add to
+        try:
+            while self.movers and nodes < budget:
+                better, used = self._split_one_move(active, node, budget - nodes)
+                nodes += used
+                if better is None:
+                    break
+                node = better
+                found.append(node)
+        finally:
+            self.kept_ids = kept_ids
+        return ([found[-1]] if found and found[-1].worst_end() < bound - IMPROVEMENT else []), nodes
+
+    def merge_drive_throughs(self, active: list[Goal], node: Node, budget: int) -> tuple[Node, int]:
+        """`node`'s plan with each waypoint the robot drives through without stopping merged
+        back into one move (`waypoints.drive_throughs`), where the plan is no worse for it: a
+        split may have led the search to a better plan in which its waypoint serves nothing,
+        and the plan should not keep a bend no one needs. The partial plans spent too."""
+        nodes = 0
+        current = self._lateness(active, node)
+        merging = True
+        while merging and nodes < budget:
+            merging = False
+            plan, _ = self.extract(node, exact=False)
+            for first, second, mover in wp.drive_throughs(plan, self.movers):
+                tried = self.search(active, min(WAYPOINT_TRIAL, budget - nodes), True, None,
+                                    wp.merge(plan, first, second, mover))
+                nodes += tried.nodes
+                if tried.node is not None and not _sooner(current, self._lateness(active, tried.node)):
+                    node, current, merging = tried.node, self._lateness(active, tried.node), True
+                    break
+                if nodes >= budget:
+                    break
+        return node, nodes
+
+    def _split_one_move(self, active: list[Goal], node: Node, budget: int) -> tuple[Node | None, int]:
+        """The first plan better than `node`'s made by splitting one of its moves at a waypoint
+        where the robot then stops for something (`waypoints.stops_there`), or None; and the
+        partial plans spent. The moves in the order they are dispatched, each after an idle time
+        only, its waypoints farthest first, a first leg too slow for the idle time not searched."""
+        plan, _ = self.extract(node, exact=False)
+        current = self._lateness(active, node)
+        nodes = 0
+        for move in plan.ordered():
+            mover = self.movers.get(move.task)
+            idle = wp.idle_time(plan, move) if mover is not None else 0.0
+            if mover is None or idle <= EPS:
+                continue
+            for point in wp.candidates(move, mover, wp.places(plan, mover)):
+                if not wp.first_leg_fits(move, mover, point, idle):
+                    continue
+                if nodes >= budget:
+                    return None, nodes
+                tried = self.search(active, min(WAYPOINT_TRIAL, budget - nodes), True, None,
+                                    wp.split(plan, move, mover, point))
+                nodes += tried.nodes
+                if tried.node is not None and _sooner(self._lateness(active, tried.node), current):
+                    return tried.node, nodes
+        return None, nodes
+
+    @staticmethod
+    def _lateness(active: list[Goal], node: Node) -> tuple[float, float]:
+        """A plan's worst-case makespan, and the sum of the earliest dates its goals are met at."""
+        met = sum(node.bounds("origin", point)[0] for g in active for point in pm.assertion_timepoints(g.hold))
+        return node.worst_end(), met
+
+    @functools.cached_property
+    def movers(self) -> dict[str, wp.Mover]:
+        return wp.movers(self.domain)
 
     def _expand(self, node: Node, resolver: Resolver | None, beyond: float = INF) -> list[Resolver] | None:
         """`resolver` applied to `node` (a copy of its parent), then the resolvers of its next flaw,
@@ -990,10 +1109,17 @@ def pick_need(node: Node) -> tuple[Assertion, list[Resolver]] | None:
 
 def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
                    insertions: list[tuple[pm.Task, int]]) -> list[Resolver]:
-    """The need's resolvers, ranked, from its producers and the tasks that could give it."""
-    inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions]
+    """The need's resolvers, ranked, from its producers and the tasks that could give it. A task
+    that gives the value back (`restores`: a probe lowered and raised again, a move from STILL to
+    STILL) comes last: it needs the value itself at its start, so the link its own need would take
+    serves the need as well, and inserted first it only adds an action (a probe of a plot the plan
+    has no goal for, whose free coordinates the insertion binds to where the robot is)."""
+    inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions
+               if not restores(task, index)]
+    restorers = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions
+                 if restores(task, index)]
     if not existing:
-        return inserts
+        return inserts + restorers
     siblings = {node.assertions[k.producer].owner for k in node.links
                 if node.assertions[k.consumer].owner == need.owner and need.owner != "problem"} - {"problem"}
     changers = node.changers(need)
@@ -1007,8 +1133,25 @@ def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
     ranked = sorted((clobbered(e), e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id, e.id)
                     for e in existing)
     links = [(r[0], Resolver("link", need=need.id, producer=r[-1])) for r in ranked]
-    # Safe links first, then new tasks, then links something may undo.
-    return [r for risky, r in links if not risky] + inserts + [r for risky, r in links if risky]
+    # Safe links first, then new tasks, then links something may undo, then tasks giving it back.
+    return [r for risky, r in links if not risky] + inserts + [r for risky, r in links if risky] + restorers
+
+
+_RESTORES: dict[tuple[int, int], bool] = {}
+
+
+def restores(task: pm.Task, index: int) -> bool:
+    """Does the task's event at `index` give back a value the task itself changed (an event of
+    the same attribute instance going from that value)? Cached by the task's identity."""
+    key = (id(task), index)
+    found = _RESTORES.get(key)
+    if found is None:
+        event = task.assertions[index]
+        assert isinstance(event, pm.Event)
+        found = any(isinstance(a, pm.Event) and a is not event and a.attribute == event.attribute
+                    and a.args == event.args and a.before == event.after for a in task.assertions)
+        _RESTORES[key] = found
+    return found
 
 
 def unbound(node: Node) -> list[Resolver] | None:

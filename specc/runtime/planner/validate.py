@@ -264,6 +264,13 @@ class Propagator:
         if isinstance(expr, Time):
             return box.setdefault("@" + expr.name, EVERYTHING)
         a = [self.forward(x, box) for x in expr.args]
+        if expr.op == "*" and expr.args[0] == expr.args[1]:  # a square is never negative
+            lo, hi = a[0]
+            if lo >= 0:
+                return lo * lo, hi * hi
+            if hi <= 0:
+                return hi * hi, lo * lo
+            return 0.0, max(lo * lo, hi * hi)
         if expr.op == "+":
             return clean((a[0][0] + a[1][0], a[0][1] + a[1][1]))
         if expr.op == "-":
@@ -301,6 +308,17 @@ class Propagator:
         if not isinstance(expr, Op):
             return True
         args = expr.args
+        if expr.op == "*" and args[0] == args[1]:
+            # x * x in t: x within the square roots of t, on either side of zero (dividing t by
+            # x's own range would never tighten it).
+            if t[1] < 0:
+                return False
+            root_lo, root_hi = math.sqrt(max(t[0], 0.0)), math.sqrt(t[1])
+            x = self.forward(args[0], box)
+            sides = [s for s in (meet(x, (root_lo, root_hi)), meet(x, (-root_hi, -root_lo))) if s is not None]
+            if not sides:
+                return False
+            return self.narrow(args[0], (min(s[0] for s in sides), max(s[1] for s in sides)), box)
         if expr.op in ("+", "-", "*", "/"):
             left, right = args
             b = self.forward(right, box)
