@@ -187,6 +187,8 @@ CODES: dict[str, Code] = {
                              "choose { branch { =>(DONE); } }"),
     "event-test": Code("a test on an event predicate (events are waited for, not tested)", "?(REPLY $ID OK);"),
     "no-executive": Code("procedures that request services verified without an executive", "specc verify --goal ..."),
+    "no-applicable-ka": Code("a request no executive KA's invocation matches (a KA per service, none for this one)",
+                             "!(EXEC LOOK $R);   (KAs for !(EXEC STOW $R) only)"),
     "shared-variable": Code("parallel branches sharing a variable the net cannot follow", "parallel { ... }"),
     "unbounded-variable": Code("a KA variable over an unbounded domain (int, string): no finite net",
                                "predicate event REPLY(id: int, ...)"),

@@ -121,8 +121,11 @@ def print_result(outcome: Outcome, out: Console) -> None:
     points = ", ".join(f"{name}={_date(date)}" for name, date in sorted(plan.schedule.items(), key=lambda kv: kv[1])
                        if "." not in name)
     out.print(f"mission timepoints: {points}", markup=False)
-    if plan.bindings:
-        out.print("bindings: " + ", ".join(f"{k}={format_value(v)}" for k, v in plan.bindings.items()), markup=False)
+    bound = {k: v for k, v in plan.bindings.items() if k not in plan.free}
+    if bound:
+        out.print("bindings: " + ", ".join(f"{k}={format_value(v)}" for k, v in bound.items()), markup=False)
+    if plan.free:
+        out.print(f"free (no action of the plan names them): {', '.join(plan.free)}", markup=False)
     out.print(f"completes by {plan.makespan:.2f} s at worst", markup=False)
     for note in result.notes:
         out.print(f"note: {note}", markup=False)
@@ -178,7 +181,8 @@ def plan_document(outcome: Outcome) -> dict[str, Any]:
         "timepoints": {name: _number(date) for name, date in plan.schedule.items()},
         "uncontrolled": {name: [_number(low), _number(high)] for name, (low, high) in plan.uncontrolled.items()},
         "assumed": dict(plan.assumed),
-        "bindings": dict(plan.bindings),
+        "bindings": {k: v for k, v in plan.bindings.items() if k not in plan.free},
+        "free": list(plan.free),
     }
     return document
 

@@ -82,3 +82,16 @@ def test_dropped_goals_say_why_and_printing_to_stdout_prints_json_only(tmp_path:
                      if line.strip().startswith("hold(CART_AT(CART1): C"))
     assert [g["line"] for g in dropped] == [cart_goal] and "impossible even alone" in dropped[0]["reason"]
     assert document["plan"]["actions"] == [] and document["plan"]["makespan"] == 0.0
+
+
+def test_the_variables_of_dropped_goals_are_said_free_not_given_a_made_up_value(tmp_path: Path) -> None:
+    # M4 with Modele1 cut to 300 s drops three photos: the initial facts PICTURE(OBJk, ?xk, ?yk)
+    # of those photos name variables no action of the plan binds.
+    document = planned(tmp_path, "atrv", "--problem", "M4", "--domain", "model1", "--horizon", "300",
+                       "--improve", "0")
+    dropped = [g["description"] for g in document["goals"] if not g["kept"]]
+    photos = sorted(d.split("(")[1].split(",")[0] for d in dropped if d.startswith("PICTURE"))
+    assert photos == ["OBJ3", "OBJ4", "OBJ5"]
+    free = document["plan"]["free"]
+    assert sorted(free) == sorted(f"?{axis}{k[-1]}" for k in photos for axis in "xy")
+    assert not set(free) & set(document["plan"]["bindings"]) and len(document["plan"]["bindings"]) == 4

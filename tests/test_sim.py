@@ -56,8 +56,11 @@ def test_room_world_loads():
     ({**EMPTY, "obstacles": [{"circle": [3.0, 3.0, float("inf")]}]}, "obstacles[0]: circle must be"),
     ({**EMPTY, "obstacles": [{"polygon": [[2, 2], [3, float("nan")], [3, 3]]}]}, "obstacles[0]: polygon must"),
     ({**EMPTY, "obstacles": [{"circle": [3.0, 3.0, 0.5]}], "targets": [{"name": "A", "x": 3.0, "y": 3.2}]},
-     "targets[0] (A) (3, 3.2) is inside an obstacle or outside the walls"),
-    ({**EMPTY, "targets": [{"name": "B", "x": 99.0, "y": 1.0}]}, "targets[0] (B) (99, 1) is inside an obstacle"),
+     "targets[0] (A) (3, 3.2) is inside obstacles[0]"),
+    ({**EMPTY, "targets": [{"name": "B", "x": 99.0, "y": 1.0}]}, "targets[0] (B) (99, 1) is outside the walls (x in"),
+    ({**EMPTY, "obstacles": [{"circle": [99.0, 3.0, 0.5]}]}, "obstacles[0] lies wholly outside the walls"),
+    ({**EMPTY, "obstacles": [{"polygon": [[9, 1], [10, 1], [10, 2]]}, {"circle": [99.0, 3.0, 0.5]}]},
+     "obstacles[1] lies wholly outside the walls"),
     ({**EMPTY, "obstacles": [{"polygon": [[2, 2], [4, 4], [4, 2], [2, 4]]}]},  # a bow tie
      "obstacles[0]: the polygon crosses itself (its edges from corner 0 and from corner 2"),
 ])
@@ -390,10 +393,10 @@ def test_every_problem_of_a_world_file_is_said_at_once():
     ({"bounds": 5}, ["[bounds] must be a table"]),
     ({"room": {"width": 10, "height": 8}, "start": {"x": 1, "y": 1},
       "objects": {"count": -1, "at": [{"x": 20, "y": 1}]}},
-     ["[objects] count must be", "objects.at[0] (20, 1) is inside an obstacle or outside the walls"]),
+     ["[objects] count must be", "objects.at[0] (20, 1) is outside the walls (x in [0, 10], y in [0, 8])"]),
     ({"room": {"width": 10, "height": 8}, "start": {"x": 5, "y": 5},
-      "obstacles": [{"circle": [5, 5, 1]}, {"circle": "bad"}]},
-     ["obstacles[1]: circle must be", "start (5, 5) is inside an obstacle"]),
+      "obstacles": [{"circle": "bad"}, {"circle": [5, 5, 1]}]},
+     ["obstacles[0]: circle must be", "start (5, 5) is inside obstacles[1]"]),
 ])
 def test_a_world_s_problems_are_said_once_each_and_together(data, problems):
     with pytest.raises(WorldError) as error:

@@ -218,6 +218,44 @@ def test_a_table_for_one_configuration_runs_the_planned_missions_alone(tmp_path:
     assert all(not line.endswith(" ") for line in (tmp_path / "tug-table.md").read_text().splitlines())
 
 
+def test_a_request_no_executive_ka_serves_is_said_by_check_and_fails_in_verify(tmp_path: Path) -> None:
+    """The guide's request protocol has a KA per service (`!(EXEC HITCH $R)`): a goal asking it
+    for a service none of them names has no applicable KA and fails when it runs. `specc check`
+    says so, and `specc verify` no longer answers it as the executive would (it said "the goal
+    achieved" of a delivery that fails at run time)."""
+    guide = (ROOT / "docs" / "your-robot.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"^```[a-z]*\n(.*?)^```$", guide, flags=re.S | re.M)
+    (block,) = [b for b in blocks if "property: executive" in b]
+    assert "!(EXEC UNHITCH $R);" in block
+    robot = tmp_path / "tug"
+    shutil.copytree(TUG, robot)
+    (robot / "procedures.spec").write_text(block.replace("!(EXEC UNHITCH $R);", "!(EXEC GOTO $R);"),
+                                           encoding="utf-8")
+    checked = specc("check", robot)
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    assert "asks for service 'GOTO', but no executive KA serves it (those of EXEC serve HITCH, UNHITCH)" in \
+        checked.stdout + checked.stderr and "[no-applicable-ka]" in checked.stdout + checked.stderr
+    proven = specc("verify", robot, "--goal", "!(FETCH A C)")
+    assert "ends: 0 with the goal achieved, 1 with it failed" in proven.stdout, proven.stdout + proven.stderr
+
+
+def test_a_request_id_outside_the_request_protocol_is_said_with_the_protocol_to_use(tmp_path: Path) -> None:
+    # The guide's procedures with every `property: executive` taken out: the requests' ids are
+    # ints the net cannot enumerate, and the message points to the protocol rather than to a
+    # domain no id has.
+    guide = (ROOT / "docs" / "your-robot.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"^```[a-z]*\n(.*?)^```$", guide, flags=re.S | re.M)
+    (block,) = [b for b in blocks if "property: executive" in b]
+    robot = tmp_path / "tug"
+    shutil.copytree(TUG, robot)
+    (robot / "procedures.spec").write_text(block.replace("property: executive;", ""), encoding="utf-8")
+    refused = specc("verify", robot, "--goal", "!(FETCH A C)")
+    said = refused.stdout + refused.stderr
+    assert refused.returncode != 0 and "variable $ID of KA 'ExecHitch' ranges over an unbounded domain" in said
+    assert said.count("a request's id: send the request and wait for its reply in a KA with `property: executive`") \
+        >= 4  # ExecXY, ExecHitch, ExecUnhitch, ExecLoad
+
+
 def test_the_guide_s_verifiable_procedures_verify_and_run_the_delivery(tmp_path: Path) -> None:
     """docs/your-robot.md's procedures written for `specc verify` (the request protocol in
     `property: executive` KAs, goals of finite domains), in place of the tug's own: the delivery

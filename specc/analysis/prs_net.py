@@ -817,11 +817,20 @@ class Translator:
         for statement in _statements(ka.body or ()):
             if isinstance(statement, rp.Assign):
                 every.add(statement.var.name)
+        # A request's id, waited for in its reply: the net follows requests only in the executive's
+        # request protocol (a KA with `property: executive`), whose id it leaves out.
+        waited = {v for statement in _statements(ka.body or ()) if isinstance(statement, rp.Step)
+                  and statement.goal.op == "^" for v in variables(statement.goal.expr)}
+        if ka.action is not None and ka.action.result is not None:
+            waited.add(ka.action.result.name)
         for var in sorted(every):
             if var in unbounded:
+                protocol = (" (a request's id: send the request and wait for its reply in a KA with `property: "
+                            "executive`, the request protocol, which the net models without the id; see "
+                            "docs/your-robot.md)" if var in waited and EXECUTIVE_PROPERTY not in ka.properties else "")
                 self._reject(ka, f"variable {var} of KA '{ka.name}' ranges over an unbounded domain (int, string...): "
-                             "give the predicate argument it stands for a finite domain, e.g. 0..5 or {A, B}",
-                             "unbounded-variable", var=var)
+                             f"give the predicate argument it stands for a finite domain, e.g. 0..5 or {{A, B}}"
+                             f"{protocol}", "unbounded-variable", var=var)
             elif var not in found:
                 self._reject(ka, f"the values of variable {var} of KA '{ka.name}' cannot be told: use it as the "
                              "argument of a predicate with a finite domain", "unbounded-variable", var=var)
@@ -1366,11 +1375,21 @@ class Translator:
         out: dict[str, dict[tuple[Any, ...], None]] = {"SUCC": {}, "FAIL": {}}
         kas = [k for k in self.library.kas if k.goal_invoked and not k.is_meta and k.trigger.head == head
                and k.name in self.translated]
-        executive = next((k for k in kas if EXECUTIVE_PROPERTY in k.properties), None)
-        if executive is not None:
-            self._executive_server(executive, posted, out)
-            return out
         origin = f"goal {head}"
+        servers = [k for k in kas if EXECUTIVE_PROPERTY in k.properties]
+        if servers:
+            # The executive serves a request only through a KA whose invocation it matches, as the
+            # interpreter runs it: `!(EXEC LOOK $R)` with KAs for `(EXEC STOW $R)` and `(EXEC
+            # GRASP $R)` only is a goal no KA achieves, and fails.
+            served = []
+            for colour in posted:
+                if self._applicable(servers, colour):
+                    served.append(colour)
+                else:
+                    self.emit.fire(f"{origin}: no KA", origin, [(f"{head}.POST", colour)], [(f"{head}.FAIL", colour)])
+                    out["FAIL"][colour] = None
+            self._executive_server(servers[0], served, out)
+            return out
         for colour in posted:
             applicable = self._applicable(kas, colour)
             if not applicable:

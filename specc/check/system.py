@@ -456,6 +456,21 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
     BAD-SERVICE at run time and `specc verify --goal` stops at it."""
     protocols = {ka.invocation.body.head: ka for ka in procedures.kas if "executive" in ka.properties
                  and isinstance(ka.invocation, m.Goal) and ka.invocation.body.args}
+    # The services each head's executive KAs serve, when every one names its service (a KA per
+    # service, `!(EXEC STOW $R)`); None when one serves any (`!(EXEC $S $R)`).
+    served: dict[str, set[str] | None] = {}
+    for ka in procedures.kas:
+        if "executive" in ka.properties and isinstance(ka.invocation, m.Goal) and ka.invocation.body.args:
+            service = ka.invocation.body.args[0]
+            head = ka.invocation.body.head
+            names = served.setdefault(head, set())
+            if names is not None:
+                if isinstance(service, m.Ref):
+                    names.add(service.text)
+                elif isinstance(service, m.String):
+                    names.add(service.value)
+                else:
+                    served[head] = None
     if not protocols:
         return
     if not executives:
@@ -472,7 +487,13 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
                 else "no executive offers"
             # A string is the service's name too, once compiled (`"AVOID-ON"`); a number never is.
             name = named.text if isinstance(named, m.Ref) else named.value if isinstance(named, m.String) else None
-            if name is not None and name not in services:
+            kas_serve = served.get(node.body.head)
+            if name is not None and kas_serve is not None and name not in kas_serve:
+                ctx.warn("no-applicable-ka", f"goal {node.body.head} asks for service '{name}', but no executive KA "
+                           f"serves it (those of {node.body.head} serve {', '.join(sorted(kas_serve))}): no KA "
+                           f"applies and the goal fails; write a KA invoked by !({node.body.head} {name} ...)",
+                           named.span)
+            elif name is not None and name not in services:
                 ctx.warn("undefined-service", f"goal {node.body.head} asks for service '{name}', which "
                          f"{which}{did_you_mean(name, services)}: it will be answered BAD-SERVICE", named.span)
             elif isinstance(named, m.Number):  # a value where the protocol's goal names the service

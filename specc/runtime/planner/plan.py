@@ -71,6 +71,9 @@ class Plan:
     now: float = 0.0  # mission time the plan was made for (a replanning starts later)
     assumed: dict[str, float] = field(default_factory=dict)
     goals: tuple[int, ...] = ()  # source lines of the problem's goals the plan meets
+    # The problem's ?variables no assertion of the plan binds (the initial facts of a dropped
+    # goal): `bindings` gives each one some value of its domain, which means nothing.
+    free: tuple[str, ...] = ()
 
     def ends_by(self, action: Action) -> float:
         """The latest date the action may end, whatever nature does."""

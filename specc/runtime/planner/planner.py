@@ -879,8 +879,9 @@ class Setup:
                            _chosen(node.bindings.value(node.assertions[k.producer].value)))
                       for k in node.links if node.assertions[k.producer].owner != node.assertions[k.consumer].owner)
         bindings = {v: _some_value(node.bindings, v) for v in self.problem.variables}
+        free = tuple(v for v in self.problem.variables if node.bindings.value(v) is None)
         plan = Plan(self.domain.name, self.problem.name, tuple(actions), tuple(orderings), causal, schedule,
-                    uncontrolled, bindings, self.context.controllability, self.now, assumed)
+                    uncontrolled, bindings, self.context.controllability, self.now, assumed, free=free)
         return plan, tuple(notes)
 
 

@@ -292,10 +292,12 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
              where.number(start_table, "theta", "start", 0.0))
     obstacles: list[Obstacle] = []
+    labels: list[str] = []  # each obstacle's place in the file, for what is said of it
     for k, entry in enumerate(where.array(data, "obstacles", ("polygon", "circle"))):
         obstacle = _obstacle(where, f"obstacles[{k}]", entry)
         if obstacle is not None:
             obstacles.append(obstacle)
+            labels.append(f"obstacles[{k}]")
     objects_table = where.table(data, "objects", ("count", "at")) or {}
     count = where.number(objects_table, "count", "objects", 0.0)
     if count < 0 or count != int(count):
@@ -325,9 +327,24 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
     # mission, far from the line that put it there.
     spots = [("start", start[:2])] + [(f"objects.at[{k}]", (x, y)) for k, (x, y) in enumerate(placed)] + [
         (f"targets[{k}] ({n})", (x, y)) for k, (n, x, y) in enumerate(targets)]
+    xmin, xmax, ymin, ymax = bounds
     for label, (x, y) in spots:
-        if x is not None and y is not None and world.clearance(x, y) <= 0:
-            where.problem(f"{label} ({x:g}, {y:g}) is inside an obstacle or outside the walls")
+        if x is None or y is None or world.clearance(x, y) > 0:
+            continue
+        if not (xmin < x < xmax and ymin < y < ymax):
+            where.problem(f"{label} ({x:g}, {y:g}) is outside the walls (x in [{xmin:g}, {xmax:g}], "
+                          f"y in [{ymin:g}, {ymax:g}])")
+        else:
+            inside = [name for name, o in zip(labels, obstacles, strict=True) if o.distance(x, y) <= 0]
+            where.problem(f"{label} ({x:g}, {y:g}) is inside {', '.join(inside) or 'an obstacle'}")
+    # An obstacle wholly past the walls is never met, and the map leaves it out: a typo.
+    for name, obstacle in zip(labels, obstacles, strict=True):
+        xs, ys = ((obstacle.x - obstacle.radius, obstacle.x + obstacle.radius),
+                  (obstacle.y - obstacle.radius, obstacle.y + obstacle.radius)) if isinstance(obstacle, Circle) else (
+            tuple(p[0] for p in obstacle.points), tuple(p[1] for p in obstacle.points))
+        if max(xs) <= xmin or min(xs) >= xmax or max(ys) <= ymin or min(ys) >= ymax:
+            where.problem(f"{name} lies wholly outside the walls (x in [{xmin:g}, {xmax:g}], "
+                          f"y in [{ymin:g}, {ymax:g}]): it is never met; move it inside or remove it")
     if where.problems:
         raise WorldError(*where.problems)
     return world
