@@ -67,6 +67,7 @@ class FunctionShape:
     most: int | None  # positional arguments it accepts (None: *args)
     returns: tuple[tuple[str, int], ...] = ()  # the string constants it returns, with their lines
     defined_in: str = ""  # where a re-exported function is written (its package's folder / file)
+    posters: tuple[tuple[str, int], ...] = ()  # the names it reads posters by (`x.read_poster("m.P")`), with lines
 
     def accepts(self, count: int) -> bool:
         return self.least <= count and (self.most is None or count <= self.most)
@@ -84,6 +85,7 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
     if required_keywords:  # a keyword-only argument without default: no positional call works
         most = -1
     returns: list[tuple[str, int]] = []
+    posters: list[tuple[str, int]] = []
     stack: list[ast.AST] = list(node.body)
     while stack:
         current = stack.pop()
@@ -92,8 +94,13 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
         if isinstance(current, ast.Return) and isinstance(current.value, ast.Constant) \
                 and isinstance(current.value.value, str):
             returns.append((current.value.value, current.lineno))
+        if (isinstance(current, ast.Call) and isinstance(current.func, ast.Attribute)
+                and current.func.attr == "read_poster" and current.args
+                and isinstance(current.args[0], ast.Constant) and isinstance(current.args[0].value, str)):
+            posters.append((current.args[0].value, current.lineno))
         stack.extend(ast.iter_child_nodes(current))
-    return FunctionShape(node.lineno, least, most, tuple(sorted(returns, key=lambda r: r[1])))
+    return FunctionShape(node.lineno, least, most, tuple(sorted(returns, key=lambda r: r[1])),
+                         posters=tuple(sorted(posters, key=lambda r: r[1])))
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,12 @@ by stopping half-way. Every plan is checked by the independent validator."""
 
 from __future__ import annotations
 
+import json
+import shutil
+import subprocess
+import sys
 from functools import cache
+from pathlib import Path
 
 import pytest
 
@@ -15,7 +20,7 @@ from specc.runtime.planner import model as pm
 from specc.runtime.planner import waypoints as wp
 from specc.runtime.planner.plan import Action, Plan
 from specc.runtime.planner.validate import validate
-from tests.atrv import atrv_models
+from tests.atrv import ATRV, atrv_models
 from tests.test_planner import from_text
 
 # A cart on a rail: it must radio a report while still, inside a window that opens at 30-31 s and
@@ -208,3 +213,26 @@ def test_no_improved_rover_plan_drives_through_a_waypoint() -> None:
     domain, problem = atrv_models("M1_model1")
     improved = checked(domain, problem, Planner(domain, improve=3000).plan(problem))
     assert wp.drive_throughs(improved, wp.movers(domain)) == []
+
+
+def test_a_rover_planning_with_improvement_carries_out_its_waypoints_in_the_simulator(tmp_path: Path) -> None:
+    # The rover's FTplan with `improve: 300;` on its first planner: M2's plan stops at (2, 5),
+    # a point no goal names, to communicate during W1, and the simulated rover drives there and
+    # meets every goal.
+    robot = tmp_path / "atrv"
+    shutil.copytree(ATRV, robot)
+    spec = robot / "ftplan.spec"
+    text = spec.read_text(encoding="utf-8")
+    first = "  planner p1 {\n    domain: model1;\n"
+    assert first in text
+    spec.write_text(text.replace(first, first + "    improve: 300;\n"), encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "specc.cli", "run", str(robot), "--mission", "M2", "--world", "W1",
+                           "--config", "Robot1", "-g", str(tmp_path / "generated"), "--runs", str(tmp_path / "runs"),
+                           "--no-pictures", "-q"], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    (log,) = (tmp_path / "runs").glob("*/events.jsonl")
+    events = [json.loads(line) for line in log.read_text(encoding="utf-8").splitlines()]
+    started = [e["text"] for e in events if e["kind"] == "ftplan" and e.get("text", "").startswith("started MOVE(")]
+    assert "started MOVE(-5, 3, 2, 5)" in started and "started MOVE(2, 5, 5, 5)" in started
+    (end,) = [e for e in events if e["kind"] == "mission-end"]
+    assert end["outcome"] == "succeeded", end

@@ -20,6 +20,7 @@ VALIDATE_ACCEPTS = frozenset({"end", "ok", "OK", "ether", "exec"})
 
 
 def check(ctx: Context) -> None:
+    posters = {module.name: {p.name for p in module.posters} for module in ctx.items(m.Module)}
     for module in ctx.items(m.Module):
         used: list[tuple[str, Span]] = []
         for request in module.requests:
@@ -63,6 +64,25 @@ def check(ctx: Context) -> None:
         for task in module.exec_tasks:
             for codel in task.codels:
                 check_call(ctx, codel.function, functions.get(codel.function), TASK_CODEL, where, codel.span)
+        for name, span in dict(used).items():
+            check_poster_reads(ctx, name, functions.get(name), posters, where, span)
+
+
+def check_poster_reads(ctx: Context, name: str, shape: FunctionShape | None, posters: dict[str, set[str]],
+                       where: str, span: Span) -> None:
+    """Each poster a codel reads by a written name (`sdi.read_poster("arm.State")`) is one a module
+    exports: a misspelt one reads None at run time, which the codel takes for "not yet"."""
+    for poster, line in shape.posters if shape is not None else ():
+        module, _, exported = poster.partition(".")
+        assert shape is not None
+        if module not in posters:
+            ctx.warn("undefined-module", f"codel '{name}' reads poster '{poster}' ({place(shape, where, line)}), "
+                     f"but no module is named '{module}'{did_you_mean(module, posters)}: it reads None", span)
+        elif exported not in posters[module]:
+            known = posters[module]
+            ctx.warn("undefined-poster", f"codel '{name}' reads poster '{poster}' ({place(shape, where, line)}), which "
+                     f"module '{module}' does not export{did_you_mean(exported, known)} (its posters: "
+                     f"{', '.join(sorted(known)) or 'none'}): it reads None", span)
 
 
 def check_call(ctx: Context, name: str, shape: FunctionShape | None, call: tuple[str, ...], where: str,

@@ -33,7 +33,7 @@ def raiseHook(sdi, request):
     sdi.cycles += 1
     if sdi.cycles < HOOK_CYCLES:
         return "exec"
-    sdi.hardware.trace.taken.add(sdi.cart)  # on the tug (the map draws it taken)
+    sdi.hardware.trace.taken.add(sdi.cart)  # on the tug (the simulator's own pictures draw it taken)
     return "end"
 
 

@@ -19,6 +19,8 @@ def squeeze(sdi, request, force=1.0):  # a default third argument is fine
 def hold(sdi, request, *rest):
     def inner():
         return "anything"  # a nested function's returns are its own
+    if sdi.read_poster("arm.State") is None or sdi.read_poster("hnad.Grip") is None:  # arm exports none; a typo
+        return "exec"
     return "SLIP" if inner() else "ether"
 
 
