@@ -454,23 +454,17 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
     """The goals of an executive KA (`property: executive`, the request protocol of Fig 4.3) name
     a service first: a constant there must be one the executive offers, or the request is answered
     BAD-SERVICE at run time and `specc verify --goal` stops at it."""
-    protocols = {ka.invocation.body.head: ka for ka in procedures.kas if "executive" in ka.properties
-                 and isinstance(ka.invocation, m.Goal) and ka.invocation.body.args}
-    # The services each head's executive KAs serve, when every one names its service (a KA per
-    # service, `!(EXEC STOW $R)`); None when one serves any (`!(EXEC $S $R)`).
+    # Each head's executive KAs, and the services they serve when every one names its service (a
+    # KA per service, `!(EXEC STOW $R)`); None when one serves any (`!(EXEC $S $R)`).
+    protocols: dict[str, m.KA] = {}
     served: dict[str, set[str] | None] = {}
     for ka in procedures.kas:
         if "executive" in ka.properties and isinstance(ka.invocation, m.Goal) and ka.invocation.body.args:
-            service = ka.invocation.body.args[0]
             head = ka.invocation.body.head
-            names = served.setdefault(head, set())
+            protocols[head] = ka
+            service, names = _service_name(ka.invocation.body.args[0]), served.setdefault(head, set())
             if names is not None:
-                if isinstance(service, m.Ref):
-                    names.add(service.text)
-                elif isinstance(service, m.String):
-                    names.add(service.value)
-                else:
-                    served[head] = None
+                served[head] = None if service is None else names | {service}
     if not protocols:
         return
     if not executives:
@@ -485,8 +479,7 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
             named = node.body.args[0]
             which = f"executive '{executives[0].name}' does not offer" if len(executives) == 1 \
                 else "no executive offers"
-            # A string is the service's name too, once compiled (`"AVOID-ON"`); a number never is.
-            name = named.text if isinstance(named, m.Ref) else named.value if isinstance(named, m.String) else None
+            name = _service_name(named)
             kas_serve = served.get(node.body.head)
             if name is not None and kas_serve is not None and name not in kas_serve:
                 ctx.warn("no-applicable-ka", f"goal {node.body.head} asks for service '{name}', but no executive KA "
@@ -501,6 +494,12 @@ def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: li
                          f"'{protocols[node.body.head].name}' is the executive's request protocol), not "
                          f"{named.value}, which {which} (services: {', '.join(sorted(services))}): it will be "
                          "answered BAD-SERVICE", named.span)
+
+
+def _service_name(arg: m.SArg) -> str | None:
+    """The service a request's first argument names: a name, or a string (the service's name too,
+    once compiled: `"AVOID-ON"`); None for a variable or a number."""
+    return arg.text if isinstance(arg, m.Ref) else arg.value if isinstance(arg, m.String) else None
 
 
 def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:

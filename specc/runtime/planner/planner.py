@@ -48,6 +48,7 @@ from specc.runtime.planner.search import (
     is_temporal,
     is_var,
     producers_of,
+    restoring_events,
     task_constraints,
     translate,
 )
@@ -477,7 +478,7 @@ class Setup:
         self.kept_ids: set[str] = set()  # a repair's instances put back from the plan it repairs
         self.context = Context(problem.end, self.origin, now, limits, {r.name: r.capacity for r in domain.resources},
                                producers_of(domain), self.nature_before, controllability,
-                               flaws == OLDEST_TASK_FIRST)
+                               flaws == OLDEST_TASK_FIRST, restoring=restoring_events(domain))
 
     def root(self, active: list[Goal], repair: Repair | None = None) -> Node:
         node = self.problem_root(active)
@@ -727,23 +728,20 @@ class Setup:
         """Plans for the `active` goals made from `node`'s by splitting its moves at waypoints
         (`waypoints`: where the robot waits, it goes part of the way to its next place), each
         better than the one before, within `budget` partial plans; and the partial plans spent.
-        Better (`_sooner`): the goals met no later and some sooner, the worst-case makespan no
-        longer (the time a wait saves comes out at the end only once the waits after it are used
-        too); the last plan's makespan beats `bound` or it is not returned. First improvement: a
-        split that makes the plan better is kept, and the moves are looked at again."""
+        Better (`_sooner`): a shorter worst-case makespan, or the same one with the goals met
+        sooner (the sum of their dates: the time a wait saves comes out at the end only once the
+        waits after it are used too); the last plan's makespan beats `bound` or it is not
+        returned. First improvement: a split that makes the plan better is kept, and the moves
+        are looked at again."""
         found: list[Node] = []
         nodes = 0
-        kept_ids = set(self.kept_ids)  # a repair's, which the splits' searches would add to
-        try:
-            while self.movers and nodes < budget:
-                better, used = self._split_one_move(active, node, budget - nodes)
-                nodes += used
-                if better is None:
-                    break
-                node = better
-                found.append(node)
-        finally:
-            self.kept_ids = kept_ids
+        while self.movers and nodes < budget:
+            better, used = self._split_one_move(active, node, budget - nodes)
+            nodes += used
+            if better is None:
+                break
+            node = better
+            found.append(node)
         return ([found[-1]] if found and found[-1].worst_end() < bound - IMPROVEMENT else []), nodes
 
     def merge_drive_throughs(self, active: list[Goal], node: Node, budget: int) -> tuple[Node, int]:
@@ -761,27 +759,27 @@ class Setup:
                 tried = self.search(active, min(WAYPOINT_TRIAL, budget - nodes), True, None,
                                     wp.merge(plan, first, second, mover))
                 nodes += tried.nodes
-                if tried.node is not None and not _sooner(current, self._lateness(active, tried.node)):
-                    node, current, merging = tried.node, self._lateness(active, tried.node), True
+                if tried.node is not None and not _sooner(current, late := self._lateness(active, tried.node)):
+                    node, current, merging = tried.node, late, True  # no worse
                     break
                 if nodes >= budget:
                     break
         return node, nodes
 
     def _split_one_move(self, active: list[Goal], node: Node, budget: int) -> tuple[Node | None, int]:
-        """The first plan better than `node`'s made by splitting one of its moves at a waypoint
-        where the robot then stops for something (`waypoints.stops_there`), or None; and the
-        partial plans spent. The moves in the order they are dispatched, each after an idle time
+        """The first plan better than `node`'s made by splitting one of its moves at a waypoint,
+        or None; and the partial plans spent. The moves in the order they are dispatched, each after an idle time
         only, its waypoints farthest first, a first leg too slow for the idle time not searched."""
         plan, _ = self.extract(node, exact=False)
         current = self._lateness(active, node)
+        reached = {name: wp.places(plan, mover) for name, mover in self.movers.items()}
         nodes = 0
         for move in plan.ordered():
             mover = self.movers.get(move.task)
             idle = wp.idle_time(plan, move) if mover is not None else 0.0
             if mover is None or idle <= EPS:
                 continue
-            for point in wp.candidates(move, mover, wp.places(plan, mover)):
+            for point in wp.candidates(move, mover, reached[move.task]):
                 if not wp.first_leg_fits(move, mover, point, idle):
                     continue
                 if nodes >= budget:
@@ -1111,14 +1109,15 @@ def pick_need(node: Node) -> tuple[Assertion, list[Resolver]] | None:
 def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
                    insertions: list[tuple[pm.Task, int]]) -> list[Resolver]:
     """The need's resolvers, ranked, from its producers and the tasks that could give it. A task
-    that gives the value back (`restores`: a probe lowered and raised again, a move from STILL to
-    STILL) comes last: it needs the value itself at its start, so the link its own need would take
+    that gives the value back (`Context.restoring`: a probe lowered and raised again, a move
+    from STILL to STILL) comes last: it needs the value itself at its start, so the link its own need would take
     serves the need as well, and inserted first it only adds an action (a probe of a plot the plan
     has no goal for, whose free coordinates the insertion binds to where the robot is)."""
+    restoring = node.ctx.restoring
     inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions
-               if not restores(task, index)]
+               if (task.name, index) not in restoring]
     restorers = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions
-                 if restores(task, index)]
+                 if (task.name, index) in restoring]
     if not existing:
         return inserts + restorers
     siblings = {node.assertions[k.producer].owner for k in node.links
@@ -1136,23 +1135,6 @@ def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
     links = [(r[0], Resolver("link", need=need.id, producer=r[-1])) for r in ranked]
     # Safe links first, then new tasks, then links something may undo, then tasks giving it back.
     return [r for risky, r in links if not risky] + inserts + [r for risky, r in links if risky] + restorers
-
-
-_RESTORES: dict[tuple[int, int], bool] = {}
-
-
-def restores(task: pm.Task, index: int) -> bool:
-    """Does the task's event at `index` give back a value the task itself changed (an event of
-    the same attribute instance going from that value)? Cached by the task's identity."""
-    key = (id(task), index)
-    found = _RESTORES.get(key)
-    if found is None:
-        event = task.assertions[index]
-        assert isinstance(event, pm.Event)
-        found = any(isinstance(a, pm.Event) and a is not event and a.attribute == event.attribute
-                    and a.args == event.args and a.before == event.after for a in task.assertions)
-        _RESTORES[key] = found
-    return found
 
 
 def unbound(node: Node) -> list[Resolver] | None:

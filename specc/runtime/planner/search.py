@@ -372,6 +372,22 @@ class Context:
     # The order the goals are taken up in, by source line (an improvement's trial); absent: the
     # goal that may come earliest first.
     goal_order: Mapping[int, int] = field(default_factory=dict)
+    # The events that give back a value their task changed (task name, event index), see restoring_events.
+    restoring: frozenset[tuple[str, int]] = frozenset()
+
+
+def restoring_events(domain: pm.PlanningDomain) -> frozenset[tuple[str, int]]:
+    """The events (task name, index) that give back a value their own task changed: another event
+    of the task on the same attribute instance goes from that value (a probe lowered and raised
+    again, a move from STILL to STILL)."""
+    found = set()
+    for task in domain.tasks:
+        events = [(i, a) for i, a in enumerate(task.assertions) if isinstance(a, pm.Event)]
+        for i, event in events:
+            if any(j != i and a.attribute == event.attribute and a.args == event.args and a.before == event.after
+                   for j, a in events):
+                found.add((task.name, i))
+    return frozenset(found)
 
 
 def producers_of(domain: pm.PlanningDomain) -> dict[str, list[tuple[pm.Task, int]]]:
