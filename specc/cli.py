@@ -152,7 +152,8 @@ def compile(paths: PathsArg,
 
 @app.command()
 def fmt(paths: PathsArg,
-        check_only: Annotated[bool, typer.Option("--check", help="Change nothing; exit 1 if a file would change.")]
+        check_only: Annotated[bool, typer.Option(
+            "--check", help="Change nothing; name each file that would change and exit 1 (--diff shows the changes).")]
         = False,
         diff: Annotated[bool, typer.Option("--diff", help="Show what would change, and change nothing.")]
         = False) -> None:
@@ -177,7 +178,7 @@ def fmt(paths: PathsArg,
         if formatted == text:
             continue
         changed.append(source.path)
-        if diff or check_only:
+        if diff:  # --check alone names the files: --diff shows the changes
             sys.stdout.writelines(difflib.unified_diff(
                 text.splitlines(keepends=True), formatted.splitlines(keepends=True),
                 f"{source.path} (now)", f"{source.path} (formatted)"))
@@ -273,7 +274,9 @@ def verify(paths: PathsArg,
            = None,
            requests: Annotated[int, typer.Option(min=1, help="Requests the task level may have outstanding "
                                                  "at once (the bound of the exploration).")] = 2,
-           max_states: Annotated[int, typer.Option(min=1, help="Stop after this many states.")] = 500_000,
+           max_states: Annotated[int, typer.Option(min=1, help="Stop after this many states (the executive's "
+                                                   "properties then hold only in the states explored: exit 1).")]
+           = 500_000,
            goal: Annotated[Optional[list[str]], typer.Option(
                help="Verify the procedures instead: the goal posted, e.g. '!(COLLECT-OBJECTS 2)' (repeatable).")]
            = None,
@@ -301,6 +304,10 @@ def verify(paths: PathsArg,
     translated into a coloured Petri net whose whole state space is explored; deadlocks,
     unbounded places, statements that never run or never succeed, endless cycles and --reach
     queries are reported with the firing sequence that shows them, in KA lines.
+
+    Exit status for the executive: 0 when every property holds in every state, 1 when one is
+    refuted or --max-states stopped the exploration; for the procedures: 0, or 1 with --strict
+    when there is a finding.
 
     Example: specc verify examples/generic --executive generic
 
@@ -854,16 +861,20 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
         note = check_kinds(events, kind or ())
     except RunError as error:
         raise _run_error(error, 2) from None
-    for said in cut:
-        err.print(f"warning: {said}", markup=False)
-    if note is not None:
-        err.print(f"note: {note}", markup=False)
     previous: float | None = None
     for event in select(events, kind or (), start, end):
         if speed > 0 and previous is not None and event["t"] > previous:
             time.sleep((event["t"] - previous) / speed)
         previous = event["t"]
         out.print(describe(event), markup=False)
+    # What the listing lacks is said under it, where a long listing leaves the reader. The note
+    # goes to stderr: the listing is flushed first, whole lines, so that where both streams share
+    # a screen or a file the note starts a line of its own.
+    out.file.flush()
+    for said in cut:
+        err.print(f"warning: {said}", markup=False)
+    if note is not None:
+        err.print(f"note: {note}", markup=False)
     if not render:
         return
     from specc.run.render import render_run
@@ -905,6 +916,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
     """
     from specc.run import RunError, writable_file
     from specc.run.measures import rich_table
+    from specc.run.mission import brief_why
     from specc.run.session import RunCrashed, RunRequest, compile_robot
     from specc.run.sweep import sweep, write_table
 
@@ -943,8 +955,8 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
         for row in cells:
             table.add_row(*row[:shown])
         table_out().print(table)
-    for failure in result.failures:
-        out.print(f"failed: {failure.name}: {failure.why}", markup=False)
+    for failure in result.failures:  # each reason cut short: the run's report.json has it whole
+        out.print(f"failed: {failure.name}: {brief_why(failure.why)}", markup=False)
     for path in written:
         out.print(f"wrote {path}", markup=False)
 
@@ -1134,7 +1146,8 @@ def campaign(
                             _names(missions) if missions is not None else defaults.missions,
                             _names(worlds) if worlds is not None else defaults.worlds, runs,
                             _names(configs) if configs is not None else defaults.configurations, _names(set_apart))
-        check_names(plan)
+        for note in check_names(plan):
+            err.print(f"note: {note}", markup=False)
         count = workers or default_workers()
         engine = (LocalEngine(setting, count, timeout) if scheduler is None
                   else DaskEngine(setting, scheduler, count, timeout))

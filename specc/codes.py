@@ -48,7 +48,8 @@ CODES: dict[str, Code] = {
                           "request: GoTo;   (not loco.GoTo)"),
     "undefined-module": Code("no module of that name", "request: lcoo.GoTo;"),
     "undefined-request": Code("no request of that name in the module", "request: loco.Trak;"),
-    "undefined-poster": Code("no poster of that name in the module", "get: loco.Robo;"),
+    "undefined-poster": Code("no poster of that name in the module (in a spec, or read by a codel or an "
+                             "executive function)", "get: loco.Robo;   sdi.read_poster(\"loco.Robo\")"),
     "undefined-field": Code("no field of that name in the record or poster", "data: pos, spede;"),
     "undefined-type": Code("no type of that name", "struct P { y: dooble; }"),
     "undefined-exec-task": Code("no exec task of that name in the module", "task: Missing;"),

@@ -565,7 +565,7 @@ def test_check_refuses_a_world_whose_start_the_body_overlaps(tmp_path: Path) -> 
     result = specc(tmp_path, "check", cart)
     assert result.returncode == 1, result.stderr
     assert "worlds/shop.toml: the robot's body (its 0.25 m radius) at its start (4.5, 1.1, heading 0 rad) " \
-           "overlaps an obstacle or a wall" in result.stderr and "[bad-world]" in result.stderr
+           "overlaps obstacles[0]: move [start]" in result.stderr and "[bad-world]" in result.stderr
 
 
 def test_a_misspelt_device_is_named_with_a_hint_at_the_codel_s_line(tmp_path: Path) -> None:

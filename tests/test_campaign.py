@@ -325,3 +325,25 @@ def test_a_damaged_or_foreign_store_is_one_clear_message_and_loses_no_verdict(tm
     result = specc("campaign", ATRV, *SMALL, "--configs", "Robot1", "--store", damaged, "--report-only", "-o",
                    tmp_path / "out")  # the configurations the store was described with
     assert result.returncode == 2 and "has the status 'weird'" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_planners_sharing_the_mutated_model_are_said_to_share_its_faults(tmp_path: Path) -> None:
+    """The rover's two planners plan in two models: no note. The tug's given one model, a mutant of
+    it reaches both, which the campaign says before it runs (their diversity is then no defence)."""
+    import shutil
+
+    from specc.campaign.campaign import CampaignPlan, check_names
+    from specc.run.session import compile_robot
+
+    assert check_names(CampaignPlan(ATRV, SETTING, "model1", 1, 0, ("M1",), ("W1",), 1, ("Robot1", "Robot1/2"))) == []
+    one_model = tmp_path / "tug"
+    shutil.copytree(ROOT / "examples" / "tug", one_model)
+    spec = (one_model / "ftplan.spec").read_text()
+    assert "careful: shuttle_slow;" in spec
+    (one_model / "ftplan.spec").write_text(spec.replace("careful: shuttle_slow;", "careful: shuttle;"))
+    generated = tmp_path / "generated"
+    robot = compile_robot(one_model, generated, lambda text: None)
+    said = check_names(CampaignPlan(one_model, Setting(generated, one_model, robot), "warehouse", 1, 0, ("shuttle",),
+                                    ("hall",), 1, ("Robot1", "Robot1/2")))
+    assert len(said) == 1 and said[0].startswith("configuration Robot1/2: planners quick, careful all plan in "
+                                                 "'warehouse', so each mutant reaches them all")

@@ -319,3 +319,25 @@ def test_an_action_the_safe_state_stopped_counts_as_failed_and_changes_nothing_m
     ftplan.stopped_as_failed("p1")
     assert ftplan.state.changing == {} and ftplan.state.facts[("PTU_POSITION", ())] == "OTHER_POSITION"
     assert ftplan.events[-1].text.startswith("stopped MOVE_PAN_TILT_UNIT(0, -30): counted as failed")
+
+
+def test_a_final_goal_met_by_its_deadline_is_met_when_the_mission_ends_after_it() -> None:
+    """`hold(CHECKED(CP1): YES, (t1, t_end))` with `t1` by 100 s: checked at 63 s and still checked
+    when the mission ends at 300 s is met; one that comes true after 100 s, or comes true in time
+    but stops holding and comes back late, is missed, and says why."""
+    from specc.runtime.ftplan.state import Goal, SystemState
+
+    def mission(*changes: tuple[float, str]) -> SystemState:
+        goal = Goal(66, "CHECKED", ("CP1",), "YES", 3.0, 100.0, True)
+        state = SystemState({("CHECKED", ("CP1",)): "NO"}, (goal,), {})
+        for now, value in changes:
+            state.facts[("CHECKED", ("CP1",))] = value
+            state.check_goals(now)
+        state.check_goals(300.0, mission_over=True)
+        return state
+
+    assert mission((63.5, "YES"), (131.5, "YES")).met == {66}
+    late = mission((120.0, "YES"))
+    assert late.met == set() and late.missed[66] == "its deadline 100 s had passed when it came true"
+    lost = mission((63.5, "YES"), (80.0, "NO"), (150.0, "YES"))
+    assert lost.met == set() and "deadline 100 s" in lost.missed[66]

@@ -115,3 +115,107 @@ def test_a_planner_block_sets_the_improvement_its_planner_makes(tmp_path: Path) 
     quick, careful = config.planners
     assert (quick.improve, careful.improve) == (0, 250)
     assert standard_planner(careful, domains).improve == 250
+
+
+# A patrol: three checkpoints, each checked by its own deadline, home at the end. Every move takes
+# 5 to 60 s whatever the places, so the tour CP1, CP2, CP3 meets every deadline at worst (68, 136
+# and 204 s, home by 266 s). The heuristic takes the lowest priority up first, CP3, and its first
+# plan drops CP3: the tour it leads into misses CP1's deadline.
+PATROL = """
+domain patrol {
+  constant CPS = {CP1, CP2, CP3};
+  constant SPOTS = {HOME, CP1, CP2, CP3};
+  attribute AT() { ?value in SPOTS; }
+  attribute CHECKED(?cp) { ?cp in CPS; ?value in {NO, YES}; }
+  resource BASE() { ?value in [0, 1]; }
+  task MOVE(?from, ?to) (t_start, t_end) {
+    ?from in SPOTS;
+    ?to in SPOTS;
+    event(AT(): (?from, ?to), t_end);
+    use(BASE(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [5, 60];
+  } nonPreemptive
+  task INSPECT(?cp) (t_start, t_end) {
+    ?cp in CPS;
+    hold(AT(): ?cp, (t_start, t_end));
+    event(CHECKED(?cp): (NO, YES), t_end);
+    use(BASE(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [3, 8];
+  } nonPreemptive
+}
+
+problem night for patrol {
+  timepoint t1, t2, t3, t_home;
+  explained event(AT(): (CP1, HOME), t_start);
+  explained event(CHECKED(CP1): (YES, NO), t_start);
+  explained event(CHECKED(CP2): (YES, NO), t_start);
+  explained event(CHECKED(CP3): (YES, NO), t_start);
+  hold(CHECKED(CP1): YES, (t1, t_end)) goal(3, 0);
+  hold(CHECKED(CP2): YES, (t2, t_end)) goal(2, 0);
+  hold(CHECKED(CP3): YES, (t3, t_end)) goal(1, 0);
+  hold(AT(): HOME, (t_home, t_end)) goal(4, 0);
+  (t1 - t_start) in [0, 100];
+  (t2 - t_start) in [0, 200];
+  (t3 - t_start) in [0, 300];
+  (t_end - t_home) in [2, 4];
+  (t_end - t_start) in [0, 360];
+}
+"""
+
+
+def spec_models(folder: Path, text: str, problem_name: str) -> tuple[pm.PlanningDomain, pm.Problem]:
+    from specc.analysis.planning import domain_model, problem_model
+    from specc.model import nodes as m
+    from specc.pipeline import load
+
+    folder.mkdir(exist_ok=True)
+    (folder / "planning.spec").write_text(text)
+    loaded = load([folder])
+    assert not loaded.errors and loaded.program is not None, loaded.diagnostics
+    problem = next(p for p in loaded.program.items if isinstance(p, m.Problem) and p.name == problem_name)
+    domain = next(d for d in loaded.program.items if isinstance(d, m.Domain) and d.name == problem.domain.text)
+    return domain_model(loaded.program, domain), problem_model(loaded.program, problem)
+
+
+def test_a_goal_the_first_tour_drops_is_kept_by_another_tour(tmp_path: Path) -> None:
+    domain, problem = spec_models(tmp_path / "patrol", PATROL, "night")
+    first = Planner(domain).plan(problem)
+    assert [g.description.split(" ")[0] for g in first.dropped] == ["CHECKED(CP3)"]
+    improved = Planner(domain, improve=300).plan(problem)
+    checked(domain, problem, improved)
+    assert improved.dropped == () and improved.plan is not None
+    assert "goal(s) kept by the improvement: CHECKED(CP3)" in improved.notes[-1]
+    visits = [a.args[0] for a in improved.plan.ordered() if a.task == "INSPECT"]
+    assert visits == ["CP1", "CP2", "CP3"]  # the only order in time for CP1 and CP2
+
+
+def test_a_goal_the_mission_end_drops_is_kept_by_a_shorter_tour(tmp_path: Path) -> None:
+    # Six photos on a line, listed zigzag (-6, 6, -4, 4, -2, 2): the tour the heuristic takes,
+    # in that order, cannot take the sixth within the mission's 400 s; a tour with the end lifted
+    # finds a shorter order, and the plan takes the end back.
+    from tests.conftest import EXAMPLES
+
+    photos = [(-6, 0.5), (6, 0.5), (-4, 0.5), (4, 0.5), (-2, 0.5), (2, 0.5)]
+    lines = ["problem zigzag for model1 {", "  timepoint t_home;"]
+    lines += [f"  timepoint t_p{i}s, t_p{i}e;" for i in range(len(photos))]
+    lines += [f"  explained event({fact}, t_start);" for fact in (
+        "AT_ROBOT_X(): (1.0, 0.0)", "AT_ROBOT_Y(): (1.0, 0.0)", "ROBOT_STATUS(): (MOVING, STILL)",
+        "PTU_POSITION(): (PTU_POSITION_IDLE, STRAIGHT)", "PTU_DRIVER_INITIALIZED(): (FALSE, TRUE)",
+        "MVT_GENERATION_INITIALIZED(): (FALSE, TRUE)")]
+    for i in range(len(photos)):
+        lines += [f"  variable ?x{i}, ?y{i};", f"  ?x{i} in [-oo, +oo];", f"  ?y{i} in [-oo, +oo];",
+                  f"  explained event(PICTURE(OBJ{i + 1}, ?x{i}, ?y{i}): (PICTURE_IDLE, NONE), t_start);"]
+    lines += ["  hold(AT_ROBOT_X(): 0.0, (t_home, t_end)) goal(4, 0);",
+              "  hold(AT_ROBOT_Y(): 0.0, (t_home, t_end)) goal(4, 0);"]
+    number = lambda v: f"0 - {abs(v):.1f}" if v < 0 else f"{v:.1f}"  # noqa: E731
+    lines += [f"  hold(PICTURE(OBJ{i + 1}, {number(x)}, {number(y)}): DONE, (t_p{i}s, t_p{i}e)) goal(2, 0);"
+              for i, (x, y) in enumerate(photos)]
+    lines += ["  (t_end - t_home) in [2, 4];", "  (t_end - t_start) in [0, 400];", "} earlyPreemptive"]
+    text = "\n".join((EXAMPLES / "atrv" / name).read_text() for name in ("model1.spec", "model1_relations.spec"))
+    domain, problem = spec_models(tmp_path / "zigzag", text + "\n" + "\n".join(lines) + "\n", "zigzag")
+    first = Planner(domain).plan(problem)
+    assert first.plan is not None and len(first.dropped) == 1
+    improved = Planner(domain, improve=300).plan(problem)
+    checked(domain, problem, improved)
+    assert improved.dropped == () and improved.plan is not None
+    assert improved.plan.makespan <= 400.0

@@ -337,3 +337,33 @@ def test_a_square_is_propagated_as_a_square_not_as_a_product_of_two_ranges() -> 
     # A square is never negative: d * d = -1 has no solution.
     negative = [pm.Relation("=", pm.Op("*", (d, d)), pm.Num(-1.0))]
     assert bounds(negative, {}, [("var", "?d")]) is None
+
+
+def test_a_goal_held_to_the_end_keeps_the_deadline_of_its_start(tmp_path: Path) -> None:
+    """`hold(CHECKED(CP1): YES, (t1, t_end))` with `(t1 - t_start) in [0, 100]`: checked by 100 s and
+    so to the end. The effects achieving it are refused after 100 s; the home goal, held from 2 s
+    before the end, keeps the horizon's deadline alone."""
+    from tests.test_plan_anytime import PATROL, spec_models
+
+    domain, problem = spec_models(tmp_path / "patrol", PATROL, "night")
+    result = export(domain, problem)
+    literals = timed_literals(result)
+    assert {(Fraction(100), "before_t1", False), (Fraction(200), "before_t2", False),
+            (Fraction(300), "before_t3", False)} <= literals
+    assert not any(name == "before_t_home" for _, name, _ in literals)
+    assert mentions(result, "CHECKED(CP1): YES", "reached by 100 s")
+
+
+def test_the_files_are_the_same_from_one_process_to_the_next(tmp_path: Path) -> None:
+    import os
+    import subprocess
+    import sys
+
+    def written(seed: str) -> list[str]:
+        folder = tmp_path / seed
+        subprocess.run([sys.executable, "-m", "specc.cli", "export", str(ATRV), "--problem", "M4", "--domain",
+                        "model2", "-o", str(folder)], check=True, capture_output=True,
+                       env={**os.environ, "PYTHONHASHSEED": seed})
+        return [(folder / name).read_text() for name in ("domain.pddl", "problem.pddl")]
+
+    assert written("1") == written("2")

@@ -510,3 +510,112 @@ def test_what_keeps_procedures_from_a_net_is_said_in_the_files_order() -> None:
 
     late, early = (error("unbounded-variable", f"line {n}", Span("p.spec", n, 1, n, 2)) for n in (51, 18))
     assert [d.message for d in TranslationError([late, early]).diagnostics] == ["line 18", "line 51"]
+
+
+# ---------------------------------------------------------------- what the executive answers
+
+PROBED = """
+module probe {
+  codels: "probe_codels";
+  request Measure {
+    type: exec;
+    output: level: double;
+    task: Sampling;
+    fail: NO_SAMPLE;
+    codel exec: measure;
+  }
+  request Spray {
+    type: exec;
+    task: Sampling;
+    codel exec: spray;
+  }
+  exec_task Sampling { period: 100 ms; }
+}
+
+executive field {
+  codels: "field_codels";
+  service MEASURE { request: probe.Measure; output: verdict; }
+  service SPRAY { request: probe.Spray; }
+}
+
+procedures tasks {
+  type SERVICES = {MEASURE, SPRAY};
+  type RESULTS = {OK, TIMEOUT, INT, ERROR, REFUSED, NO_SAMPLE, HEAVY, LIGHT, NONE};
+  predicate event REPLY(id: int, result: RESULTS);
+  predicate EXEC(service: SERVICES, result: RESULTS);
+  action MEASURE() -> int = service MEASURE;
+  action SPRAY() -> int = service SPRAY;
+  ka Exec {
+    invocation: !(EXEC $SERVICE $RESULT);
+    property: executive;
+    body { !(SEND $SERVICE $ID); ^(REPLY $ID $RESULT); }
+  }
+  ka SendMeasure { invocation: !(SEND MEASURE $ID); action: (MEASURE) -> $ID; }
+  ka SendSpray { invocation: !(SEND SPRAY $ID); action: (SPRAY) -> $ID; }
+  ka Check {
+    invocation: !(CHECK);
+    body {
+      !(EXEC MEASURE $V);
+      if ?(= $V HEAVY) {
+        !(EXEC SPRAY $S);
+      } else {
+        if ?(= $V LIGHT) {
+          !(EXEC SPRAY $S);
+        }
+      }
+    }
+  }
+}
+
+system field {
+  modules: probe;
+  executive: field;
+  supervisor: tasks;
+}
+"""
+PROBE_CODELS = 'def measure(sdi, request):\n    return "end"\n\n\ndef spray(sdi, request):\n    return "end"\n'
+VERDICT = ('def verdict(ctx, outputs):\n'
+           '    return "HEAVY" if outputs.level > 0.6 else "LIGHT" if outputs.level > 0.3 else "NONE"\n')
+SPRAY_LINES = [n for n, line in enumerate(PROBED.splitlines(), start=1) if "!(EXEC SPRAY $S);" in line]
+
+
+def probed(folder: Path, text: str = PROBED) -> str:
+    """`text` with the codels its module and its executive name, written next to it."""
+    (folder / "probe_codels.py").write_text(PROBE_CODELS, encoding="utf-8")
+    (folder / "field_codels.py").write_text(VERDICT, encoding="utf-8")
+    return text
+
+
+def test_a_service_s_output_function_may_answer_any_word_of_the_result_s_domain(tmp_path: Path) -> None:
+    """MEASURE's output function returns HEAVY, LIGHT or NONE when the service worked, which the
+    net cannot compute: both spray branches are reached without any `--fail`."""
+    branches = [parse_query(f"Check:{line}") for line in SPRAY_LINES]
+    report = check(probed(tmp_path), "!(CHECK)", tmp_path, queries=branches)
+    assert "unreachable" not in report.kinds() and report.findings == [], report.kinds()
+    assert [answer.reached for answer in report.answers] == [True, True]
+    assert report.succeeded >= 1 and report.failed == 0
+
+
+def test_a_service_without_an_output_function_answers_ok_when_it_works(tmp_path: Path) -> None:
+    """The executive answers OK to a service that has no output function: neither branch runs
+    unless MEASURE may fail (a failing service answers any word of the domain)."""
+    text = probed(tmp_path, PROBED.replace(" output: verdict;", ""))
+    expected = f"KA 'Check': these statements can never run: {SPRAY_LINES[0]} !(EXEC SPRAY $S); " \
+               f"{SPRAY_LINES[1]} !(EXEC SPRAY $S)"
+    assert finding(check(text, "!(CHECK)", tmp_path), "unreachable") == expected
+    assert "unreachable" not in check(text, "!(CHECK)", tmp_path, failing=["MEASURE"]).kinds()
+
+
+@pytest.mark.parametrize(("failing", "failures"), [
+    ((), set()),
+    (("MEASURE",), {"TIMEOUT", "INT", "ERROR", "REFUSED", "NO_SAMPLE"}),
+])
+def test_an_output_function_s_answers_leave_the_failures_to_fail(tmp_path: Path, failing: tuple[str, ...],
+                                                                 failures: set[str]) -> None:
+    """The words the executive answers a failure with (its own categories, the module request's
+    reports) come only with `--fail`, as for any service; the output's words come either way."""
+    program = program_of(probed(tmp_path), tmp_path)
+    block = next(i for i in program.items if isinstance(i, m.Procedures))
+    translation = translate(program, block, [rp.parse_goal("!(CHECK)")], failing=failing)
+    answers = translation.net.transitions["service MEASURE answers"].bindings or ()
+    assert {binding["1"][1] for binding in answers} == {"OK", "HEAVY", "LIGHT", "NONE"} | failures

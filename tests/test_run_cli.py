@@ -265,6 +265,41 @@ def test_the_table_of_measures_comes_from_one_command(tmp_path: Path) -> None:
     assert all((Path(run["folder"]) / "events.jsonl").is_file() for run in data["runs"])
 
 
+def test_a_failed_mission_says_each_reason_once_and_its_summary_cuts_it_short() -> None:
+    """FTplan gives every goal it abandons at once the same reason, every planner's diagnostics:
+    said once for the goals it stands for, cut short in the summary's line and the table's
+    failures, whole in the run's report."""
+    from specc.run.mission import MissionRun, brief_why, missed_goals
+    from specc.run.session import RunOutcome
+    from specc.run.sweep import SweepResult
+
+    diagnostics = ("every planner's plan left them aside (quick: CART_AT(CART1) = C (line 115, priority 2): "
+                   "impossible even alone: every partial plan failed; most often: "
+                   + "t_end - MOVE.t_start in [80, inf] contradicts [3, 8.7], which the plan already implies, " * 20
+                   + "the goal's dates: t1 < t2 (line 117))")
+    cart, dock, home = ("CART_AT(CART1) = C (line 115, priority 2)", "AT() = DOCK (line 116, priority 1)",
+                        "AT() = HOME (line 118, priority 1)")
+    why = missed_goals({cart: diagnostics, dock: diagnostics, home: "its deadline 300 s has passed"})
+    assert why == (f"3 planned goal(s) missed: {cart}, {dock}: {diagnostics}; "
+                   f"{home}: its deadline 300 s has passed")
+    why += "; 51 action failure(s); the last: MOVE(AWAY, DOCK) overran its planned duration [3, 80] s"
+    brief = brief_why(why)
+    assert len(brief) < 600 < len(why)
+    assert brief.startswith(f"3 planned goal(s) missed: {cart}, {dock}: every planner's plan left them aside "
+                            "(quick: CART_AT(CART1)")
+    assert brief.count("…") == 1 and "…)" in brief  # cut inside the diagnostics, their bracket closed
+    # The short reasons after it, whole.
+    assert brief.endswith(f"; {home}: its deadline 300 s has passed; 51 action failure(s); the last: "
+                          "MOVE(AWAY, DOCK) overran its planned duration [3, 80] s")
+    assert brief_why("every goal achieved (9)") == "every goal achieved (9)"
+    run = MissionRun("tug", "shuttle", "blocked", 0, "failed", why, (), 893.0, 29.0, 8.6, 51, {}, (), ())
+    assert run.summary().splitlines()[0] == f"tug's mission shuttle in blocked (seed 0): failed: {brief}"
+    report = {"mission": "shuttle", "world": "blocked", "outcome": "failed", "why": why, "measures": {}}
+    table = SweepResult("tug", [RunOutcome(Path("runs/tug-shuttle-blocked-s0"), "tug", report, run.summary())])
+    assert f"- tug-shuttle-blocked-s0: {brief}\n" in table.markdown()
+    assert table.to_json()["runs"][0]["why"] == why
+
+
 def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
     result = specc("table", ATRV, "--mission", "M1", "--mission", "M7", "--world", "W1", "--config", "Robot1",
                    "--runs", tmp_path)
@@ -287,6 +322,15 @@ def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:
     some = specc("replay", tmp_path, "--kind", "action", "--kind", "mission-start", "--no-render")
     assert some.returncode == 0 and "mission-start" in some.stdout
     assert "note: no event of kind 'action' in this log" in some.stderr
+    # On one screen (both streams into one), the note closes the listing on a line of its own.
+    (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\n'
+                                           '{"t": 85.2, "kind": "reply", "service": "MOVE", "id": 8, "result": "OK"}\n')
+    shared = subprocess.run([sys.executable, "-m", "specc.cli", "replay", str(tmp_path), "--kind", "reply",
+                             "--kind", "fact", "--no-render"], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, timeout=300)
+    assert shared.returncode == 0, shared.stdout
+    assert shared.stdout.splitlines() == ["    85.200  reply            MOVE #8 -> OK",
+                                          "note: no event of kind 'fact' in this log (it has: mission-start, reply)"]
     (tmp_path / "events.jsonl").write_text('{"t": 0, "kind": "mission-start"}\nnot json\n')
     assert_clean_failure(specc("replay", tmp_path), 2, "events.jsonl")
 

@@ -149,7 +149,7 @@ def test_a_failure_reason_of_a_page_keeps_the_pictures_title_to_three_lines() ->
     title = RunInfo("scout", "Robot1/2", "morning", "orchard", 0, "failed", why, 500.0).title()
     lines = title.splitlines()
     assert len(lines) == 3 and lines[0].startswith("scout Robot1/2, mission morning")
-    assert lines[-1].endswith("(the whole of it: summary.txt)")
+    assert lines[-1].endswith("(the whole of it: report.json)")
     short = RunInfo("scout", "", "morning", "orchard", 0, "succeeded", "every goal met", 500.0).title()
     assert short == "scout, mission morning, world orchard, seed 0 — succeeded: every goal met"
 
@@ -186,13 +186,33 @@ def test_the_service_bars_pair_each_request_with_its_reply(hunt: MissionRun) -> 
     for bar in bars:
         reply = replies[bar.id]
         assert bar.ended == reply["t"] and bar.result == reply["result"]
-        assert bar.outcome == reply_outcome(reply["result"])
+        assert bar.outcome == reply_outcome(reply) and (bar.outcome == "ok") == reply["ok"]
         assert bar.started is None or bar.requested <= bar.started <= bar.ended
     outcomes = {(b.service, b.outcome) for b in bars}
     assert ("SEARCH-OBJ", "ok") in outcomes  # a count of objects seen is a success
     assert ("EXEC-TRAJ-GOAL", "interrupted") in outcomes  # §5.5: a detection stops the exploration move
-    assert reply_outcome("OK") == reply_outcome(2) == "ok" and reply_outcome("INT") == "interrupted"
-    assert reply_outcome("TIMEOUT") == reply_outcome("BLOCKED") == "failed"
+
+
+def reply(result: Any, **ok: bool) -> dict[str, Any]:
+    return {"t": 3.0, "kind": "reply", "service": "PROBE", "id": 1, "result": result, "detail": "", **ok}
+
+
+def test_a_service_whose_output_function_returns_a_word_succeeded() -> None:
+    """The executive's `ok` tells a success from a failure, not the result's word: an output
+    function may return HEAVY, or even TIMEOUT, for a service that ended well."""
+    events = [{"t": 1.0, "kind": "request", "service": "PROBE", "id": 1, "request": "probe.Weigh"},
+              {"t": 1.0, "kind": "activity", "service": "PROBE", "id": 1, "from": "WAIT", "to": "INIT"},
+              {"t": 2.0, "kind": "activity", "service": "PROBE", "id": 1, "from": "INIT", "to": "EXEC"},
+              reply("HEAVY", ok=True),
+              {"t": 3.0, "kind": "activity", "service": "PROBE", "id": 1, "from": "EXEC", "to": "ETHER"}]
+    [bar] = service_bars(events)
+    assert (bar.result, bar.outcome) == ("HEAVY", "ok")
+    assert reply_outcome(reply("TIMEOUT", ok=True)) == "ok"
+    assert reply_outcome(reply("OK", ok=False)) == reply_outcome(reply("BLOCKED", ok=False)) == "failed"
+    assert reply_outcome(reply("INT", ok=False)) == "interrupted"
+    # A log written before replies said `ok`: OK or a count is all there is to go by.
+    assert reply_outcome(reply("OK")) == reply_outcome(reply(2)) == "ok"
+    assert reply_outcome(reply("INT")) == "interrupted" and reply_outcome(reply("TIMEOUT")) == "failed"
 
 
 def test_motions_alternate_and_the_arm_moves_for_its_services(hunt: MissionRun) -> None:

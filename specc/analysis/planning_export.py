@@ -199,10 +199,24 @@ def write_pddl(exported: Exported, folder: Path) -> tuple[Path, Path]:
     writer.write_problem(str(problem_path))
     # PDDLWriter leaves static functions (the duration tables) out of the problem kind, so it omits the
     # requirement they need; strict PDDL parsers (VAL) reject `:functions` without it.
-    text = domain_path.read_text()
+    text = _sorted_constants(domain_path.read_text())
     if "(:functions" in text and ":numeric-fluents" not in text:
-        domain_path.write_text(text.replace("(:requirements :strips", "(:requirements :strips :numeric-fluents", 1))
+        text = text.replace("(:requirements :strips", "(:requirements :strips :numeric-fluents", 1)
+    domain_path.write_text(text)
     return domain_path, problem_path
+
+
+def _sorted_constants(domain: str) -> str:
+    """The domain's `(:constants ...)` with each type's names sorted: PDDLWriter lists them from a
+    set, in an order that changes from one process to the next, and the same specs should give
+    the same files."""
+    head, found, rest = domain.partition(" (:constants")
+    if not found:
+        return domain
+    block, end, tail = rest.partition("\n )\n")
+    lines = [" ".join(sorted(names.split())) + " - " + kind if " - " in line else line
+             for line in block.split("\n") for names, _, kind in [line.partition(" - ")]]
+    return head + found + "\n   ".join(line.strip() for line in lines) + end + tail
 
 
 def constant_set_names(program: m.Program, domain: m.Domain) -> dict[frozenset[str], str]:
@@ -771,6 +785,11 @@ class _Exporter:
             found = {}
         for (_, name), dom in found.items():
             self.dates[name] = dom if isinstance(dom, tuple) else FULL
+        # The latest dates the constraints give without the mission's latest end: a goal's own
+        # deadline, not the horizon's, which is exported on its own.
+        unbounded = bounds(pm.without_latest_end(p).constraints, {("time", p.start): (0.0, 0.0)}, wanted) or {}
+        self.own_latest: dict[str, float] = {name: dom[1] if isinstance(dom, tuple) else math.inf
+                                             for (_, name), dom in unbounded.items()}
 
     # ------------------------------------------------------------ types
     def task_variables(self, task: pm.Task) -> list[str]:
@@ -967,7 +986,11 @@ class _Exporter:
         literal makes false then. The final goal keeps it true afterwards."""
         p = self.problem
         end = goal.time if isinstance(goal, pm.Event) else goal.end
-        if end == p.end:
+        if isinstance(goal, pm.Hold) and end == p.end and math.isfinite(self.own_latest.get(goal.start, math.inf)):
+            # Held to the end from a date with a deadline of its own (`(t1 - t_start) in [0, 100]`):
+            # it must come true by then, and an effect achieving it later is refused as well.
+            end = goal.start
+        elif end == p.end:
             return  # bounded by the horizon's deadline
         latest = self.dates.get(end, FULL)[1]
         # `end - c in [a, b]` with c contingent: whatever nature picks for c, end <= earliest(c) + b.
@@ -1286,8 +1309,9 @@ class _Exporter:
                       "required.")
         if goals_with_windows:
             self.note("the goals' time windows are reduced to final goals (PDDL 2.1 has no timed goals), with a "
-                      "deadline when the window's end is bounded (see above): a goal must still hold at the end of "
-                      "the plan, and the minimal delays (e.g. a goal holding from 2 s before the horizon) are dropped.")
+                      "deadline when the window's end is bounded, or the start of a goal held to the end (see "
+                      "above): a goal must still hold at the end of the plan, and the minimal delays (e.g. a goal "
+                      "holding from 2 s before the horizon) are dropped.")
 
     def instances(self, a: pm.Event) -> list[dict[str, pm.Expr]]:
         """Bindings of the problem variables in the arguments of a given event: those that unify it

@@ -21,7 +21,8 @@ What maps to what:
 - fact-invoked KAs get a token in INIT when a conclusion matches their invocation (Fig 4.25);
 - the executive: the KA marked `property: executive` is the request protocol (Fig 4.3); its goal
   is modelled by the services it names: a service starts when its group place is IDLE and no
-  group holds a service it conflicts with (§5.4.1), then answers (an environment choice);
+  group holds a service it conflicts with (§5.4.1), then answers (an environment choice): OK, or
+  with an output function any value of the answer's domain but its failures, which `--fail` adds;
 - evaluable predicates and primitive actions are environment choices over their results.
 
 Rejected with a diagnostic (§4.4.10): `#` and `%`, meta KAs, variables without a finite domain,
@@ -63,6 +64,10 @@ class Service:
     name: str
     group: str | None  # the group place holding it while it runs
     excluded_by: tuple[tuple[str, str], ...]  # (group place, service) that must not be running
+    # What the executive answers when it worked: OK, or what its output function returns (a value
+    # the net cannot compute, so any value of the answer's domain).
+    output_function: str | None = None
+    failure_reports: frozenset[str] = frozenset()  # the report codes its module request fails with
 
 
 @dataclass
@@ -1506,7 +1511,7 @@ class Translator:
                                               for g in groups)):
                 reads = list(zip(groups, states, strict=True))
                 self.emit.fire(f"{origin} starts", origin, [*takes, *reads], [*puts, *reads])
-            answers = [r for r in results if self.executive.may_fail(name) or _success(r)]
+            answers = [r for r in results if self.executive.may_fail(name) or _success(r, service)]
             self.result.environment.add(f"{origin} answers")
             for result in answers:
                 answer = colour[:-1] + (result,)
@@ -1577,10 +1582,24 @@ def _arithmetic_closure(links: Sequence[tuple[str, Any]], found: dict[str, dict[
 
 
 
-def _success(result: Any) -> bool:
-    """What a service answers when it worked: OK, or a value its output gives (a number); any
-    other symbol is a failure category (TIMEOUT, INT, ERROR, REFUSED, ZOMBIE, a module's report)."""
-    return result == "OK" or isinstance(result, int)
+# What the executive answers on its own when a service did not work (specc/runtime/executive.py):
+# refused, interrupted, out of time, a ZOMBIE, an input or output function that raised, a module's
+# error status.
+EXECUTIVE_FAILURES = frozenset({"TIMEOUT", "INT", "REFUSED", "ZOMBIE", "ERROR", "BAD-SERVICE", "BAD-INPUT",
+                                "FINAL_ERROR", "SERVER_ERROR", "CS_ERROR"})
+
+
+def _success(result: Any, service: Service) -> bool:
+    """May `service` answer `result` when it worked? Without an output function the executive
+    answers OK; a number of the domain is kept too, as before (more than the executive sends, so
+    nothing it does is left out). With one it answers what the function returns, which only running
+    it tells: any value of the domain the procedure receives it in (HEAVY, LIGHT...), except the
+    words the executive answers this service's failures with (its own categories, its module
+    request's reports), which `--fail` brings in: the procedures cannot tell such a word from a
+    failure, so the net does not either."""
+    if service.output_function is None:
+        return result == "OK" or isinstance(result, int)
+    return result not in EXECUTIVE_FAILURES and result not in service.failure_reports
 
 
 def _written(block: Sequence[rp.Statement], bound: set[str]) -> set[str]:

@@ -115,15 +115,19 @@ def executive_model(program: m.Program, procedures: m.Procedures, failing: Seque
         return None
     assert systems[0].executive is not None
     name = systems[0].executive.text
-    executive: m.Executive | None = symbols_of(program).blocks[m.Executive].get(name)
+    symbols = symbols_of(program)
+    executive: m.Executive | None = symbols.blocks[m.Executive].get(name)
     if executive is None:
         return None
     spec = executive_spec(program, executive_controller(program, executive))
     group_of = {service: group for group, services in spec.groups.items() for service in services}
+    requests = {s.name: symbols.service_request(s) for s in executive.services}
     services = {}
     for service in spec.services.values():
         excluded = tuple(sorted((group_of[c], c) for c in service.conflicts if c in group_of))
-        services[service.name] = Service(service.name, group_of.get(service.name), excluded)
+        request = requests.get(service.name)
+        reports = frozenset(r.text for r in request.fail) if request is not None else frozenset()
+        services[service.name] = Service(service.name, group_of.get(service.name), excluded, service.output, reports)
     unknown = sorted(set(failing) - set(services) - {"*"})
     if unknown:
         raise ValueError(f"executive '{name}' offers no service {', '.join(unknown)} (it offers "

@@ -176,8 +176,10 @@ def campaign_defaults(generated: Path, folder: Path, robot_name: str) -> Default
     return Defaults(planners[0].domain, planned, tuple(system.worlds), configurations)
 
 
-def check_names(plan: CampaignPlan) -> None:
-    """Every configuration, mission and world named, checked before anything runs (RunError)."""
+def check_names(plan: CampaignPlan) -> list[str]:
+    """Every configuration, mission and world named, checked before anything runs (RunError).
+    Returns notes: a configuration whose planners share the mutated model, so that each mutant
+    reaches them all (a common-mode fault: seed 004 diversifies models, §3.1, §4.1.2.2)."""
     from specc.run.mission import check_mission, load_robot
 
     if plan.runs < 1:
@@ -190,6 +192,7 @@ def check_names(plan: CampaignPlan) -> None:
     if unknown:
         raise RunError(f"--set-apart {', '.join(unknown)}: not among the campaign's worlds ({', '.join(plan.worlds)})")
     robot = load_robot(plan.setting.generated, plan.setting.example, plan.setting.robot)
+    notes: dict[str, str] = {}
     for configuration in plan.configurations:
         for name in plan.missions:
             mission = robot.mission(name)
@@ -197,11 +200,19 @@ def check_names(plan: CampaignPlan) -> None:
                 raise RunError(f"mission {mission.name} of robot '{robot.name}' is not planned: a campaign injects "
                                "faults into the planning model of planned missions")
             for world in plan.worlds:
-                planned_in = check_mission(robot, mission, world, 0, None, configuration).planning.planned_in
-                if plan.domain not in planned_in:
+                setup = check_mission(robot, mission, world, 0, None, configuration).planning
+                if plan.domain not in setup.planned_in:
                     raise RunError(f"configuration {configuration} does not plan in '{plan.domain}' (it plans in "
-                                   f"{', '.join(sorted(planned_in))}): a campaign injects faults into the model "
+                                   f"{', '.join(sorted(setup.planned_in))}): a campaign injects faults into the model "
                                    "its configurations use")
+                sharing = [p.name for p in setup.config.planners if p.domain == plan.domain]
+                if len(sharing) > 1:
+                    notes[configuration] = (
+                        f"configuration {configuration}: planners {', '.join(sharing)} all plan in '{plan.domain}', "
+                        "so each mutant reaches them all (a fault common to them): their diversity is measured "
+                        "against model faults only with a model of their own each (seed 004 §3.1; §4.1.2.2: "
+                        "Modele1 and Modele2)")
+    return list(notes.values())
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from specc.check.codels import check_call, python_functions
+from specc.check.codels import check_call, check_poster_reads, python_functions
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
@@ -71,6 +71,7 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
     ctx.duplicates(executive.parameters, "parameter")
     services = ctx.symbols.services_of(executive)
     functions = python_functions(ctx, executive.codel_module) if executive.codel_module else None
+    posters = {module.name: {p.name for p in module.posters} for module in ctx.items(m.Module)}
     for ref in executive.rules:
         ctx.lookup(m.RuleBase, ref, ref.span, "undefined-rules")
     for service in executive.services:
@@ -104,8 +105,9 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
             if len(io.parts) >= 2:
                 resolve_poster(ctx, io)
             elif functions is None:
-                ctx.report("missing-property",
-                           f"'{io.text}' is a function: give the executive 'codels: \"python.module\";'", io.span)
+                if executive.codel_module is None:  # else the module is missing or unreadable: said once, there
+                    ctx.report("missing-property",
+                               f"'{io.text}' is a function: give the executive 'codels: \"python.module\";'", io.span)
             elif io.text not in functions:
                 ctx.report("undefined-codel", f"function '{io.text}' is not defined in "
                            f"{executive.codel_module.value if executive.codel_module else ''}"
@@ -113,6 +115,7 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
             elif executive.codel_module is not None:
                 check_call(ctx, io.text, functions[io.text], INPUT_FUNCTION if io is service.input else OUTPUT_FUNCTION,
                            executive.codel_module.value, io.span)
+                check_poster_reads(ctx, io.text, functions[io.text], posters, executive.codel_module.value, io.span)
         timeout = service.timeout
         if timeout is not None:
             for value in (timeout.start, timeout.interm, timeout.final):

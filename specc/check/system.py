@@ -283,11 +283,40 @@ def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goa
         elif len(service.takes) != given:
             ctx.report("arity-mismatch", f"service '{service.name}' takes {len(service.takes)} input(s) "
                        f"({', '.join(t.text for t in service.takes) or 'none'}), {given} given", target.span)
+        else:
+            inputs = request_inputs(ctx, service)
+            check_constant_inputs(ctx, binding.target_args, [inputs.get(t.text) for t in service.takes],
+                                  f"service '{service.name}'")
     else:
         request = resolve_request(ctx, target)
         if request is not None and len(request.inputs) != given:
             ctx.report("arity-mismatch", f"request '{target.text}' takes {len(request.inputs)} input(s) "
                        f"({', '.join(i.name for i in request.inputs) or 'none'}), {given} given", target.span)
+        elif request is not None:
+            check_constant_inputs(ctx, binding.target_args, list(request.inputs), f"request '{target.text}'")
+
+
+def check_constant_inputs(ctx: Context, args: tuple[m.IxExpr, ...], inputs: list[m.TypedName | None],
+                          target: str) -> None:
+    """A binding's constant argument (`service REPORT(FAST)`) must be a value of the input it
+    gives: the request refuses it at run time, at every replanning."""
+    enums = {e.name: set(e.values) for module in ctx.items(m.Module) for e in module.enums}
+    for arg, typed in zip(args, inputs, strict=False):
+        if typed is None or typed.type.size is not None or not isinstance(arg, m.Number | m.IxName):
+            continue
+        kind, value = typed.type.name, arg.value if isinstance(arg, m.Number) else arg.name
+        if kind in NUMERIC_INPUTS:
+            refused = isinstance(value, str)
+        elif kind in WHOLE_INPUTS:
+            refused = isinstance(value, str) or not float(value).is_integer()
+        elif kind in enums:
+            refused = value not in enums[kind]
+        else:
+            continue  # text or a structure: the runtime reads what it is given
+        if refused:
+            allowed = f" ({', '.join(sorted(enums[kind]))})" if kind in enums else ""
+            ctx.report("bad-argument-type", f"{value} cannot be input '{typed.name}' of {target}, of type "
+                       f"{kind}{allowed}", arg.span)
 
 
 def check_binding_report(ctx: Context, report: m.BindingReport, reports: dict[str, int]) -> None:

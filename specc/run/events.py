@@ -18,7 +18,7 @@ know):
 | `goal` | a goal is posted to the supervisor, and when it ends | `goal`, `status` (posted, succeeded, failed) |
 | `request` | the task level asks the executive for a service (RQST EXEC, §3.9) | `service`, `id`, `request` |
 | `activity` | an executive activity changes phase (Fig 3.3; WAIT→INIT is its start) | `service`, `id`, `from`, `to` |
-| `reply` | the executive answers `(REPLY id result)` | `service`, `id`, `result`, `detail` |
+| `reply` | the executive answers `(REPLY id result)` | `service`, `id`, `result`, `detail`, `ok` (it succeeded) |
 | `warning` | the executive sends `(WARNING service id type)` | `service`, `id`, `type`, `detail` |
 | `reflex` | a reflex of the executive fires (§3.5) | `reflex`, `on` (trigger, source), `code`, `actions` |
 | `fact` | a fact of the supervisor's database is concluded or retracted | `fact`, `change` |
@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from types import TracebackType
 from typing import IO, Any
@@ -121,6 +122,18 @@ class EventLog:
     def __exit__(self, kind: type[BaseException] | None, value: BaseException | None,
                  traceback: TracebackType | None) -> None:
         self.close()
+
+
+def reply_succeeded(reply: Mapping[str, Any]) -> bool:
+    """Whether a `reply` event says its service succeeded: its `ok`, as the executive said it.
+
+    A service's output function may return any word, so the result alone cannot tell a success
+    from a failure; a log written before replies carried `ok` leaves only the result to go by
+    (OK or a number, as an output function counting something returns, is then taken for one)."""
+    if "ok" in reply:
+        return bool(reply["ok"])
+    result = reply.get("result")
+    return result == "OK" or (isinstance(result, int | float) and not isinstance(result, bool))
 
 
 def read_events(path: str | Path, notes: list[str] | None = None) -> list[dict[str, Any]]:

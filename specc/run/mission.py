@@ -48,7 +48,7 @@ from types import ModuleType
 from typing import Any, NamedTuple
 
 from specc.run import RunError
-from specc.run.events import EventLog
+from specc.run.events import EventLog, reply_succeeded
 from specc.run.package import import_robot
 from specc.run.plans import BoundExecutor, FtplanJournal, run_ftplan
 from specc.run.recording import PoseRecorder, world_fields
@@ -59,6 +59,11 @@ from specc.runtime.system import DEFAULT_HORIZON, MissionSpec, SystemSpec
 ROBOT_MOVING = 0.005  # m/s at the wheel rims: slower than this, the robot stands still
 SAMPLE_PRIORITY = 1000  # the motion sampler runs after the physics and codels of its instant
 PROGRESS_PERIOD = 10.0  # s of simulated time between two progress reports
+# Characters a one-line summary keeps of one reason, and of what a bracket in it holds: a goal's
+# reason may hold every planner's diagnostics, a page of them; the run's report.json keeps it whole.
+REASON_WIDTH = 300
+DETAIL_WIDTH = 120
+OPENING, CLOSING = "([", ")]"
 
 
 class MissionProgress(NamedTuple):
@@ -227,7 +232,7 @@ class MissionRun:
 
     def summary(self) -> str:
         lines = [f"{self.robot}'s mission {self.mission} in {self.world} (seed {self.seed}): "
-                 f"{self.outcome}: {self.why}"]
+                 f"{self.outcome}: {brief_why(self.why)}"]
         lines += [f"  {goal}: {status}" for goal, status in self.goals]
         lines.append(f"  {self.distance:.1f} m travelled, {self.requests} service request(s), "
                      f"{len(self.incidents)} incident(s)")
@@ -417,15 +422,15 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
                            "planner_failures": result.planner_failures,
                            # the mission exception: no plan in time (not the horizon stopping the run)
                            "planning_failure": "" if stopped else result.failure}
-        # What went wrong on the way, which the goals' reasons (a plan leaving them aside) hide.
+        # What went wrong on the way, which the goals' reasons (a plan leaving them aside) hide:
+        # a reason of its own, so that a summary cutting the goals' reasons short still says it.
         failed = [e.text for e in result.events if e.kind == "action-failed"]
-        failures = f" ({len(failed)} action failure(s); the last: {failed[-1]})" if failed else ""
+        failures = f"; {len(failed)} action failure(s); the last: {failed[-1]}" if failed else ""
         if stopped:
             outcome, why = "horizon", f"{result.failure}: {len(result.met)} of {len(met) + len(result.missed)} " \
                                       f"planned goal(s) met{failures}"
         elif outcome == "succeeded" and (result.failure or result.missed):
-            outcome, why = "failed", (result.failure or f"{len(result.missed)} planned goal(s) missed: " + "; ".join(
-                f"{goal}: {reason}" for goal, reason in result.missed.items())) + failures
+            outcome, why = "failed", (result.failure or missed_goals(result.missed)) + failures
         elif outcome == "succeeded":
             why = f"every goal achieved ({len(intentions)} posted, {len(result.met)} planned)" if intentions \
                 else f"every planned goal achieved ({len(result.met)})"
@@ -506,14 +511,84 @@ def _outcome(intentions: list[tuple[str, Any]], horizon: float,
     return "succeeded", f"every goal achieved ({len(intentions)})"
 
 
+def missed_goals(missed: Mapping[str, str]) -> str:
+    """The planned goals missed (goal -> why), each reason said once, after the goals it stands
+    for: FTplan gives every goal it abandons at once the same reason, every planner's
+    diagnostics, which would otherwise be repeated for each."""
+    goals_of: dict[str, list[str]] = {}
+    for goal, reason in missed.items():
+        goals_of.setdefault(reason, []).append(goal)
+    return f"{len(missed)} planned goal(s) missed: " + "; ".join(
+        f"{', '.join(goals)}: {reason}" for reason, goals in goals_of.items())
+
+
+def brief_why(why: str, width: int = REASON_WIDTH, detail_width: int = DETAIL_WIDTH) -> str:
+    """`why` for a one-line summary: in each of its reasons (its parts between "; " outside any
+    brackets), what a bracket holds (a planner's diagnostics...) cut after about `detail_width`
+    characters, then the reason after about `width`, each cut marked by an ellipsis and the
+    brackets it leaves open closed. The full text is the run's report's."""
+    return "; ".join(_cut(_cut_details(reason, detail_width), width) for reason in _reasons(why))
+
+
+def _reasons(text: str) -> list[str]:
+    reasons: list[str] = []
+    depth = start = 0
+    for k, char in enumerate(text):
+        if char in OPENING:
+            depth += 1
+        elif char in CLOSING:
+            depth = max(0, depth - 1)
+        elif depth == 0 and text.startswith("; ", k):
+            reasons.append(text[start:k])
+            start = k + 2
+    return [*reasons, text[start:]]
+
+
+def _cut_details(text: str, width: int) -> str:
+    """`text` with what each of its outermost brackets holds cut after about `width` characters."""
+    parts: list[str] = []
+    depth = start = 0
+    for k, char in enumerate(text):
+        if char in OPENING:
+            if depth == 0:
+                parts.append(text[start:k + 1])
+                start = k + 1
+            depth += 1
+        elif char in CLOSING and depth:
+            depth -= 1
+            if depth == 0:
+                parts.append(_cut(text[start:k], width))
+                start = k
+    parts.append(_cut(text[start:], width) if depth else text[start:])
+    return "".join(parts)
+
+
+def _cut(text: str, width: int) -> str:
+    """`text` cut at a word's end before `width` characters, with an ellipsis and the brackets
+    the cut leaves open closed."""
+    if len(text) <= width:
+        return text
+    kept = text[:width]
+    if " " in kept:
+        kept = kept[: kept.rindex(" ")]
+    kept = kept.rstrip(" ,;:" + OPENING)
+    still_open: list[str] = []
+    for char in kept:
+        if char in OPENING:
+            still_open.append(CLOSING[OPENING.index(char)])
+        elif char in CLOSING and still_open:
+            still_open.pop()
+    return kept + "…" + "".join(reversed(still_open))
+
+
 def why_failed(trace: Iterable[Any], events: list[Mapping[str, Any]]) -> str:
     """The first statement that failed in the goal's intention, and the last service reply that
-    was not OK before it (what the procedures most likely reacted to)."""
+    was a failure before it (what the procedures most likely reacted to)."""
     failure = next((entry for entry in trace if " failed" in entry.text), None)
     if failure is None:
         return "no applicable KA succeeded"
     refused = next((e for e in reversed(events) if e["kind"] == "reply" and e["t"] <= failure.time
-                    and e.get("result") != "OK"), None)
+                    and not reply_succeeded(e)), None)
     answer = ""
     if refused is not None:
         detail = f" ({refused['detail']})" if refused.get("detail") else ""
@@ -579,7 +654,8 @@ class Recorder:
             return
         result = message.result if isinstance(message.result, int | float | str) else str(message.result)
         self.replies[f"{message.service} {result}"] += 1
-        self.log.emit(now, "reply", service=message.service, id=message.id, result=result, detail=message.detail)
+        self.log.emit(now, "reply", service=message.service, id=message.id, result=result, detail=message.detail,
+                      ok=message.ok)
 
     # ------------------------------------------------------------ the supervisor
     def operator(self, text: str) -> None:

@@ -10,8 +10,8 @@ subclass's: `BoundExecutor` does it as the system block's `bindings` say,
 
 - `TASK(?a) => goal G(?a)`: the supervisor is given `!(G a)`; the action ends when the goal
   succeeds, fails when it fails (seed 004 §4.1.1: OpenPRS procedures carry out IxTeT's actions);
-- `=> service S(?a)`: the executive runs S with those inputs; OK ends the action, any other
-  reply fails it;
+- `=> service S(?a)`: the executive runs S with those inputs; its success (OK, or whatever its
+  output function returns) ends the action, any other reply fails it;
 - `=> request module.R(?a)`: the module request itself, as the functional level answers it.
 
 What the log holds: every `action` as it starts and as it ends, fails or is stopped (`status`,
@@ -403,7 +403,7 @@ class BoundExecutor(KernelExecutor):
             reply = self._replies.pop(run.handle, None)
             if reply is None:
                 return False
-            run.ok = reply.result == "OK"
+            run.ok = reply.ok
             detail = f" ({reply.detail})" if reply.detail else ""
             run.why = "" if run.ok else f"{run.action.text()} failed: {run.said['service']} answered " \
                                         f"{reply.result}{detail}"
@@ -429,9 +429,9 @@ class BoundExecutor(KernelExecutor):
         return {}
 
     def _refused(self, requests: Iterable[int]) -> str:
-        """The last reply other than OK to the services a goal's procedures asked for: most likely
-        what they failed on."""
-        replies = [self._replies[i] for i in requests if i in self._replies and self._replies[i].result != "OK"]
+        """The last failure the services a goal's procedures asked for replied: most likely what
+        they failed on."""
+        replies = [self._replies[i] for i in requests if i in self._replies and not self._replies[i].ok]
         if not replies:
             return ""
         reply = replies[-1]

@@ -42,6 +42,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from specc.run import RunError, pictures
+from specc.run.events import reply_succeeded
 from specc.runtime.body import RobotConfig
 from specc.runtime.planner.plan import Value, format_call, format_value
 from specc.runtime.sim import Target, Window, World, WorldError, parse_world
@@ -88,9 +89,9 @@ FTPLAN_MARKERS = {  # kind: (row, offset, marker, colour)
 }
 PLAN_LINE, SWITCH_LINE = "#9ca3af", "#7c3aed"
 
-# A service's activity, by its reply (specc.runtime.executive): OK, or what its output function
-# returns (SEARCH-OBJ's count of objects seen), is a success; INT an interruption; any other
-# word (TIMEOUT, REFUSED, the module's report code...) a failure.
+# A service's activity, by its reply (specc.runtime.executive): a success whatever word or number
+# its output function returns (the reply's `ok` says so, specc.run.events.reply_succeeded); INT
+# an interruption; any other reply (TIMEOUT, REFUSED, the module's report code...) a failure.
 SERVICE_COLOURS = {"ok": "#16a34a", "interrupted": "#f97316", "failed": "#dc2626", "running": "#9ca3af"}
 INTERRUPTED = "INT"
 ENDED = ("ETHER",)  # the phase an activity leaves the executive's list for (Fig 3.3)
@@ -148,9 +149,9 @@ class RunInfo:
         if self.distance is not None:
             what += f", {self.distance:.1f} m travelled"
         # A failure's reason may run to a page (every goal given up, with why): the picture keeps
-        # its first lines, the run's summary has it whole.
+        # its first lines, the run's report has it whole.
         return textwrap.fill(f"{who}, mission {self.mission}, world {self.world}, seed {self.seed} — {what}",
-                             TITLE_WIDTH, max_lines=TITLE_LINES, placeholder=" … (the whole of it: summary.txt)")
+                             TITLE_WIDTH, max_lines=TITLE_LINES, placeholder=" … (the whole of it: report.json)")
 
 
 def run_info(events: Events) -> RunInfo:
@@ -374,10 +375,11 @@ class ServiceBar:
     outcome: str  # ok | interrupted | failed | running
 
 
-def reply_outcome(result: Any) -> str:
-    if result == "OK" or (isinstance(result, int | float) and not isinstance(result, bool)):
+def reply_outcome(reply: Mapping[str, Any]) -> str:
+    """ok, interrupted or failed: what a `reply` event says of its activity."""
+    if reply_succeeded(reply):
         return "ok"
-    return "interrupted" if result == INTERRUPTED else "failed"
+    return "interrupted" if reply.get("result") == INTERRUPTED else "failed"
 
 
 def service_bars(events: Events) -> list[ServiceBar]:
@@ -385,7 +387,7 @@ def service_bars(events: Events) -> list[ServiceBar]:
     requested: dict[int, tuple[str, float]] = {}
     started: dict[int, float] = {}
     ended: dict[int, float] = {}
-    results: dict[int, Any] = {}
+    replies: dict[int, Mapping[str, Any]] = {}
     for event in events:
         kind = event.get("kind")
         if kind == "request":
@@ -397,14 +399,14 @@ def service_bars(events: Events) -> list[ServiceBar]:
             if event["to"] in ENDED:
                 ended[ident] = float(event["t"])
         elif kind == "reply":
-            results[int(event["id"])] = event.get("result")
+            replies[int(event["id"])] = event
     end = last_time(events)
     bars = []
     for ident, (service, at) in requested.items():
-        result = results.get(ident)
-        closed = ident in ended or ident in results
+        reply = replies.get(ident)
+        outcome = reply_outcome(reply) if reply is not None else "failed" if ident in ended else "running"
         bars.append(ServiceBar(service, ident, at, started.get(ident), ended.get(ident, end),
-                               result, reply_outcome(result) if closed else "running"))
+                               reply.get("result") if reply is not None else None, outcome))
     return bars
 
 

@@ -300,7 +300,7 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         why = result.why
         planners_said = [e["text"] for e in result.events if e["kind"] == "ftplan" and e["event"] in PLANNER_FAILURES]
         if result.extension_measures.get("planning_failure") and planners_said:  # what the planner itself said
-            why += f" (last planner failure: {planners_said[-1]})"
+            why += f"; last planner failure: {planners_said[-1]}"
         report = {"outcome": "succeeded" if result.outcome == "succeeded" else result.outcome, "why": why,
                   "simulated_time": round(result.simulated_time, 3), "goals": [list(g) for g in result.goals],
                   "measures": result.measures(), "incidents": list(result.incidents)}

@@ -25,7 +25,7 @@ from typing import Any
 
 from specc.run import RunError
 from specc.run.measures import MeanMeasures, Measures, markdown_table, measure_table
-from specc.run.mission import load_robot
+from specc.run.mission import brief_why, load_robot
 from specc.run.session import RunCrashed, RunOutcome, RunRequest, plan_run, run_planned
 from specc.runtime.ftplan import planner_processes_kept
 
@@ -82,8 +82,8 @@ class SweepResult:
         if crashed:
             text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
         if self.failures:
-            text += "\nFailures (each run's log is in its folder):\n\n" + "".join(
-                f"- {f.name}: {f.why}\n" for f in self.failures)
+            text += "\nFailures (each run's log is in its folder, and the whole why in its report.json):\n\n" + "".join(
+                f"- {f.name}: {brief_why(f.why)}\n" for f in self.failures)
         return text
 
     def mission_cells(self) -> tuple[list[str], list[list[str]]]:

@@ -32,7 +32,9 @@ both could end up running.
 Results of (REPLY id result): OK, or what the service's output function returns; the module's
 report code for an intrinsic failure (a REPLY END whose bilan is not OK); INT when interrupted;
 TIMEOUT, REFUSED, ZOMBIE (ended after a ZOMBIE and its abort), BAD-SERVICE, or the module's
-error status (FINAL_ERROR, SERVER_ERROR, CS_ERROR, TIMEOUT) for REPLY ERROR. WARNING types:
+error status (FINAL_ERROR, SERVER_ERROR, CS_ERROR, TIMEOUT) for REPLY ERROR. An output function
+may return any word, a failure's word too, so the result alone cannot tell them apart: the
+message's `ok` does (the module ended the request with an OK report). WARNING types:
 ZOMBIE (§3.4.1), BAD-ID (RQST INT for an unknown id), ERROR (the executive entered its general
 ERROR state, §3.4.2; service EXECUTIVE, id 0).
 """
@@ -171,6 +173,7 @@ class Message(NamedTuple):
     result: Any  # REPLY: the result; WARNING: the event type
     detail: str = ""
     time: float = 0.0
+    ok: bool = False  # REPLY: the service succeeded, whatever its result (see the module's docstring)
 
     @property
     def fact(self) -> tuple[Any, ...]:
@@ -508,22 +511,23 @@ class Executive:
             if self._control(service.name, "END") == "ERROR":
                 self._fatal(f"the controller rejected the end of {service.name}")
 
-    def _result(self, activity: Activity, reply: Reply) -> tuple[Any, str]:
+    def _result(self, activity: Activity, reply: Reply) -> tuple[Any, str, bool]:
+        """The result of (REPLY id result), its detail, and whether the service succeeded."""
         if reply.status is Status.END:
             if reply.report.code != "OK":
-                return reply.report.code, reply.report.detail
+                return reply.report.code, reply.report.detail, False
             output = activity.service.output
             if output is None:
-                return "OK", ""
+                return "OK", "", True
             try:
-                return getattr(self.codels, output)(self.context, reply.output), ""
+                return getattr(self.codels, output)(self.context, reply.output), "", True
             except Exception as exc:  # the user's output function
-                return "ERROR", f"output of {activity.service.name}: {type(exc).__name__}: {exc}"
+                return "ERROR", f"output of {activity.service.name}: {type(exc).__name__}: {exc}", False
         if reply.status is Status.INTERRUPTED:
-            return "INT", reply.report.code
+            return "INT", reply.report.code, False
         if reply.status is Status.ZOMBIE:  # refused because its module is frozen
-            return "REFUSED", reply.report.detail
-        return reply.status.value, f"{reply.report.code}: {reply.report.detail}".strip(": ")
+            return "REFUSED", reply.report.detail, False
+        return reply.status.value, f"{reply.report.code}: {reply.report.detail}".strip(": "), False
 
     def _on_abort_reply(self, activity: Activity, reply: Reply) -> None:
         """REPLY ABORT: only news for a ZOMBIE, whose module it unfreezes (§3.4.1)."""
@@ -628,14 +632,14 @@ class Executive:
         for observer in self.observers:
             self._guarded(observer, activity, source, target)
 
-    def _answer(self, activity: Activity, result: Any, detail: str = "") -> None:
+    def _answer(self, activity: Activity, result: Any, detail: str = "", ok: bool = False) -> None:
         if not activity.answered:
             activity.answered = True
-            self._tell("REPLY", activity.service.name, activity.id, result, detail)
+            self._tell("REPLY", activity.service.name, activity.id, result, detail, ok)
 
-    def _end(self, activity: Activity, result: Any, detail: str = "") -> None:
+    def _end(self, activity: Activity, result: Any, detail: str = "", ok: bool = False) -> None:
         """The activity leaves the list (ETHER); the client hears its result unless it already has."""
-        self._answer(activity, result, detail)
+        self._answer(activity, result, detail, ok)
         for timer in activity.timers:
             timer.cancel()
         self._move(activity, Phase.ETHER)
@@ -649,8 +653,8 @@ class Executive:
             if not zombies:
                 del self.zombies[activity.service.module]
 
-    def _tell(self, kind: str, service: str, ident: int, result: Any, detail: str = "") -> None:
-        message = Message(kind, service, ident, result, detail, self.kernel.now)
+    def _tell(self, kind: str, service: str, ident: int, result: Any, detail: str = "", ok: bool = False) -> None:
+        message = Message(kind, service, ident, result, detail, self.kernel.now, ok)
         self.messages.append(message)
         for listener in self.listeners:
             self._guarded(listener, message)

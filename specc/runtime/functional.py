@@ -321,6 +321,10 @@ class Activity:
         raise AttributeError(f"request '{self.spec.name}' has no output '{name}'")
 
 
+class EnumFieldError(ValueError):
+    """A codel left an enum field of its module's SDI holding what is not one of the enum's values."""
+
+
 class TransitionError(RuntimeError):
     """An arc that Fig. 2.3 does not have: a bug in the runtime, never a user error."""
 
@@ -472,6 +476,11 @@ class Module:
         self.name = spec.name
         self.codels = codels
         self.sdi = spec.sdi_type()
+        # The SDI's enum fields, with the values a codel may set each to (a member, or its name
+        # or value as text): checked after every codel, since the SDI takes any assignment.
+        self._enum_fields = [(f.name, type(value), {m.name for m in type(value)} | {m.value for m in type(value)})
+                             for f in dataclasses.fields(self.sdi)
+                             if isinstance(value := getattr(self.sdi, f.name), enum.Enum)]
         self.sdi._module = self
         self.activities: dict[int, Activity] = {}  # every activity not in ETHER
         self.posters = {p.name: Poster[Any](p) for p in spec.posters}
@@ -509,8 +518,28 @@ class Module:
             found = getattr(self.codels, name, None)
             if not callable(found):
                 raise LookupError(f"codel '{name}' is not defined in {self.spec.codel_module}")
+            if self._enum_fields:
+                found = functools.partial(self._enum_checked, found)
             self._functions[name] = found
         return found
+
+    def _enum_checked(self, codel: Callable[..., Any], *args: Any) -> Any:
+        """`codel(*args)`, then ValueError (the codel's error) if it left an enum field of the SDI
+        holding what is not one of its values (`sdi.state = "MOVNG"`); the field keeps the value it
+        had, so that the module's other codels go on with a value of the type."""
+        sdi = self.sdi
+        before = [getattr(sdi, field_name) for field_name, _, _ in self._enum_fields]
+        result = codel(*args)
+        for (field_name, enum_type, allowed), kept in zip(self._enum_fields, before, strict=True):
+            value = getattr(sdi, field_name)
+            if not isinstance(value, enum_type) and (not isinstance(value, str) or value not in allowed):
+                setattr(sdi, field_name, kept)
+                code = getattr(codel, "__code__", None)
+                place = f" ({_shown(code.co_filename)}:{code.co_firstlineno})" if code is not None else ""
+                raise EnumFieldError(f"the SDI's field '{field_name}' set to {value!r}{place}, not a value of "
+                                     f"{enum_type.__name__} ({', '.join(m.name for m in enum_type)})"
+                                     f"{did_you_mean(str(value), [m.name for m in enum_type])}")
+        return result
 
     # -- requests
     def submit(self, request: str, input_: Any, sink: ReplySink, parent: Activity | None = None) -> int:
@@ -591,6 +620,9 @@ class Module:
             for other in list(self.activities.values()):
                 if other.state in (State.INIT, State.EXEC) and spec.conflicts_with(other.spec):
                     self.interrupt(other, spec.name)
+        # Its one cycle is over: the auto posters of this activity show what its codel wrote,
+        # before the client hears the reply.
+        self.cycle_done(spec.name)
         status = Status.END if outcome is None else Status.FINAL_ERROR
         self.emit(sink, self.reply(rqst_id, spec.name, status, outcome or Report("OK"), output))
 
@@ -736,6 +768,8 @@ class Module:
         missing = f"'{type(self.sdi).__name__}' object has no attribute '"
         text = str(exc)
         # Python names the attribute of a failed read (exc.name), not of a failed assignment.
+        if isinstance(exc, EnumFieldError):  # raised once the codel returned: it names the codel's place
+            return f"ValueError: {text}"
         if isinstance(exc, AttributeError) and text.startswith(missing) and text.endswith("'"):
             name = text[len(missing):-1]
             fields = [f.name for f in dataclasses.fields(self.sdi)]

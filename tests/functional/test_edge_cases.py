@@ -156,6 +156,32 @@ def test_a_poster_named_after_a_request_codel_is_updated_by_its_cycles(robot: Ro
     assert abs(snapshot.date - 0.02) < 1e-9  # start at 0, exec (copy) at 10 ms, named at 20 ms
 
 
+def test_a_poster_named_after_a_control_request_is_updated_when_it_runs(robot: Robot) -> None:
+    # A control request's one cycle is its validate codel: the poster shows what it wrote, by the
+    # time the client has its reply.
+    client = robot.client()
+    robot.kernel.run_for(0.05)
+    reply = client.call("Set", robot.package.alpha.SetInput(value=2.5))
+    snapshot = client.poster("Settings")
+    assert reply.status is Status.END and snapshot is not None
+    assert snapshot.data.value == 2.5 and abs(snapshot.date - robot.kernel.now) < 1e-9 and snapshot.date > 0
+
+
+def test_a_codel_setting_an_enum_field_to_no_value_of_its_enum_is_a_codel_error(robot: Robot) -> None:
+    # A value's name (or the member itself) is one of its values; a misspelt one fails the
+    # activity at once, naming the field, the values and the codel, and the field keeps its value.
+    _, replies = send(robot, "C", "mode:BUSY,ether")
+    robot.kernel.run_for(0.05)
+    assert replies[-1].status is Status.END and robot.alpha.sdi.mode == "BUSY"
+    _, replies = send(robot, "C", "mode:BUSSY,exec")
+    robot.kernel.run_for(0.05)
+    final = replies[-1]
+    assert final.status is Status.FINAL_ERROR and final.report.code == "CODEL_ERROR"
+    assert "field 'mode' set to 'BUSSY'" in final.report.detail and "(IDLE, BUSY)" in final.report.detail
+    assert "did you mean 'BUSY'?" in final.report.detail and "scripted_codels" in final.report.detail
+    assert robot.alpha.sdi.mode == "BUSY"
+
+
 def test_manual_posters_are_written_by_codels_and_unknown_ones_are_codel_errors(robot: Robot) -> None:
     client = robot.client()
     client.call("Set", robot.package.alpha.SetInput(value=3.0))

@@ -97,6 +97,9 @@ class SystemState:
     # the state rules `on ended` say): their value is uncertain meanwhile, so a goal on one is not
     # met when the mission ends there (stopped at the horizon). Fact -> the action.
     changing: dict[FactKey, Running] = field(default_factory=dict)
+    # The final goals that came true by their deadline and have held since: met if they still hold
+    # when the mission ends, however long after their deadline that is.
+    reached: set[int] = field(default_factory=set)  # goal lines
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -139,15 +142,22 @@ class SystemState:
         newly = []
         for goal in self.open_goals():
             in_time = now <= goal.deadline + 1e-6
+            holds = self.holds(goal)
+            if goal.final and holds and in_time:
+                self.reached.add(goal.line)
+            elif not holds:
+                self.reached.discard(goal.line)  # it must come true again, by its deadline
             running = self.changing.get(goal.key) if mission_over else None
             stopped = running.text() if running is not None else None
-            if self.holds(goal) and stopped is None and (mission_over if goal.final else in_time):
+            late = goal.final and goal.line not in self.reached  # came true after its deadline, if at all
+            if holds and stopped is None and not late and (mission_over if goal.final else in_time):
                 self.met.add(goal.line)
                 newly.append(goal)
-            elif mission_over or not in_time:
+            elif mission_over or (not in_time and goal.line not in self.reached):
                 self.missed[goal.line] = (
                     f"not known when the mission ended: {stopped}, which changes it, was stopped on the way"
-                    if stopped is not None else "not met when the mission ended" if mission_over
+                    if stopped is not None else f"its deadline {goal.deadline:g} s had passed when it came true"
+                    if holds and late else "not met when the mission ended" if mission_over
                     else f"its deadline {goal.deadline:g} s has passed")
         return newly
 

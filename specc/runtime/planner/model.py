@@ -333,6 +333,16 @@ def latest_end(problem: Problem) -> float:
                 if isinstance(c, Member) and c.expr == span and isinstance(c.domain, Interval)), default=INF)
 
 
+def without_latest_end(problem: Problem) -> Problem:
+    """The problem with no latest end: the bounds written on `t_end - t_start` keep their lower
+    bound only (the mission may still have to last so long)."""
+    span = Op("-", (Time(problem.end), Time(problem.start)))
+    return replace(problem, constraints=tuple(
+        Member(span, Interval(c.domain.low, INF), c.contingent, c.line)
+        if isinstance(c, Member) and c.expr == span and isinstance(c.domain, Interval) else c
+        for c in problem.constraints))
+
+
 def with_horizon(problem: Problem, seconds: float) -> Problem:
     """The problem with its mission ending by `seconds` after its start: the bounds written on
     `t_end - t_start` are cut to it (a lower bound beyond it comes down with it)."""

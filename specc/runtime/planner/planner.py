@@ -219,10 +219,16 @@ class Planner:
         for goal in sorted((g for g in candidates if g not in kept), key=lambda g: (-g.priority, g.index)):
             if spent >= budget:
                 break
-            tried = setup.search(kept + [goal], budget - spent)
-            spent += tried.nodes
-            if tried.node is not None:
-                kept, node = kept + [goal], tried.node
+            # Other tours first, with half of what is left (they need no more when the mission's
+            # end is what drops the goal), then the search in the heuristic's order.
+            with_goal, used = setup.tour_in_time(kept + [goal], node, (budget - spent + 1) // 2)
+            spent += used
+            if with_goal is None and spent < budget:
+                tried = setup.search(kept + [goal], budget - spent)
+                spent += tried.nodes
+                with_goal = tried.node
+            if with_goal is not None:
+                kept, node = kept + [goal], with_goal
                 plan, notes = setup.extract(node, self.exact)
                 gained.append(goal.text)
         first = plan.makespan
@@ -318,6 +324,10 @@ class Planner:
                           notes=(*notes, note))
 
 
+class _Enough(Exception):
+    """`Setup.reorder`'s caller has what it looked for."""
+
+
 def _sooner(late: tuple[float, float], than: tuple[float, float]) -> bool:
     """Is a plan of `late` (`Setup._lateness`) better than one of `than`? An earlier worst-case
     end, or the same one with its goals met sooner."""
@@ -378,6 +388,11 @@ def _source(a: pm.Assertion) -> str:
     return f"fact {pm.subject(a)}({', '.join(pm.describe(x) for x in a.args)}) = {pm.describe(value)}"
 
 
+def _owner(owner: str) -> str:
+    """An assertion's owner as a sentence names it: a task (`MOVE#3`), or the problem."""
+    return "the problem" if owner == "problem" else owner
+
+
 def _generic(message: str) -> str:
     """A dead end's message without instance numbers, so that alike failures count together."""
     return re.sub(r"#\d+", "", message)
@@ -392,6 +407,7 @@ class Setup:
     def __init__(self, domain: pm.PlanningDomain, problem: pm.Problem, now: float, limits: Limits,
                  controllability: str = STRONG, heuristic: str = STANDARD, flaws: str = NEWEST_TASK_FIRST) -> None:
         self.heuristic = heuristic
+        self.limits, self.controllability, self.flaws = limits, controllability, flaws
         if problem.domain != domain.name:
             raise PlanningInputError(f"problem '{problem.name}' is written for domain '{problem.domain}', "
                                      f"not '{domain.name}'")
@@ -649,16 +665,20 @@ class Setup:
             cut = _push(stack, node, choice, used, allowed) or cut
         return nodes, "cut" if cut else "done", found
 
-    def reorder(self, active: list[Goal], bound: float, budget: int, waypoints: bool = False) -> tuple[list[Node], int]:
+    def reorder(self, active: list[Goal], bound: float, budget: int, waypoints: bool = False,
+                enough: Callable[[list[int], Node, int], tuple[bool, int]] | None = None,
+                trial: int = REORDER_TRIAL) -> tuple[list[Node], int]:
         """Plans for the `active` goals whose worst-case makespan beats `bound`, each better than
         the one before, found by taking the goals up in other orders within `budget` partial
         plans. The search plans first for the goal that may come earliest; among goals that may
         all come as early (the photos of a tour), the order it takes them up in is the order of
         the tour. An iterated local search over that order: first improvement over every segment
         reversed (2-opt), then every goal moved elsewhere, each order searched depth first within
-        REORDER_TRIAL partial plans; at a local optimum, a seeded random reversal of the current
+        `trial` partial plans; at a local optimum, a seeded random reversal of the current
         order and on from there (the same problem gives the same plans). With `waypoints`, each
-        order's plan is measured once its waits are used (`waypoints`, within REORDER_TRIAL more)."""
+        order's plan is measured once its waits are used (`waypoints`, within REORDER_TRIAL more).
+        With `enough`, asked of each better order with its plan (and the partial plans it may still spend),
+        answering whether to stop and the partial plans it spent, the search stops when it says so."""
         found: list[Node] = []
         try:
             root = self.root(active)
@@ -683,11 +703,11 @@ class Setup:
             nonlocal nodes, bound
             self.context = replace(context, goal_order={line: rank for rank, line in enumerate(order)})
             # Depth first without a bound: a bound makes it thrash far from where the order leads.
-            tried = self.search(active, min(REORDER_TRIAL, budget - nodes), discrepancies=False)
+            tried = self.search(active, min(trial, budget - nodes), discrepancies=False)
             nodes += tried.nodes
             if tried.node is None:
                 return INF
-            ways, used = self.waypoints(active, tried.node, INF, min(REORDER_TRIAL, max(0, budget - nodes))) if (
+            ways, used = self.waypoints(active, tried.node, INF, min(trial, max(0, budget - nodes))) if (
                 waypoints) else ([], 0)
             nodes += used
             best = ways[-1] if ways else tried.node
@@ -695,6 +715,11 @@ class Setup:
             if end < bound - IMPROVEMENT:
                 found.append(best)
                 bound = end
+                if enough is not None:
+                    stop, used = enough(order, best, max(0, budget - nodes))
+                    nodes += used
+                    if stop:
+                        raise _Enough
             return end
 
         def neighbours(order: list[int]) -> Iterator[list[int]]:
@@ -720,9 +745,40 @@ class Setup:
                     i, j = sorted(chance.sample(range(len(current)), 2))
                     current = current[:i] + current[i:j + 1][::-1] + current[j + 1:]
                     value = makespan(current)
+        except _Enough:
+            pass
         finally:
             self.context = context
         return found, nodes
+
+    def tour_in_time(self, active: list[Goal], node: Node, budget: int) -> tuple[Node | None, int]:
+        """A plan for the `active` goals, which the search in the heuristic's order of taking them
+        up did not find, when the mission's latest end is what keeps it from them: `reorder`'s
+        local search over the orders, on the problem with that end lifted (where an order too
+        slow for the mission still has a plan and a makespan, so the search can walk towards
+        faster tours), until a plan found there takes the end back: the problem's plan. None if
+        no tour does within `budget`; and the partial plans spent. `node`, a plan for some of the
+        goals, sizes each order's trial: a depth-first search the order leads needs about as many
+        partial plans as the plan has actions, and an order that fails would take the whole trial."""
+        latest = pm.latest_end(self.problem)
+        if latest == INF:
+            return None, 0
+        in_time: list[Node] = []
+
+        def ends_in_time(order: list[int], plan: Node, left: int) -> tuple[bool, int]:
+            bounded = plan.copy()
+            try:
+                bounded.require(self.origin, self.problem.end, -INF, latest)
+            except DeadEnd:
+                return False, 0
+            in_time.append(bounded)
+            return True, 0
+
+        lifted = Setup(self.domain, pm.without_latest_end(self.problem), self.now, self.limits,
+                       self.controllability, self.heuristic, self.flaws)
+        trial = min(REORDER_TRIAL, 20 + 4 * len(node.instances))
+        _, spent = lifted.reorder(active, INF, budget, enough=ends_in_time, trial=trial)
+        return (in_time[0] if in_time else None), spent
 
     def waypoints(self, active: list[Goal], node: Node, bound: float, budget: int) -> tuple[list[Node], int]:
         """Plans for the `active` goals made from `node`'s by splitting its moves at waypoints
@@ -1007,8 +1063,9 @@ def select(node: Node) -> list[Resolver] | None:
                     producer = node.assertions[threat.link.producer]
                     consumer = node.assertions[threat.link.consumer]
                     event = threat.event
-                    raise DeadEnd(f"{event.text(node.bindings)} of {event.owner} may come while {consumer.owner} "
-                                  f"needs the {consumer.attribute} value {producer.owner} gives it")
+                    raise DeadEnd(f"{event.text(node.bindings)} of {_owner(event.owner)} may come while "
+                                  f"{_owner(consumer.owner)} needs the {consumer.attribute} value "
+                                  f"{_owner(producer.owner)} gives it")
                 if len(resolvers) == 1:
                     # Constraints only tighten: a threat with one resolver left keeps just that one.
                     resolvers[0].apply(node)

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, overload
@@ -189,33 +189,41 @@ class World:
                             width: float = 0.0) -> float:
         """How far a body at `pose` stands from the nearest obstacle or wall (0 or less: they
         overlap): a disc of `radius`, or a `length` x `width` box turned by the pose's heading."""
+        return min(distance for distance, _ in self._clearances(pose, radius, length, width))
+
+    def _clearances(self, pose: tuple[float, float, float], radius: float, length: float,
+                    width: float) -> Iterator[tuple[float, str]]:
+        """How far the body stands from the walls, then from each obstacle, with what it is."""
         x, y, theta = pose
-        if length <= 0:
-            return self.clearance(x, y) - radius
-        box = _Box(x, y, theta, length / 2, width / 2)
         xmin, xmax, ymin, ymax = self.bounds
+        if length <= 0:
+            yield min(x - xmin, xmax - x, y - ymin, ymax - y) - radius, "the walls"
+            for k, obstacle in enumerate(self.obstacles):
+                yield obstacle.distance(x, y) - radius, f"obstacles[{k}]"
+            return
+        box = _Box(x, y, theta, length / 2, width / 2)
         # A box is convex: its corners come nearest the walls.
-        found = min(min(cx - xmin, xmax - cx, cy - ymin, ymax - cy) for cx, cy in box.corners)
-        for obstacle in self.obstacles:
+        yield min(min(cx - xmin, xmax - cx, cy - ymin, ymax - cy) for cx, cy in box.corners), "the walls"
+        for k, obstacle in enumerate(self.obstacles):
             if isinstance(obstacle, Circle):
-                found = min(found, box.distance(obstacle.x, obstacle.y) - obstacle.radius)
+                yield box.distance(obstacle.x, obstacle.y) - obstacle.radius, f"obstacles[{k}]"
             elif box.meets(obstacle):
-                return 0.0
+                yield 0.0, f"obstacles[{k}]"
             else:
-                found = min(found, *(obstacle.distance(cx, cy) for cx, cy in box.corners),
-                            *(box.distance(px, py) for px, py in obstacle.points))
-        return found
+                yield min(*(obstacle.distance(cx, cy) for cx, cy in box.corners),
+                          *(box.distance(px, py) for px, py in obstacle.points)), f"obstacles[{k}]"
 
     def start_overlap(self, radius: float, length: float = 0.0, width: float = 0.0) -> str | None:
         """Why a body (a disc of `radius`, or a `length` x `width` box) cannot start at the world's
-        start: it overlaps an obstacle or a wall (the physics would shove it out at once, or wedge
-        it); None when it stands clear."""
-        if self.footprint_clearance(self.start, radius, length, width) > 0:
+        start: it overlaps obstacles or the walls, named (the physics would shove it out at once, or
+        wedge it); None when it stands clear."""
+        overlapped = [part for distance, part in self._clearances(self.start, radius, length, width) if distance <= 0]
+        if not overlapped:
             return None
         x, y, theta = self.start
         shape = f"its {length:g} x {width:g} m box" if length > 0 else f"its {radius:g} m radius"
-        return (f"the robot's body ({shape}) at its start ({x:g}, {y:g}, heading {theta:g} rad) overlaps an "
-                "obstacle or a wall: move [start] in the world file, or the obstacle")
+        return (f"the robot's body ({shape}) at its start ({x:g}, {y:g}, heading {theta:g} rad) overlaps "
+                f"{', '.join(overlapped)}: move [start] in the world file, or the obstacle")
 
     def segments(self) -> list[tuple[float, float, float, float]]:
         """Every straight edge: the polygons' and the four walls'."""

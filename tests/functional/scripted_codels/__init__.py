@@ -3,7 +3,8 @@ the successive codel calls return. `raise` raises, `exit` calls sys.exit(3), `no
 beta.Child with script X (X's own steps separated by `;`) and continues with `exec`.
 `to:module.request:X:R` sends that request (script X, steps separated by `;`; `-` for a request
 without input) and returns R; `write:P` writes poster P by hand and continues with `exec`;
-`copy` copies the SDI's value into `copied` and continues with `exec`."""
+`copy` copies the SDI's value into `copied` and continues with `exec`; `mode:M` sets the SDI's enum
+field `mode` to the text M and continues with `exec`."""
 
 def play(state, sdi, request):
     script = [s for s in request.script.split(",") if s]
@@ -35,5 +36,8 @@ def play(state, sdi, request):
         return "exec"
     if outcome == "copy":
         sdi.copied = sdi.value
+        return "exec"
+    if outcome.startswith("mode:"):
+        sdi.mode = outcome[5:]
         return "exec"
     return outcome

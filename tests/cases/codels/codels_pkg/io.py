@@ -9,6 +9,8 @@ def where_to():  # an input function is called with (ctx)
 
 
 def how_it_went(ctx, output):
+    if ctx.read_poster("hand.Grips") is None:  # no such poster: reads None at run time
+        return "UNKNOWN"
     return "OK"
 
 
