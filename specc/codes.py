@@ -169,6 +169,8 @@ CODES: dict[str, Code] = {
     "unknown-heuristic": Code("a planner heuristic that does not exist", "heuristic: fastest;"),
     "unusable-correspondence": Code("a view correspondence that can neither read FTplan's state nor be written by a "
                                     "report", "PTU(): ?p <=> PTU_POS(): ?q;"),
+    "over-capacity": Code("a task uses more of a resource than its capacity (the upper bound of its ?value)",
+                          "resource ARM() { ?value in [0, 1]; } ... use(ARM(): 2, (t_start, t_end));"),
     "negative-amount": Code("a resource amount or a contingent duration below zero",
                             "contingent (t_end - t_start) in [-5, 80];"),
     "bad-duration": Code("a duration that is zero where it must not be, or too long to be a number of seconds",

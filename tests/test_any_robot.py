@@ -266,6 +266,23 @@ def test_a_goal_the_robot_cannot_reach_fails_with_the_modules_reason(cart: Path)
 
 
 
+def test_a_goal_failed_by_a_function_that_raised_says_what_it_raised(tmp_path: Path) -> None:
+    """A procedure's action bound to the user's Python (a rule base's `decide` refusing an input
+    outside its domain, say) raises: the run's why is that exception, not only the KA that failed."""
+    spec = SPEC.replace("  action GOTO(x: float, y: float) -> int = service GOTO;\n",
+                        "  action GOTO(x: float, y: float) -> int = service GOTO;\n"
+                        "  action CHECK(x: float) = \"cart_codels.checks.check\";\n"
+                        "  ka InRange { invocation: !(IN-RANGE $X); action: (CHECK $X); }\n").replace(
+        "body { !(SEND-GOTO $X $Y $ID);", "body { !(IN-RANGE $X); !(SEND-GOTO $X $Y $ID);")
+    cart = write_robot(tmp_path, spec)
+    (cart / "cart_codels" / "checks.py").write_text(
+        "def check(ctx, x):\n    if x > 5:\n        raise ValueError(f'x={x} is outside its domain [0, 5]')\n")
+    result = specc(tmp_path, "run", cart, "--goal", "!(GO 9 1)", "--folder", tmp_path / "far", "-q")
+    assert result.returncode == 1, result.stderr
+    why = json.loads((tmp_path / "far" / "report.json").read_text())["why"]
+    assert "(CHECK 9) raised ValueError: x=9 is outside its domain [0, 5]" in why, why
+
+
 def test_a_reflex_that_fires_is_in_the_log_before_what_it_does(tmp_path: Path) -> None:
     stop = "  request Stop { type: control; validate: stopNow; }\n"
     spec = SPEC.replace("  exec_task Motion", stop + "  exec_task Motion")

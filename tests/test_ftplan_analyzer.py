@@ -217,3 +217,21 @@ def test_messages_are_one_line_naming_the_rule_and_the_action() -> None:
     for v in violations:
         assert "\n" not in v.message and v.message.startswith(f"line {v.line}: ")
         assert v.action and v.action in v.message
+
+
+def test_a_start_the_problem_explains_holds_until_nature_s_first_event() -> None:
+    """A window written as closed at the start by the problem itself (`explained event(...: (IN,
+    OUT), t_start)`) rather than by nature: before its opening, the analyzer reads it OUT, as the
+    planner and the validator do, not unknown. The plan passes; a communication moved before the
+    window is refused for it."""
+    plan = planned("M1_model1")
+    problem = atrv_models("M1_model1")[1]
+    explained = replace(problem, assertions=tuple(
+        replace(a, kind="explained") if isinstance(a, pm.Event) and a.kind == "contingent"
+        and a.attribute == "VISIBILITY_WINDOW" and a.time == problem.start else a for a in problem.assertions))
+    assert explained != problem
+    assert analyse(plan, config(), SystemState.from_problem(explained), explained) == []
+    talk = action(plan, "COMMUNICATE(W1)")
+    early = analyse(shifted(plan, talk, -30.0), config(), SystemState.from_problem(explained), explained)
+    violation = found(early, rule_line("requires VISIBILITY_WINDOW(?w): IN"), talk.id)
+    assert "VISIBILITY_WINDOW(W1) is OUT" in violation.message

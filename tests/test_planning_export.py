@@ -367,3 +367,17 @@ def test_the_files_are_the_same_from_one_process_to_the_next(tmp_path: Path) -> 
         return [(folder / name).read_text() for name in ("domain.pddl", "problem.pddl")]
 
     assert written("1") == written("2")
+
+
+def test_the_files_read_back_for_aries_have_whole_durations(modele1: Exported, tmp_path: Path) -> None:
+    """PDDL has only `number`: the reader makes Modele1's duration table real, which Aries refuses;
+    `read_pddl` gives it back as whole numbers, the rest of the problem untouched."""
+    from specc.analysis.planning_export import read_pddl
+
+    domain, problem = write_pddl(modele1, tmp_path)
+    plain = PDDLReader().parse_problem(str(domain), str(problem))
+    ready = read_pddl(domain, problem)
+    durations = {f.name for f in plain.fluents if "duration" in f.name.lower()}
+    assert durations and all(plain.fluent(name).type.is_real_type() for name in durations)
+    assert all(ready.fluent(name).type.is_int_type() for name in durations)
+    assert {a.name for a in ready.actions} == {a.name for a in plain.actions} and ready.goals == plain.goals

@@ -619,3 +619,14 @@ def test_an_output_function_s_answers_leave_the_failures_to_fail(tmp_path: Path,
     translation = translate(program, block, [rp.parse_goal("!(CHECK)")], failing=failing)
     answers = translation.net.transitions["service MEASURE answers"].bindings or ()
     assert {binding["1"][1] for binding in answers} == {"OK", "HEAVY", "LIGHT", "NONE"} | failures
+
+
+def test_a_request_protocol_whose_answer_has_no_domain_is_refused_not_a_deadlock(tmp_path: Path) -> None:
+    """Without `predicate EXEC(...)` the net has no answer for any service: saying "deadlock" would
+    report what the robot never does; the missing declaration is said instead, at the KA."""
+    text = probed(tmp_path, PROBED.replace("  predicate EXEC(service: SERVICES, result: RESULTS);\n", "")
+                  .replace("!(EXEC SPRAY $S);", "!(EXEC SPRAY $V);"))
+    with pytest.raises(TranslationError) as raised:
+        check(text, "!(CHECK)", tmp_path)
+    [diagnostic] = [d for d in raised.value.diagnostics if "answer of EXEC" in d.message]
+    assert diagnostic.code == "unbounded-variable" and "declare `predicate EXEC(" in diagnostic.message

@@ -100,6 +100,23 @@ def test_a_rule_cannot_start_a_service_beside_the_one_it_is_declared_to_wait_for
     assert run(robot(tmp_path, rule), "shop", 2).ok
 
 
+def test_a_conflict_declared_one_way_is_said_with_the_verdict(tmp_path: Path) -> None:
+    """BACK waits for GO, GO names no conflict with BACK: a GO asked for while BACK runs starts
+    beside it, which exclusion (the arcs as written) allows; the verdict says so, and how to make
+    them never run together."""
+    result = run(robot(tmp_path, ""), "shop", 2)
+    assert result.ok and result.one_way == (("BACK", "wait", "GO"),)
+    said = list(describe(result))[-1]
+    assert said.startswith("conflicts declared one way only (exclusion reads them as written): GO may start while "
+                           "BACK runs (BACK waits for GO, GO does not name BACK)")
+    both = tmp_path / "both"
+    both.mkdir()
+    paths = robot(both, "")
+    paths[0].write_text(paths[0].read_text().replace("service GO { request: arm.Go; }",
+                                                     "service GO { request: arm.Go; conflicts { BACK: wait; } }"))
+    assert run(paths, "shop", 2).one_way == ()
+
+
 def test_a_rule_keeping_a_service_waiting_starves_it_unless_it_has_a_start_timeout(tmp_path: Path) -> None:
     rule = 'backNever: event == "START", service == "BACK" ==> restrict status == "WAIT";'
     starving = run(robot(tmp_path, rule), "shop", 1)

@@ -219,6 +219,61 @@ def _sorted_constants(domain: str) -> str:
     return head + found + "\n   ".join(line.strip() for line in lines) + end + tail
 
 
+def read_pddl(domain: Path, problem: Path) -> UPProblem:
+    """The files `write_pddl` wrote, read back by unified-planning's reader as a planner through it
+    takes them: Aries (`OneshotPlanner(name="aries")`) solves what this returns, not the reader's
+    problem itself, whose durations PDDL's `number` makes real (`with_integer_functions`)."""
+    from unified_planning.io import PDDLReader
+
+    return with_integer_functions(PDDLReader().parse_problem(str(domain), str(problem)))
+
+
+def with_integer_functions(problem: UPProblem) -> UPProblem:
+    """The problem as unified-planning's PDDL reader gives it, with each static numeric function
+    whose values are all whole numbers typed as an integer: PDDL has only `number`, which the
+    reader makes real, and Aries takes only integer durations (Modele1's MOVE_duration). The
+    files are not changed; nothing else in the problem is."""
+    changed = {effect.fluent.fluent().name for action in problem.actions for effects in action.effects.values()
+               for effect in effects} | {effect.fluent.fluent().name for effects in problem.timed_effects.values()
+                                         for effect in effects}
+    values = problem.explicit_initial_values
+    retyped = {}
+    for fluent in problem.fluents:
+        if fluent.type.is_real_type() and fluent.name not in changed and all(
+                value.constant_value() == int(value.constant_value())
+                for key, value in values.items() if key.fluent() == fluent):
+            retyped[fluent.name] = Fluent(fluent.name, IntType(), fluent.signature)
+
+    def integer(expression: Any) -> Any:
+        if expression.is_fluent_exp() and expression.fluent().name in retyped:
+            return retyped[expression.fluent().name](*expression.args)
+        return expression
+
+    result = UPProblem(problem.name)
+    for fluent in problem.fluents:
+        default = problem.fluents_defaults.get(fluent)
+        if fluent.name in retyped:
+            whole = None if default is None else Int(int(default.constant_value()))
+            result.add_fluent(retyped[fluent.name], default_initial_value=whole)
+        else:
+            result.add_fluent(fluent, default_initial_value=default)
+    result.add_objects(problem.all_objects)
+    for action in problem.actions:
+        copy = action.clone()
+        duration = action.duration
+        copy.set_closed_duration_interval(integer(duration.lower), integer(duration.upper))
+        result.add_action(copy)
+    for key, value in values.items():
+        fresh = integer(key)
+        result.set_initial_value(fresh, Int(int(value.constant_value())) if fresh is not key else value)
+    for timing, effects in problem.timed_effects.items():
+        for effect in effects:
+            result.add_timed_effect(timing, effect.fluent, effect.value)
+    for goal in problem.goals:
+        result.add_goal(goal)
+    return result
+
+
 def constant_set_names(program: m.Program, domain: m.Domain) -> dict[frozenset[str], str]:
     """The domain's named constant sets (`constant OBJECTS = {...}`), by their members: the
     planning records spell the sets out, so the names are found again here."""

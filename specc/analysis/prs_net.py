@@ -631,6 +631,8 @@ class Translator:
             self.posted.setdefault(goal.expr.head, {})[posted] = None
             self.result.top.append((goal.expr.head, posted))
         self._servers()
+        if self.diagnostics:  # a request protocol the net cannot answer
+            raise TranslationError(self.diagnostics)
         initial: dict[str, dict[Any, int]] = {}
         colours: dict[str, list[Any]] = {}
         for place, place_colours, marking in self.db.places():
@@ -1470,6 +1472,14 @@ class Translator:
         assert self.executive is not None
         head = ka.trigger.head
         results = self.db.argument_values(head, len(ka.trigger.args) - 1)
+        if not results or not any(p.name == head for p in self.node_ast.predicates):
+            # The answers would be only the words the KAs happen to write (no OK): services would
+            # never answer, a deadlock the robot does not have.
+            self._reject(ka, f"the answer of {head} (its last argument) has no declared domain, so the net cannot "
+                         f"tell what the services answer: declare `predicate {head}(service: SERVICES, ..., result: "
+                         "RESULTS);` with a type of the answers the procedures expect (OK, and the failures they "
+                         "test)", "unbounded-variable")
+            return
         for colour in posted:
             name = colour[0]
             service = self.executive.services.get(name)

@@ -306,6 +306,9 @@ class Verification:
     violations: dict[str, Violation]
     left_out: tuple[str, ...] = ()  # the sends the model leaves out ("module.request sends module.request")
     parts: tuple[tuple[str, ...], ...] = ()  # the independent parts explored one by one (services), if several
+    # Conflicts declared by one side only: (source, policy, target), the target starting beside a
+    # running source unhindered; exclusion, which reads the arcs as written, allows it.
+    one_way: tuple[tuple[str, str, str], ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -831,7 +834,11 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
 
 def verify(program: m.Program, executive: m.Executive, requests: int = 2, limit: int = 200_000,
            progress: Callable[[int], None] | None = None) -> Verification:
-    return explorer_for(program, executive, requests).explore(limit, progress)
+    explorer = explorer_for(program, executive, requests)
+    arcs = {(a.source, a.target): a.policy for a in executive_controller(program, executive).graph.arcs}
+    one_way = tuple(sorted((source, policy, target) for (source, target), policy in arcs.items()
+                           if source != target and (target, source) not in arcs))
+    return dataclasses.replace(explorer.explore(limit, progress), one_way=one_way)
 
 
 def describe(result: Verification) -> Iterator[str]:
@@ -852,3 +859,9 @@ def describe(result: Verification) -> Iterator[str]:
     if result.left_out:
         yield (f"left out of the model, as nothing the requests they send do can reach the executive: "
                f"{'; '.join(result.left_out)}")
+    if result.one_way:
+        verbs = {"wait": "waits for", "interrupt": "interrupts"}
+        said = "; ".join(f"{target} may start while {source} runs ({source} {verbs[policy]} {target}, {target} does "
+                         f"not name {source})" for source, policy, target in result.one_way)
+        yield (f"conflicts declared one way only (exclusion reads them as written): {said}; for two services "
+               "never to run together, give each a conflict with the other")

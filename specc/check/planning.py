@@ -207,6 +207,10 @@ class ScopeChecker(Visitor):
         if s.verb != "use" or not isinstance(s.when, m.Window):
             self.ctx.report("unsupported-resource-use", f"the planner borrows resources over an interval only: "
                             f"write use(R(): amount, (t1, t2)); '{s.verb}' at one instant is not planned", s.span)
+        elif s.when.start == s.when.end:
+            self.ctx.report("unsupported-resource-use", f"use over ({s.when.start}, {s.when.end}) is at one instant: "
+                            "the planner borrows resources over an interval only; write use(R(): amount, (t1, t2)) "
+                            "with two timepoints", s.span)
         self.attr_value(s.attr, self.scope, resource=True)
         for time in (s.when.start, s.when.end) if isinstance(s.when, m.Window) else (s.when,):
             self.time(time, self.scope)
@@ -214,6 +218,22 @@ class ScopeChecker(Visitor):
         if amount is not None and amount < 0:
             self.ctx.warn("negative-amount", f"a task {s.verb}s {amount:g} of {s.attr.attribute}: an amount is 0 or "
                           "more (what it gives back is its end)", s.attr.value.span)
+        capacity = self.capacity(s.attr.attribute)
+        if amount is not None and capacity is not None and amount > capacity:
+            self.ctx.warn("over-capacity", f"a task {s.verb}s {amount:g} of {s.attr.attribute}, whose capacity is "
+                          f"{capacity:g}: the planner never inserts it; lower the amount or raise the resource's "
+                          "?value bound", s.attr.value.span)
+
+    def capacity(self, name: str) -> float | None:
+        """A resource's capacity: the upper bound of its `?value in [low, high]`, when constant."""
+        resource = self.domain.attributes.get(name)
+        if not isinstance(resource, m.Resource):
+            return None
+        for statement in resource.body:
+            if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
+                    and statement.expr.name == VALUE_VAR and isinstance(statement.domain, m.Interval)):
+                return constant_value(statement.domain.high)
+        return None
 
     def visit_InConstraint(self, s: m.InConstraint) -> None:
         self.expr(s.expr, self.scope)

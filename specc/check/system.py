@@ -11,7 +11,8 @@ from collections.abc import Mapping
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.check.executive import resolve_poster, resolve_request
-from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks
+from specc.check.ftplan import _quiet, check_attribute, check_bound, check_task, check_terms, planned_tasks
+from specc.check.planning import tables
 from specc.check.procedures import Domains
 from specc.check.symbols import first_by_name
 from specc.diagnostics import did_you_mean
@@ -257,8 +258,52 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
         check_terms(ctx, (*binding.args, *plain, *inner))
         check_bound(ctx, binders, (*plain, *inner), f"task '{binding.task}'")
         check_binding_target(ctx, system, binding, goals, services)
+        if binding.kind == "goal" and supervisor is not None:
+            check_goal_binding_values(ctx, ftplan, supervisor, binding)
         if binding.report is not None:
             check_binding_report(ctx, binding.report, reports)
+
+
+def check_goal_binding_values(ctx: Context, ftplan: m.FtPlan, supervisor: m.Procedures, binding: m.Binding) -> None:
+    """A task's parameter passed to a goal (`TRAVEL(?a, ?b) => goal GO-ROOM(?b)`) may take only
+    values the goal's predicate declares there: the planners' domains give its values, and one
+    outside the predicate's domain makes such an action fail at run time, before any service."""
+    declared = next((p for p in supervisor.predicates if p.name == binding.target.text), None)
+    if declared is None or len(declared.params) != len(binding.target_args):
+        return
+    names = [a.name if isinstance(a, m.IxVar) else None for a in binding.args]
+    for position, arg in enumerate(binding.target_args):
+        if not isinstance(arg, m.IxVar) or arg.name not in names:
+            continue
+        allowed = Domains(supervisor).values(declared.params[position].domain)
+        values = task_parameter_values(ctx, ftplan, binding.task, names.index(arg.name))
+        if allowed is None or values is None:
+            continue
+        outside = sorted(values - {str(v) for v in allowed})
+        if outside:
+            ctx.warn("value-outside-domain", f"{arg.name} of task '{binding.task}' may be {', '.join(outside)}, "
+                     f"which {declared.name}'s '{declared.params[position].name}' does not hold "
+                     f"({', '.join(str(v) for v in allowed)}): such an action's goal fails at run time; pass what "
+                     "the goal takes, or widen its domain", arg.span)
+
+
+def task_parameter_values(ctx: Context, ftplan: m.FtPlan, task_name: str, position: int) -> set[str] | None:
+    """The symbols the task's parameter at `position` may take, in every planner's domain (None
+    when one does not say them as a set of symbols)."""
+    values: set[str] = set()
+    for planner in ftplan.planners:
+        domain = ctx.named(m.Domain).get(planner.domain.text) if planner.domain is not None else None
+        if domain is None:
+            continue
+        found = tables(_quiet(ctx), domain.members)
+        task = found.tasks.get(task_name)
+        if task is None or position >= len(task.params):
+            continue
+        said = found.value_domain(task, task.params[position].name)  # type: ignore[arg-type]
+        if said is None:
+            return None
+        values |= said
+    return values
 
 
 def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goals: dict[str, int],

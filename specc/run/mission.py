@@ -582,9 +582,10 @@ def _cut(text: str, width: int) -> str:
 
 
 def why_failed(trace: Iterable[Any], events: list[Mapping[str, Any]]) -> str:
-    """The first statement that failed in the goal's intention, and the last service reply that
-    was a failure before it (what the procedures most likely reacted to)."""
-    failure = next((entry for entry in trace if " failed" in entry.text), None)
+    """The first statement that failed in the goal's intention (or the user's function that raised,
+    which made it fail), and the last service reply that was a failure before it (what the
+    procedures most likely reacted to)."""
+    failure = next((entry for entry in trace if " failed" in entry.text or " raised " in entry.text), None)
     if failure is None:
         return "no applicable KA succeeded"
     refused = next((e for e in reversed(events) if e["kind"] == "reply" and e["t"] <= failure.time

@@ -40,6 +40,7 @@ from typing import Any, TypeVar
 
 import pytest
 
+from specc.analysis.planning_export import with_integer_functions
 from specc.runtime.planner import Planner
 from specc.runtime.planner import model as pm
 from specc.runtime.planner.validate import validate
@@ -234,54 +235,6 @@ def test_cold_plan_command() -> None:
           f"baseline: cold `specc check -q examples/atrv` {baseline:.3f} s (start, imports, load and check; "
           f"planning is the difference):\n  " + "\n  ".join(lines)
           + f"\n  issue #25: under {COLD_GOAL:g} s on {met} of 8 missions")
-
-
-def with_integer_functions(problem: Any) -> Any:
-    """The problem as unified-planning's PDDL reader gives it, with each static numeric function
-    whose values are all whole numbers typed as an integer: PDDL has only `number`, which the
-    reader makes real, and Aries takes only integer durations (Modele1's MOVE_duration). The
-    files are not changed; nothing else in the problem is."""
-    import unified_planning.shortcuts as up
-
-    changed = {effect.fluent.fluent().name for action in problem.actions for effects in action.effects.values()
-               for effect in effects} | {effect.fluent.fluent().name for effects in problem.timed_effects.values()
-                                         for effect in effects}
-    values = problem.explicit_initial_values
-    retyped = {}
-    for fluent in problem.fluents:
-        if fluent.type.is_real_type() and fluent.name not in changed and all(
-                value.constant_value() == int(value.constant_value())
-                for key, value in values.items() if key.fluent() == fluent):
-            retyped[fluent.name] = up.Fluent(fluent.name, up.IntType(), fluent.signature)
-
-    def integer(expression: Any) -> Any:
-        if expression.is_fluent_exp() and expression.fluent().name in retyped:
-            return retyped[expression.fluent().name](*expression.args)
-        return expression
-
-    result = up.Problem(problem.name)
-    for fluent in problem.fluents:
-        default = problem.fluents_defaults.get(fluent)
-        if fluent.name in retyped:
-            whole = None if default is None else up.Int(int(default.constant_value()))
-            result.add_fluent(retyped[fluent.name], default_initial_value=whole)
-        else:
-            result.add_fluent(fluent, default_initial_value=default)
-    result.add_objects(problem.all_objects)
-    for action in problem.actions:
-        copy = action.clone()
-        duration = action.duration
-        copy.set_closed_duration_interval(integer(duration.lower), integer(duration.upper))
-        result.add_action(copy)
-    for key, value in values.items():
-        fresh = integer(key)
-        result.set_initial_value(fresh, up.Int(int(value.constant_value())) if fresh is not key else value)
-    for timing, effects in problem.timed_effects.items():
-        for effect in effects:
-            result.add_timed_effect(timing, effect.fluent, effect.value)
-    for goal in problem.goals:
-        result.add_goal(goal)
-    return result
 
 
 PDDL_MISSIONS = tuple(f"M{k}_{model}" for model in ("model1", "model2") for k in (1, 2, 3))

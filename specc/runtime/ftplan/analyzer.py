@@ -104,12 +104,23 @@ class Projection:
             for key, value in consequences(config.state_rules, "ended", action.task, action.args, view):
                 self.effects.setdefault(key, []).append(Change(value, ends, f"set when {action.id} ends", action.id))
         self.events = _contingent_events(problem, _timepoint_dates(plan, state))
+        # What the problem says such an attribute starts at (`explained event(EMPTY(R104): (NO,
+        # YES), t_start)`), before nature's first event on it.
+        self.starts: dict[FactKey, Value] = {}
+        for a in problem.assertions:
+            if isinstance(a, pm.Event) and a.kind == "explained" and a.goal is None and a.time == problem.start:
+                started, start = constant_key(a.attribute, a.args), constant(a.after)
+                if started is not None and start is not None:
+                    self.starts[started] = start
 
     def timeline(self, key: FactKey) -> Timeline:
         events = self.events.get(key)
         if events is not None:
-            # Nature sets these, whatever FTplan believes: its state has no say on them.
-            return Timeline(None, "before the problem's first event on it", tuple(events))
+            # Nature sets these, whatever FTplan believes: its state has no say on them, the
+            # problem's start does.
+            start = self.starts.get(key)
+            return Timeline(start, "the problem's start" if start is not None
+                            else "before the problem's first event on it", tuple(events))
         initial = self.facts.get(key)
         origin = "FTplan's state" if initial is not None else "not in FTplan's state"
         return Timeline(initial, origin, tuple(self.effects.get(key, ())))

@@ -685,6 +685,10 @@ class Node:
         for a in task.assertions:
             new = self.add_written(a, instance.var, point, instance.id)
             if new.kind == "use":
+                amount, capacity = self.bindings.resolve(new.value), self.ctx.capacity.get(new.attribute, 1.0)
+                if is_number(amount) and float(amount) > capacity + TOLERANCE:  # alone, with no other use beside it
+                    raise DeadEnd(f"{task.name} uses {float(amount):g} of {new.attribute}(), more than its capacity "
+                                  f"{capacity:g}")
                 self.require(new.start, new.end, 0.0)
             else:
                 self._own_support(self.assertions[own_from:], instance)
