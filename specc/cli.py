@@ -441,9 +441,9 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
             err.print(f"error: {exc}", markup=False)
             raise typer.Exit(1) from None
     explored = result.space.unfolded
-    out.print(f"explored: the reduced net, {len(explored.slots)} places and {len(explored.steps)} transitions "
-              "(places no firing marks dropped, single-consumer places merged: the same deadlocks, ends and "
-              "cycles)", markup=False)
+    out.print(f"explored: the unfolded net reduced to {len(explored.slots)} of its {len(full.slots)} places and "
+              f"{len(explored.steps)} of its {len(full.steps)} transitions (places no firing marks dropped, "
+              "single-consumer places merged: the same deadlocks, ends and cycles)", markup=False)
     for path, chosen, what in ((pnml, explored, "the reduced net explored"), (pnml_full, full, "the full net")):
         if path is None:
             continue

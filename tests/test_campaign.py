@@ -216,6 +216,8 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     assert "its Robot1 succeeded in about 54% of missions under faults, its Robot1/2 in about 73%" in text
     assert "| model1-0001 | numeric |" in text and "| 0% | 50% |" in text
     assert "| σ̄_p | σ̄_c | σ̄_h | ν̄ | κ̄ |" in text
+    # One kept mutant: the report says it weighs the whole of each mean under faults.
+    assert "**few mutants:** the means under faults are over 1 kept mutant(s); one mutant's runs weigh 100%" in text
     written = write_report(report, tmp_path / "out")
     assert [p.name for p in written] == ["campaign.md", "campaign.json", "campaign.png"] and is_png(written[2])
 

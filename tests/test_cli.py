@@ -355,8 +355,8 @@ def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Pa
     lines = result.stdout.splitlines()
     assert lines[0].startswith("net of CollectObjects") and f"wrote {pnml} (the reduced net explored)" in lines
     # The PNML is the net whose states are counted: the reduced one, as printed.
-    explored = next(line for line in lines if line.startswith("explored: the reduced net, "))
-    places, transitions = (int(n) for n in re.findall(r"(\d+) (?:places|transitions)", explored))
+    explored = next(line for line in lines if line.startswith("explored: the unfolded net reduced to "))
+    places, transitions = (int(n) for n in re.findall(r"(\d+) of its \d+ (?:places|transitions)", explored))
     written = pnml.read_text(encoding="utf-8")
     assert written.count("<place ") == places and written.count("<transition ") == transitions
     assert any(re.match(r"\d+ states of the reduced net in ", line) for line in lines)

@@ -22,6 +22,8 @@ from specc.campaign.store import MutantRecord, ResultStore
 from specc.run.measures import MeanMeasures, Measures, aggregate, kinds_of
 
 FAULTY, FAULT_FREE = "F*", "∅"
+# Below this many kept mutants the report says how much one mutant weighs in each mean.
+FEW_MUTANTS = 10
 # The seed's headline (§4.2.2.3, without W4): ν̄ up 19 points, "41 %" relative. The relative figure
 # is on the failure rate (with W4, a 12-point communication gain is called 64 %: a base of 18.75 %,
 # a failure rate), so the seed's Robot1 failed 0.19 / 0.41 = 46 % of its missions under faults.
@@ -200,6 +202,11 @@ def markdown(report: CampaignReport) -> str:
     if report.headlines:
         lines += ["## Headline", ""]
         lines += [f"- {h.text()}" for h in report.headlines]
+        kept = len(report.per_mutant)
+        if 0 < kept < FEW_MUTANTS:
+            lines.append(f"- **few mutants:** the means under faults are over {kept} kept mutant(s); one mutant's "
+                         f"runs weigh {1 / kept:.0%} of each, so a difference of that size may be one mutant's doing "
+                         "(seed 004 kept 28 of 38, §4.2.2.1; `--mutants N` draws more)")
         seed_abs, seed_rel = SEED_HEADLINE
         seed_failed = seed_abs / seed_rel
         lines += [f"- for reference, seed 004's own campaign (§4.2.2.3, W* \\ W4, its rover and missions): "
