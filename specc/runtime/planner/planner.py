@@ -246,8 +246,9 @@ class Planner:
         phases: tuple[tuple[str, Callable[[list[Goal], float, int], tuple[list[Node], int]], int], ...] = (
             ("waypoints", lambda active, limit, share: setup.waypoints(active, node, limit, share), 4),
             ("branch and bound", setup.improve, 6),
-            ("other goal orders", setup.reorder, 2),
-            ("other goal orders with waypoints", functools.partial(setup.reorder, waypoints=True), 1))
+            ("other goal orders", functools.partial(setup.reorder, trial=order_trial(node)), 2),
+            ("other goal orders with waypoints",
+             functools.partial(setup.reorder, waypoints=True, trial=order_trial(node)), 1))
         for name, search, share in phases:
             found, used = search(kept, bound, (budget - spent) // share) if spent < budget else ([], 0)
             spent += used
@@ -322,6 +323,13 @@ class Planner:
                          for g in setup.goals)
         return PlanResult(plan, outcomes, nodes=attempt.nodes, seconds=time.perf_counter() - started,
                           notes=(*notes, note))
+
+
+def order_trial(plan: Node) -> int:
+    """The partial plans a depth-first search led by one order of the goals may take: an order
+    that leads to a plan needs about one to five per action of a plan like `plan` (the rover's
+    missions: 2.9-5.2), and one that fails spends the whole trial, which should not be wasted."""
+    return min(REORDER_TRIAL, 20 + 6 * len(plan.instances))
 
 
 class _Enough(Exception):
@@ -707,7 +715,7 @@ class Setup:
             nodes += tried.nodes
             if tried.node is None:
                 return INF
-            ways, used = self.waypoints(active, tried.node, INF, min(trial, max(0, budget - nodes))) if (
+            ways, used = self.waypoints(active, tried.node, INF, min(REORDER_TRIAL, max(0, budget - nodes))) if (
                 waypoints) else ([], 0)
             nodes += used
             best = ways[-1] if ways else tried.node
@@ -758,8 +766,7 @@ class Setup:
         slow for the mission still has a plan and a makespan, so the search can walk towards
         faster tours), until a plan found there takes the end back: the problem's plan. None if
         no tour does within `budget`; and the partial plans spent. `node`, a plan for some of the
-        goals, sizes each order's trial: a depth-first search the order leads needs about as many
-        partial plans as the plan has actions, and an order that fails would take the whole trial."""
+        goals, sizes each order's trial (`order_trial`)."""
         latest = pm.latest_end(self.problem)
         if latest == INF:
             return None, 0
@@ -776,8 +783,7 @@ class Setup:
 
         lifted = Setup(self.domain, pm.without_latest_end(self.problem), self.now, self.limits,
                        self.controllability, self.heuristic, self.flaws)
-        trial = min(REORDER_TRIAL, 20 + 4 * len(node.instances))
-        _, spent = lifted.reorder(active, INF, budget, enough=ends_in_time, trial=trial)
+        _, spent = lifted.reorder(active, INF, budget, enough=ends_in_time, trial=order_trial(node))
         return (in_time[0] if in_time else None), spent
 
     def waypoints(self, active: list[Goal], node: Node, bound: float, budget: int) -> tuple[list[Node], int]:
