@@ -63,3 +63,18 @@ def test_compile_reports_what_check_reports_and_nothing_more(case: Path, tmp_pat
     assert "Traceback" not in shown and "internal error" not in shown, shown
     assert compiled == checked and compile_codes == check_codes, shown
     assert checked != 0 or "\n0 error(s)" in check_shown, check_shown  # a case of warnings only compiles
+
+
+def test_a_binding_s_constant_is_checked_against_its_own_module_s_enum(tmp_path: Path) -> None:
+    """Two modules each with an enum named `speed`: `drive.Go(FAST)` is a value of drive's, not
+    of arm's, whichever module comes last."""
+    base = (CASES / "system_planned.spec").read_text()
+    text = base.replace("  request Lift { type: control; input: height: double; }\n",
+                        "  request Lift { type: control; input: height: double; }\n"
+                        "  enum speed { SLOW, FAST }\n  request Pace { type: control; input: s: speed; }\n")
+    text += "\nmodule arm {\n  number: 2;\n  enum speed { CREEP, QUICK }\n}\n"
+    for value, wrong in (("FAST", False), ("QUICK", True)):
+        spec = tmp_path / f"{value}.spec"
+        spec.write_text(text.replace("LIFT() => request drive.Lift(HIGH);", f"LIFT() => request drive.Pace({value});"))
+        found = [d for d in load([spec]).diagnostics if d.code == "bad-argument-type"]
+        assert bool(found) == wrong, [d.message for d in found]

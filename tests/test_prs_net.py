@@ -630,3 +630,12 @@ def test_a_request_protocol_whose_answer_has_no_domain_is_refused_not_a_deadlock
         check(text, "!(CHECK)", tmp_path)
     [diagnostic] = [d for d in raised.value.diagnostics if "answer of EXEC" in d.message]
     assert diagnostic.code == "unbounded-variable" and "declare `predicate EXEC(" in diagnostic.message
+
+
+def test_an_answer_domain_without_ok_is_refused_not_a_deadlock(tmp_path: Path) -> None:
+    """SPRAY has no output function: it answers OK when it works. A result type without OK would
+    leave the net no answer for it, a deadlock the robot does not have: said instead."""
+    text = probed(tmp_path, PROBED.replace("type RESULTS = {OK, TIMEOUT,", "type RESULTS = {TIMEOUT,"))
+    with pytest.raises(TranslationError) as raised:
+        check(text, "!(CHECK)", tmp_path)
+    assert any("service SPRAY answers OK when it works" in d.message for d in raised.value.diagnostics)

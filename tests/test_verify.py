@@ -115,6 +115,9 @@ def test_a_conflict_declared_one_way_is_said_with_the_verdict(tmp_path: Path) ->
     paths[0].write_text(paths[0].read_text().replace("service GO { request: arm.Go; }",
                                                      "service GO { request: arm.Go; conflicts { BACK: wait; } }"))
     assert run(paths, "shop", 2).one_way == ()
+    # A control service takes no time, so nothing has an arc to it: its own arcs are not one-way
+    # by omission (the rover's PTU-INIT and STOP-NAV interrupt what they stop).
+    assert run([EXAMPLES / "atrv"], "atrv", 1).one_way == ()
 
 
 def test_a_rule_keeping_a_service_waiting_starves_it_unless_it_has_a_start_timeout(tmp_path: Path) -> None:

@@ -1522,6 +1522,10 @@ class Translator:
                 reads = list(zip(groups, states, strict=True))
                 self.emit.fire(f"{origin} starts", origin, [*takes, *reads], [*puts, *reads])
             answers = [r for r in results if self.executive.may_fail(name) or _success(r, service)]
+            if not answers:  # it would never answer: a deadlock of the model, not of the robot
+                self._reject(ka, f"service {name} answers OK when it works, which the domain of {head}'s answer "
+                             f"({', '.join(map(str, results))}) lacks: add OK to it", "unbounded-variable")
+                continue
             self.result.environment.add(f"{origin} answers")
             for result in answers:
                 answer = colour[:-1] + (result,)

@@ -41,6 +41,7 @@ from typing import Any
 
 from specc.analysis import kheops as k
 from specc.analysis.controller import Controller, executive_controller, mentioned_where
+from specc.analysis.incompat import build_graph
 from specc.analysis.service_list import executive_spec
 from specc.check.symbols import symbols_of
 from specc.model import nodes as m
@@ -835,9 +836,13 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
 def verify(program: m.Program, executive: m.Executive, requests: int = 2, limit: int = 200_000,
            progress: Callable[[int], None] | None = None) -> Verification:
     explorer = explorer_for(program, executive, requests)
-    arcs = {(a.source, a.target): a.policy for a in executive_controller(program, executive).graph.arcs}
+    graph = build_graph(program, executive)
+    arcs = {(a.source, a.target): a.policy for a in graph.arcs}
+    # A control service takes no time: no arc ends at one, so an arc from one is one-way by
+    # nature, not by an entry left out.
     one_way = tuple(sorted((source, policy, target) for (source, target), policy in arcs.items()
-                           if source != target and (target, source) not in arcs))
+                           if source != target and (target, source) not in arcs
+                           and source not in graph.control and target not in graph.control))
     return dataclasses.replace(explorer.explore(limit, progress), one_way=one_way)
 
 

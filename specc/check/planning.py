@@ -208,7 +208,8 @@ class ScopeChecker(Visitor):
             self.ctx.report("unsupported-resource-use", f"the planner borrows resources over an interval only: "
                             f"write use(R(): amount, (t1, t2)); '{s.verb}' at one instant is not planned", s.span)
         elif s.when.start == s.when.end:
-            self.ctx.report("unsupported-resource-use", f"use over ({s.when.start}, {s.when.end}) is at one instant: "
+            instant = getattr(s.when.start, "name", "one timepoint")
+            self.ctx.report("unsupported-resource-use", f"use over ({instant}, {instant}) is at one instant: "
                             "the planner borrows resources over an interval only; write use(R(): amount, (t1, t2)) "
                             "with two timepoints", s.span)
         self.attr_value(s.attr, self.scope, resource=True)
@@ -219,13 +220,14 @@ class ScopeChecker(Visitor):
             self.ctx.warn("negative-amount", f"a task {s.verb}s {amount:g} of {s.attr.attribute}: an amount is 0 or "
                           "more (what it gives back is its end)", s.attr.value.span)
         capacity = self.capacity(s.attr.attribute)
-        if amount is not None and capacity is not None and amount > capacity:
+        if s.verb == "use" and amount is not None and capacity is not None and amount > capacity:
             self.ctx.warn("over-capacity", f"a task {s.verb}s {amount:g} of {s.attr.attribute}, whose capacity is "
                           f"{capacity:g}: the planner never inserts it; lower the amount or raise the resource's "
                           "?value bound", s.attr.value.span)
 
     def capacity(self, name: str) -> float | None:
-        """A resource's capacity: the upper bound of its `?value in [low, high]`, when constant."""
+        """A resource's capacity: the upper bound of its `?value in [low, high]` when constant, 1
+        without one (as the planner takes it)."""
         resource = self.domain.attributes.get(name)
         if not isinstance(resource, m.Resource):
             return None
@@ -233,7 +235,7 @@ class ScopeChecker(Visitor):
             if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
                     and statement.expr.name == VALUE_VAR and isinstance(statement.domain, m.Interval)):
                 return constant_value(statement.domain.high)
-        return None
+        return 1.0
 
     def visit_InConstraint(self, s: m.InConstraint) -> None:
         self.expr(s.expr, self.scope)

@@ -331,21 +331,24 @@ def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goa
         else:
             inputs = request_inputs(ctx, service)
             check_constant_inputs(ctx, binding.target_args, [inputs.get(t.text) for t in service.takes],
-                                  f"service '{service.name}'")
+                                  f"service '{service.name}'", service.request.parts[0] if service.request else "")
     else:
         request = resolve_request(ctx, target)
         if request is not None and len(request.inputs) != given:
             ctx.report("arity-mismatch", f"request '{target.text}' takes {len(request.inputs)} input(s) "
                        f"({', '.join(i.name for i in request.inputs) or 'none'}), {given} given", target.span)
         elif request is not None:
-            check_constant_inputs(ctx, binding.target_args, list(request.inputs), f"request '{target.text}'")
+            check_constant_inputs(ctx, binding.target_args, list(request.inputs), f"request '{target.text}'",
+                                  target.parts[0])
 
 
 def check_constant_inputs(ctx: Context, args: tuple[m.IxExpr, ...], inputs: list[m.TypedName | None],
-                          target: str) -> None:
+                          target: str, module_name: str) -> None:
     """A binding's constant argument (`service REPORT(FAST)`) must be a value of the input it
-    gives: the request refuses it at run time, at every replanning."""
-    enums = {e.name: set(e.values) for module in ctx.items(m.Module) for e in module.enums}
+    gives: the request refuses it at run time, at every replanning. Enums are the request's
+    module's (two modules may each have an enum of one name)."""
+    enums = {e.name: set(e.values) for module in ctx.items(m.Module) if module.name == module_name
+             for e in module.enums}
     for arg, typed in zip(args, inputs, strict=False):
         if typed is None or typed.type.size is not None or not isinstance(arg, m.Number | m.IxName):
             continue

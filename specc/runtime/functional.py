@@ -621,8 +621,10 @@ class Module:
                 if other.state in (State.INIT, State.EXEC) and spec.conflicts_with(other.spec):
                     self.interrupt(other, spec.name)
         # Its one cycle is over: the auto posters of this activity show what its codel wrote,
-        # before the client hears the reply.
-        self.cycle_done(spec.name)
+        # before the client hears the reply; not after a refusal or a codel that raised (half
+        # written: its posters keep their last date, as a permanent codel's do).
+        if outcome is None:
+            self.cycle_done(spec.name)
         status = Status.END if outcome is None else Status.FINAL_ERROR
         self.emit(sink, self.reply(rqst_id, spec.name, status, outcome or Report("OK"), output))
 

@@ -165,6 +165,10 @@ def test_a_poster_named_after_a_control_request_is_updated_when_it_runs(robot: R
     snapshot = client.poster("Settings")
     assert reply.status is Status.END and snapshot is not None
     assert snapshot.data.value == 2.5 and abs(snapshot.date - robot.kernel.now) < 1e-9 and snapshot.date > 0
+    # A refused one (its validate codel returned a fail message) leaves the poster as it was.
+    robot.kernel.run_for(0.05)
+    refused = client.call("Set", robot.package.alpha.SetInput(value=-1.0))
+    assert refused.report.code == "NEGATIVE" and client.poster("Settings") == snapshot
 
 
 def test_a_codel_setting_an_enum_field_to_no_value_of_its_enum_is_a_codel_error(robot: Robot) -> None:
