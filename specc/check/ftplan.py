@@ -188,13 +188,20 @@ def planned_tasks(ctx: Context, ftplan: m.FtPlan) -> DomainTables:
     and the attributes of FTplan's state (those of the planners without a view)."""
     found = DomainTables()
     viewed = viewed_planners(ftplan)
+    for name, tabled in planner_tables(ctx, ftplan).items():
+        found.tasks.update(tabled.tasks)
+        if name not in viewed:
+            found.attributes.update(tabled.attributes)
+    return found
+
+
+def planner_tables(ctx: Context, ftplan: m.FtPlan) -> dict[str, DomainTables]:
+    """Each planner's domain (includes expanded), by planner name: those whose domain exists."""
+    found = {}
     for planner in ftplan.planners:
         domain = ctx.named(m.Domain).get(planner.domain.text) if planner.domain is not None else None
         if domain is not None:
-            tabled = tables(_quiet(ctx), domain.members)
-            found.tasks.update(tabled.tasks)
-            if planner.name not in viewed:
-                found.attributes.update(tabled.attributes)
+            found[planner.name] = tables(_quiet(ctx), domain.members)
     return found
 
 

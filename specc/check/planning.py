@@ -20,6 +20,15 @@ VALUE_VAR = "?value"
 PROBLEM_TIMEPOINTS = ("t_start", "t_end")
 
 
+def declared_domain(block: m.Attribute | m.Resource | m.Task, variable: str) -> Any:
+    """The domain the block's `variable in ...` declares (a set union, an interval), or None."""
+    for statement in block.body:
+        if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
+                and statement.expr.name == variable):
+            return statement.domain
+    return None
+
+
 @dataclass
 class DomainTables:
     """What one domain (or problem) sees once its includes are expanded."""
@@ -37,14 +46,11 @@ class DomainTables:
             found.update(v for n in walk(node) if isinstance(n, m.SetLiteral) for v in n.values)
         return found
 
-    def value_domain(self, attribute: m.Attribute | m.Resource, variable: str = VALUE_VAR) -> set[str] | None:
+    def value_domain(self, attribute: m.Attribute | m.Resource | m.Task, variable: str = VALUE_VAR) -> set[str] | None:
         """The symbolic values `?value` (or another of the attribute's variables, one of its
-        parameters) may take, when its domain is a set of symbols."""
-        for statement in attribute.body:
-            if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
-                    and statement.expr.name == variable and isinstance(statement.domain, m.SetUnion)):
-                return self.set_values(statement.domain)
-        return None
+        parameters; or a task's parameter) may take, when its domain is a set of symbols."""
+        domain = declared_domain(attribute, variable)
+        return self.set_values(domain) if isinstance(domain, m.SetUnion) else None
 
     def set_values(self, union: m.SetUnion) -> set[str] | None:
         values: set[str] = set()
@@ -231,11 +237,8 @@ class ScopeChecker(Visitor):
         resource = self.domain.attributes.get(name)
         if not isinstance(resource, m.Resource):
             return None
-        for statement in resource.body:
-            if (isinstance(statement, m.InConstraint) and isinstance(statement.expr, m.IxVar)
-                    and statement.expr.name == VALUE_VAR and isinstance(statement.domain, m.Interval)):
-                return constant_value(statement.domain.high)
-        return 1.0
+        domain = declared_domain(resource, VALUE_VAR)
+        return constant_value(domain.high) if isinstance(domain, m.Interval) else 1.0
 
     def visit_InConstraint(self, s: m.InConstraint) -> None:
         self.expr(s.expr, self.scope)

@@ -11,8 +11,8 @@ from collections.abc import Mapping
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
 from specc.check.executive import resolve_poster, resolve_request
-from specc.check.ftplan import _quiet, check_attribute, check_bound, check_task, check_terms, planned_tasks
-from specc.check.planning import tables
+from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks, planner_tables
+from specc.check.planning import DomainTables
 from specc.check.procedures import Domains
 from specc.check.symbols import first_by_name
 from specc.diagnostics import did_you_mean
@@ -239,6 +239,7 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
     goals = achievable_goals(supervisor) if supervisor is not None else {}
     services = ctx.symbols.services_of(executive) if executive is not None else {}
     reports = {u.task: len(u.args) for u in ftplan.state_updates if u.report == "report"}
+    domains = planner_tables(ctx, ftplan)
     for binding in bindings:
         check_task(ctx, tasks, binding.task, binding.span, binding.args)
         plain = tuple(a for a in binding.target_args if not isinstance(a, m.IxCall))
@@ -259,12 +260,13 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
         check_bound(ctx, binders, (*plain, *inner), f"task '{binding.task}'")
         check_binding_target(ctx, system, binding, goals, services)
         if binding.kind == "goal" and supervisor is not None:
-            check_goal_binding_values(ctx, ftplan, supervisor, binding)
+            check_goal_binding_values(ctx, domains, supervisor, binding)
         if binding.report is not None:
             check_binding_report(ctx, binding.report, reports)
 
 
-def check_goal_binding_values(ctx: Context, ftplan: m.FtPlan, supervisor: m.Procedures, binding: m.Binding) -> None:
+def check_goal_binding_values(ctx: Context, domains: Mapping[str, DomainTables], supervisor: m.Procedures,
+                              binding: m.Binding) -> None:
     """A task's parameter passed to a goal (`TRAVEL(?a, ?b) => goal GO-ROOM(?b)`) may take only
     values the goal's predicate declares there: the planners' domains give its values, and one
     outside the predicate's domain makes such an action fail at run time, before any service."""
@@ -272,11 +274,12 @@ def check_goal_binding_values(ctx: Context, ftplan: m.FtPlan, supervisor: m.Proc
     if declared is None or len(declared.params) != len(binding.target_args):
         return
     names = [a.name if isinstance(a, m.IxVar) else None for a in binding.args]
+    predicate_domains = Domains(supervisor)
     for position, arg in enumerate(binding.target_args):
         if not isinstance(arg, m.IxVar) or arg.name not in names:
             continue
-        allowed = Domains(supervisor).values(declared.params[position].domain)
-        values = task_parameter_values(ctx, ftplan, binding.task, names.index(arg.name))
+        allowed = predicate_domains.values(declared.params[position].domain)
+        values = task_parameter_values(domains, binding.task, names.index(arg.name))
         if allowed is None or values is None:
             continue
         outside = sorted(values - {str(v) for v in allowed})
@@ -287,19 +290,15 @@ def check_goal_binding_values(ctx: Context, ftplan: m.FtPlan, supervisor: m.Proc
                      "the goal takes, or widen its domain", arg.span)
 
 
-def task_parameter_values(ctx: Context, ftplan: m.FtPlan, task_name: str, position: int) -> set[str] | None:
+def task_parameter_values(domains: Mapping[str, DomainTables], task_name: str, position: int) -> set[str] | None:
     """The symbols the task's parameter at `position` may take, in every planner's domain (None
     when one does not say them as a set of symbols)."""
     values: set[str] = set()
-    for planner in ftplan.planners:
-        domain = ctx.named(m.Domain).get(planner.domain.text) if planner.domain is not None else None
-        if domain is None:
-            continue
-        found = tables(_quiet(ctx), domain.members)
+    for found in domains.values():
         task = found.tasks.get(task_name)
         if task is None or position >= len(task.params):
             continue
-        said = found.value_domain(task, task.params[position].name)  # type: ignore[arg-type]
+        said = found.value_domain(task, task.params[position].name)
         if said is None:
             return None
         values |= said
@@ -347,8 +346,7 @@ def check_constant_inputs(ctx: Context, args: tuple[m.IxExpr, ...], inputs: list
     """A binding's constant argument (`service REPORT(FAST)`) must be a value of the input it
     gives: the request refuses it at run time, at every replanning. Enums are the request's
     module's (two modules may each have an enum of one name)."""
-    enums = {e.name: set(e.values) for module in ctx.items(m.Module) if module.name == module_name
-             for e in module.enums}
+    enums = module_enums(ctx, module_name)
     for arg, typed in zip(args, inputs, strict=False):
         if typed is None or typed.type.size is not None or not isinstance(arg, m.Number | m.IxName):
             continue
@@ -523,7 +521,8 @@ def check_service_actions(ctx: Context, procedures: m.Procedures, executives: li
         for param, taken_input in zip(action.params, service.takes, strict=True):
             typed = inputs.get(taken_input.text)
             if typed is not None:
-                check_argument_type(ctx, procedures, param, typed, service.name)
+                check_argument_type(ctx, procedures, param, typed, service.name,
+                                    service.request.parts[0] if service.request else "")
 
 
 def check_executive_goals(ctx: Context, procedures: m.Procedures, executives: list[m.Executive], without: str,
@@ -579,13 +578,20 @@ def _service_name(arg: m.SArg) -> str | None:
     return arg.text if isinstance(arg, m.Ref) else arg.value if isinstance(arg, m.String) else None
 
 
+def module_enums(ctx: Context, module_name: str) -> dict[str, set[str]]:
+    """The enums of a module, by name, with their values: a request's input names its own
+    module's (two modules may each have an enum of one name)."""
+    return {e.name: set(e.values) for module in ctx.items(m.Module) if module.name == module_name
+            for e in module.enums}
+
+
 def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:
     request = ctx.symbols.service_request(service)
     return {i.name: i for i in request.inputs} if request is not None else {}
 
 
 def check_argument_type(ctx: Context, procedures: m.Procedures, param: m.PParam, typed: m.TypedName,
-                        service: str) -> None:
+                        service: str, module_name: str) -> None:
     """A PRS parameter's domain must hold only values the request's input can take."""
     kind = domain_kind(procedures, param.domain)
     input_type = typed.type.name
@@ -600,9 +606,9 @@ def check_argument_type(ctx: Context, procedures: m.Procedures, param: m.PParam,
     elif input_type == "bool":
         accepted = kind == "symbol" and symbols(procedures, param.domain) <= {"true", "false", "TRUE", "FALSE"}
     else:
-        enum = next((e for mod in ctx.items(m.Module) for e in mod.enums if e.name == input_type), None)
+        enum = module_enums(ctx, module_name).get(input_type)
         accepted = enum is not None and kind == "symbol" and bool(symbols(procedures, param.domain)) \
-            and symbols(procedures, param.domain) <= set(enum.values)
+            and symbols(procedures, param.domain) <= enum
     if not accepted:
         ctx.report("bad-argument-type", f"'{param.name}' ({describe_domain(param.domain)}) cannot be service "
                    f"'{service}''s input '{typed.name}' of type {input_type}"

@@ -504,6 +504,10 @@ class Setup:
                                producers_of(domain), self.nature_before, controllability,
                                flaws == OLDEST_TASK_FIRST, restoring=restoring_events(domain))
 
+    def for_problem(self, problem: pm.Problem) -> Setup:
+        """Another problem made ready with this one's domain, date and settings."""
+        return Setup(self.domain, problem, self.now, self.limits, self.controllability, self.heuristic, self.flaws)
+
     def root(self, active: list[Goal], repair: Repair | None = None) -> Node:
         node = self.problem_root(active)
         if repair is None:
@@ -781,8 +785,7 @@ class Setup:
             in_time.append(bounded)
             return True, 0
 
-        lifted = Setup(self.domain, pm.without_latest_end(self.problem), self.now, self.limits,
-                       self.controllability, self.heuristic, self.flaws)
+        lifted = self.for_problem(pm.without_latest_end(self.problem))
         _, spent = lifted.reorder(active, INF, budget, enough=ends_in_time, trial=order_trial(node))
         return (in_time[0] if in_time else None), spent
 
