@@ -147,6 +147,27 @@ def test_the_net_and_the_interpreter_agree_on_the_finer_points(tmp_path: Path, b
     assert ends[expected] >= 1 and all(n == 0 for outcome, n in ends.items() if outcome != expected), report.kinds()
 
 
+def test_a_value_outside_its_declared_domain_is_a_finding_of_the_net_and_a_failure_of_the_interpreter(
+        tmp_path: Path) -> None:
+    """A counter counting past N's domain 0..2: the net reports the value it has no room for,
+    and the interpreter refuses to conclude it (the KA fails) instead of running on outside
+    what was proved."""
+    spec_file = tmp_path / "cases.spec"
+    spec_file.write_text(outcome_spec("assign @I = 0; while ?(< @I 4) { assign @I = (+ @I 1); } =>(N @I);",
+                                      "predicate functional N(v: 0..2);"), encoding="utf-8")
+    loaded = load([spec_file])
+    assert loaded.program is not None and not loaded.errors
+    block = next(i for i in loaded.program.items if isinstance(i, m.Procedures))
+    report = verify(loaded.program, block, [rp.parse_goal("!(GO)")])
+    assert "out-of-domain" in report.kinds() and report.succeeded == 0
+    supervisor = Supervisor(library(block))
+    intention = supervisor.post("!(GO)")
+    supervisor.run()
+    assert intention.status == "failed" and supervisor.database.facts("N") == []
+    said = "4 is outside the domain the spec declares for N's argument 1 ({0, 1, 2})"
+    assert any(said in line for line in intention.lines())
+
+
 def test_branches_sharing_a_variable_are_rejected(tmp_path: Path) -> None:
     spec_file = tmp_path / "cases.spec"
     spec_file.write_text(outcome_spec("assign @X = A; parallel { branch { assign @X = B; } branch { ^(P @X); } }"),

@@ -213,6 +213,27 @@ def test_a_conclusion_with_an_unbound_argument_fails_a_retraction_changes_nothin
                                       "Sloppy:4: =>(FACT $X) failed: $X is unbound"]
 
 
+def test_a_fact_outside_its_predicate_s_declared_domain_is_refused() -> None:
+    """What `verify --goal` proves holds for the declared domains only: a KA concluding
+    (OBJ-FOUND 7) under `OBJ-FOUND(n: 0..5)` fails there, and a user's conclusion or goal
+    outside them is their mistake."""
+    found = Predicate("OBJ-FOUND", "functional", 1, domains=(tuple(range(6)),))
+    moved = Predicate("MOVE", "standard", 2, domains=(None, ("A", "B")))
+    s = supervisor(ka("Count", "!(COUNT $N)", step("=>(OBJ-FOUND $N)", 3), line=2),
+                   ka("Move", "!(MOVE $X $Y)", line=5), predicates=(found, moved))
+    assert done(s, "!(COUNT 5)").status == "succeeded"
+    late = done(s, "!(COUNT 7)")
+    assert late.status == "failed" and s.database.facts("OBJ-FOUND") == [parse_fact("(OBJ-FOUND 5)")]
+    assert "Count:3: =>(OBJ-FOUND $N) failed: =>(OBJ-FOUND 7): 7 is outside the domain the spec " \
+           "declares for OBJ-FOUND's argument 1 ({0, 1, 2, 3, 4, 5})" in "\n".join(late.lines())
+    with pytest.raises(ValueError, match=r"C is outside the domain the spec declares for MOVE's argument 2 \(\{A, B\}"):
+        s.post("!(MOVE 99 C)")
+    with pytest.raises(ValueError, match="9 is outside"):
+        s.conclude("(OBJ-FOUND 9)")
+    assert done(s, "!(MOVE 99 $Y)").status == "succeeded"  # an unbound argument is no value yet
+    s.conclude("(~ (MOVE 1 A))")  # a standard predicate's negation, in the domain
+
+
 # ---------------------------------------------------------------- preserve and maintain
 
 
@@ -620,6 +641,24 @@ def test_exec_request_interrupts_a_zombie_and_returns_the_final_reply(executive:
     after = s.post("!(EXEC-REQUEST FREE $RESULT)")  # the module accepts requests again
     until_done(s, after)
     assert after.bindings == {"$RESULT": "OK"}
+
+
+def test_a_reply_outside_its_declared_domain_is_received_and_noted_as_an_incident(executive: Any) -> None:
+    """The executive's BAD-SERVICE is not in REPLY's declared domain: the procedures' proofs did
+    not cover it, which the executive notes; the robot still gets the reply, as it would."""
+    library, functions = exec_request_library(TWO_ARCS)
+    reply = Predicate("REPLY", "event", 2, domains=(None, ("OK", "ZOMBIE")))
+    s = Supervisor(dataclasses.replace(library, predicates=(reply,)), functions, executive=executive)
+    executive.context.vars["next"] = ["exec"]
+    ok = s.post("!(EXEC-REQUEST FREE $RESULT)")
+    until_done(s, ok)
+    assert ok.bindings == {"$RESULT": "OK"} and executive.incidents == []
+    unknown = s.post("!(EXEC-REQUEST FLY $RESULT)")
+    until_done(s, unknown)
+    assert unknown.bindings == {"$RESULT": "BAD-SERVICE"}
+    assert executive.incidents == ["the supervisor received (REPLY 2 BAD-SERVICE): BAD-SERVICE is outside the "
+                                   "domain the spec declares for REPLY's argument 2 ({OK, ZOMBIE}), which `specc "
+                                   "verify --goal` assumes: add BAD-SERVICE to it"]
 
 
 def test_a_failed_test_says_what_its_variables_held() -> None:

@@ -4,6 +4,7 @@ of the predicates' arguments (for the Petri-net translation)."""
 
 from __future__ import annotations
 
+from specc.check.procedures import Domains
 from specc.model import nodes as m
 from specc.runtime import procedures as rp
 
@@ -85,11 +86,17 @@ def predicate_kind(node: m.PredicateDecl) -> str:
     return "standard"
 
 
+def predicate(node: m.PredicateDecl, domains: Domains) -> rp.Predicate:
+    finite = tuple(domains.values(p.domain) for p in node.params)
+    return rp.Predicate(node.name, predicate_kind(node), len(node.params), node.binding.value if node.binding else "",
+                        finite if any(d is not None for d in finite) else ())
+
+
 def library(node: m.Procedures) -> rp.Library:
+    domains = Domains(node)
     return rp.Library(
         name=node.name,
-        predicates=tuple(rp.Predicate(p.name, predicate_kind(p), len(p.params), p.binding.value if p.binding else "")
-                         for p in node.predicates),
+        predicates=tuple(predicate(p, domains) for p in node.predicates),
         primitives=tuple(primitive(a) for a in node.actions),
         kas=tuple(ka(k) for k in node.kas),
         source=node.span.file,

@@ -160,6 +160,20 @@ class Predicate:
     kind: str  # one of PREDICATE_KINDS
     arity: int
     binding: str = ""  # evaluable: "python.module.function"
+    # The values each argument may take where the spec gives a finite domain (`n: 0..5`,
+    # `state: {GO, END}`), None where it does not (`int`, `string`); () when no argument has one.
+    # What `specc verify --goal` proves assumes them: the supervisor refuses a fact outside them.
+    domains: tuple[tuple[Any, ...] | None, ...] = ()
+
+    def outside(self, args: tuple[Any, ...]) -> str | None:
+        """What of `args` lies outside the declared domains, said for a message; None if nothing."""
+        # A fact of another arity is the database's to refuse, not this check's.
+        for index, (value, allowed) in enumerate(zip(args, self.domains, strict=False)):
+            if allowed is not None and not isinstance(value, Var) and value not in allowed:
+                shown = ", ".join(str(v) for v in allowed)
+                return (f"{value} is outside the domain the spec declares for {self.name}'s argument {index + 1} "
+                        f"({{{shown}}}), which `specc verify --goal` assumes: add {value} to it")
+        return None
 
 
 @dataclass(frozen=True)

@@ -477,6 +477,9 @@ class Supervisor:
     def post(self, goal: Goal | str) -> Intention:
         """A top-level goal, e.g. `post("!(COLLECT-OBJECTS 3)")`; its intention is returned."""
         goal = parse_goal(goal) if isinstance(goal, str) else goal
+        outside = self._outside(_polarity(goal.expr)[1]) if goal.expr.head in self.database.predicates else None
+        if outside is not None:
+            raise ValueError(f"{goal}: {outside}")
         intention = Intention(goal=goal, trigger=goal.expr)
         frame = _Frame(None, {}, intention)
         thread = _Thread(intention)
@@ -1045,15 +1048,23 @@ class Supervisor:
         else:
             self._retract(fact)
 
-    def _conclude(self, fact: Compound) -> None:
+    def _outside(self, fact: Compound) -> str | None:
+        """What of `fact` lies outside its predicate's declared domains (None if nothing)."""
+        predicate = self.database.predicates.get(fact.head)
+        return predicate.outside(fact.args) if predicate is not None and predicate.domains else None
+
+    def _conclude(self, fact: Compound, checked: bool = True) -> None:
         negative, positive = _polarity(fact)
+        outside = self._outside(positive) if checked else None
+        if outside is not None:
+            raise ExecutionError(f"=>{fact}: {outside}")
         kind = self.database.kind(positive.head)
         if kind == "evaluable":
             raise ExecutionError(f"=>{fact}: {positive.head} is evaluable, it cannot be concluded")
         if kind == "event":
             if negative:
                 raise ExecutionError(f"=>{fact}: an event cannot be concluded false")
-            self._signal(positive)
+            self._signal(positive, checked=False)  # its domain is checked above
             return
         if self.database._store(positive, negative):
             self._changed()
@@ -1067,10 +1078,13 @@ class Supervisor:
         if self.database._remove(positive, negative):
             self._changed()
 
-    def _signal(self, event: Compound) -> None:
+    def _signal(self, event: Compound, checked: bool = True) -> None:
         if event.head in self.database.predicates and self.database.kind(event.head) in _STORED_KINDS:
-            self._conclude(event)  # the library keeps these facts: the message concludes one
+            self._conclude(event, checked)  # the library keeps these facts: the message concludes one
             return
+        outside = self._outside(event) if checked else None
+        if outside is not None:
+            raise ExecutionError(f"{event}: {outside}")
         if not self._invoke(event):
             self.database._add_event(event)
         self._changed()
@@ -1165,8 +1179,15 @@ class Supervisor:
 
     # ------------------------------------------------------------ the executive
     def _on_message(self, message: Message) -> None:
+        """An executive message, as a basic event. One outside its predicate's declared domain
+        (a result the procedures do not list) is what the procedures' proofs did not cover: the
+        executive notes an incident, and the event is still received, as the robot would."""
         head, *args = message.fact
-        self._signal(Compound(head, tuple(args)))
+        event = Compound(head, tuple(args))
+        outside = self._outside(event)
+        if outside is not None and self.executive is not None:
+            self.executive.incidents.append(f"the supervisor received {event}: {outside}")
+        self._signal(event, checked=False)
 
 
 def _expression(condition: Goal | Compound) -> Compound:

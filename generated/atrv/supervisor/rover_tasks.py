@@ -18,7 +18,34 @@ from specc.runtime.procedures import (  # noqa: F401
 from specc.runtime.supervisor import Supervisor
 
 PREDICATES = (
-    Predicate(name='REPLY', kind='event', arity=2),
+    Predicate(
+        name='REPLY',
+        kind='event',
+        arity=2,
+        domains=(
+            None,
+            (
+                'OK',
+                'ERROR',
+                'TIMEOUT',
+                'INT',
+                'REFUSED',
+                'BAD-INPUT',
+                'BAD_GOAL',
+                'POSE_NOT_FOUND',
+                'LASER_FAILURE',
+                'BLOCKED',
+                'NO_PROGRESS',
+                'BAD_POSITION',
+                'PTU_TIMEOUT',
+                'PTU_MOVING',
+                'NO_TARGET_IN_VIEW',
+                'BAD_DURATION',
+                'NO_VISIBILITY',
+                'LINK_LOST',
+            ),
+        ),
+    ),
 )
 
 PRIMITIVES = (

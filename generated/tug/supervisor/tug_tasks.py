@@ -18,8 +18,27 @@ from specc.runtime.procedures import (  # noqa: F401
 from specc.runtime.supervisor import Supervisor
 
 PREDICATES = (
-    Predicate(name='REPLY', kind='event', arity=2),
-    Predicate(name='HOOK', kind='functional', arity=1),
+    Predicate(
+        name='REPLY',
+        kind='event',
+        arity=2,
+        domains=(
+            None,
+            (
+                'OK',
+                'ERROR',
+                'TIMEOUT',
+                'INT',
+                'REFUSED',
+                'BLOCKED',
+                'NO_CART',
+                'ALREADY_HITCHED',
+                'BAD_LOAD',
+                'BAD-INPUT',
+            ),
+        ),
+    ),
+    Predicate(name='HOOK', kind='functional', arity=1, domains=(('FREE', 'BUSY'),)),
 )
 
 PRIMITIVES = (
