@@ -146,7 +146,8 @@ def compile(paths: PathsArg,
     if len(paths) == 1 and robot is None:  # what `specc run` would compile: it need not do it again
         from specc.run.package import remember_compilation
 
-        remember_compilation(paths[0], output, name, result.files)
+        remember_compilation(paths[0], output, name, result.files,
+                             [d.headline() for d in [*loaded.diagnostics, *result.warnings] if d.severity == "warning"])
     out.print(f"wrote {len(written)} file(s) to {folder}", markup=False)
 
 
@@ -228,11 +229,11 @@ def graph(paths: PathsArg,
 
     if incompat == net:
         err.print("error: say what to draw: --incompat or --net", markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     refuse_unwritable(output, "the picture", "-o", "net.png" if net else "incompat.png", picture=True)
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     if net:
         draw_procedures_net(loaded, procedures, goal or [], ka, output or Path("net.png"))
         return
@@ -247,8 +248,14 @@ def graph(paths: PathsArg,
         picture = draw_incompatibility_graph(incompatibility, output, f"executive {chosen.name}")
     except (OSError, ValueError) as exc:
         err.print(f"error: cannot write '{output}': {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(CANNOT_VERIFY) from None
     out.print(f"wrote {picture}", markup=False)
+
+
+# `specc verify` and `specc graph` exit 2 when they cannot do what is asked (a bad option, specs
+# with errors, procedures no net can stand for, a file they cannot write), so that a script tells
+# that apart from a property refuted or a finding (1).
+CANNOT_VERIFY = 2
 
 
 def choose_executive(program: m.Program, name: str | None) -> m.Executive:
@@ -256,15 +263,15 @@ def choose_executive(program: m.Program, name: str | None) -> m.Executive:
     executives: Mapping[str, m.Executive] = symbols_of(program).blocks[m.Executive]
     if not executives:
         err.print("error: no executive block in these specs", markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     if name is None and len(executives) > 1:
         err.print(f"error: several executives ({', '.join(sorted(executives))}); pick one with --executive",
                   markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     chosen = executives.get(name) if name else next(iter(executives.values()))
     if chosen is None:
         err.print(f"error: no executive '{name}' (there are: {', '.join(sorted(executives))})", markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     return chosen
 
 
@@ -307,7 +314,8 @@ def verify(paths: PathsArg,
 
     Exit status for the executive: 0 when every property holds in every state, 1 when one is
     refuted or --max-states stopped the exploration; for the procedures: 0, or 1 with --strict
-    when there is a finding.
+    when there is a finding; 2 when nothing could be verified (a bad option, specs with errors,
+    procedures no net can stand for).
 
     Example: specc verify examples/generic --executive generic
 
@@ -323,7 +331,7 @@ def verify(paths: PathsArg,
     if only_with_goal:
         err.print(f"error: {', '.join(only_with_goal)}: for verifying procedures only; add --goal '!(GOAL ...)' "
                   "(the goal posted), or leave out what verifies procedures to verify the executive", markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     from rich.status import Status
 
     from specc.analysis import kheops
@@ -332,7 +340,7 @@ def verify(paths: PathsArg,
 
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     chosen = choose_executive(loaded.program, executive)
     started = time.perf_counter()
     with Status("compiling the controller", console=err) as status:
@@ -341,7 +349,7 @@ def verify(paths: PathsArg,
                              lambda states: status.update(f"exploring: {states} states"))
         except kheops.KheopsError as exc:
             err.print(exc.headline(), markup=False)
-            raise typer.Exit(1) from None
+            raise typer.Exit(CANNOT_VERIFY) from None
     for line in describe(result):
         out.print(line, markup=False)
     out.print(f"{result.states} states, {result.transitions} transitions, at most {requests} outstanding "
@@ -357,19 +365,19 @@ def draw_procedures_net(loaded: Loaded, name: str | None, goals: list[str], ka: 
     if not goals:
         err.print("error: say which goal is posted: --goal '!(GOAL ...)' (the net holds the KAs it reaches)",
                   markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     translation = translate_procedures(loaded, name, goals, [], [])
     if ka is not None and ka not in translation.kas:
         err.print(f"error: KA '{ka}' is not among the KAs the goal reaches: {', '.join(translation.kas)}",
                   markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     only = None if ka is None else (lambda place: place.startswith(f"{ka}."))
     title = f"procedures {translation.net.name}" + (f": KA {ka}" if ka else "")
     try:
         picture = draw_net(translation.net, output, title, translation.where, only=only)
     except (OSError, ValueError) as exc:
         err.print(f"error: cannot draw '{output}': {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(CANNOT_VERIFY) from None
     out.print(f"wrote {picture}", markup=False)
 
 
@@ -387,7 +395,7 @@ def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], fac
         initial = [rp.parse_fact(f) for f in facts]
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(CANNOT_VERIFY) from None
     candidates = list(blocks.values())
     if name is None and len(candidates) > 1:  # the blocks whose KAs achieve every goal posted
         heads = {g.expr.head for g in posted}
@@ -400,16 +408,16 @@ def translate_procedures(loaded: Loaded, name: str | None, goals: list[str], fac
             f"several procedures ({', '.join(sorted(blocks))}) achieve the goal, or none does; pick one with " \
             "--procedures"
         err.print(f"error: {what}", markup=False)
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     try:
         return translate(loaded.program, chosen, posted, initial, ["*" if f == "all" else f for f in failing])
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(CANNOT_VERIFY) from None
     except TranslationError as exc:
         for diagnostic in exc.diagnostics:
             err.print(render(diagnostic, loaded.sources), markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(CANNOT_VERIFY) from None
 
 
 def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], failing: list[str], reach: list[str],
@@ -422,12 +430,12 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
 
     loaded = load(paths)
     if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+        raise typer.Exit(CANNOT_VERIFY)
     try:
         queries = [parse_query(q) for q in reach]
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(CANNOT_VERIFY) from None
     started = time.perf_counter()
     translation = translate_procedures(loaded, name, goals, facts, failing)
     net = translation.net
@@ -439,7 +447,7 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
             result = analyse(translation, queries, max_states, lambda n: status.update(f"exploring: {n} states"))
         except ValueError as exc:
             err.print(f"error: {exc}", markup=False)
-            raise typer.Exit(1) from None
+            raise typer.Exit(CANNOT_VERIFY) from None
     explored = result.space.unfolded
     out.print(f"explored: the unfolded net reduced to {len(explored.slots)} of its {len(full.slots)} places and "
               f"{len(explored.steps)} of its {len(full.steps)} transitions (places no firing marks dropped, "
@@ -451,7 +459,7 @@ def verify_procedures(paths: list[Path], goals: list[str], facts: list[str], fai
             path.write_text(petri.to_pnml(chosen), encoding="utf-8")
         except OSError as exc:
             err.print(f"error: cannot write '{path}': {exc}", markup=False)
-            raise typer.Exit(1) from None
+            raise typer.Exit(CANNOT_VERIFY) from None
         out.print(f"wrote {path} ({what})", markup=False)
     for finding in result.findings:
         out.print(f"{finding.kind}: {finding.message}", markup=False)
@@ -587,9 +595,13 @@ def export_problem(paths: PathsArg,
                    keep_markers: Annotated[bool, typer.Option(
                        help="Keep the values that only mark a task in progress (MOVE's AT_ROBOT_X = 1000), which "
                             "the compact encoding leaves out.")] = False,
+                   allow_partial: Annotated[bool, typer.Option(
+                       help="Write the files even when a task of the domain cannot be exported (each one is said "
+                            "as a warning): a planner reading them misses what that task does.")] = False,
                    ) -> None:
     """Export a planning domain and problem through unified-planning to PDDL 2.1, saying what could not
-    be expressed.
+    be expressed. A task the export must leave out is an error, and nothing is written, unless
+    --allow-partial.
 
     Example: specc export examples/tug --problem shuttle -o build/pddl"""
     from specc.analysis.planning import domain_block, domain_model, problem_model
@@ -608,15 +620,27 @@ def export_problem(paths: PathsArg,
     block = domain_block(loaded.program, chosen)
     exported = export(domain_model(loaded.program, block), problem_model(loaded.program, chosen),
                       constant_set_names(loaded.program, block), compact=not keep_markers)
-    try:
-        written = write_pddl(exported, output)
-    except OSError as exc:
-        err.print(f"error: cannot write into '{output}': {exc}", markup=False)
-        raise typer.Exit(1) from None
-    for path in written:
-        out.print(f"wrote {path}", markup=False)
+    # A task left out takes away what specc's planner could use: the files would be another,
+    # harder problem, often one with no plan at all, which a planner reports as unsolvable.
+    partial = bool(exported.left_out) and not allow_partial
+    if not partial:
+        try:
+            written = write_pddl(exported, output)
+        except OSError as exc:
+            err.print(f"error: cannot write into '{output}': {exc}", markup=False)
+            raise typer.Exit(1) from None
+        for path in written:
+            out.print(f"wrote {path}", markup=False)
     for note in exported.unsupported:
         out.print(f"not expressed: {note}", markup=False)
+    for task, why in exported.left_out.items():
+        severity = "error" if partial else "warning"
+        err.print(f"{severity}: task {task} of domain '{block.name}' is left out of the export: {why}.", markup=False)
+    if partial:
+        err.print(f"error: {len(exported.left_out)} task(s) of domain '{block.name}' cannot be exported (above): the "
+                  "PDDL files would lack them, and a planner reading them would not find the plans that need them; "
+                  "nothing written (--allow-partial writes them anyway)", markup=False)
+        raise typer.Exit(1)
     if not exported.problem.actions:  # files a planner can only answer "unsolvable": say so, and fail
         err.print(f"error: no task of domain '{block.name}' could be exported (each one's reason is above): the "
                   "PDDL files have no action", markup=False)
@@ -956,7 +980,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
             table.add_row(*row[:shown])
         table_out().print(table)
     for failure in result.failures:  # each reason cut short: the run's report.json has it whole
-        out.print(f"failed: {failure.name}: {brief_why(failure.why)}", markup=False)
+        out.print(f"{failure.outcome}: {failure.name}: {brief_why(failure.why)}", markup=False)
     for path in written:
         out.print(f"wrote {path}", markup=False)
 
@@ -1261,9 +1285,39 @@ class CampaignProgress:
 GC_THRESHOLDS = (50_000, 20, 20)
 
 
+class ReaderGone:
+    """Standard output that outlives its reader: once the pipe is closed (`specc run ... | head`),
+    what is written is dropped instead of raising, so that the command ends as it would have (a
+    campaign finishes its runs, the exit status still says how the mission went) rather than with
+    click's silent status 1 for a broken pipe."""
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+        self._gone = False
+
+    def write(self, text: str) -> int:
+        if not self._gone:
+            try:
+                return int(self._stream.write(text))
+            except BrokenPipeError:
+                self._gone = True
+        return len(text)
+
+    def flush(self) -> None:
+        if not self._gone:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self._gone = True
+
+    def __getattr__(self, name: str) -> Any:  # isatty, encoding, fileno...: the stream's own
+        return getattr(self._stream, name)
+
+
 def main() -> None:
     """The `specc` command: runs one subcommand, then ends the process at once."""
     gc.set_threshold(*GC_THRESHOLDS)
+    sys.stdout = ReaderGone(sys.stdout)  # type: ignore[assignment]
     try:
         app()
     except KeyboardInterrupt:

@@ -57,6 +57,9 @@ CODES: dict[str, Code] = {
     "undefined-codel": Code("a codel function the codel module does not define", "codel exec: stpe;"),
     "bad-codel-signature": Code("a user function cannot be called with the arguments the runtime passes it",
                                 "def watch(sdi, request): ...   (an exec task's codel gets (sdi))"),
+    "undeclared-send": Code("a codel sends a request (`sdi.send_request`) its request's `sends:` does not list "
+                            "(warning): the incompatibility graph and `specc verify` leave it out",
+                            'sdi.send_request("ptu.Sweep")   (no sends: ptu.Sweep;)'),
     "undeclared-result": Code("a codel returns a string its request does not declare (no such state or fail)",
                               'return "SLIPPED"   (fail: SLIP;)'),
     "undefined-codel-state": Code("a codel leads to a state the request has no codel for",
@@ -155,6 +158,9 @@ CODES: dict[str, Code] = {
     "undeclared-variable": Code("a task uses a ?variable it does not declare", "?y in PLACES;   (no ?y)"),
     "undeclared-timepoint": Code("a timepoint the task does not declare", "event(AT(): (A, B), t_middle);"),
     "empty-interval": Code("an interval whose low bound is above its high", "(t_end - t_start) in [10, 5];"),
+    "contradictory-constraints": Code("a problem's temporal constraints that cannot all hold (with what the planner "
+                                      "requires of every problem: each timepoint between t_start and t_end)",
+                                      "(t_o - t_start) in [10, 20];  (t_c - t_start) in [50, 60];  t_c < t_o;"),
     "event-without-transition": Code("an event that does not change the value", "event(AT(): (A, A), t);"),
     "hold-transition": Code("a hold given a transition", "hold(AT(): (A, B), (t1, t2));"),
     "goal-outside-problem": Code("a goal in a task: goals belong to a problem (or a fragment it includes)",

@@ -68,6 +68,7 @@ class FunctionShape:
     returns: tuple[tuple[str, int], ...] = ()  # the string constants it returns, with their lines
     defined_in: str = ""  # where a re-exported function is written (its package's folder / file)
     posters: tuple[tuple[str, int], ...] = ()  # the names it reads posters by (`x.read_poster("m.P")`), with lines
+    sends: tuple[tuple[str, int], ...] = ()  # the requests it sends by name (`x.send_request("m.R")`), with lines
 
     def accepts(self, count: int) -> bool:
         return self.least <= count and (self.most is None or count <= self.most)
@@ -85,22 +86,32 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
     if required_keywords:  # a keyword-only argument without default: no positional call works
         most = -1
     returns: list[tuple[str, int]] = []
-    posters: list[tuple[str, int]] = []
+    named: dict[str, list[tuple[str, int]]] = {"read_poster": [], "send_request": []}
     stack: list[ast.AST] = list(node.body)
     while stack:
         current = stack.pop()
         if isinstance(current, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
             continue  # a nested function's returns are its own
-        if isinstance(current, ast.Return) and isinstance(current.value, ast.Constant) \
-                and isinstance(current.value.value, str):
-            returns.append((current.value.value, current.lineno))
+        if isinstance(current, ast.Return) and current.value is not None:
+            returns += [(value, current.lineno) for value in _strings_returned(current.value)]
         if (isinstance(current, ast.Call) and isinstance(current.func, ast.Attribute)
-                and current.func.attr == "read_poster" and current.args
+                and current.func.attr in named and current.args
                 and isinstance(current.args[0], ast.Constant) and isinstance(current.args[0].value, str)):
-            posters.append((current.args[0].value, current.lineno))
+            named[current.func.attr].append((current.args[0].value, current.lineno))
         stack.extend(ast.iter_child_nodes(current))
     return FunctionShape(node.lineno, least, most, tuple(sorted(returns, key=lambda r: r[1])),
-                         posters=tuple(sorted(posters, key=lambda r: r[1])))
+                         posters=tuple(sorted(named["read_poster"], key=lambda r: r[1])),
+                         sends=tuple(sorted(named["send_request"], key=lambda r: r[1])))
+
+
+def _strings_returned(value: ast.expr) -> list[str]:
+    """The string constants a returned expression may be: the constant itself, or either side of
+    a conditional (`"exec" if moving else "ether"`)."""
+    if isinstance(value, ast.Constant) and isinstance(value.value, str):
+        return [value.value]
+    if isinstance(value, ast.IfExp):
+        return _strings_returned(value.body) + _strings_returned(value.orelse)
+    return []
 
 
 @dataclass(frozen=True)

@@ -328,6 +328,32 @@ def test_an_extension_hook_that_raises_is_named_with_where_it_raised(tmp_path: P
     assert result.returncode == (2 if hook == "prepare" else 1)
     assert (tmp_path / "run" / "events.jsonl").exists() == (hook == "measure")
 
+def test_every_run_says_what_check_warns_of(tmp_path: Path) -> None:
+    """A codel reading a poster that does not exist reads None: `specc check` warns, and so does
+    every `specc run`, the one that compiles and the next (which does not compile again)."""
+    codels = CODELS.replace("    sdi.x, sdi.y = x, y  # the Pose poster\n",
+                            "    sdi.x, sdi.y = x, y  # the Pose poster\n    sdi.read_poster('drive.Poze')\n")
+    cart = write_robot(tmp_path, codels=codels)
+    warned = "[undefined-poster]"
+    assert warned in specc(tmp_path, "check", cart).stderr
+    for folder in ("first", "second"):
+        result = specc(tmp_path, "run", cart, "--folder", tmp_path / folder, "-q")
+        assert result.returncode == 0 and warned in result.stderr, result.stderr
+    assert "compiled" not in result.stderr  # the second run did not compile, and still said it
+
+
+def test_codels_that_cannot_be_imported_are_bad_input_said_before_anything_runs(tmp_path: Path) -> None:
+    """`specc check` never imports codels; `specc run` imports them before it makes the run
+    folder, so a broken import is one message and exit 2, not a run that crashed at 0 s (which a
+    table would count as a failed mission)."""
+    cart = write_robot(tmp_path, codels="import no_such_module_anywhere\n" + CODELS)
+    result = specc(tmp_path, "run", cart, "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 2, result.stderr
+    assert "module 'drive': its codels 'cart_codels.drive' import what cannot be found: No module named " \
+           "'no_such_module_anywhere' (cart_codels/drive.py:1)" in result.stderr, result.stderr
+    assert "Traceback" not in result.stderr and not (tmp_path / "run").exists()
+
+
 @pytest.mark.parametrize(("args", "message"), [
     (("--mission", "collect"), "has no mission 'collect' (its missions: deliver)"),
     (("--world", "yard"), "has no world 'yard' (its worlds: shop"),
@@ -337,6 +363,7 @@ def test_an_extension_hook_that_raises_is_named_with_where_it_raised(tmp_path: P
     (("--goal", "!(GO 1)"), "GO takes 2 argument(s), 1 given"),
     (("--goal", "!(GO $X 1)"), "goal of constants"),
     (("--goal", "!(GO 1e999 1)"), "not a PRS goal (number 1e999 is too large)"),
+    (("--goal", "!(GO A 1)"), "A is not a number: argument 1 of GO reaches 'x' (float) of action GOTO"),
     (("--goal", "!(GO 1 2)", "--mission", "deliver"), "give --mission or --goal, not both"),
     (("--config", "Robot1"), "--config: mission deliver of robot 'cart' is not planned"),
 ])

@@ -130,8 +130,8 @@ def test_a_store_refuses_to_mix_two_campaigns(tmp_path: Path) -> None:
         assert store.count() == 1 and list(store.outcomes()) == [outcome]
 
 
-def measures(kappa: int = 0, distance: float = 10.0) -> dict[str, object]:
-    return {"kappa": kappa, "distance": distance}
+def measures(kappa: int = 0, distance: float = 10.0, activity_time: float = 30.0) -> dict[str, object]:
+    return {"kappa": kappa, "distance": distance, "activity_time": activity_time}
 
 
 def outcomes_of(mutant: str, values: list[dict[str, object]], status: str = "done") -> list[Outcome]:
@@ -142,14 +142,17 @@ def outcomes_of(mutant: str, values: list[dict[str, object]], status: str = "don
 def test_the_seeds_filters_set_aside_mutants_that_never_plan_or_change_nothing() -> None:
     original = [measures(), measures(distance=12.0)]
     outcomes = (outcomes_of(ORIGINAL, original) + outcomes_of("same", original)
-                + outcomes_of("blind", [measures(kappa=1), measures(kappa=1)])
+                + outcomes_of("blind", [measures(kappa=1, activity_time=0.0), measures(kappa=1, activity_time=0.0)])
+                # Planned, ran its plan, then failed to replan: it did plan (seed 004's filter is
+                # for mutants that find no plan), so it is kept.
+                + outcomes_of("late", [measures(kappa=1, activity_time=40.0), measures(kappa=1, activity_time=0.0)])
                 + outcomes_of("changed", [measures(), measures(distance=3.0)])
                 + outcomes_of("hung", original, status="timeout")
                 + outcomes_of("half", original)[:1]
                 + [Outcome(Experiment("Robot1/2", "same", "M1", "W1", 0), "done", measures(distance=1.0), 1.0)])
-    verdicts = judge(outcomes, "Robot1", ["same", "blind", "changed", "hung", "half"], expected=2)
+    verdicts = judge(outcomes, "Robot1", ["same", "blind", "late", "changed", "hung", "half"], expected=2)
     assert {m: v.verdict for m, v in verdicts.items()} == {
-        "same": EQUIVALENT, "blind": NEVER_PLANS, "changed": KEPT, "hung": KEPT, "half": UNJUDGED}
+        "same": EQUIVALENT, "blind": NEVER_PLANS, "late": KEPT, "changed": KEPT, "hung": KEPT, "half": UNJUDGED}
     assert verdicts["changed"].detail == "1 of 2 experiments differ"
 
 
@@ -220,6 +223,42 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     assert "**few mutants:** the means under faults are over 1 kept mutant(s); one mutant's runs weigh 100%" in text
     written = write_report(report, tmp_path / "out")
     assert [p.name for p in written] == ["campaign.md", "campaign.json", "campaign.png"] and is_png(written[2])
+
+
+def test_the_configurations_are_compared_on_the_experiments_each_finished(tmp_path: Path) -> None:
+    """Robot1/2 crashed on the kept mutant in W4: that activity leaves both configurations'
+    means (else Robot1's failure there would count and Robot1/2's would not, a gain from a
+    crash), and the report says how many were left out. (One that timed out is run again by a
+    resumed campaign, and until then the campaign is not finished.)"""
+    with ResultStore(tmp_path / "r.sqlite") as store:
+        store.describe({"robot": "atrv", "domain": "model1", "configurations": ["Robot1", "Robot1/2"],
+                        "missions": ["M1"], "worlds": ["W1", "W4"], "runs": 1, "set_apart": []})
+        store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
+        store.judge([("model1-0001", KEPT, "")])
+
+        def one(configuration: str, mutant: str, world: str, success: bool | None) -> None:
+            goals = {"asked": 1, "met": 1 if success else 0}
+            measures = None if success is None else {
+                "configuration": configuration, "mission": "M1", "world": world, "seed": 0,
+                "goals": [{"kind": kind, **goals} for kind in "pch"], "kappa": 0, "replannings": 0,
+                "activity_time": 10.0, "distance": 5.0, "mission_time": 100.0, "planner_failures": 0,
+                "believed": goals}
+            store.record(Outcome(Experiment(configuration, mutant, "M1", world, 0),
+                                 "done" if success is not None else "crashed", measures, 1.0))
+
+        for configuration in ("Robot1", "Robot1/2"):
+            for world in ("W1", "W4"):
+                one(configuration, ORIGINAL, world, True)
+        one("Robot1", "model1-0001", "W1", True)
+        one("Robot1", "model1-0001", "W4", False)
+        one("Robot1/2", "model1-0001", "W1", True)
+        one("Robot1/2", "model1-0001", "W4", None)  # crashed
+        report = build_report(store)
+    every = next(h for h in report.headlines if h.worlds == "W*")
+    assert every.faulty == (1.0, 1.0)  # W1 alone, for both: not (0.5, 1.0)
+    assert report.unpaired == 1
+    assert "- 1 activity (a mutant or the original in a mission, world and seed) left out of every configuration's " \
+           "means" in markdown(report)
 
 
 def test_a_report_needs_a_store_that_holds_a_campaign(tmp_path: Path) -> None:
@@ -349,3 +388,37 @@ def test_planners_sharing_the_mutated_model_are_said_to_share_its_faults(tmp_pat
                                     ("hall",), 1, ("Robot1", "Robot1/2")))
     assert len(said) == 1 and said[0].startswith("configuration Robot1/2: planners quick, careful all plan in "
                                                  "'warehouse', so each mutant reaches them all")
+
+
+def test_a_store_refuses_the_results_of_a_changed_robot_and_lets_the_report_s_options_change(tmp_path: Path) -> None:
+    """The robot's files (or specc) changed since the store was begun: its results would mix two
+    robots in one report, so the resume is refused, saying so. Which worlds the report also
+    leaves out (`--set-apart`) only shapes the report: a resume may change it."""
+    from specc.run.package import robot_digest
+
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    (robot / "robot.spec").write_text("module m { }\n")
+    first = {"robot": "robot", "runs": 1, "set_apart": ["W4"], "files": robot_digest(robot)[:16]}
+    with ResultStore(tmp_path / "c.sqlite") as store:
+        store.describe(first)
+        store.describe({**first, "set_apart": []})  # accepted, and kept
+        assert store.description()["set_apart"] == []
+        (robot / "robot.spec").write_text("module m { number: 2; }\n")
+        changed = {**first, "files": robot_digest(robot)[:16]}
+        assert changed["files"] != first["files"]
+        with pytest.raises(RunError, match=r"the robot's specs, codels and worlds, or specc itself, changed since"):
+            store.describe(changed)
+
+
+def test_an_experiment_that_timed_out_is_run_again_by_a_resumed_campaign(tmp_path: Path) -> None:
+    """A wall-clock timeout says how busy the machine was, not what the robot did: a resumed
+    campaign runs the experiment again, and its new outcome replaces the timeout."""
+    experiment = Experiment("Robot1", ORIGINAL, "M1", "W1", 0)
+    with ResultStore(tmp_path / "c.sqlite") as store:
+        store.record(Outcome(experiment, "timeout", None, 4.0, "killed after 4 s"))
+        assert experiment.key not in store.done()
+        store.record(Outcome(experiment, "done", {"kappa": 0}, 30.0))
+        assert experiment.key in store.done() and [o.status for o in store.outcomes()] == ["done"]
+        with pytest.raises(RunError, match="already in"):
+            store.record(Outcome(experiment, "done", {"kappa": 0}, 30.0))

@@ -286,7 +286,7 @@ def test_the_command_ends_without_teardown_but_runs_exit_handlers_and_keeps_its_
 
 def test_verify_options_of_procedures_without_a_goal_are_refused(tmp_path: Path) -> None:
     result = specc("verify", str(EXAMPLES / "tug"), "--pnml", str(tmp_path / "net.pnml"), "--fact", "(BUSY)")
-    assert result.returncode == 1 and "--fact, --pnml: for verifying procedures only; add --goal" in result.stderr
+    assert result.returncode == 2 and "--fact, --pnml: for verifying procedures only; add --goal" in result.stderr
     assert not (tmp_path / "net.pnml").exists()
 
 
@@ -300,7 +300,7 @@ def test_replay_refuses_a_time_window_that_holds_nothing(tmp_path: Path) -> None
 def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> None:
     proved = specc("verify", str(EXAMPLES / "generic"), "--executive", "fig35", "--requests", "1")
     assert proved.returncode == 0, proved.stderr
-    assert proved.stdout.count(": holds - ") == 4 and "states" in proved.stdout
+    assert proved.stdout.count(": holds - ") == 5 and "states" in proved.stdout
     from tests.test_verify import robot
 
     spec = robot(tmp_path, 'backAnyway: event == "START", service == "BACK" ==> restrict status == "OK";',
@@ -309,7 +309,7 @@ def test_verify_proves_or_refutes_with_a_trace_and_exit_code(tmp_path: Path) -> 
     assert refuted.returncode == 1
     assert "exclusion: REFUTED" in refuted.stdout and "2. task: RQST EXEC BACK" in refuted.stdout
     ambiguous = specc("verify", str(EXAMPLES / "generic"))
-    assert ambiguous.returncode == 1 and "pick one with --executive" in ambiguous.stderr
+    assert ambiguous.returncode == 2 and "pick one with --executive" in ambiguous.stderr
     assert "Traceback" not in ambiguous.stderr + refuted.stderr
 
 
@@ -370,14 +370,14 @@ def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Pa
 
 def test_verify_procedures_rejects_bad_goals_and_unrepresentable_procedures(tmp_path: Path) -> None:
     garbled = specc("verify", str(EXAMPLES / "hilare"), "--goal", "COLLECT-OBJECTS 1")
-    assert garbled.returncode == 1 and "is not a goal" in garbled.stderr
+    assert garbled.returncode == 2 and "is not a goal" in garbled.stderr
     query = specc("verify", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--reach", "Explore:999")
-    assert query.returncode == 1 and "no statement at Explore:999: its statements are on lines" in query.stderr
+    assert query.returncode == 2 and "no statement at Explore:999: its statements are on lines" in query.stderr
     spec = tmp_path / "tasks.spec"
     spec.write_text("procedures t {\n  predicate closed DOOR(s: {OPEN});\n  predicate GO();\n"
                     "  ka Go { invocation: !(GO); body { #(DOOR OPEN); } }\n}\n", encoding="utf-8")
     rejected = specc("verify", str(spec), "--goal", "!(GO)")
-    assert rejected.returncode == 1
+    assert rejected.returncode == 2
     assert f"{spec}:4:37: error: '#' (preserve/maintain) has no Petri-net equivalent" in rejected.stderr
     assert "[unsupported-goal]" in rejected.stderr
     assert "Traceback" not in garbled.stderr + query.stderr + rejected.stderr
@@ -393,9 +393,9 @@ def test_graph_draws_the_procedures_net_or_one_ka(tmp_path: Path) -> None:
     everything, take = ((tmp_path / name).read_text(encoding="utf-8") for name in ("net.svg", "take.svg"))
     assert "Explore:254" in everything and "Explore:254" not in take and "TakeObject:236" in take
     unknown = specc("graph", "--net", str(EXAMPLES / "hilare"), "--goal", "!(COLLECT-OBJECTS 1)", "--ka", "Nope")
-    assert unknown.returncode == 1 and "KA 'Nope' is not among the KAs the goal reaches" in unknown.stderr
+    assert unknown.returncode == 2 and "KA 'Nope' is not among the KAs the goal reaches" in unknown.stderr
     goalless = specc("graph", "--net", str(EXAMPLES / "hilare"))
-    assert goalless.returncode == 1 and "--goal" in goalless.stderr and "Traceback" not in goalless.stderr
+    assert goalless.returncode == 2 and "--goal" in goalless.stderr and "Traceback" not in goalless.stderr
 
 
 def test_verify_procedures_says_when_it_stopped_short() -> None:
@@ -566,3 +566,16 @@ def test_plan_printed_to_a_pipe_keeps_its_tables_whole() -> None:
     assert "…" not in result.stdout
     assert all(heading in result.stdout for heading in ("start", "action", "duration", "ends by", "may start",
                                                          "preemption"))
+
+
+def test_a_reader_that_left_does_not_change_the_exit_status() -> None:
+    """`specc ... | head`: once the pipe's reader is gone, what is written is dropped and the
+    command ends with its own status (0: the specs check), not click's silent 1 for a broken pipe."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # the reader left before the first line
+    try:
+        done = subprocess.run([sys.executable, "-m", "specc.cli", "check", str(EXAMPLES / "tug")], cwd=ROOT,
+                              stdout=write_end, stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(write_end)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr

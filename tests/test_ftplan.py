@@ -208,6 +208,40 @@ def test_goals_abandoned_when_every_plan_leaves_them_aside_spare_the_final_goals
 
 
 
+HOME = ("AT_ROBOT_X", "AT_ROBOT_Y")
+
+
+@dataclass
+class MoreGoalsEachTime:
+    """A planner that plans, at its k-th request, for the first k goals of the mission but the
+    return home (those of them its problem still has) and for the return home: each of its plans
+    leaves the others open."""
+
+    asked: int = 0
+
+    def plan(self, problem: pm.Problem, now: float) -> PlanResult:
+        self.asked += 1
+        first = sorted(a.line for a in mission()[1].assertions if a.goal is not None and a.attribute not in HOME)
+        kept = replace(problem, assertions=tuple(a for a in problem.assertions if a.goal is None
+                                                 or a.attribute in HOME or a.line in first[:self.asked]))
+        return Planner(mission()[0]).plan(kept, now)
+
+
+def test_a_plan_that_reached_goals_held_to_the_end_is_progress_and_the_rest_are_planned_again() -> None:
+    """M1's photos kept to the mission's end (as an item left at its station is): a photo taken
+    is met only when the mission ends. A plan that took one has not "met nothing": the one planner
+    is asked again for the rest, as many times as it takes, instead of FTplan giving them up after
+    its first plan."""
+    _, problem = mission()
+    photos_kept = replace(problem, assertions=tuple(
+        replace(a, end=problem.end) if a.goal is not None and a.attribute == "PICTURE" else a  # type: ignore[call-arg]
+        for a in problem.assertions))
+    result = FtPlan(config(("p1",)), photos_kept, LocalPool({"p1": MoreGoalsEachTime()}), ScriptedExecutor()).run()
+    goals = [g for g in photos_kept.assertions if g.goal is not None]
+    assert result.success and len(result.met) == len(goals), result.missed
+    assert result.plannings == len(goals) - len(HOME)  # one per goal but the return home
+
+
 @dataclass
 class DropsGoalSaying(DropsGoal):
     """A planner that leaves one goal out and says why, as a planner whose search ran out does."""

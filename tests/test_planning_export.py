@@ -11,6 +11,7 @@ from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from typer.testing import CliRunner, Result
 from unified_planning.io import PDDLReader
 from unified_planning.model import DurativeAction
 
@@ -381,3 +382,161 @@ def test_the_files_read_back_for_aries_have_whole_durations(modele1: Exported, t
     assert durations and all(plain.fluent(name).type.is_real_type() for name in durations)
     assert all(ready.fluent(name).type.is_int_type() for name in durations)
     assert {a.name for a in ready.actions} == {a.name for a in plain.actions} and ready.goals == plain.goals
+
+
+# A number only a macro's table writes (`_p in {A} => _x =. 7`): WORK must be at x = 7, which no
+# assertion names. specc's planner moves there and works; the export must ground ?x over 7 too.
+TABLE_SPEC = """
+domain d {
+  attribute X() { ?value in [-oo, +oo]; }
+  attribute DONE() { ?value in {YES, NO}; }
+  macro spot(_p, _x) { _p in {A} => _x =. 7; _p in {B} => _x =. 3; }
+  task MOVE(?x1, ?x2) (t_start, t_end) {
+    ?x1 in [0, 10];
+    ?x2 in [0, 10];
+    event(X(): (?x1, ?x2), t_end);
+    contingent (t_end - t_start) in [5, 10];
+  } nonPreemptive
+  task WORK(?p, ?x) (t_start, t_end) {
+    ?p in {A};
+    spot(?p, ?x);
+    hold(X(): ?x, (t_start, t_end));
+    event(DONE(): (NO, YES), t_end);
+    contingent (t_end - t_start) in [2, 5];
+  } nonPreemptive
+}
+problem p for d {
+  timepoint t_g;
+  explained event(X(): (0, 2), t_start);
+  explained event(DONE(): (YES, NO), t_start);
+  hold(DONE(): YES, (t_g, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 100];
+}
+"""
+
+# A battery that a leg of a table drains (`?b2 =. ?b1 - 1.5 * ?d`, ?d from the leg's row): the
+# numbers a plan reaches are not enumerated, so GOTO has no ground instance.
+LEGS_SPEC = """
+domain legs {
+  attribute AT() { ?value in {DOCK, S1, P1}; }
+  attribute BATT() { ?value in [0, 100]; }
+  macro leg(_p1, _p2, _d) {
+    variable ?e;
+    ?e in {E_DOCK_S1, E_S1_P1};
+    _p1 in {DOCK} => ?e in {E_DOCK_S1};
+    _p2 in {DOCK} => ?e in {E_DOCK_S1};
+    _p1 in {P1} => ?e in {E_S1_P1};
+    _p2 in {P1} => ?e in {E_S1_P1};
+    ?e in {E_DOCK_S1} => _d =. 10;
+    ?e in {E_S1_P1} => _d =. 6;
+  }
+  task GOTO(?p1, ?p2, ?b1, ?b2) (t_start, t_end) {
+    variable ?d;
+    ?p1 in {DOCK, S1, P1};
+    ?p2 in {DOCK, S1, P1};
+    ?p1 != ?p2;
+    leg(?p1, ?p2, ?d);
+    event(AT(): (?p1, ?p2), t_end);
+    event(BATT(): (?b1, ?b2), t_end);
+    ?b2 =. ?b1 -. 1.5 *. ?d;
+    ?b2 in [10, 100];
+    contingent (t_end - t_start) in [5, 10];
+  } nonPreemptive
+  task WAIT() (t_start, t_end) {
+    hold(AT(): DOCK, (t_start, t_end));
+    contingent (t_end - t_start) in [1, 2];
+  } nonPreemptive
+}
+problem go for legs {
+  timepoint t_g;
+  explained event(AT(): (P1, DOCK), t_start);
+  explained event(BATT(): (0, 45), t_start);
+  hold(AT(): S1, (t_g, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 100];
+}
+"""
+
+
+def export_command(tmp_path: Path, text: str, problem: str, *extra: str) -> Result:
+    """`specc export` on `text`, in this process (the files go to tmp_path/pddl)."""
+    from specc.cli import app
+
+    spec = tmp_path / "spec" / "robot.spec"
+    spec.parent.mkdir(exist_ok=True)
+    spec.write_text(text)
+    return CliRunner().invoke(app, ["export", str(spec.parent), "--problem", problem, "-o", str(tmp_path / "pddl"),
+                                    *extra])
+
+
+def test_a_number_only_a_macros_table_writes_is_ground_and_the_task_kept(tmp_path: Path) -> None:
+    from tests.test_planner import from_text
+
+    result = export(*from_text(TABLE_SPEC))
+    assert not result.left_out
+    assert {a.name for a in result.problem.actions} == {"MOVE", "WORK"}
+    objects = {o.name for o in result.problem.all_objects}
+    # 7 from the table's row WORK reads; 3 is the row of ?p = B, which WORK never is.
+    assert "X_7" in objects and "X_3" not in objects
+    done = export_command(tmp_path, TABLE_SPEC, "p")
+    assert done.exit_code == 0, done.stderr
+    assert "(:durative-action work" in (tmp_path / "pddl" / "domain.pddl").read_text().lower()
+    assert "left out" not in done.stderr
+
+
+def test_a_number_a_constraint_sets_is_ground_too() -> None:
+    from tests.test_planner import from_text
+
+    plain = TABLE_SPEC.replace("spot(?p, ?x);", "?x =. 7;")
+    result = export(*from_text(plain))
+    assert not result.left_out and "X_7" in {o.name for o in result.problem.all_objects}
+
+
+def test_the_problem_a_macros_table_needs_is_solved_from_the_files(tmp_path: Path) -> None:
+    pytest.importorskip("up_aries")
+    from unified_planning.engines import PlanGenerationResultStatus
+    from unified_planning.shortcuts import OneshotPlanner, get_environment
+
+    from specc.analysis.planning_export import read_pddl
+    from tests.test_planner import from_text
+
+    domain, problem = write_pddl(export(*from_text(TABLE_SPEC)), tmp_path)
+    get_environment().credits_stream = None
+    with OneshotPlanner(name="aries") as planner:
+        solved = planner.solve(read_pddl(domain, problem), timeout=60)
+    assert solved.status in (PlanGenerationResultStatus.SOLVED_SATISFICING,
+                             PlanGenerationResultStatus.SOLVED_OPTIMALLY)
+    assert [a.action.name for _, a, _ in solved.plan.timed_actions] == ["move", "work"]
+
+
+def test_a_task_short_of_numbers_is_left_out_with_why() -> None:
+    from tests.test_planner import from_text
+
+    result = export(*from_text(LEGS_SPEC))
+    assert {a.name for a in result.problem.actions} == {"WAIT"}
+    assert list(result.left_out) == ["GOTO"]
+    why = result.left_out["GOTO"]
+    # Which parameter lacks numbers, one it would take, and why the export did not reach it.
+    assert "?b2 would need another number, e.g. ?b2 = 30 with ?p1 = DOCK, ?p2 = S1, ?b1 = 45" in why
+    assert "leads ?b2 anywhere in [" in why and "not enumerated" in why
+    assert not mentions(result, "GOTO is dropped")
+
+
+def test_export_fails_when_a_task_is_left_out_unless_partial_is_allowed(tmp_path: Path) -> None:
+    refused = export_command(tmp_path, LEGS_SPEC, "go")
+    assert refused.exit_code == 1
+    assert "error: task GOTO of domain 'legs' is left out of the export: " in refused.stderr
+    assert "--allow-partial" in refused.stderr and not (tmp_path / "pddl").exists()
+    allowed = export_command(tmp_path, LEGS_SPEC, "go", "--allow-partial")
+    assert allowed.exit_code == 0, allowed.stderr
+    assert "warning: task GOTO of domain 'legs' is left out of the export: " in allowed.stderr
+    assert "error" not in allowed.stderr
+    assert "(:durative-action goto" not in (tmp_path / "pddl" / "domain.pddl").read_text().lower()
+
+
+def test_a_task_no_values_can_meet_is_a_note_not_a_loss() -> None:
+    from tests.test_planner import from_text
+
+    never = TABLE_SPEC.replace("?p in {A};", "?p in {A};\n    ?x =. 7;\n    ?x > 8;")
+    result = export(*from_text(never))
+    assert not result.left_out and {a.name for a in result.problem.actions} == {"MOVE"}
+    assert mentions(result, "WORK is left out: no values at all meet its constraints")

@@ -194,3 +194,20 @@ def test_an_event_whose_ka_context_fails_stays_for_a_wait(tmp_path: Path) -> Non
     intention = supervisor.post("!(GO)")
     supervisor.run()
     assert intention.status == "succeeded"
+
+
+def test_a_set_domain_may_hold_negative_numbers(tmp_path: Path) -> None:
+    """`{-30, 0}` as a range `-30..0` is: the numbers, negative ones included, reach the
+    interpreter's domains, and `fmt` writes them back as they were."""
+    from specc.syntax.printer import format_source
+
+    text = "procedures p {\n  predicate TILT(t: {-30, +5, 0});\n}\n"
+    spec_file = tmp_path / "tilt.spec"
+    spec_file.write_text(text, encoding="utf-8")
+    loaded = load([spec_file])
+    assert loaded.program is not None and not loaded.errors, [d.message for d in loaded.errors]
+    block = next(i for i in loaded.program.items if isinstance(i, m.Procedures))
+    (tilt,) = library(block).predicates
+    assert tilt.domains == ((-30, 5, 0),)
+    (source,) = loaded.program.files
+    assert format_source(source, text, loaded.comments[source.path]) == text.replace("+5", "5")

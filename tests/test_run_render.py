@@ -328,3 +328,51 @@ def test_a_box_footprint_is_drawn_to_its_whole_extent_with_its_front_marked() ->
     assert any(abs(y - 2.0) < 1e-9 and x > 1.0 for x, y in front)
     turned = outline(box, (0.0, 0.0, math.pi / 2))  # facing +y: the length lies along y
     assert turned[:, 1].max() == pytest.approx(0.45) and turned[:, 0].max() == pytest.approx(0.3)
+
+
+def test_a_goal_failed_by_a_fail_statement_is_said_to_fail_there() -> None:
+    """`fail;` leaves no "... failed: why" line of its own: the run's reason names the statement,
+    not only the top-level "every applicable KA failed"."""
+    from specc.run.mission import why_failed
+    from specc.runtime.procedures import KA, Compound, Fail, Goal, If, Library, Step
+    from specc.runtime.supervisor import Supervisor
+
+    keep = KA(name="Keep", invocation=Goal("!", Compound("KEEP")), line=2,
+              body=(If(Goal("?", Compound("Q"), 3), (Step(Goal("=>", Compound("P"), 4)),), (Fail(5),), 3),))
+    supervisor = Supervisor(Library("tasks", kas=(keep,)))
+    intention = supervisor.post("!(KEEP)")
+    supervisor.run()
+    assert intention.status == "failed" and why_failed(intention.trace, []) == "Keep:5: fail"
+
+
+def test_a_table_lists_each_run_that_did_not_succeed_with_its_outcome(tmp_path: Path) -> None:
+    """A run stopped at the horizon is not a mission that failed: the table says which it was."""
+    from specc.run.session import RunOutcome
+    from specc.run.sweep import SweepResult, mission_rows
+
+    def outcome(name: str, ended: str, why: str) -> RunOutcome:
+        return RunOutcome(tmp_path / name, "cart", {"outcome": ended, "why": why, "mission": "m", "world": "w",
+                                                    "simulated_time": 10.0}, "")
+
+    runs = [outcome("cart-m-w-s0", "succeeded", "every goal achieved (1)"),
+            outcome("cart-m-w-s1", "horizon", "!(GO 1 2) still running at the 60 s horizon"),
+            outcome("cart-m-w-s2", "failed", "!(GO 1 2) failed: Go:3: ?(= $R OK)")]
+    result = SweepResult("cart", runs, missions=mission_rows(runs))
+    assert [(f.name, f.outcome) for f in result.failures] == [("cart-m-w-s1", "horizon"), ("cart-m-w-s2", "failed")]
+    text = result.markdown()
+    assert "- cart-m-w-s1 (horizon): !(GO 1 2) still running at the 60 s horizon\n" in text
+    assert "- cart-m-w-s2 (failed): !(GO 1 2) failed: Go:3: ?(= $R OK)\n" in text
+
+
+def test_a_goal_still_running_at_the_horizon_says_what_it_waited_on() -> None:
+    """A ZOMBIE the procedures never interrupted holds its request without a final reply: the
+    horizon's reason names it, in the phase its activity last entered, and since when."""
+    from specc.run.mission import waiting_on
+
+    events = [{"kind": "request", "id": 1, "service": "GOTO", "t": 0.0},
+              {"kind": "activity", "id": 1, "service": "GOTO", "from": "INIT", "to": "EXEC", "t": 0.0},
+              {"kind": "reply", "id": 1, "service": "GOTO", "result": "OK", "t": 9.0},
+              {"kind": "request", "id": 2, "service": "OPEN-DRAWER", "t": 9.5},
+              {"kind": "activity", "id": 2, "service": "OPEN-DRAWER", "from": "EXEC", "to": "ZOMBIE", "t": 14.0}]
+    assert waiting_on(events) == "; waiting on OPEN-DRAWER (id 2) in ZOMBIE since 14.0 s"
+    assert waiting_on(events[:3]) == ""

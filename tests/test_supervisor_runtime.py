@@ -283,6 +283,15 @@ def test_logic_variables_unify_once_program_variables_are_reassigned() -> None:
     assert done(s, "!(PROGRAM $R)").bindings == {"$R": 12}
 
 
+def test_a_program_variable_inside_an_expression_of_a_goal_is_read() -> None:
+    """`!(NOTED (+ @I 1))`: @I is no argument of NOTED itself, so the goal reads it (a loop's
+    counter passed on to a subgoal), as the Petri-net translation does."""
+    s = supervisor(ka("Count", "!(COUNT)", Assign(Var("@I"), 2), step("!(NOTED (+ @I 1))", 3), line=2),
+                   ka("Noted", "!(NOTED $N)", step("=>(SEEN $N)", 6), line=5))
+    assert done(s, "!(COUNT)").status == "succeeded"
+    assert s.database.facts("SEEN") == [parse_fact("(SEEN 3)")]
+
+
 def test_a_logic_variable_once_bound_is_tested_not_rebound() -> None:
     s = supervisor(ka("Same", "!(SAME)", step("?(COLOUR $C)"), step("?(SHADE $C)")))
     s.conclude("(COLOUR RED)")
@@ -641,6 +650,19 @@ def test_exec_request_interrupts_a_zombie_and_returns_the_final_reply(executive:
     after = s.post("!(EXEC-REQUEST FREE $RESULT)")  # the module accepts requests again
     until_done(s, after)
     assert after.bindings == {"$RESULT": "OK"}
+
+
+def test_the_supervisor_s_request_ids_are_none_another_client_gave(executive: Any) -> None:
+    """A program's own request with id 1 (refused: BAD-SERVICE) before the supervisor's first:
+    the supervisor's request gets an id of its own, and its reply, not the program's."""
+    library, functions = exec_request_library(TWO_ARCS)
+    s = Supervisor(library, functions, executive=executive)
+    executive.request("FLY", 1)
+    executive.kernel.run_for(0.1)
+    executive.context.vars["next"] = ["exec"]
+    intention = s.post("!(EXEC-REQUEST FREE $RESULT)")
+    until_done(s, intention)
+    assert intention.bindings == {"$RESULT": "OK"} and intention.requests == [2]
 
 
 def test_a_reply_outside_its_declared_domain_is_received_and_noted_as_an_incident(executive: Any) -> None:

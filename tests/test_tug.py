@@ -277,3 +277,24 @@ def test_the_guide_s_verifiable_procedures_verify_and_run_the_delivery(tmp_path:
     ran = specc("run", robot, "--mission", "deliver", "--world", "crowded", "--runs", tmp_path / "runs", "-q",
                 "--no-pictures", "-g", tmp_path / "generated")  # not the repository's generated/: a copy's
     assert ran.returncode == 0, ran.stderr
+
+
+def test_the_task_level_s_inputs_of_the_wrong_count_or_type_are_answered_bad_input(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """GOTO takes x and y, doubles: one input, or a word for x, is the task level's mistake
+    (BAD-INPUT, saying which), not an input function that failed (ERROR)."""
+    import importlib
+
+    from specc.runtime import functional as rt
+
+    monkeypatch.syspath_prepend(str(ROOT / "generated"))
+    monkeypatch.syspath_prepend(str(TUG))  # the codels
+    registry = rt.Registry()
+    importlib.import_module("tug.modules").create_all(registry)
+    executive = importlib.import_module("tug.executive.tug").create(registry)
+    executive.request("GOTO", 1, inputs=(2.0,))
+    executive.request("GOTO", 2, inputs=("far", 1.0))
+    replies = [m for m in executive.messages if m.kind == "REPLY"]
+    assert [(m.id, m.result) for m in replies] == [(1, "BAD-INPUT"), (2, "BAD-INPUT")]
+    assert replies[0].detail == "GOTO takes x, y from the task level; 1 given"
+    assert replies[1].detail == "GOTO's input x: expected float, got str"

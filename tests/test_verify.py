@@ -107,8 +107,19 @@ def test_a_conflict_declared_one_way_is_said_with_the_verdict(tmp_path: Path) ->
     result = run(robot(tmp_path, ""), "shop", 2)
     assert result.ok and result.one_way == (("BACK", "wait", "GO"),)
     said = list(describe(result))[-1]
-    assert said.startswith("conflicts declared one way only (exclusion reads them as written): GO may start while "
-                           "BACK runs (BACK waits for GO, GO does not name BACK)")
+    assert said.startswith("conflicts declared one way only, which the states explored show running together "
+                           "(exclusion reads them as written): GO starts while BACK runs (BACK waits for GO, GO does "
+                           "not name BACK)")
+    # The controller's own rules may keep them apart all the same: then nothing is said.
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    rule = ('BackState: {"BACK", "IDLE"};\n  init @BackState = "IDLE";\n'
+            '  goAfterBack: event == "START", service == "GO", @BackState == "BACK" ==> restrict status == "WAIT";')
+    paths = robot(kept, "")
+    paths[0].write_text(paths[0].read_text().replace('outputs status: {"OK", "WAIT", "REFUSE", "ERROR"};',
+                                                     'outputs status: {"OK", "WAIT", "REFUSE", "ERROR"}, ' + rule))
+    apart = run(paths, "shop", 2)
+    assert apart.ok and apart.one_way == ()
     both = tmp_path / "both"
     both.mkdir()
     paths = robot(both, "")
@@ -138,7 +149,41 @@ def test_a_rule_the_controller_cannot_follow_puts_the_executive_in_error(tmp_pat
 
 
 def test_every_property_is_named_and_explained() -> None:
-    assert set(PROPERTIES) == {"exclusion", "one-reply", "no-starvation", "no-error"}
+    assert set(PROPERTIES) == {"exclusion", "one-reply", "no-starvation", "no-error", "settles"}
+
+
+RESTARTED = """
+module ptu {
+  codels: "ptu_codels";
+  request Point { type: exec; task: Axes; incompatible_with: Point, Sweep; codel exec: sweep; }
+  request Sweep { type: exec; task: Axes; incompatible_with: Point, Sweep; codel exec: sweep; }
+  exec_task Axes { period: 100 ms; }
+}
+module camera {
+  codels: "ptu_codels";
+  request Panorama { type: exec; task: Grab; incompatible_with: Panorama; sends: ptu.Sweep; codel exec: sweep; }
+  exec_task Grab { period: 100 ms; }
+}
+executive e {
+  service SWEEP { request: ptu.Sweep; conflicts { SWEEP: interrupt; } }
+  service PANORAMA { request: camera.Panorama; conflicts { PANORAMA: wait; } }
+  reflex again on reply SWEEP => start SWEEP;
+}
+"""
+
+
+def test_a_reaction_loop_outside_time_is_a_finding_not_a_verifier_that_never_ends(tmp_path: Path) -> None:
+    """A reflex restarting SWEEP on every reply, and its module frozen by a ZOMBIE: the module
+    refuses each start at once, the refusal is a reply, the reflex starts SWEEP again, with no
+    time passing (the robot would stand at that instant for ever). The exploration ends, and
+    `settles` is refuted with the events that lead there."""
+    (tmp_path / "ptu_codels.py").write_text("def sweep(sdi, request):\n    return 'exec'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text(RESTARTED)
+    result = run([spec], "e", 2)
+    assert result.complete and "settles" in result.violations
+    violation = result.violations["settles"]
+    assert "went on for 10,000 decisions" in violation.message and "ptu: Sweep goes ZOMBIE" in violation.trace
 
 
 def test_a_refusing_rule_is_answered_refused_and_keeps_every_property(tmp_path: Path) -> None:
@@ -576,3 +621,44 @@ def test_a_reflex_aborting_a_service_gone_zombie_frees_it_whichever_the_source_n
     spec.write_text(ZOMBIE_REFLEX % source)
     result = run([spec], "eye", 1)
     assert result.complete and result.violations == {}, result.violations
+
+
+REFUSED_AGAIN = """
+module ptu {
+  codels: "ptu_codels";
+  request Sweep { type: exec; task: Axes; fail: NO; validate: refuse; incompatible_with: Sweep; codel exec: sweep; }
+  exec_task Axes { period: 100 ms; }
+}
+executive e {
+  service SWEEP { request: ptu.Sweep; conflicts { SWEEP: interrupt; } }
+  reflex again on reply SWEEP => start SWEEP;
+}
+"""
+
+
+def test_a_reaction_loop_at_run_time_ends_in_the_error_state(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A reflex starting SWEEP again on every reply, and a module whose validate codel refuses
+    it at once: each refusal is a reply, each reply a new start, at one instant. Instead of
+    holding the robot at that instant for ever, the running executive enters its ERROR state,
+    which refuses every request and so ends the loop, saying why. (`specc verify`'s modules do
+    not refuse at a validate codel: this loop is one it does not see.)"""
+    import importlib
+
+    from specc.runtime import executive as rx
+    from specc.runtime import functional as rt
+    from tests.functional.conftest import compile_robot
+
+    (tmp_path / "ptu_codels.py").write_text("def sweep(sdi, request):\n    return 'ether'\n\n\n"
+                                            "def refuse(sdi, request):\n    return 'NO'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text(REFUSED_AGAIN)
+    name = compile_robot(spec, tmp_path / "generated", "looping")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.syspath_prepend(str(tmp_path / "generated"))
+    monkeypatch.setattr(rx, "CYCLES_PER_INSTANT", 500)
+    registry = rt.Registry()
+    importlib.import_module(f"{name}.modules").create_all(registry)
+    executive = importlib.import_module(f"{name}.executive.e").create(registry)
+    executive.request("SWEEP", 1)
+    registry.kernel.run_for(0.5)
+    assert executive.error is not None and "500 cycles at 0 s with no time passing" in executive.error

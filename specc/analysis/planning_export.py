@@ -9,9 +9,13 @@ The encoding, chosen for the temporal planners of unified_planning (Aries) and f
 - symbolic sets become user types (a laminar family of the sets the parameters and the fluents
   need; a set crossing another falls back to its smallest enclosing type, or to `symbol`);
 - a numeric slot (attribute argument or value) is ground over the numbers that appear in the
-  domain and the problem, and those the tasks' events lead to from them (`reach_numbers`,
-  within the declared domains): the slots a task variable links share one user type, with one object
-  per number (`AT_ROBOT_X_4`), so Modele1's real-valued MOVE and TAKE_PICTURE become finite;
+  domain's and the problem's assertions, those a task's constraint sets a variable to (`?x =. 7`,
+  or a macro's table: `_p in {A} => _x =. 7`, `constrained_numbers`), and those the tasks' events
+  lead to from them one number at a time (`reach_numbers`), within the declared domains: the slots
+  a task variable links share one user type, with one object per number (`AT_ROBOT_X_4`), so
+  Modele1's real-valued MOVE and TAKE_PICTURE become finite. A number reached only through a
+  choice (`?b2 =. ?b1 - 1.5 * ?d` with ?d taken from a table) is not enumerated: the sums of such
+  steps grow without a useful bound;
 - a task is a durative action; its variables used in assertions (`?state`) become parameters. The
   duration comes from a small interval propagation of the task's constraints with the parameters
   ground: constant, or a static function of the parameters (`MOVE_duration(?x1, ?y1, ?x2, ?y2)`),
@@ -35,7 +39,10 @@ The encoding, chosen for the temporal planners of unified_planning (Aries) and f
   latest date of its end (`past_T`); the horizon's latest end is a deadline (`within_horizon`,
   made false by a timed literal, is required by every action).
 
-Whatever cannot be said this way is listed, one sentence each, in `Exported.unsupported`.
+Whatever cannot be said this way is listed, one sentence each, in `Exported.unsupported`. A task
+that could run but gets no action (no ground instance, too many, no bounded duration) is in
+`Exported.left_out` instead, with why and what to do: the files then lack an action specc's
+planner may use, and a problem needing it has no plan from them (`specc export` fails).
 """
 
 from __future__ import annotations
@@ -99,6 +106,8 @@ FULL: Span = (-math.inf, math.inf)
 class Exported:
     problem: UPProblem  # a temporal unified_planning problem (durative actions)
     unsupported: list[str] = field(default_factory=list)  # what could not be expressed faithfully
+    # The domain's tasks with no action in the problem, each with why and what the user may do about it.
+    left_out: dict[str, str] = field(default_factory=dict)
 
 
 def export(domain: pm.PlanningDomain, problem: pm.Problem,
@@ -572,6 +581,18 @@ def _positions(a: pm.Event | pm.Hold) -> Iterator[tuple[int, pm.Expr, str]]:
         yield VALUE, a.value, "value"
 
 
+def _number_set(c: pm.Constraint) -> tuple[str, float] | None:
+    """(variable, number) when the constraint sets a variable to one number: `?x =. 7`, `?x in [7, 7]`."""
+    if isinstance(c, pm.Relation) and c.op == "=":
+        for var, number in ((c.left, c.right), (c.right, c.left)):
+            if isinstance(var, pm.Var) and isinstance(number, pm.Num):
+                return var.name, number.value
+    if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var) and isinstance(c.domain, pm.Interval) \
+            and c.domain.low == c.domain.high:
+        return c.expr.name, c.domain.low
+    return None
+
+
 def _constant(e: pm.Expr) -> bool:
     return isinstance(e, (pm.Num, pm.Sym))
 
@@ -655,6 +676,10 @@ class _Exporter:
                     self.passage_parts |= {id(transit.leave): "leave", id(transit.hold): "hold",
                                            id(transit.arrive): "arrive"}
         self.notes: dict[str, None] = {}  # ordered, deduplicated
+        self.left_out: dict[str, str] = {}
+        # Per numeric class (by id), the first event of each task that leads from one of its
+        # numbers to a range rather than one number (`reach_numbers`): why a task may lack values.
+        self.unreached: dict[int, dict[tuple[str, int], str]] = {}
         self.up = UPProblem(problem.name)
         self.names: set[str] = set()
         self.fluents: dict[str, Any] = {}
@@ -683,7 +708,7 @@ class _Exporter:
         for task in self.domain.tasks:
             self.add_task(task)
         self.add_problem()
-        return Exported(self.up, list(self.notes))
+        return Exported(self.up, list(self.notes), dict(self.left_out))
 
     def note_markers(self) -> None:
         if not self.markers:
@@ -778,7 +803,31 @@ class _Exporter:
                 classes[root] = _NumericClass(stem, prefix)
             classes[root].values |= {v for v in constants.get((attribute, pos), ()) if isinstance(v, float)}
         self.classes = classes
+        self.constrained_numbers()
         self.reach_numbers()
+
+    def constrained_numbers(self) -> None:
+        """Add to each numeric class the numbers a task's constraint sets one of its variables to:
+        `?x =. 7`, alone or as what an implication concludes when its condition may hold (a macro's
+        table: `_p in {A} => _x =. 7`). The planner may take them, and no assertion need write them:
+        without them such a task would have no ground instance."""
+        for task in self.domain.tasks:
+            for c in task.constraints:
+                set_to = _number_set(c.consequence if isinstance(c, pm.Implies) else c)
+                if set_to is None:
+                    continue
+                var, value = set_to
+                cls = self.numeric_class(task.name, var)
+                if cls is None or value in cls.values or not self.declared_for(task, var, value):
+                    continue
+                if isinstance(c, pm.Implies) and bounds([*task.constraints, c.condition], {}, []) is None:
+                    continue  # a row of the table this task never reads (`?p in {A}` with `_p in {B} => ...`)
+                cls.values.add(value)
+
+    def declared_for(self, task: pm.Task, var: str, value: float) -> bool:
+        """Is `value` within the domains declared for every slot the task's variable fills?"""
+        return all(d.low <= value <= d.high for slot in self.var_slots(task, var)
+                   if isinstance(d := self.declared(slot), pm.Interval))
 
     def reach_numbers(self) -> None:
         """Add to each numeric class the numbers a task's events lead to from the numbers it has:
@@ -799,17 +848,22 @@ class _Exporter:
                         self.numeric_class(task.name, a.after.name)
                     if source is None or target is None:
                         continue
-                    allowed = [d for slot in self.var_slots(task, a.after.name)
-                               if isinstance(d := self.declared(slot), pm.Interval)]
                     for before in sorted(source.values):
                         if (id(a), before) in tried:
                             continue
                         tried.add((id(a), before))
                         found = bounds(task.constraints, {("var", a.before.name): (before, before)},
                                        [("var", a.after.name)])
-                        value = _single(found[("var", a.after.name)]) if found is not None else None
-                        if not isinstance(value, float) or value in target.values or not all(
-                                d.low <= value <= d.high for d in allowed):
+                        after = found[("var", a.after.name)] if found is not None else None
+                        value = _single(after)
+                        if isinstance(after, tuple) and value is None:
+                            self.unreached.setdefault(id(target), {}).setdefault((task.name, id(a)), (
+                                f"from {a.before.name} = {_seconds(before)}, {task.name}'s {_describe(a)} leads "
+                                f"{a.after.name} anywhere in [{_seconds(after[0])}, {_seconds(after[1])}], not to one "
+                                "number (it depends on another choice the planner makes); such numbers are not "
+                                "enumerated, as their sums along a plan have no useful bound"))
+                        if not isinstance(value, float) or value in target.values or not self.declared_for(
+                                task, a.after.name, value):
                             continue
                         if len(target.values) >= REACHED_NUMBERS:
                             cut.add(target.type_name)
@@ -1065,6 +1119,67 @@ class _Exporter:
                   "initial literal makes false then (PDDL 2.1 has no timed goals).")
 
     # ------------------------------------------------------------ tasks
+    def leave_out(self, task: pm.Task, why: str) -> None:
+        """The task gets no action: a faithful encoding when no value at all meets its constraints,
+        else a loss the user must hear of (`Exported.left_out`)."""
+        if bounds(task.constraints, {("time", task.start): (0.0, 0.0)}, []) is None:
+            self.note(f"{task.name} is left out: no values at all meet its constraints, so it can never run.")
+        else:
+            self.left_out[task.name] = why
+
+    def grounding(self, task: pm.Task, params: Sequence[_ActionParam], kept: Mapping[str, Sequence[Any]]) -> str:
+        """Why the numbers the parameters are ground over miss those the task needs (which
+        parameter, a number it would take, and how the export failed to reach it), and what the user
+        can do about it: the end of the sentence of `leave_out`."""
+        numeric = [p for p in params if p.numeric]
+        if not numeric:
+            return ""
+        shown = "; ".join(f"{p.var} in {{{', '.join(_seconds(v) for v in kept.get(p.var, p.values))}}}"
+                          for p in numeric)
+        why = (f"its numeric parameters are ground over the numbers written in the domain's and the problem's "
+               f"assertions, those its constraints set them to, and those the tasks' events lead to one number at a "
+               f"time ({shown})")
+        short = self.short_of_numbers(task, params, kept)
+        if short is not None:
+            param, example = short
+            why += f": {param.var} would need another number, e.g. {example}"
+            suspects = [param]
+        else:
+            suspects = numeric
+        reasons = [reason[0].upper() + reason[1:] for p in suspects
+                   for reason in self.unreached.get(p.numbers, {}).values()]
+        return ". ".join([why, *dict.fromkeys(reasons)]) + (
+            ". Write the numbers it needs into the specs (as values of assertions, or as an implication's constants), "
+            "or plan with `specc plan`, which takes every real value")
+
+    def short_of_numbers(self, task: pm.Task, params: Sequence[_ActionParam],
+                         kept: Mapping[str, Sequence[Any]]) -> tuple[_ActionParam, str] | None:
+        """The first numeric parameter that, left free while the others take their ground values,
+        meets the task's constraints: the one short of numbers, with a value it would take (one
+        number if some tuple of the others fixes it, else a range). A value an event leads to is
+        tried first (the battery after a move, not before it). Tries at most CHOICE_LIMIT tuples of
+        the others per parameter: it only words a message."""
+        reached = {a.after.name for a in task.assertions
+                   if isinstance(a, pm.Event) and isinstance(a.before, pm.Var) and isinstance(a.after, pm.Var)}
+        for param in sorted((p for p in params if p.numeric), key=lambda p: p.var not in reached):
+            others = [p for p in params if p is not param]
+            ranged: str | None = None
+            for combination in itertools.islice(itertools.product(*(kept[p.var] for p in others)), CHOICE_LIMIT):
+                fixed: dict[Key, Dom] = {("time", task.start): (0.0, 0.0)}
+                fixed.update({("var", p.var): self.dom(p, v) for p, v in zip(others, combination, strict=True)})
+                found = bounds(task.constraints, fixed, [("var", param.var)])
+                dom = found[("var", param.var)] if found is not None else None
+                if not isinstance(dom, tuple):
+                    continue
+                value = _single(dom)
+                given = f" with {self.show_tuple(others, combination)}" if others else ""
+                if isinstance(value, float):
+                    return param, f"{param.var} = {_seconds(value)}{given}"
+                ranged = ranged or f"{param.var} in [{_seconds(dom[0])}, {_seconds(dom[1])}]{given}"
+            if ranged is not None:
+                return param, ranged
+        return None
+
     def add_task(self, task: pm.Task) -> None:
         variables = self.task_variables(task)
         params: list[_ActionParam] = []
@@ -1072,8 +1187,10 @@ class _Exporter:
             cls = self.numeric_class(task.name, var)
             if cls is not None:
                 if not cls.values:
-                    self.note(f"{task.name} is dropped: its numeric variable {var} takes no value that appears in "
-                              "the domain or the problem.")
+                    why = self.unreached.get(id(cls), {}).values()
+                    self.leave_out(task, f"its numeric variable {var} takes no number written in the domain or the "
+                                         f"problem{''.join('; ' + w for w in why)}. Write the numbers it needs into "
+                                         "the specs (as values of assertions, or as an implication's constants)")
                     return
                 params.append(_ActionParam(var.lstrip("?"), var, True, sorted(cls.values), self.class_types[id(cls)],
                                            id(cls)))
@@ -1082,8 +1199,8 @@ class _Exporter:
                 is_numeric = any(isinstance(c, pm.Member) and c.expr == pm.Var(var)
                                  and isinstance(c.domain, pm.Interval) for c in task.constraints)
                 if is_numeric:
-                    self.note(f"{task.name} is dropped: its numeric variable {var} is in no attribute, so it "
-                              "cannot be ground.")
+                    self.leave_out(task, f"its numeric variable {var} is in no attribute, so it cannot be ground. "
+                                         "Name it in an assertion, or make it a local variable")
                     return
                 params.append(_ActionParam(var.lstrip("?"), var, False, self.set_values(s), self.set_type(s)))
         action = DurativeAction(self.unique(task.name), OrderedDict((p.name, p.up_type) for p in params))
@@ -1127,19 +1244,14 @@ class _Exporter:
             kept[p.var] = [v for v in p.values
                            if not constraints or bounds(constraints, {("var", p.var): self.dom(p, v)}, []) is not None]
             if not kept[p.var]:
-                self.note(f"{task.name} is dropped: no value of {p.var} meets its constraints.")
+                advice = self.grounding(task, [p], {}) if p.numeric else ""
+                self.leave_out(task, f"no value of {p.var} meets its constraints" + (f": {advice}" if advice else ""))
                 return False
-        numeric = [p for p in params if p.numeric]
-        if numeric:
-            ground = "; ".join(f"{p.var} in {{{', '.join(_seconds(v) for v in kept[p.var])}}}" for p in numeric)
-            self.note(f"{task.name}: the real-valued {', '.join(p.var for p in numeric)} are ground over the numbers "
-                      f"that appear in the domain and the problem, and those the tasks' events lead to from them, "
-                      f"that meet its constraints ({ground}), which makes a "
-                      "PDDL encoding possible; any other value the planner could choose is lost.")
         coupled_params = [p for p in params if any(("var", p.var) in _keys(c) for c in coupled)]
         tuples = list(itertools.product(*(kept[p.var] for p in coupled_params)))
         if len(tuples) > TABLE_LIMIT:
-            self.note(f"{task.name} is dropped: {len(tuples)} ground parameter tuples are too many to tabulate.")
+            self.leave_out(task, f"its {len(tuples)} ground parameter tuples are too many to tabulate (at most "
+                                 f"{TABLE_LIMIT}). Narrow its parameters' domains")
             return False
         contingent = any(c.contingent and (_keys(c) & times) for c in task.constraints
                          if isinstance(c, (pm.Relation, pm.Member)))
@@ -1155,8 +1267,16 @@ class _Exporter:
             assert isinstance(span, tuple)
             durations[combination] = span
         if not durations:
-            self.note(f"{task.name} is dropped: no ground parameters meet its constraints.")
+            advice = self.grounding(task, coupled_params, kept)
+            self.leave_out(task, "no ground parameters meet its constraints" + (f": {advice}" if advice else ""))
             return False
+        numeric = [p for p in params if p.numeric]
+        if numeric:
+            ground = "; ".join(f"{p.var} in {{{', '.join(_seconds(v) for v in kept[p.var])}}}" for p in numeric)
+            self.note(f"{task.name}: the real-valued {', '.join(p.var for p in numeric)} are ground over the numbers "
+                      f"that appear in the domain and the problem, and those the tasks' events lead to from them, "
+                      f"that meet its constraints ({ground}), which makes a "
+                      "PDDL encoding possible; any other value the planner could choose is lost.")
         unbounded = [k for k, s in durations.items() if math.isinf(s[1])]
         if unbounded:
             latest = self.dates.get(self.problem.end, FULL)[1]
@@ -1165,7 +1285,9 @@ class _Exporter:
                 for k in unbounded:
                     del durations[k]
                 if not durations:
-                    self.note(f"{task.name} is dropped: its duration has no upper bound.")
+                    remedy = "" if contingent else ", or give the problem a latest end"
+                    self.leave_out(task, "its duration has no upper bound (nature could make it last forever, or "
+                                         f"nothing bounds it). Bound it in the task{remedy}")
                     return False
                 self.note(f"{task.name}: its {len(unbounded)} ground parameter tuples whose duration has no upper "
                           f"bound (e.g. {self.show_tuple(coupled_params, unbounded[0])}) are left out.")

@@ -24,7 +24,9 @@ by states whose every continuation was explored. Properties:
 - no-starvation: from every state, a WAIT activity of a service without a start timeout can
   leave WAIT without the task level's help;
 - no-error: the executive never enters its general ERROR state (§3.4.2), which in normal
-  operation "ne doit jamais se produire".
+  operation "ne doit jamais se produire";
+- settles: the executive handles every event in finitely many cycles (DECISIONS_PER_EVENT at
+  most): no reaction loop that would hold the robot at one instant.
 """
 
 from __future__ import annotations
@@ -54,7 +56,16 @@ PROPERTIES = {
     "one-reply": "every accepted request ends with exactly one final reply",
     "no-starvation": "a WAIT service without a start timeout can always still start, with no new request",
     "no-error": "the executive never enters its general ERROR state",
+    "settles": "every event is handled in finitely many executive cycles, with no reaction loop outside time",
 }
+# Executive decisions one event may take before its handling counts as a loop: an event takes a
+# few (the request, the starts asked again, a reflex or two); a reflex restarting on every reply a
+# service its frozen module answers at once takes them without end, and so would the robot.
+DECISIONS_PER_EVENT = 10_000
+
+
+class Unsettled(Exception):
+    """The executive's handling of one event went on past DECISIONS_PER_EVENT decisions."""
 
 
 # ---------------------------------------------------------------- the abstract surroundings
@@ -237,6 +248,9 @@ class ModelModules(dict[str, ModelModule]):
     def get(self, name: str, default: Any = None) -> Any:  # type: ignore[override]
         return self[name] if name in self._names else default
 
+    def __contains__(self, name: object) -> bool:  # every module of the model is there, made or not
+        return name in self._names
+
 
 class ModelRegistry:
     def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]], codes: tuple[str, ...] = ()):
@@ -322,6 +336,7 @@ class Explorer:
                  parts: Sequence[tuple[str, ...]] = ()):
         self.spec = dataclasses.replace(spec, services={
             name: dataclasses.replace(s, args={}, input=None, output=None) for name, s in spec.services.items()})
+        self.decisions = 0  # the decisions taken for the event being stepped (see Unsettled)
         self.decide = self._watched(decide)
         # Services that share nothing (see `independent_parts`) are explored part by part: the
         # executive's states are then the products of the parts' states, which are not listed.
@@ -336,6 +351,8 @@ class Explorer:
         self.check_passes = bool(self.parts) or observable_requests(spec, modules) != self._observable
         self.passes_matter = False
         self.arcs = arcs
+        # (running, started): a service entered EXEC while the other was in EXEC, in some state explored.
+        self.together: set[tuple[str, str]] = set()
         self.requests = requests
         # The report codes reflexes look for: module activities may end with them too.
         self.codes = tuple(sorted({str(r.value) for r in self.spec.reflexes if r.op is not None} - {"OK"}))
@@ -345,7 +362,7 @@ class Explorer:
         registry = ModelRegistry(self.modules, self.codes)
         executive = rx.Executive(self.spec, self.decide, registry)  # type: ignore[arg-type]
         world = World(executive, registry)
-        executive.observers.append(functools.partial(_check_exclusion, world, self.arcs))
+        executive.observers.append(functools.partial(_check_exclusion, world, self.arcs, self.together))
         return world
 
     def key(self, world: World) -> Key:
@@ -444,8 +461,12 @@ class Explorer:
         executive = world.executive
         before = {a.id: a.answered for a in executive.activities.values()}
         fresh = world.next_id
+        self.decisions = 0
         try:
             event.run(world)
+        except Unsettled as exc:
+            world.problems.append(("settles", str(exc)))
+            return world
         except Exception as exc:  # the runtime itself failed: a finding, not a crash of the verifier
             world.problems.append(("no-error", f"the executive raised {type(exc).__name__}: {exc}"))
             return world
@@ -495,6 +516,12 @@ class Explorer:
         such a decision would make that pass depend on how often it runs)."""
 
         def watched(inputs: Mapping[str, Any], calls: Calls) -> Decision:
+            self.decisions += 1
+            if self.decisions > DECISIONS_PER_EVENT:
+                raise Unsettled(f"the executive's handling of this event went on for {DECISIONS_PER_EVENT:,} "
+                                f"decisions (the last: {inputs.get('event')} of {inputs.get('service')}) with no "
+                                "time passing: a reaction loop, as a reflex starting on every reply a service its "
+                                "module answers at once (a frozen module, a conflict) makes")
             asked = self.asked
             if asked is None:
                 return decide(inputs, calls)
@@ -693,13 +720,15 @@ def _timer_label(timer: ModelTimer) -> str:
     return which
 
 
-def _check_exclusion(world: World, arcs: set[tuple[str, str]], activity: rx.Activity, source: rx.Phase,
-                     target: rx.Phase) -> None:
+def _check_exclusion(world: World, arcs: set[tuple[str, str]], together: set[tuple[str, str]],
+                     activity: rx.Activity, source: rx.Phase, target: rx.Phase) -> None:
     if target is not rx.Phase.EXEC:
         return
     for other in world.executive.activities.values():
-        if other is not activity and other.state is rx.Phase.EXEC and (activity.service.name,
-                                                                       other.service.name) in arcs:
+        if other is activity or other.state is not rx.Phase.EXEC:
+            continue
+        together.add((other.service.name, activity.service.name))
+        if (activity.service.name, other.service.name) in arcs:
             world.problems.append(("exclusion", f"{activity.service.name} (id {activity.id}) entered EXEC while "
                                                 f"{other.service.name} (id {other.id}), which it must interrupt "
                                                 "or wait for, is in EXEC"))
@@ -838,12 +867,15 @@ def verify(program: m.Program, executive: m.Executive, requests: int = 2, limit:
     explorer = explorer_for(program, executive, requests)
     graph = build_graph(program, executive)
     arcs = {(a.source, a.target): a.policy for a in graph.arcs}
+    result = explorer.explore(limit, progress)
     # A control service takes no time: no arc ends at one, so an arc from one is one-way by
-    # nature, not by an entry left out.
+    # nature, not by an entry left out. Of the others, those the exploration saw the target of
+    # start while the source ran: the controller's own rules may keep them apart all the same.
     one_way = tuple(sorted((source, policy, target) for (source, target), policy in arcs.items()
                            if source != target and (target, source) not in arcs
-                           and source not in graph.control and target not in graph.control))
-    return dataclasses.replace(explorer.explore(limit, progress), one_way=one_way)
+                           and source not in graph.control and target not in graph.control
+                           and (source, target) in explorer.together))
+    return dataclasses.replace(result, one_way=one_way)
 
 
 def describe(result: Verification) -> Iterator[str]:
@@ -866,7 +898,8 @@ def describe(result: Verification) -> Iterator[str]:
                f"{'; '.join(result.left_out)}")
     if result.one_way:
         verbs = {"wait": "waits for", "interrupt": "interrupts"}
-        said = "; ".join(f"{target} may start while {source} runs ({source} {verbs[policy]} {target}, {target} does "
+        said = "; ".join(f"{target} starts while {source} runs ({source} {verbs[policy]} {target}, {target} does "
                          f"not name {source})" for source, policy, target in result.one_way)
-        yield (f"conflicts declared one way only (exclusion reads them as written): {said}; for two services "
-               "never to run together, give each a conflict with the other")
+        yield (f"conflicts declared one way only, which the states explored show running together (exclusion "
+               f"reads them as written): {said}; for two services never to run together, give each a conflict "
+               "with the other")

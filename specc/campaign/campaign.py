@@ -38,11 +38,15 @@ class CampaignPlan:
     set_apart: tuple[str, ...] = ()  # worlds the means are also given without (seed 004 set W4 apart)
 
     def description(self, mutant_ids: Sequence[str]) -> dict[str, Any]:
-        """What makes two campaigns the same (the store refuses to mix two different ones)."""
+        """What makes two campaigns the same (the store refuses to mix two different ones): the
+        options, and the robot's files and specc's sources (a digest: results of a changed robot
+        or another specc are not added to those of the first)."""
+        from specc.run.package import robot_digest
+
         return {"robot": self.robot.name, "domain": self.domain, "mutants": list(mutant_ids),
                 "missions": list(self.missions), "worlds": list(self.worlds), "runs": self.runs,
                 "configurations": list(self.configurations), "timing": self.setting.timing,
-                "set_apart": list(self.set_apart)}
+                "set_apart": list(self.set_apart), "files": robot_digest(self.robot)[:16]}
 
     def experiments(self, configuration: str, mutants: Iterable[str]) -> list[Experiment]:
         return [Experiment(configuration, mutant, mission, world, seed) for mutant in mutants
@@ -59,10 +63,11 @@ class Verdict:
 def judge(outcomes: Iterable[Outcome], configuration: str, mutants: Sequence[str], expected: int
           ) -> dict[str, Verdict]:
     """The filters of seed 004 §4.2.2.1 on the results of `configuration` (the mutated model
-    alone): a mutant that finds no plan in any mission (every experiment a planner failure, κ = 1)
-    never plans; one whose every experiment gives the original's measures exactly is equivalent
-    (no influence on the system in these activities); the others are kept. A mutant with fewer
-    than `expected` results is not judged yet."""
+    alone): a mutant that finds no plan in any mission never plans (every experiment a planner
+    failure, κ = 1, before any action ran: a mutant whose first plan ran and whose replanning
+    failed later did plan); one whose every experiment gives the original's measures exactly is
+    equivalent (no influence on the system in these activities); the others are kept. A mutant
+    with fewer than `expected` results is not judged yet."""
     mine: dict[str, list[Outcome]] = {}
     for outcome in outcomes:
         if outcome.experiment.configuration == configuration:
@@ -75,8 +80,10 @@ def judge(outcomes: Iterable[Outcome], configuration: str, mutants: Sequence[str
             verdicts[mutant] = Verdict(mutant, UNJUDGED, f"{len(results)} of {expected} results")
             continue
         done = [o for o in results if o.status == "done" and o.measures is not None]
-        if len(done) == len(results) and all(o.measures is not None and o.measures["kappa"] == 1 for o in done):
-            verdicts[mutant] = Verdict(mutant, NEVER_PLANS, "no plan in any mission (κ = 1 in every experiment)")
+        if len(done) == len(results) and all(o.measures is not None and o.measures["kappa"] == 1
+                                             and o.measures["activity_time"] == 0 for o in done):
+            verdicts[mutant] = Verdict(mutant, NEVER_PLANS, "no plan in any mission (κ = 1 before any action, "
+                                                            "in every experiment)")
         elif len(done) == len(results) and all(original.get(_activity(o.experiment)) == o.measures for o in done):
             verdicts[mutant] = Verdict(mutant, EQUIVALENT, "every measure equals the original model's")
         else:

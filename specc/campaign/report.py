@@ -97,6 +97,9 @@ class CampaignReport:
     per_mutant: tuple[tuple[MutantRecord, dict[str, MeanMeasures | None]], ...]  # kept ones, per configuration
     headlines: tuple[Headline, ...]
     coverage: tuple[Coverage, ...]
+    # Activities (a mutant, or the original, in a mission, world and seed) left out of the means
+    # because some configuration did not finish them: the means compare the same experiments.
+    unpaired: int = 0
 
     def with_verdict(self, verdict: str) -> list[MutantRecord]:
         return [m for m in self.mutants if m.verdict == verdict]
@@ -113,6 +116,15 @@ def build_report(store: ResultStore) -> CampaignReport:
     configurations: list[str] = list(description.get("configurations", []))
     kept = {m.id for m in mutants if m.verdict == KEPT}
     measures = [(o, Measures.from_json(o.measures)) for o in outcomes if o.status == "done" and o.measures]
+    # The configurations are compared on the same mutants and activities: an experiment one of
+    # them did not finish (a timeout, a crash) leaves that activity out of every one's means,
+    # instead of a failure left out of one side only.
+    finished: dict[tuple[str, str, str, int], set[str]] = {}
+    for o, _ in measures:
+        finished.setdefault(_paired(o), set()).add(o.experiment.configuration)
+    unpaired = {key for key, done_by in finished.items() if key[0] in kept | {ORIGINAL}
+                and not done_by >= set(configurations)}
+    measures = [(o, m) for o, m in measures if _paired(o) not in unpaired]
     world_sets = world_subsets(description)
     means = []
     for configuration in configurations:
@@ -138,7 +150,13 @@ def build_report(store: ResultStore) -> CampaignReport:
             if all(v is not None for v in faulty + free):
                 headlines.append(Headline(label, first, second, faulty, free))  # type: ignore[arg-type]
     return CampaignReport(description, mutants, outcomes, tuple(means), tuple(per_mutant), tuple(headlines),
-                          coverage(description, mutants, outcomes))
+                          coverage(description, mutants, outcomes), len(unpaired))
+
+
+def _paired(o: Outcome) -> tuple[str, str, str, int]:
+    """An experiment's mutant and activity: what the configurations are compared on."""
+    e = o.experiment
+    return e.mutant, e.mission, e.world, e.seed
 
 
 def world_subsets(description: dict[str, Any]) -> tuple[tuple[str, frozenset[str]], ...]:
@@ -162,14 +180,16 @@ def _quotient(mean: MeanMeasures, name: str) -> float:
 def coverage(description: dict[str, Any], mutants: Iterable[MutantRecord],
              outcomes: Iterable[Outcome]) -> tuple[Coverage, ...]:
     """Each configuration's experiments run against those it has to run: the first runs the
-    original and every mutant, the others the original and the mutants kept (or not judged yet)."""
+    original and every mutant, the others the original and the mutants kept (or not judged yet).
+    One that timed out is still to run: a resumed campaign runs it again."""
     configurations: list[str] = list(description.get("configurations", []))
     activities = len(description.get("missions", [])) * len(description.get("worlds", [])) * description.get("runs", 0)
     mutants = list(mutants)
     runs_later = {m.id for m in mutants if m.verdict in (KEPT, UNJUDGED)}
     done: dict[str, int] = {}
     for outcome in outcomes:
-        done[outcome.experiment.configuration] = done.get(outcome.experiment.configuration, 0) + 1
+        if outcome.status != "timeout":
+            done[outcome.experiment.configuration] = done.get(outcome.experiment.configuration, 0) + 1
     return tuple(Coverage(c, done.get(c, 0), activities * (1 + (len(mutants) if k == 0 else len(runs_later))))
                  for k, c in enumerate(configurations))
 
@@ -196,8 +216,16 @@ def markdown(report: CampaignReport) -> str:
               + "; ".join(f"{c.configuration} {c.done:,} of {c.expected:,}" for c in report.coverage)]
     unfinished = [c.configuration for c in report.coverage if not c.complete]
     if unfinished:
-        lines.append(f"- **not finished: {', '.join(unfinished)}.** The means cover the experiments run so far; "
-                     "the same command resumes the campaign")
+        timed_out = sum(o.status == "timeout" for o in report.outcomes)
+        lines.append(f"- **not finished: {', '.join(unfinished)}.** The means cover the experiments every "
+                     "configuration has run so far; the same command resumes the campaign"
+                     + (f" and runs again the {timed_out} that timed out (a larger --timeout if they keep doing so)"
+                        if timed_out else ""))
+    elif report.unpaired:
+        lines.append(f"- {report.unpaired} activit{'y' if report.unpaired == 1 else 'ies'} (a mutant or the original "
+                     "in a mission, world and seed) left out of every configuration's means: some configuration did "
+                     "not finish it (it timed out or crashed, below), and the configurations are compared on the "
+                     "same experiments")
     lines.append("")
     if report.headlines:
         lines += ["## Headline", ""]

@@ -23,6 +23,8 @@ from specc.run import RunError
 
 # What a resumed campaign may add to (see ResultStore.describe), and whether the first must stay.
 GROWING = {"configurations": True, "mutants": False}
+# What only shapes the report (the worlds the means are also given without): a resume may change it.
+REPORT_ONLY = {"set_apart"}
 
 
 def _shown(value: Any) -> str:
@@ -116,12 +118,15 @@ class ResultStore:
         stored = self.description()
         if stored:
             differs = sorted(k for k in set(stored) | set(description) if stored.get(k) != description.get(k))
-            grows = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))]
+            grows = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))
+                     or k in REPORT_ONLY]
             if set(differs) - set(grows):
                 said = "; ".join(f"{k}: {_shown(stored.get(k))} stored, {_shown(description.get(k))} asked"
                                  for k in differs)
-                raise RunError(f"'{self.path}' holds another campaign ({said}): give another --store, or the "
-                               "options it was run (or last grown) with to resume it")
+                files = (" (files: the robot's specs, codels and worlds, or specc itself, changed since: a "
+                         "campaign's results all come from one robot and one specc)") if "files" in differs else ""
+                raise RunError(f"'{self.path}' holds another campaign ({said}){files}: give another --store, or "
+                               "the options it was run (or last grown) with to resume it")
             with self.db:
                 self.db.executemany("UPDATE campaign SET value = ? WHERE name = ?",
                                     [(json.dumps(description[k]), k) for k in grows])
@@ -164,11 +169,13 @@ class ResultStore:
     # ------------------------------------------------------------ results
     def record(self, outcome: Outcome) -> None:
         """Store one experiment's outcome, committed at once; a second outcome for the same
-        experiment is an error (a campaign runs each experiment once)."""
+        experiment is an error (a campaign runs each experiment once), but for one that timed
+        out, which a resumed campaign runs again (`done`) and whose new outcome replaces it."""
         e = outcome.experiment
         measures = json.dumps(outcome.measures, sort_keys=True) if outcome.measures is not None else None
         try:
             with self.db:
+                self.db.execute("DELETE FROM results WHERE key = ? AND status = 'timeout'", (e.key,))
                 self.db.execute("INSERT INTO results VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                                 (e.key, e.configuration, e.mutant, e.mission, e.world, e.seed, outcome.status,
                                  measures, outcome.seconds, outcome.why, time.time()))
@@ -176,7 +183,9 @@ class ResultStore:
             raise RunError(f"experiment {e.key} is already in '{self.path}'") from None
 
     def done(self) -> set[str]:
-        return {key for (key,) in self._rows("SELECT key FROM results")}
+        """The experiments a resumed campaign need not run again: all but those that timed out (a
+        wall-clock limit, which a busy machine or a small --timeout may have hit)."""
+        return {key for (key,) in self._rows("SELECT key FROM results WHERE status != 'timeout'")}
 
     def outcomes(self) -> Iterator[Outcome]:
         rows = self._rows("SELECT key, configuration, mutant, mission, world, seed, status, measures, seconds, why "

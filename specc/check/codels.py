@@ -21,6 +21,7 @@ VALIDATE_ACCEPTS = frozenset({"end", "ok", "OK", "ether", "exec"})
 
 def check(ctx: Context) -> None:
     posters = {module.name: {p.name for p in module.posters} for module in ctx.items(m.Module)}
+    requests = {module.name: {r.name for r in module.requests} for module in ctx.items(m.Module)}
     for module in ctx.items(m.Module):
         used: list[tuple[str, Span]] = []
         for request in module.requests:
@@ -66,6 +67,38 @@ def check(ctx: Context) -> None:
                 check_call(ctx, codel.function, functions.get(codel.function), TASK_CODEL, where, codel.span)
         for name, span in dict(used).items():
             check_poster_reads(ctx, name, functions.get(name), posters, where, span)
+        for request in module.requests:
+            check_sends(ctx, module, request, functions, requests, where)
+
+
+def check_sends(ctx: Context, module: m.Module, request: m.Request, functions: Mapping[str, FunctionShape | None],
+                requests: Mapping[str, set[str]], where: str) -> None:
+    """Each request a codel of `request` sends by a written name (`sdi.send_request("ptu.Sweep")`)
+    exists, and the request's `sends:` lists it: the incompatibility graph and `specc verify`
+    know a codel's sends from that line only, so one left out is a send whose effect (another
+    module's activity interrupted) nothing they prove covers."""
+    declared = {ref.text for ref in request.sends}
+    codels = [(c.function, c.span) for c in request.codels]
+    if request.validate is not None:
+        codels.append((request.validate.text, request.validate.span))
+    said: set[str] = set()
+    for name, span in codels:
+        shape = functions.get(name)
+        for target, line in shape.sends if shape is not None else ():
+            if target in declared or target in said:
+                continue
+            said.add(target)
+            assert shape is not None
+            other, _, sent = target.partition(".")
+            if sent not in requests.get(other, ()):
+                known = [f"{o}.{r}" for o, names in requests.items() for r in names]
+                ctx.warn("undefined-request", f"codel '{name}' sends '{target}' ({place(shape, where, line)}), but no "
+                         f"module has that request{did_you_mean(target, known)}: the send fails at run time", span)
+            else:
+                ctx.warn("undeclared-send", f"codel '{name}' of request {module.name}.{request.name} sends '{target}' "
+                         f"({place(shape, where, line)}), which the request's 'sends:' does not list: the "
+                         f"incompatibility graph and `specc verify` leave that send out, so what they prove may not "
+                         f"hold of the robot; add 'sends: {target};' to request {request.name}", request.span)
 
 
 def check_poster_reads(ctx: Context, name: str, shape: FunctionShape | None, posters: dict[str, set[str]],

@@ -212,9 +212,13 @@ def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Servic
         replies = {"OK"} | {f.text for f in request.fail} | RUNTIME_CODES | set(
             ctx.symbols.requests_of(module) if module is not None else ())
         if value is not None and value not in replies:
-            ctx.warn("reflex-never-fires", f"'{source.text}' never replies '{value}' (its fail messages: "
-                     f"{', '.join(f.text for f in request.fail) or 'none'}): this reflex cannot fire; declare the "
-                     "fail message or fix the name", comparison.span)
+            # A reflex reads the module's report (OK, a fail message, the runtime's codes, the request
+            # that interrupted it), not the result the executive gives the task level (INT, TIMEOUT...).
+            ctx.warn("reflex-never-fires", f"'{source.text}''s module never reports '{value}' (a reflex compares "
+                     f"the module's report: OK, its fail messages ({', '.join(f.text for f in request.fail) or 'none'}"
+                     f"), the runtime's codes or the request that interrupted it, not the result the executive "
+                     "answers the task level): this reflex cannot fire; declare the fail message or fix the name",
+                     comparison.span)
     for action in reflex.actions:
         target = action.target
         if action.verb == "request":

@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from specc.check.context import Context
+from specc.check.expressions import UnknownFunction, lowered
 from specc.model import nodes as m
 from specc.model.visitor import Visitor, walk
+from specc.runtime.planner import model as pm
 from specc.runtime.planner.model import FUNCTIONS, fold
 
 VALUE_VAR = "?value"
@@ -38,6 +40,9 @@ class DomainTables:
     attributes: dict[str, m.Attribute | m.Resource] = field(default_factory=dict)
     macros: dict[str, m.Macro] = field(default_factory=dict)
     tasks: dict[str, m.Task] = field(default_factory=dict)
+    # An include names no fragment (reported): what it would declare is missing, so the names
+    # it would have declared are not checked, which would say each use of them is unknown.
+    incomplete: bool = False
 
     def symbols(self) -> set[str]:
         """Every symbolic value a constant set or an attribute domain mentions."""
@@ -68,6 +73,9 @@ class DomainTables:
         return values
 
 
+MISSING_FRAGMENT = object()  # what `expand` gives for an include of a fragment that does not exist
+
+
 def expand(ctx: Context, members: Iterable[Any], chain: tuple[str, ...] = ()) -> Iterator[Any]:
     """Members with every `include` replaced by the fragment's own (expanded) members.
 
@@ -86,6 +94,8 @@ def expand(ctx: Context, members: Iterable[Any], chain: tuple[str, ...] = ()) ->
             fragment = ctx.lookup(m.Fragment, member.name, member.span, "undefined-fragment")
             if fragment is not None:
                 yield from expand(ctx, fragment.members, chain + (member.name,))
+            else:
+                yield MISSING_FRAGMENT
 
 
 def check_include_cycles(ctx: Context) -> None:
@@ -116,6 +126,9 @@ def tables(ctx: Context, members: Iterable[Any], base: DomainTables | None = Non
         result.tasks.update(base.tasks)
     seen_ids: set[int] = set()
     for member in expand(ctx, members):
+        if member is MISSING_FRAGMENT:
+            result.incomplete = True
+            continue
         if id(member) in seen_ids:
             continue  # the same fragment included twice adds nothing new
         seen_ids.add(id(member))
@@ -158,6 +171,12 @@ class ScopeChecker(Visitor):
         self.symbols = domain.symbols()
         self.scope = Scope("task")
         self.named: set[str] = set()  # the names the statements checked mention: timepoints among them
+
+    def unknown(self, code: str, kind: str, name: str, known: Iterable[str], span: m.Span, suffix: str = "") -> None:
+        """An unknown name, said unless an include names no fragment (reported there): the names
+        that fragment would have declared would each be said unknown, at every use."""
+        if not self.domain.incomplete:
+            self.ctx.unknown(code, kind, name, known, span, suffix)
 
     def scope_for(self, kind: str, body: Iterable[Any], params: Iterable[m.IxVar] = (),
                   timepoints: Iterable[str] = (), macro_params: Iterable[str] = ()) -> Scope:
@@ -256,7 +275,7 @@ class ScopeChecker(Visitor):
     def visit_MacroCall(self, s: m.MacroCall) -> None:
         macro = self.domain.macros.get(s.name)
         if macro is None:
-            self.ctx.unknown("undefined-macro", "macro", s.name, self.domain.macros, s.span)
+            self.unknown("undefined-macro", "macro", s.name, self.domain.macros, s.span)
         elif len(macro.params) != len(s.args):
             self.ctx.report("arity-mismatch",
                             f"macro '{s.name}' takes {len(macro.params)} argument(s), {len(s.args)} given", s.span)
@@ -280,18 +299,23 @@ class ScopeChecker(Visitor):
                 self.ctx.report("value-outside-domain",
                                 f"'{arg.name}' is not a value of {a.attribute}'s {attribute.params[k].name} "
                                 f"({', '.join(sorted(allowed_arg))})", arg.span)
+            if attribute is not None and k < len(attribute.params):
+                self.symbols_for_numbers(arg, attribute, attribute.params[k].name,
+                                         f"{a.attribute}'s {attribute.params[k].name}", scope)
         values = (a.value.before, a.value.after) if isinstance(a.value, m.Transition) else (a.value,)
         allowed = self.domain.value_domain(attribute) if attribute is not None else None
         for value in values:
             if not (allowed is not None and isinstance(value, m.IxName)):
                 self.expr(value, scope)  # symbols of a known domain are checked against it below
         if attribute is None:
-            self.ctx.unknown("undefined-attribute", "resource" if resource else "attribute", a.attribute,
+            self.unknown("undefined-attribute", "resource" if resource else "attribute", a.attribute,
                              self.domain.attributes, a.span)
             return
         if len(attribute.params) != len(a.args):
             self.ctx.report("arity-mismatch",
                             f"'{a.attribute}' takes {len(attribute.params)} argument(s), {len(a.args)} given", a.span)
+        for value in values:
+            self.symbols_for_numbers(value, attribute, VALUE_VAR, a.attribute, scope)
         if allowed is None:
             return
         for value in values:
@@ -299,6 +323,26 @@ class ScopeChecker(Visitor):
                 self.ctx.report("value-outside-domain",
                                 f"'{value.name}' is not a value of {a.attribute} ({', '.join(sorted(allowed))})",
                                 value.span)
+
+    def symbols_for_numbers(self, e: m.IxExpr, block: m.Attribute | m.Resource, variable: str, what: str,
+                            scope: Scope) -> None:
+        """Report the symbols `e` gives where `block`'s `variable` takes numbers (its domain is an
+        interval; a resource's amount always is): the planner would only fail on them deep in
+        its search, as if the goals were out of reach."""
+        domain = declared_domain(block, variable)
+        numeric = isinstance(domain, m.Interval) or (isinstance(block, m.Resource) and variable == VALUE_VAR)
+        if not numeric:
+            return
+        low, high = (constant_value(domain.low), constant_value(domain.high)) if isinstance(
+            domain, m.Interval) else (None, None)
+        numbers = f"numbers in [{low:g}, {high:g}]" if low is not None and high is not None else "numbers"
+        said = (f"an amount of {what}, which is a number" if isinstance(block, m.Resource) and variable == VALUE_VAR
+                else f"a value of {what}, which takes {numbers}")
+        for node in walk(e):
+            if (isinstance(node, m.IxName) and node.name in self.symbols
+                    and node.name not in scope.timepoints | scope.macro_params):
+                self.ctx.report("value-outside-domain",
+                                f"'{node.name}' is not {said}; write a number or a ?variable", node.span)
 
     def domain_value(self, d: m.DomainValue, scope: Scope) -> None:
         if isinstance(d, m.Interval):
@@ -311,7 +355,7 @@ class ScopeChecker(Visitor):
             return
         for part in d.parts:
             if isinstance(part, m.SetRef) and part.name not in self.domain.constants:
-                self.ctx.unknown("undefined-constant", "constant set", part.name, self.domain.constants, part.span)
+                self.unknown("undefined-constant", "constant set", part.name, self.domain.constants, part.span)
 
     def time(self, e: m.IxExpr, scope: Scope) -> None:
         if isinstance(e, m.IxName):
@@ -337,7 +381,7 @@ class ScopeChecker(Visitor):
                 self.named.add(node.name)
                 known = scope.timepoints | scope.macro_params | self.symbols
                 if node.name not in known:
-                    self.ctx.unknown("undefined-name", "name", node.name, known, node.span,
+                    self.unknown("undefined-name", "name", node.name, known, node.span,
                                      " (not a timepoint, a macro parameter or a declared symbolic value)")
 
 
@@ -383,6 +427,7 @@ def check(ctx: Context) -> None:
         if target is None:
             continue
         problem_tables = tables(ctx, problem.body, domains[target.name])
+        problem_tables.incomplete |= domains[target.name].incomplete
         check_members(ctx, problem_tables)  # what its own fragments bring (macros, attributes)
         statements = [s for s in problem_tables.members if not isinstance(
             s, (m.Constant, m.Attribute, m.Resource, m.Macro, m.Task))]
@@ -391,6 +436,7 @@ def check(ctx: Context) -> None:
         checker.statements(statements, scope)
         if not any(getattr(s, "goal", None) is not None for s in statements):
             ctx.warn("no-goals", f"problem '{problem.name}' has no goal(...) to plan for", problem.span)
+        check_temporal_network(ctx, problem, statements, scope.timepoints)
     check_include_cycles(ctx)
     included = {member.name for item in ctx.program.items if isinstance(item, (m.Domain, m.Problem, m.Fragment))
                 for member in getattr(item, "members", getattr(item, "body", ())) if isinstance(member, m.Include)}
@@ -398,3 +444,113 @@ def check(ctx: Context) -> None:
         if fragment.name not in included:
             ctx.warn("unused-fragment", f"fragment '{fragment.name}' is included by no domain, problem or "
                      "fragment, so nothing checks or uses it", fragment.span)
+
+
+@dataclass(frozen=True)
+class Bound:
+    """`t(second) - t(first) <= weight` in a problem's temporal network, and where it comes from:
+    a constraint as written (with its span), or what the planner always requires (no span)."""
+
+    first: str
+    second: str
+    weight: float
+    text: str
+    span: m.Span | None = None
+
+
+def temporal_bounds(statements: Iterable[Any], timepoints: set[str]) -> list[Bound]:
+    """The problem's temporal network: its constraints that bound a difference of two timepoints
+    (or a date), as the planner reads them, and what the planner requires of every problem: each
+    timepoint at or after t_start, each it schedules by t_end, each hold's start before its end."""
+    start, end = PROBLEM_TIMEPOINTS
+    bounds: list[Bound] = []
+
+    def add(first: str, second: str, low: float, high: float, text: str, span: m.Span | None) -> None:
+        if high < pm.INF:
+            bounds.append(Bound(first, second, high, text, span))
+        if low > -pm.INF:
+            bounds.append(Bound(second, first, -low, text, span))
+
+    natures: set[str] = set()
+    for s in statements:
+        constraint: pm.Member | pm.Relation | None = None
+        try:
+            if isinstance(s, m.InConstraint) and isinstance(s.domain, m.Interval):
+                low, high = constant_value(s.domain.low), constant_value(s.domain.high)
+                if low is not None and high is not None:
+                    expr = lowered(s.expr, timepoints)
+                    constraint = pm.Member(expr, pm.Interval(low, high))
+                    text = f"{pm.describe(expr)} in [{low:g}, {high:g}]"
+            elif isinstance(s, m.RelConstraint):
+                left, right = lowered(s.left, timepoints), lowered(s.right, timepoints)
+                constraint = pm.Relation("=" if s.op in ("=.", "==") else s.op, left, right)
+                text = f"{pm.describe(left)} {s.op} {pm.describe(right)}"
+        except UnknownFunction:
+            continue  # reported by the scope checks
+        if constraint is not None and pm.timepoints_of(constraint):
+            try:
+                pieces = pm.differences(constraint, origin=start)
+            except ValueError:
+                continue  # not a difference of dates: not a temporal constraint the planner takes
+            for first, second, low, high in pieces:
+                add(first, second, low, high, f"{text} (line {s.span.line})", s.span)
+        elif isinstance(s, m.Hold) and isinstance(s.start, m.IxName) and isinstance(s.end, m.IxName):
+            add(s.start.name, s.end.name, 0.0, pm.INF,
+                f"the hold of {s.attr.attribute} from {s.start.name} to {s.end.name} (line {s.span.line})", None)
+        elif isinstance(s, m.Event) and s.kind == "contingent" and isinstance(s.time, m.IxName):
+            natures.add(s.time.name)
+    for point in sorted(timepoints - {start}):
+        add(start, point, 0.0, pm.INF, f"{point} >= {start} (every timepoint comes at or after the start)", None)
+        if point not in natures | {end}:
+            add(point, end, 0.0, pm.INF, f"{point} <= {end} (the planner dates every timepoint by the end)", None)
+    return bounds
+
+
+def negative_cycle(bounds: list[Bound]) -> list[Bound] | None:
+    """Bounds that cannot all hold (a cycle of the network whose weights sum below zero), or None
+    (Bellman-Ford from a source before every timepoint)."""
+    points = sorted({b.first for b in bounds} | {b.second for b in bounds})
+    distance = dict.fromkeys(points, 0.0)
+    last: dict[str, Bound] = {}
+    relaxed: Bound | None = None
+    for _ in range(len(points)):
+        relaxed = None
+        for b in bounds:
+            if distance[b.first] + b.weight < distance[b.second] - 1e-9:
+                distance[b.second] = distance[b.first] + b.weight
+                last[b.second] = relaxed = b
+        if relaxed is None:
+            return None
+    assert relaxed is not None
+    point = relaxed.second
+    for _ in range(len(points)):  # back far enough to be on the cycle, not on a path into it
+        point = last[point].first
+    cycle: list[Bound] = []
+    at = point
+    while True:
+        b = last[at]
+        cycle.append(b)
+        at = b.first
+        if at == point:
+            return cycle[::-1]
+
+
+def check_temporal_network(ctx: Context, problem: m.Problem, statements: list[Any], timepoints: set[str]) -> None:
+    """The problem's temporal constraints must be able to hold together: when they cannot, the
+    planner has no plan to give, whatever its domain (and nature's instants promise dates no
+    realisation keeps: a plan would be judged against no nature at all)."""
+    cycle = negative_cycle(temporal_bounds(statements, timepoints))
+    if cycle is None:
+        return
+    said: list[str] = []
+    # The written constraints in source order, then what the planner requires of every problem.
+    for b in sorted(cycle, key=lambda b: (b.span is None, b.span.line if b.span else 0)):
+        if b.text not in said:
+            said.append(b.text)
+    written = sorted({id(b.span): b.span for b in cycle if b.span is not None}.values(),
+                     key=lambda span: (span.file, span.line, span.column))
+    listed = said[0] if len(said) == 1 else f"{', '.join(said[:-1])} and {said[-1]}"
+    span = written[0] if written else problem.span
+    ctx.report("contradictory-constraints", f"the temporal constraints of problem '{problem.name}' cannot all hold: "
+               f"{listed}; loosen or remove one of them", span,
+               *((other, "and this constraint") for other in written[1:]))

@@ -52,6 +52,7 @@ class RuleVisitor(Visitor):
             self.in_action = False
             self.conjuncts = {id(c) for c in conjuncts(node.condition)}
             self.visit(node.condition)
+            self.check_together(conjuncts(node.condition))
             self.conjuncts = set()
         self.in_action = True
         for action in node.actions:
@@ -100,6 +101,29 @@ class RuleVisitor(Visitor):
             self.ctx.warn("comparison-never-holds", f"{node.attr.name} {node.op} {value:g} never holds: "
                           f"'{node.attr.name}' lies in [{low:g}, {high:g}]; the rule testing it never fires",
                           node.span)
+
+    def check_together(self, parts: list[m.Node]) -> None:
+        """Comparisons of one numeric attribute with numbers that no value satisfies together
+        (`charge < 10, charge > 20`): the rule never fires. Each alone may hold (`check_range`)."""
+        # (attribute, of the previous cycle) -> low, low included, high, high included
+        bounds: dict[tuple[str, bool], tuple[float, bool, float, bool]] = {}
+        for part in parts:
+            if not (isinstance(part, m.KCompare) and isinstance(part.value, m.Number) and part.attr.index is None
+                    and math.isfinite(part.value.value) and part.op in ("<", "<=", ">", ">=", "==")):
+                continue  # an indexed attribute's comparisons may each be of another element
+            name, value, op = part.attr.name, part.value.value, part.op
+            key = (name, part.attr.previous)
+            low, low_in, high, high_in = bounds.get(key, (-math.inf, False, math.inf, False))
+            if op in (">", ">=", "==") and (value > low or value == low and op == ">"):
+                low, low_in = value, op != ">"
+            if op in ("<", "<=", "==") and (value < high or value == high and op == "<"):
+                high, high_in = value, op != "<"
+            bounds[key] = (low, low_in, high, high_in)
+            if low > high or low == high and not (low_in and high_in):
+                self.ctx.warn("comparison-never-holds", f"{name} {op} {value:g} never holds together with the "
+                              f"rule's other comparisons of '{name}' (no value is both above {low:g} and below "
+                              f"{high:g} as they ask): the rule never fires", part.span)
+                return
 
     def is_bool(self, attr: m.AttrRef) -> bool:
         declared = self.declared.get(attr.name)

@@ -7,6 +7,7 @@ service exactly the inputs it takes, with values of their types."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
@@ -93,12 +94,16 @@ def check_devices(ctx: Context, system: m.System) -> None:
     if system.devices is None:
         return
     ctx.duplicates(system.devices.entries, "devices of module", key="module")
+    declared = ctx.named(m.Module)
     listed = {ref.text for ref in system.modules}
+    misspelt = listed - set(declared)  # reported where `modules:` names them
     body = {e.name: e.value for e in system.body.entries} if system.body is not None else {}
     present = {"sonars": "sonars", "laser": "laser_beams", "arm": "arm_joints"}  # devices a body may lack
     for grant in system.devices.entries:
         if grant.module not in listed:
-            ctx.unknown("undefined-module", "module", grant.module, listed, grant.span,
+            if grant.module in declared and misspelt:
+                continue  # most likely the one misspelt in `modules:`: one error, there, is enough
+            ctx.unknown("undefined-module", "module", grant.module, listed - misspelt, grant.span,
                         f" of system '{system.name}' (its modules get devices)")
         for device in grant.devices:
             if device.text not in DEVICES:
@@ -407,25 +412,29 @@ def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], proced
 
 
 def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures,
-                      needs: Mapping[tuple[str, int], str]) -> None:
+                      needs: Mapping[tuple[str, int], NumberNeed]) -> None:
     """A mission's constant arguments lie in the finite domains the goal's predicate declares, and
-    a symbol never stands where every KA the goal invokes needs a number (`needs`, the procedures'
-    `numeric_positions`)."""
-    check_numeric_arguments(ctx, goal.body, needs)
-    declared = next((p for p in procedures.predicates if p.name == goal.body.head), None)
-    if declared is None or len(declared.params) != len(goal.body.args):
-        return
+    a symbol (a number with a fraction) never stands where every KA the goal invokes needs a
+    number (a whole number): `needs`, the procedures' `numeric_positions`."""
     for position, arg in enumerate(goal.body.args):
-        value = arg.value if isinstance(arg, m.Number) else arg.text if isinstance(arg, m.Ref) else None
-        outside = argument_outside(procedures, goal.body.head, position, value)
-        if outside is not None:
-            ctx.report("bad-argument", outside, arg.span)
+        value = arg.value if isinstance(arg, m.Number | m.String) else arg.text if isinstance(arg, m.Ref) else None
+        problem = goal_argument_problem(procedures, needs, goal.body.head, position, value)
+        if problem is not None:
+            ctx.report("bad-argument", problem, arg.span)
+
+
+def goal_argument_problem(procedures: m.Procedures, needs: Mapping[tuple[str, int], NumberNeed], head: str,
+                          position: int, value: object) -> str | None:
+    """Why `value` cannot stand at `position` among the arguments of a goal `head` (None when it
+    can, or nothing says): outside the finite domain the predicate declares there, or not the
+    number every KA the goal invokes passes it on to (`needs`). For a mission's goal and for
+    `specc run --goal` alike."""
+    return argument_outside(procedures, head, position, value) or number_problem(needs, head, position, value)
 
 
 def argument_outside(procedures: m.Procedures, head: str, position: int, value: object) -> str | None:
     """Why `value`, at `position` among the arguments of a goal `head`, lies outside the finite
-    domain the predicate declares there (None when it lies inside, or nothing says): for a
-    mission's goal and for `specc run --goal` alike."""
+    domain the predicate declares there (None when it lies inside, or nothing says)."""
     declared = next((p for p in procedures.predicates if p.name == head), None)
     if declared is None or position >= len(declared.params) or value is None:
         return None
@@ -437,17 +446,41 @@ def argument_outside(procedures: m.Procedures, head: str, position: int, value: 
     return f"{value} is not in the domain of '{param.name}' of {declared.name} ({shown})"
 
 
-def check_numeric_arguments(ctx: Context, goal: m.SExp, needs: Mapping[tuple[str, int], str]) -> None:
-    """`bad-argument` for a symbol where the goal's KAs pass the argument on to a number."""
+def number_problem(needs: Mapping[tuple[str, int], NumberNeed], head: str, position: int,
+                   value: object) -> str | None:
+    """Why `value` cannot go where the goal's KAs pass argument `position` on to a number: a
+    symbol, or a number with a fraction where a whole one is needed (None when it can)."""
+    need = needs.get((head, position))
+    if need is None or value is None:
+        return None
+    where = f"argument {position + 1} of {head} reaches {need.reason}"
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return f"{value} is not a number: {where}"
+    if need.whole and not float(value).is_integer():
+        return f"{value} is not a whole number: {where}"
+    return None
+
+
+def check_numeric_arguments(ctx: Context, goal: m.SExp, needs: Mapping[tuple[str, int], NumberNeed]) -> None:
+    """`bad-argument` for a constant the goal's KAs cannot pass on to the number they need."""
     for position, arg in enumerate(goal.args):
-        reason = needs.get((goal.head, position))
-        if reason is not None and isinstance(arg, m.Ref | m.String):
-            shown = arg.text if isinstance(arg, m.Ref) else repr(arg.value)
-            ctx.report("bad-argument", f"{shown} is not a number: argument {position + 1} of {goal.head} reaches "
-                       f"{reason}", arg.span)
+        value = arg.value if isinstance(arg, m.Number) else arg.text if isinstance(arg, m.Ref) else \
+            repr(arg.value) if isinstance(arg, m.String) else None
+        problem = number_problem(needs, goal.head, position, value)
+        if problem is not None:
+            ctx.report("bad-argument", problem, arg.span)
 
 
-def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], str]:
+@dataclass(frozen=True)
+class NumberNeed:
+    """A goal argument every KA of the goal passes on to a number: the parameter it reaches, said
+    for messages, and whether that number must be whole (an `int` parameter)."""
+
+    reason: str
+    whole: bool
+
+
+def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], NumberNeed]:
     """The (goal head, argument position) that every KA invoked by the head passes on to a number:
     a primitive action's parameter of a numeric domain, or such a position of a subgoal; with the
     parameter reached (for the message). A fixed point over the KAs, as a goal's KAs call goals."""
@@ -456,16 +489,17 @@ def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], str]:
     for ka in procedures.kas:
         if isinstance(ka.invocation, m.Goal) and ka.invocation.op == "!":
             kas.setdefault(ka.invocation.body.head, []).append(ka)
-    found: dict[tuple[str, int], str] = {}
+    found: dict[tuple[str, int], NumberNeed] = {}
 
-    def reached(ka: m.KA, var: str) -> str | None:
+    def reached(ka: m.KA, var: str) -> NumberNeed | None:
         """What numeric parameter `var` of `ka` is passed to, if any."""
         if ka.action is not None:
             action = actions.get(ka.action.call.head)
             for arg, param in zip(ka.action.call.args, action.params if action is not None else (), strict=False):
-                if isinstance(arg, m.LogicVar) and arg.name == var and \
-                        domain_kind(procedures, param.domain) in ("int", "number"):
-                    return f"'{param.name}' ({describe_domain(param.domain)}) of action {ka.action.call.head}"
+                kind = domain_kind(procedures, param.domain)
+                if isinstance(arg, m.LogicVar) and arg.name == var and kind in ("int", "number"):
+                    return NumberNeed(f"'{param.name}' ({describe_domain(param.domain)}) of action "
+                                      f"{ka.action.call.head}", kind == "int")
         for node in walk(ka.body) if ka.body is not None else ():
             if isinstance(node, m.Goal) and node.op == "!":
                 for position, arg in enumerate(node.body.args):
@@ -490,7 +524,7 @@ def numeric_positions(procedures: m.Procedures) -> dict[tuple[str, int], str]:
                         break
                     reasons.append(reason)
                 else:
-                    found[(head, position)] = reasons[0]
+                    found[(head, position)] = NumberNeed(reasons[0].reason, all(r.whole for r in reasons))
                     changed = True
     return found
 
@@ -607,6 +641,9 @@ def check_argument_type(ctx: Context, procedures: m.Procedures, param: m.PParam,
         accepted = kind == "symbol" and symbols(procedures, param.domain) <= {"true", "false", "TRUE", "FALSE"}
     else:
         enum = module_enums(ctx, module_name).get(input_type)
+        structs = {s.name for module in ctx.items(m.Module) if module.name == module_name for s in module.structs}
+        if enum is None and input_type not in structs:
+            return  # a type no module declares: `undefined-type` said so where it is written
         accepted = enum is not None and kind == "symbol" and bool(symbols(procedures, param.domain)) \
             and symbols(procedures, param.domain) <= enum
     if not accepted:

@@ -283,6 +283,7 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
                        "(give its system 'supervisor: NAME;')")
     if timing not in TIMINGS:
         raise RunError(f"timing '{timing}': give {' or '.join(TIMINGS)}")
+    import_user_code(robot)
     world_file = robot.world_file(world or mission.world)
     if mission.plan is None:
         if configuration is not None or domains:
@@ -467,6 +468,27 @@ class Assembly:
         return self.registry.kernel
 
 
+def import_user_code(robot: Robot) -> None:
+    """Import the Python the run will call, as `assemble` will (from the robot's folder): each
+    module's codels, the executive's input and output functions, the procedures' bindings. One
+    that cannot be imported is bad input, said before anything runs (RunError), not a run that
+    crashes at its start; what is imported stays imported for the run."""
+    from specc.runtime import executive as rx
+    from specc.runtime import procedures as rp
+
+    system = robot.system
+    try:
+        with contextlib.chdir(robot.folder):
+            for generated in robot.part("modules").MODULES.values():
+                rt.load_codels(generated.SPEC)
+            if system.executive:
+                rx.load_codels(robot.part("executive").EXECUTIVES[system.executive].SPEC)
+            if system.supervisor:
+                rp.load_functions(robot.part("supervisor").LIBRARIES[system.supervisor].LIBRARY)
+    except ImportError as error:
+        raise RunError(str(error)) from None
+
+
 def assemble(robot: Robot, ground: Any, world_path: Path, seed: int,
              log: Callable[[str], None] | None = None) -> Assembly:
     """The robot's modules on one kernel with the simulated body in `ground` (the world as the run
@@ -503,12 +525,36 @@ def _outcome(intentions: list[tuple[str, Any]], horizon: float,
              events: Iterable[Mapping[str, Any]]) -> tuple[str, str]:
     running = [goal for goal, intention in intentions if intention.status == "running"]
     if running:
-        return "horizon", f"{', '.join(running)} still running at the {horizon:g} s horizon"
+        return "horizon", f"{', '.join(running)} still running at the {horizon:g} s horizon" + waiting_on(events)
     failed = [(goal, intention) for goal, intention in intentions if intention.status == "failed"]
     if failed:
         goal, intention = failed[0]
         return "failed", f"{goal} failed: {why_failed(intention.trace, list(events))}"
     return "succeeded", f"every goal achieved ({len(intentions)})"
+
+
+OUTSTANDING_SHOWN = 3  # services named in a horizon's reason
+
+
+def waiting_on(events: Iterable[Mapping[str, Any]]) -> str:
+    """`; waiting on: SERVICE (id N) in PHASE since T s, ...`: the requests the log shows without
+    a final reply when the run ended, each in the phase its activity last entered (a ZOMBIE the
+    procedures never interrupted, a WAIT never granted): what a goal still running waited for.
+    Empty when none is."""
+    asked: dict[Any, str] = {}
+    phases: dict[Any, tuple[str, float]] = {}
+    for e in events:
+        if e["kind"] == "request":
+            asked[e["id"]] = str(e.get("service") or e.get("request"))
+        elif e["kind"] == "reply":
+            asked.pop(e["id"], None)
+        elif e["kind"] == "activity":
+            phases[e["id"]] = (str(e["to"]), float(e["t"]))
+    shown = [f"{service} (id {ident})" + (f" in {phases[ident][0]} since {phases[ident][1]:.1f} s"
+                                          if ident in phases else "")
+             for ident, service in list(asked.items())[:OUTSTANDING_SHOWN]]
+    more = f" and {len(asked) - OUTSTANDING_SHOWN} more" if len(asked) > OUTSTANDING_SHOWN else ""
+    return f"; waiting on {', '.join(shown)}{more}" if shown else ""
 
 
 def missed_goals(missed: Mapping[str, str]) -> str:
@@ -585,7 +631,8 @@ def why_failed(trace: Iterable[Any], events: list[Mapping[str, Any]]) -> str:
     """The first statement that failed in the goal's intention (or the user's function that raised,
     which made it fail), and the last service reply that was a failure before it (what the
     procedures most likely reacted to)."""
-    failure = next((entry for entry in trace if " failed" in entry.text or " raised " in entry.text), None)
+    failure = next((entry for entry in trace if " failed" in entry.text or " raised " in entry.text
+                    or entry.text == "fail"), None)  # `fail;`: the statement itself is the reason
     if failure is None:
         return "no applicable KA succeeded"
     refused = next((e for e in reversed(events) if e["kind"] == "reply" and e["t"] <= failure.time

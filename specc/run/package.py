@@ -31,6 +31,10 @@ class Compiled:
     robot: str  # the package's name
     folder: Path  # OUTPUT/<robot>
     rewritten: bool  # the package on disk was stale (or missing) and has been written
+    # What `specc check` warns of in these specs, a headline each: kept with the stamp, so that
+    # every run says them, not only the one that compiled (a run may succeed for a reason a
+    # warning gives, such as a codel reading a poster that does not exist).
+    warnings: tuple[str, ...] = ()
 
 
 def ensure_compiled(specs: Path, output: Path) -> Compiled:
@@ -65,13 +69,16 @@ def ensure_compiled(specs: Path, output: Path) -> Compiled:
             result.write(folder)
         except OSError as exc:
             raise RunError(f"cannot write the package into '{folder}': {exc.strerror}") from None
-    stamp.write(robot, folder, result.files)
-    return Compiled(robot, folder, not up_to_date)
+    warnings = tuple(d.headline() for d in [*loaded.diagnostics, *result.warnings] if d.severity == "warning")
+    stamp.write(robot, folder, result.files, warnings)
+    return Compiled(robot, folder, not up_to_date, warnings)
 
 
-def remember_compilation(specs: Path, output: Path, robot: str, files: Mapping[str, str]) -> None:
-    """Stamp a compilation `specc compile` made, so that the next run need not compile again."""
-    _Stamp(specs, output).write(robot, output / robot, files)
+def remember_compilation(specs: Path, output: Path, robot: str, files: Mapping[str, str],
+                         warnings: Sequence[str] = ()) -> None:
+    """Stamp a compilation `specc compile` made (with the headlines of its warnings), so that the
+    next run need not compile again."""
+    _Stamp(specs, output).write(robot, output / robot, files, warnings)
 
 
 class _Stamp:
@@ -86,7 +93,7 @@ class _Stamp:
         cache = stamps_folder()
         self.path = cache / f"{where}.json" if cache is not None else None
         # Problems finding the specs: no digest, so `load` reports them as it does for `check`.
-        self.inputs = None if problems or self.path is None else _digest([_compiler_digest()] + [
+        self.inputs = None if problems or self.path is None else _digest([compiler_digest()] + [
             f"{file.name}:{_file_digest(file)}" for file in files])
 
     def still_current(self) -> Compiled | None:
@@ -95,19 +102,20 @@ class _Stamp:
         try:
             data = json.loads(self.path.read_text(encoding="utf-8"))
             robot, folder, written = data["robot"], Path(data["folder"]), data["files"]
+            warnings = tuple(str(w) for w in data["warnings"])
             if data["inputs"] != self.inputs or not isinstance(written, dict) \
                     or folder != (self.output / robot).resolve():  # another package of that name elsewhere
                 return None
-        except (OSError, ValueError, KeyError, TypeError):
+        except (OSError, ValueError, KeyError, TypeError):  # KeyError: a stamp of an older specc too
             return None
         if not all(_file_digest(folder / relative) == digest for relative, digest in written.items()):
             return None  # a file edited or deleted since
-        return Compiled(robot, folder, False)
+        return Compiled(robot, folder, False, warnings)
 
-    def write(self, robot: str, folder: Path, files: Mapping[str, str]) -> None:
+    def write(self, robot: str, folder: Path, files: Mapping[str, str], warnings: Sequence[str]) -> None:
         if self.inputs is None or self.path is None:
             return
-        data = {"robot": robot, "folder": str(folder.resolve()), "inputs": self.inputs,
+        data = {"robot": robot, "folder": str(folder.resolve()), "inputs": self.inputs, "warnings": list(warnings),
                 "files": {relative: _digest([text]) for relative, text in sorted(files.items())}}
         with contextlib.suppress(OSError):  # without a stamp the next run compiles again: slower, still right
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -139,7 +147,7 @@ def _file_digest(path: Path) -> str | None:
 
 
 @functools.cache
-def _compiler_digest() -> str:
+def compiler_digest() -> str:
     """Every source of the compiler (runtimes included: cheaper than telling which feed the
     generator, and a change there recompiles at worst)."""
     from specc.resources import grammar_path, templates_dir
@@ -147,6 +155,17 @@ def _compiler_digest() -> str:
     sources = sorted(p for p in _COMPILER.rglob("*.py") if p.is_file())
     sources += [grammar_path(), *sorted(p for p in templates_dir().rglob("*") if p.is_file())]
     return disk_cache.source_digest(sources)
+
+
+ROBOT_FILES = (".spec", ".py", ".toml")  # what a robot's folder holds that its runs depend on
+
+
+def robot_digest(folder: Path) -> str:
+    """A digest of what runs of the robot in `folder` give depends on besides their options: its
+    specs, codels and worlds (by path and content) and specc's own sources."""
+    files = sorted(p for p in folder.rglob("*") if p.is_file() and p.suffix in ROBOT_FILES
+                   and "__pycache__" not in p.parts)
+    return _digest([compiler_digest()] + [f"{p.relative_to(folder).as_posix()}:{_file_digest(p)}" for p in files])
 
 
 def _reads(path: Path) -> str | None:

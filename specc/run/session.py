@@ -146,6 +146,9 @@ def compile_robot(specs: Path, generated: Path, note: Callable[[str], None] | No
     compiled = ensure_compiled(specs, generated)
     if compiled.rewritten and note is not None:
         note(f"compiled {specs} into {compiled.folder} (it was stale)")
+    if note is not None:
+        for warning in compiled.warnings:  # every run, as `specc check` would say them
+            note(warning)
     return compiled.robot
 
 
@@ -340,13 +343,14 @@ def _checked_goal(robot: Any, text: str, specs: Path) -> str:
         raise RunError(f"--goal {text}: no KA of procedures '{library.name}' is invoked by it (they are invoked by "
                        f"{shown})")
     procedures = _procedures_of(specs, library.name)
-    if procedures is not None:  # the domains the predicate declares, as check holds a mission's goals to
-        from specc.check.system import argument_outside
+    if procedures is not None:  # the domains and numbers the goal's KAs need, as check holds a mission's goals to
+        from specc.check.system import goal_argument_problem, numeric_positions
 
+        needs = numeric_positions(procedures)
         for position, value in enumerate(goal.expr.args):
-            outside = argument_outside(procedures, head, position, value)
-            if outside is not None:
-                raise RunError(f"--goal {text}: {outside}")
+            problem = goal_argument_problem(procedures, needs, head, position, value)
+            if problem is not None:
+                raise RunError(f"--goal {text}: {problem}")
     return text
 
 

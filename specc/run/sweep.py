@@ -37,6 +37,7 @@ class Failure:
     name: str  # the run folder's name
     folder: Path
     why: str
+    outcome: str = "failed"  # the report's: failed, horizon (still running at the horizon's end) or crashed
 
 
 @dataclass(frozen=True)
@@ -68,8 +69,8 @@ class SweepResult:
 
     @property
     def failures(self) -> list[Failure]:
-        return [Failure(o.folder.name, o.folder, str(o.report.get("why", ""))) for o in self.outcomes
-                if not o.succeeded]
+        return [Failure(o.folder.name, o.folder, str(o.report.get("why", "")), str(o.report.get("outcome", "failed")))
+                for o in self.outcomes if not o.succeeded]
 
     def markdown(self) -> str:
         if self.rows:
@@ -83,7 +84,7 @@ class SweepResult:
             text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
         if self.failures:
             text += "\nFailures (each run's log is in its folder, and the whole why in its report.json):\n\n" + "".join(
-                f"- {f.name}: {brief_why(f.why)}\n" for f in self.failures)
+                f"- {f.name} ({f.outcome}): {brief_why(f.why)}\n" for f in self.failures)
         return text
 
     def mission_cells(self) -> tuple[list[str], list[list[str]]]:

@@ -47,15 +47,22 @@ import itertools
 import operator
 import time
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from specc.runtime.functional import HISTORY, Registry, Reply, Status, build_record, check_record
+from specc.runtime.functional import HISTORY, Registry, Reply, Status, build_record, check_record, check_value
 from specc.runtime.kernel import Timer
 from specc.runtime.rules import Decision
 
 # ---------------------------------------------------------------- Fig 3.3
+
+
+# Executive cycles one instant may take before they count as a reaction loop that would hold the
+# robot at that instant for ever: an event takes a few (a request, the starts asked again, a
+# reflex or two); the executive then enters its ERROR state, which refuses every request and so
+# ends the loop.
+CYCLES_PER_INSTANT = 100_000
 
 
 class Phase(enum.StrEnum):
@@ -239,6 +246,12 @@ class Executive:
         self._inbox: deque[tuple[Callable[..., None], tuple[Any, ...]]] = deque()
         self._busy = False
         self._internal_ids = itertools.count(-1, -1)
+        self._highest_id = 0  # of the ids task-level clients gave their requests (see `fresh_id`)
+        missing = sorted({s.module for s in spec.services.values() if s.module not in registry.modules})
+        if missing:  # else each request would fail later with a KeyError of the module's name
+            raise ValueError(f"executive '{spec.name}': its services run requests of module(s) "
+                             f"{', '.join(missing)}, which the registry does not have: create the modules on it "
+                             "first (the package's `modules.create_all(registry)`)")
         for name in {r.source.partition(".")[0] for r in spec.reflexes if "." in r.source}:
             module = registry.modules.get(name)
             if module is not None:
@@ -254,8 +267,16 @@ class Executive:
             raise TypeError(f"inputs of {service}: give a tuple of values in the order the service takes them, e.g. "
                             f"(3.0, 4.0), not {type(inputs).__name__} {inputs!r}")
         ident = next(self._internal_ids) if ident is None else ident
+        self._highest_id = max(self._highest_id, ident)
         self._post(self._on_request, service, ident, tuple(inputs))
         return ident
+
+    def fresh_id(self) -> int:
+        """An id no task-level client has given a request yet: two clients of one executive (a
+        program's own requests and a supervisor's) that each counted from 1 would each take the
+        other's replies for their own."""
+        self._highest_id += 1
+        return self._highest_id
 
     def interrupt(self, ident: int) -> None:
         """RQST INT: the client no longer wants service `ident` (no reply of its own, §3.4.1)."""
@@ -299,8 +320,14 @@ class Executive:
         if self._busy:
             return
         self._busy = True
+        cycles = 0
         try:
             while self._inbox:
+                cycles += 1
+                if cycles == CYCLES_PER_INSTANT:
+                    self._fatal(f"{CYCLES_PER_INSTANT:,} cycles at {self.kernel.now:g} s with no time passing: a "
+                                "reaction loop (a reflex starting a service again on every reply its module gives "
+                                "at once?); `specc verify` shows how (its `settles` property)")
                 started = time.perf_counter()
                 self._in_modules = 0.0
                 handler, args = self._inbox.popleft()
@@ -332,6 +359,11 @@ class Executive:
         if len(inputs) != len(service.takes):
             taken = ", ".join(service.takes) or "no input"
             self._end(activity, "BAD-INPUT", f"{name} takes {taken} from the task level; {len(inputs)} given")
+            return
+        problem = _taken_problem(self.registry.modules[service.module].spec.requests[service.request].input_type,
+                                 service.takes, inputs)
+        if problem:  # the task level's mistake, as a wrong count of inputs is
+            self._end(activity, "BAD-INPUT", f"{name}'s input {problem}")
             return
         try:
             activity.input = self._input(service, inputs)
@@ -665,6 +697,19 @@ class Executive:
             callback(*args)
         except Exception as exc:
             self.incidents.append(f"{getattr(callback, '__name__', callback)!s}: {type(exc).__name__}: {exc}")
+
+
+def _taken_problem(input_type: Any, takes: Sequence[str], inputs: Sequence[Any]) -> str:
+    """What is wrong with the values the task level gave for the inputs a service `takes` (their
+    types, as the request declares them), '' when nothing is."""
+    kinds = {f[0]: f for f in getattr(input_type, "__specc_fields__", ())}
+    for name, value in zip(takes, inputs, strict=True):
+        if name in kinds:
+            _, kind, size = kinds[name]
+            problem = check_value(build_record(kind, value), kind, size)
+            if problem:
+                return f"{name}: {problem}"
+    return ""
 
 
 def _input_fields(input_type: Any, value: Any, origin: str) -> Mapping[str, Any]:

@@ -325,6 +325,10 @@ class EnumFieldError(ValueError):
     """A codel left an enum field of its module's SDI holding what is not one of the enum's values."""
 
 
+class CodelMissing(LookupError):
+    """The codels a module was given have no function of a name its spec gives a codel."""
+
+
 class TransitionError(RuntimeError):
     """An arc that Fig. 2.3 does not have: a bug in the runtime, never a user error."""
 
@@ -517,7 +521,9 @@ class Module:
         if found is None:
             found = getattr(self.codels, name, None)
             if not callable(found):
-                raise LookupError(f"codel '{name}' is not defined in {self.spec.codel_module}")
+                given = getattr(self.codels, "__name__", None) if isinstance(self.codels, ModuleType) else None
+                raise CodelMissing(f"codel '{name}' is not defined in " + (
+                    given or f"the codels given to module '{self.name}' ({type(self.codels).__name__})"))
             if self._enum_fields:
                 found = functools.partial(self._enum_checked, found)
             self._functions[name] = found
@@ -526,19 +532,26 @@ class Module:
     def _enum_checked(self, codel: Callable[..., Any], *args: Any) -> Any:
         """`codel(*args)`, then ValueError (the codel's error) if it left an enum field of the SDI
         holding what is not one of its values (`sdi.state = "MOVNG"`); the field keeps the value it
-        had, so that the module's other codels go on with a value of the type."""
+        had, so that the module's other codels go on with a value of the type. A name it was given
+        (`sdi.state = "MOVING"`) becomes the member, so that every codel after it reads a member
+        (which the generated `enum.StrEnum` also makes equal to its name)."""
         sdi = self.sdi
         before = [getattr(sdi, field_name) for field_name, _, _ in self._enum_fields]
         result = codel(*args)
         for (field_name, enum_type, allowed), kept in zip(self._enum_fields, before, strict=True):
             value = getattr(sdi, field_name)
-            if not isinstance(value, enum_type) and (not isinstance(value, str) or value not in allowed):
-                setattr(sdi, field_name, kept)
-                code = getattr(codel, "__code__", None)
-                place = f" ({_shown(code.co_filename)}:{code.co_firstlineno})" if code is not None else ""
-                raise EnumFieldError(f"the SDI's field '{field_name}' set to {value!r}{place}, not a value of "
-                                     f"{enum_type.__name__} ({', '.join(m.name for m in enum_type)})"
-                                     f"{did_you_mean(str(value), [m.name for m in enum_type])}")
+            if isinstance(value, enum_type):
+                continue
+            if isinstance(value, str) and value in allowed:
+                setattr(sdi, field_name, enum_type[value] if value in enum_type.__members__ else enum_type(value))
+                continue
+            setattr(sdi, field_name, kept)
+            code = getattr(codel, "__code__", None)
+            place = f" (in {code.co_name}, {_shown(code.co_filename)}:{code.co_firstlineno})" if code is not None \
+                else ""
+            raise EnumFieldError(f"the SDI's field '{field_name}' was left holding {value!r}{place}, not a value "
+                                 f"of {enum_type.__name__} ({', '.join(m.name for m in enum_type)})"
+                                 f"{did_you_mean(str(value), [m.name for m in enum_type])}")
         return result
 
     # -- requests
@@ -772,6 +785,8 @@ class Module:
         # Python names the attribute of a failed read (exc.name), not of a failed assignment.
         if isinstance(exc, EnumFieldError):  # raised once the codel returned: it names the codel's place
             return f"ValueError: {text}"
+        if isinstance(exc, CodelMissing):  # raised by specc looking the codel up: no place of the user's
+            return text
         if isinstance(exc, AttributeError) and text.startswith(missing) and text.endswith("'"):
             name = text[len(missing):-1]
             fields = [f.name for f in dataclasses.fields(self.sdi)]
@@ -800,6 +815,14 @@ class Module:
 
     # -- endings
     def end(self, activity: Activity, report: Report) -> None:
+        """The activity's success; an output its codels left holding what its type does not
+        (`request.travelled = "far"` for a double) is their error instead, as an input would be."""
+        if activity.output is not None:
+            as_declared(activity.output)
+            problem = check_record(activity.output, activity.spec.output_type)
+            if problem:
+                self.extrinsic(activity, "CODEL_ERROR", f"the output of {activity.spec.name}: {problem}")
+                return
         self.finish(activity, State.ETHER, Status.END, report)
 
     def extrinsic(self, activity: Activity, code: str, detail: str) -> None:
@@ -956,6 +979,28 @@ def check_record(value: Any, expected: type | None) -> str:
         if problem:
             return f"{f[0]}: {problem}"
     return ""
+
+
+def as_declared(record: Any) -> None:
+    """What a codel wrote into `record` made what its type says, as its clients read it: a whole
+    number in a `double`/`float` field (`= 3`) the float, an enum's name (`= "OBSTACLE"`) its
+    member (nested records and lists too). What fits no such reading is left for `check_record`."""
+    for name, kind, size in getattr(record, "__specc_fields__", ()):
+        value = getattr(record, name)
+        if size is not None and isinstance(value, list):
+            value[:] = [_declared(v, kind) for v in value]
+        else:
+            setattr(record, name, _declared(value, kind))
+
+
+def _declared(value: Any, kind: Any) -> Any:
+    if kind == "float" and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    if isinstance(kind, type) and issubclass(kind, enum.Enum):
+        return kind.__members__.get(value, value) if isinstance(value, str) else value
+    if not isinstance(kind, str):
+        as_declared(value)
+    return value
 
 
 def build_record(kind: Any, value: Any) -> Any:

@@ -412,7 +412,10 @@ class PrimitiveContext:
             executive.request(service, ident, tuple(inputs))
 
     def new_id(self) -> int:
-        return next(self.supervisor._ids)
+        """A request id of the task level: the executive's next fresh one when there is an
+        executive (other clients may use it too), else the supervisor's own count."""
+        executive = self.supervisor.executive
+        return executive.fresh_id() if executive is not None else next(self.supervisor._ids)
 
     def log(self, text: str) -> None:
         """A message for the operator: logged, and kept in the intention's trace."""
@@ -938,7 +941,9 @@ class Supervisor:
             return set().union(*(self._outputs(a) for a in expr.args if isinstance(a, Compound)))
         if expr.head in _BUILTINS or self.database.kind(expr.head) == "evaluable":
             return set()
-        return {v.name for v in _variables(expr) if v.is_program}
+        # An argument itself, not one inside an expression (`!(NOTED (+ @I 1))` reads @I), as the
+        # Petri-net translation reads them (`specc.analysis.prs_net.outputs`).
+        return {a.name for a in expr.args if isinstance(a, Var) and a.is_program}
 
     def _solve(self, expr: Term, env: dict[str, Any], ctx: PrimitiveContext
                ) -> Iterator[tuple[dict[str, Any], tuple[_Occurrence, ...]]]:

@@ -542,6 +542,12 @@ class Builder(Transformer[Token, Any]):
     def psymset(self, meta: Meta, children: list[Any]) -> m.SymbolSet:
         return m.SymbolSet(values=tuple(str(c) for c in children), span=self.span(meta))
 
+    def psigned(self, meta: Meta, children: list[Token]) -> str:
+        """A negative (or explicitly positive) number among a PRS set's values: `{-30, 0}`."""
+        self.signed_number(meta, children)  # a sign that is no sign (IxTeT's `-.`) is said there
+        sign, number = children
+        return f"-{number}" if str(sign) == "-" else str(number)
+
     def prange(self, meta: Meta, children: list[Token]) -> m.IntRange:
         bounds: list[int] = []
         sign = 1

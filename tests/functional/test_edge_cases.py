@@ -176,14 +176,35 @@ def test_a_codel_setting_an_enum_field_to_no_value_of_its_enum_is_a_codel_error(
     # activity at once, naming the field, the values and the codel, and the field keeps its value.
     _, replies = send(robot, "C", "mode:BUSY,ether")
     robot.kernel.run_for(0.05)
-    assert replies[-1].status is Status.END and robot.alpha.sdi.mode == "BUSY"
+    # The name given became the member, which equals its name too: codels may compare either way.
+    mode = robot.alpha.sdi.mode
+    busy = type(mode).BUSY
+    assert replies[-1].status is Status.END and mode is busy and mode == "BUSY" and "BUSY" == mode
     _, replies = send(robot, "C", "mode:BUSSY,exec")
     robot.kernel.run_for(0.05)
     final = replies[-1]
     assert final.status is Status.FINAL_ERROR and final.report.code == "CODEL_ERROR"
-    assert "field 'mode' set to 'BUSSY'" in final.report.detail and "(IDLE, BUSY)" in final.report.detail
+    assert "field 'mode' was left holding 'BUSSY' (in " in final.report.detail
+    assert "(IDLE, BUSY)" in final.report.detail
     assert "did you mean 'BUSY'?" in final.report.detail and "scripted_codels" in final.report.detail
     assert robot.alpha.sdi.mode == "BUSY"
+
+
+def test_an_output_of_the_wrong_type_is_the_codel_s_error_and_whole_numbers_of_doubles_become_floats(
+        robot: Robot) -> None:
+    """`request.trace = 7` into a string output: the activity ends with CODEL_ERROR naming the
+    output, as an input of the wrong type is refused, not with END and a number its client reads
+    as text. A whole number written into a double is the float the type says."""
+    from specc.runtime.functional import as_declared
+
+    _, replies = send(robot, "A", "badtrace")
+    robot.kernel.run_for(0.05)
+    final = replies[-1]
+    assert final.status is Status.FINAL_ERROR and final.report.code == "CODEL_ERROR"
+    assert final.report.detail == "the output of A: trace: expected str, got int"
+    output = robot.package.alpha.GetOutput(value=3)
+    as_declared(output)
+    assert output.value == 3.0 and isinstance(output.value, float)
 
 
 def test_manual_posters_are_written_by_codels_and_unknown_ones_are_codel_errors(robot: Robot) -> None:
@@ -361,3 +382,19 @@ def test_codels_given_by_their_module_s_dotted_name_are_imported(robot: Robot) -
     assert made["alpha"].codels is codels
     with pytest.raises(ImportError, match="cannot import its codels 'no_such_codels.alpha'"):
         robot.package.create_all(rt.Registry(), {"alpha": "no_such_codels.alpha"})
+
+
+def test_codels_given_as_an_object_without_a_codel_are_named_in_the_error(scripted_package: types.ModuleType) -> None:
+    """`create(registry, codels=SimpleNamespace(...))` lacking a codel: the error names the codels
+    given, not the module the spec would have imported, and no place inside specc."""
+    from types import SimpleNamespace
+
+    registry = rt.Registry()
+    alpha = scripted_package.alpha.create(registry, SimpleNamespace())
+    replies: list[rt.Reply] = []
+    alpha.submit("A", scripted_package.alpha.AInput(script="exec"), replies.append)
+    registry.kernel.run_for(0.05)
+    final = replies[-1]
+    assert final.report.code == "CODEL_ERROR"
+    assert final.report.detail.endswith("is not defined in the codels given to module 'alpha' (SimpleNamespace)")
+    assert "functional.py" not in final.report.detail

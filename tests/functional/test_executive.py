@@ -62,6 +62,13 @@ def shop(shop_package: ModuleType) -> Shop:
 LONG = ",".join(["exec"] * 100)  # one second at the 10 ms period of task T
 
 
+def test_an_executive_on_a_registry_without_its_modules_is_refused_at_once(shop_package: ModuleType) -> None:
+    """Not a KeyError of a module's name at the first request: the modules it needs, named."""
+    with pytest.raises(ValueError, match=r"executive 'shop': its services run requests of module\(s\) alpha, "
+                                         r"beta, which the registry does not have: create the modules"):
+        importlib.import_module("shop.executive.shop").create(rt.Registry())
+
+
 def test_a_service_runs_through_wait_init_exec_and_replies_ok(shop: Shop) -> None:
     shop.ask("FREE", 1, "exec,exec")
     shop.run(1)

@@ -11,7 +11,7 @@ from typing import Any
 from specc.runtime import functional as rt
 
 
-class GripState(enum.Enum):
+class GripState(enum.StrEnum):
     OPEN = "OPEN"
     CLOSE = "CLOSE"
 

@@ -11,7 +11,7 @@ from typing import Any
 from specc.runtime import functional as rt
 
 
-class TrajKind(enum.Enum):
+class TrajKind(enum.StrEnum):
     SEGMENT = "SEGMENT"
     ARC = "ARC"
     BROKEN_LINE = "BROKEN_LINE"
@@ -105,7 +105,7 @@ SPEC = rt.ModuleSpec(
     requests={
         "avoidOnOff": rt.RequestSpec(name="avoidOnOff", kind="control", input_type=AvoidOnOffInput, output_type=None, validate="setAvoidMode", codels={}, yields={}, fail=(), incompatible=(), task=None, sends=()),
         "setDynamic": rt.RequestSpec(name="setDynamic", kind="control", input_type=SetDynamicInput, output_type=None, validate="checkDynamic", codels={}, yields={}, fail=("BAD_DYNAMIC_PARAMS",), incompatible=(), task=None, sends=()),
-        "execPosterTraj": rt.RequestSpec(name="execPosterTraj", kind="exec", input_type=ExecPosterTrajInput, output_type=None, validate=None, codels={"start": "readTrajPoster", "exec": "generateSetpoint", "end": "endTraj", "inter": "stopTraj"}, yields={}, fail=("POSTER_NOT_FOUND", "INVALID_TRAJECTORY"), incompatible=("execPosterTraj",), task="TrajTask", sends=("avoid.Filter",)),
+        "execPosterTraj": rt.RequestSpec(name="execPosterTraj", kind="exec", input_type=ExecPosterTrajInput, output_type=None, validate=None, codels={"start": "readTrajPoster", "exec": "generateSetpoint", "end": "endTraj", "inter": "stopTraj"}, yields={}, fail=("POSTER_NOT_FOUND", "INVALID_TRAJECTORY"), incompatible=("execPosterTraj",), task="TrajTask", sends=("avoid.Filter", "loco.Track")),
     },
     tasks=(
         rt.ExecTaskSpec(name="TrajTask", period=0.05, delay=0.0, priority=20, init="initPilo", permanent=None),

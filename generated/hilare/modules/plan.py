@@ -11,7 +11,7 @@ from typing import Any
 from specc.runtime import functional as rt
 
 
-class TrajKind(enum.Enum):
+class TrajKind(enum.StrEnum):
     SEGMENT = "SEGMENT"
     ARC = "ARC"
     BROKEN_LINE = "BROKEN_LINE"

@@ -11,7 +11,7 @@ from typing import Any
 from specc.runtime import functional as rt
 
 
-class WatchReport(enum.Enum):
+class WatchReport(enum.StrEnum):
     OBSTACLE = "OBSTACLE"
 
 

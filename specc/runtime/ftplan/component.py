@@ -507,7 +507,7 @@ class FtPlan:
         action failure, and the repaired plan is carried out in its stead (`repair`): FTplan's
         recovery starts only when the repair fails, as IxTeT-eXeC tells FTplan of a failure only
         after its own repair failed (seed 004 §3.2.2.3)."""
-        met_before = len(self.state.met)
+        met_before = self.progress()
         self.log("execute", f"{k}'s plan of {len(plan.actions)} actions starts", k)
         ended: set[str] = set()  # ids of the current plan's actions that ended
 
@@ -546,7 +546,13 @@ class FtPlan:
         left = ", ".join(g.text() for g in self.state.pending())
         if left:
             self.log("goals-open", f"{k}'s plan ended with goals open: {left}", k)
-        return "met" if len(self.state.met) > met_before else "idle"
+        return "met" if self.progress() > met_before else "idle"
+
+    def progress(self) -> int:
+        """How many goals are met, or reached and holding (a final goal, such as an item left at
+        its station until the end, is met only when the mission ends: reaching it is progress
+        all the same, and the plan that did so is not one that met nothing)."""
+        return len(self.state.met) + len(self.state.reached)
 
     def repair(self, k: str, plan: Plan, ended: Collection[str], failed: str) -> Plan | None:
         """Plan repair (seed 004 §3.2.1, IxTeT-eXeC's): k, if its block says `repair: on`, is sent

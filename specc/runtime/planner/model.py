@@ -20,10 +20,12 @@ Semantics (shared with docs/planning.md):
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Union
 
 INF = float("inf")
+EPS = 0.01  # seconds between two events that must not be simultaneous (IxTeT's strict precedence)
 
 # ---------------------------------------------------------------- expressions
 
@@ -167,6 +169,71 @@ def constraint_names(c: Constraint, kind: type) -> set[str]:
     if isinstance(c, Relation):
         return names_in(c.left, kind) | names_in(c.right, kind)
     return constraint_names(c.condition, kind) | constraint_names(c.consequence, kind)
+
+
+# ---------------------------------------------------------------- temporal constraints
+
+
+def linear(e: Expr) -> tuple[dict[str, float], float] | None:
+    """`e` as sum(coefficient * timepoint) + constant, or None when it is not linear in time."""
+    if isinstance(e, Num):
+        return {}, e.value
+    if isinstance(e, Time):
+        return {e.name: 1.0}, 0.0
+    if isinstance(e, Op) and e.op in ("+", "-", "neg"):
+        parts = [linear(a) for a in e.args]
+        if any(p is None for p in parts):
+            return None
+        sign = -1.0 if e.op in ("-", "neg") else 1.0
+        first = parts[0]
+        assert first is not None
+        if e.op == "neg":
+            return {k: -v for k, v in first[0].items()}, -first[1]
+        second = parts[1]
+        assert second is not None
+        coefficients = dict(first[0])
+        for k, v in second[0].items():
+            coefficients[k] = coefficients.get(k, 0.0) + sign * v
+        return {k: v for k, v in coefficients.items() if v}, first[1] + sign * second[1]
+    return None
+
+
+def differences(c: Member | Relation, rename: Callable[[str], str] = str,
+                origin: str = "t_start") -> list[tuple[str, str, float, float]]:
+    """A temporal constraint as `low <= t(b) - t(a) <= high` requirements, its timepoints
+    renamed (a date alone is measured from `origin`); ValueError when it is not a difference of
+    two timepoints."""
+    if isinstance(c, Member):
+        if not isinstance(c.domain, Interval):
+            raise ValueError("a timepoint takes numbers")
+        form = linear(c.expr)
+        low, high = c.domain.low, c.domain.high
+    else:
+        left, right = linear(c.left), linear(c.right)
+        form = None
+        if left is not None and right is not None:
+            coefficients = dict(left[0])
+            for k, v in right[0].items():
+                coefficients[k] = coefficients.get(k, 0.0) - v
+            form = ({k: v for k, v in coefficients.items() if v}, left[1] - right[1])
+        strict = EPS if c.op in ("<", ">") else 0.0
+        bounds = {"=": (0.0, 0.0), "<": (-INF, -strict), "<=": (-INF, 0.0), ">": (strict, INF), ">=": (0.0, INF)}
+        if c.op not in bounds:
+            raise ValueError(f"'{c.op}' between timepoints")
+        low, high = bounds[c.op]
+    if form is None:
+        raise ValueError("not linear in time")
+    coefficients, constant = form
+    low, high = low - constant, high - constant
+    plus = [k for k, v in coefficients.items() if v == 1.0]
+    minus = [k for k, v in coefficients.items() if v == -1.0]
+    if len(coefficients) == 2 and len(plus) == 1 and len(minus) == 1:
+        return [(rename(minus[0]), rename(plus[0]), low, high)]
+    if len(coefficients) == 1 and len(plus) == 1:
+        return [(origin, rename(plus[0]), low, high)]
+    if len(coefficients) == 1 and len(minus) == 1:
+        return [(rename(minus[0]), origin, low, high)]
+    raise ValueError("only differences of two timepoints are temporal constraints")
 
 
 # ---------------------------------------------------------------- assertions

@@ -185,7 +185,10 @@ class Planner:
                     kept.append(goal)
                     best = tried
                 else:
-                    why = (f"cannot be met together with the goals kept before it ({', '.join(g.text for g in kept)})"
+                    # "Cannot" only when every partial plan failed; a search that ran out of its
+                    # budget proves nothing (`explain` says it ran out).
+                    together = "cannot be met" if tried.exhausted else "was not planned"
+                    why = (f"{together} together with the goals kept before it ({', '.join(g.text for g in kept)})"
                            if kept else "not met alone either (no goal was kept before it)")
                     outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False,
                                                        f"{why}: {explain(tried)}")
@@ -369,6 +372,35 @@ def impossible_alone(alone: Attempt, goal: Goal, problem: pm.Problem) -> str | N
     return f"impossible even alone: {explain(alone)}" + (f"; the goal's dates: {', '.join(bounds)}" if bounds else "")
 
 
+def nature_conflict(constraints: list[tuple[pm.Constraint, list[tuple[str, str, float, float]]]]) -> str | None:
+    """Why the problem's constraints on nature's instants (each with its difference pieces) cannot
+    all hold, naming a smallest set of them that cannot, or None when they can."""
+
+    def consistent(chosen: list[tuple[pm.Constraint, list[tuple[str, str, float, float]]]]) -> bool:
+        network = STN()
+        try:
+            for _, pieces in chosen:
+                for first, second, low, high in pieces:
+                    network.add(first, second, low, high)
+        except Inconsistent:
+            return False
+        return True
+
+    if consistent(constraints):
+        return None
+    # The first prefix that cannot hold, then each of its constraints left out when the rest still
+    # cannot: what remains is a conflict where every constraint counts.
+    end = next(k for k in range(1, len(constraints) + 1) if not consistent(constraints[:k]))
+    conflict = constraints[:end]
+    for item in list(conflict[:-1]):
+        trial = [x for x in conflict if x is not item]
+        if not consistent(trial):
+            conflict = trial
+    said = [f"{_constraint_text(c)} (line {c.line})" if c.line else _constraint_text(c) for c, _ in conflict]
+    listed = said[0] if len(said) == 1 else f"{', '.join(said[:-1])} and {said[-1]}"
+    return f"the problem's constraints on nature's instants cannot all hold: {listed}"
+
+
 def _constraint_text(c: pm.Constraint) -> str:
     if isinstance(c, pm.Member) and isinstance(c.domain, pm.Interval):
         return f"{pm.describe(c.expr)} in [{c.domain.low:g}, {c.domain.high:g}]"
@@ -446,6 +478,16 @@ class Setup:
                     raise PlanningInputError(
                         f"{_source(a)}: '{value.name}' is not a value of {declared.name} "
                         f"({', '.join(declared.values.values)}), in problem '{problem.name}'")
+                # A symbol where numbers are meant would only fail deep in the search, as if the
+                # goals were out of reach.
+                if (declared is not None and isinstance(declared.values, pm.Interval)
+                        and isinstance(value, pm.Sym)):
+                    raise PlanningInputError(
+                        f"{_source(a)}: '{value.name}' is not a value of {declared.name}, whose values are numbers "
+                        f"in [{declared.values.low:g}, {declared.values.high:g}], in problem '{problem.name}'")
+            if isinstance(a, pm.Use) and isinstance(a.amount, pm.Sym):
+                raise PlanningInputError(f"{_source(a)}: '{a.amount.name}' is not an amount of {a.resource}: "
+                                         f"a resource is used by a number, in problem '{problem.name}'")
         for task in domain.tasks:  # a task the search could not insert is refused here, once
             for temporal in task_constraints(task).temporal:
                 try:
@@ -461,6 +503,7 @@ class Setup:
         self.requirements: list[tuple[str, str, float, float]] = []
         self.nature_before: set[tuple[str, str]] = set()
         natures = set(self.contingent) | {self.origin}
+        on_nature: list[tuple[pm.Constraint, list[tuple[str, str, float, float]]]] = []
         for c in problem.constraints:
             if isinstance(c, pm.Implies) or not is_temporal(c):
                 if isinstance(c, pm.Member) and isinstance(c.expr, pm.Var):
@@ -471,6 +514,8 @@ class Setup:
                 pieces = differences(c, origin=self.origin)
             except ValueError as error:
                 raise PlanningInputError(f"line {c.line}: {error}") from None
+            if any({first, second} <= natures for first, second, _, _ in pieces):
+                on_nature.append((c, pieces))
             for first, second, low, high in pieces:
                 nature = {first, second} <= natures
                 if nature and first == self.origin and second in bounds:
@@ -484,10 +529,15 @@ class Setup:
                     self.nature_before.add((second, first))
                 # Constraints among nature's instants alone describe nature: nothing to plan.
         for point, (low, high) in bounds.items():
-            if not (-INF < low <= high < INF):
+            if not (math.isfinite(low) and math.isfinite(high)):
                 raise PlanningInputError(f"contingent instant '{point}' needs bounds from {self.origin} "
                                          f"(e.g. `({point} - {self.origin}) in [a, b];`)")
         self.bounds = bounds
+        # The planner trusts what the problem says of nature's instants (their bounds, and the
+        # orders in `nature_before`), and the validator judges a plan on the realisations that
+        # keep it: when no realisation can, any plan would pass for a nature that cannot be, so
+        # the problem's constraints are contradictory and no plan is made (problem_root).
+        self.nature_conflict = nature_conflict(on_nature)
         # A goal's own timepoints (used by no other assertion) leave with it.
         used_by: dict[str, set[int]] = {}
         for i, a in enumerate(problem.assertions):
@@ -556,6 +606,8 @@ class Setup:
         return node
 
     def problem_root(self, active: list[Goal]) -> Node:
+        if self.nature_conflict is not None:
+            raise DeadEnd(self.nature_conflict)
         node = Node(self.context)
         problem = self.problem
         active_indexes = {g.index for g in active}

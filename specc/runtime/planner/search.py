@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from specc.runtime.planner import model as pm
+from specc.runtime.planner.model import EPS, differences
 from specc.runtime.planner.numeric import (
     IDENTITY_CACHE_LIMIT,
     DurationSpec,
@@ -48,7 +49,6 @@ from specc.runtime.stn import STN, Inconsistent, for_every_offset
 INF = math.inf
 STRONG, PSEUDO = "strong", "pseudo"  # the controllability a plan is searched for (see above)
 CONTROLLABILITIES = (STRONG, PSEUDO)
-EPS = 0.01  # seconds between two events that must not be simultaneous (IxTeT's strict precedence)
 TOLERANCE = 1e-6
 SURELY = 10 * TOLERANCE  # a bound this close counts as met: the network loosens each constraint by TOLERANCE
 Term = float | str  # a value, or a variable when the string holds a '?'
@@ -871,65 +871,3 @@ def _could_be(e: pm.Expr, wanted: Term, task: pm.Task, bindings: Bindings) -> bo
                 return False
         return True
     return True
-
-
-def linear(e: pm.Expr) -> tuple[dict[str, float], float] | None:
-    """`e` as sum(coefficient * timepoint) + constant, or None when it is not linear in time."""
-    if isinstance(e, pm.Num):
-        return {}, e.value
-    if isinstance(e, pm.Time):
-        return {e.name: 1.0}, 0.0
-    if isinstance(e, pm.Op) and e.op in ("+", "-", "neg"):
-        parts = [linear(a) for a in e.args]
-        if any(p is None for p in parts):
-            return None
-        sign = -1.0 if e.op in ("-", "neg") else 1.0
-        first = parts[0]
-        assert first is not None
-        if e.op == "neg":
-            return {k: -v for k, v in first[0].items()}, -first[1]
-        second = parts[1]
-        assert second is not None
-        coefficients = dict(first[0])
-        for k, v in second[0].items():
-            coefficients[k] = coefficients.get(k, 0.0) + sign * v
-        return {k: v for k, v in coefficients.items() if v}, first[1] + sign * second[1]
-    return None
-
-
-def differences(c: pm.Member | pm.Relation, rename: Callable[[str], str] = str,
-                origin: str = "t_start") -> list[tuple[str, str, float, float]]:
-    """A temporal constraint as `low <= t(b) - t(a) <= high` requirements, its timepoints
-    renamed (a date alone is measured from `origin`); ValueError when it is not a difference of
-    two timepoints."""
-    if isinstance(c, pm.Member):
-        if not isinstance(c.domain, pm.Interval):
-            raise ValueError("a timepoint takes numbers")
-        form = linear(c.expr)
-        low, high = c.domain.low, c.domain.high
-    else:
-        left, right = linear(c.left), linear(c.right)
-        form = None
-        if left is not None and right is not None:
-            coefficients = dict(left[0])
-            for k, v in right[0].items():
-                coefficients[k] = coefficients.get(k, 0.0) - v
-            form = ({k: v for k, v in coefficients.items() if v}, left[1] - right[1])
-        strict = EPS if c.op in ("<", ">") else 0.0
-        bounds = {"=": (0.0, 0.0), "<": (-INF, -strict), "<=": (-INF, 0.0), ">": (strict, INF), ">=": (0.0, INF)}
-        if c.op not in bounds:
-            raise ValueError(f"'{c.op}' between timepoints")
-        low, high = bounds[c.op]
-    if form is None:
-        raise ValueError("not linear in time")
-    coefficients, constant = form
-    low, high = low - constant, high - constant
-    plus = [k for k, v in coefficients.items() if v == 1.0]
-    minus = [k for k, v in coefficients.items() if v == -1.0]
-    if len(coefficients) == 2 and len(plus) == 1 and len(minus) == 1:
-        return [(rename(minus[0]), rename(plus[0]), low, high)]
-    if len(coefficients) == 1 and len(plus) == 1:
-        return [(origin, rename(plus[0]), low, high)]
-    if len(coefficients) == 1 and len(minus) == 1:
-        return [(rename(minus[0]), origin, low, high)]
-    raise ValueError("only differences of two timepoints are temporal constraints")

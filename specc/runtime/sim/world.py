@@ -296,9 +296,12 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
         where.problem(f"the walls reach {max(abs(b) for b in bounds):g} m from the origin: at most {MAX_EXTENT:g} m "
                       "(the physics and the pictures lose precision beyond)")
         bounds = None
+    said = len(where.problems)
     start_table = where.table(data, "start", ("x", "y", "theta")) or {}
     start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
              where.number(start_table, "theta", "start", 0.0))
+    # A [start] already found wrong (`xx = 1.5`) is not placed again from its defaults: one error.
+    start_read = len(where.problems) == said
     obstacles: list[Obstacle] = []
     labels: list[str] = []  # each obstacle's place in the file, for what is said of it
     for k, entry in enumerate(where.array(data, "obstacles", ("polygon", "circle"))):
@@ -333,15 +336,16 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
                   tuple(windows), description, source)
     # Targets too: a station a robot is sent to inside a crate or past a wall fails its every
     # mission, far from the line that put it there.
-    spots = [("start", start[:2])] + [(f"objects.at[{k}]", (x, y)) for k, (x, y) in enumerate(placed)] + [
+    spots = ([("start", start[:2])] if start_read else []) + [
+        (f"objects.at[{k}]", (x, y)) for k, (x, y) in enumerate(placed)] + [
         (f"targets[{k}] ({n})", (x, y)) for k, (n, x, y) in enumerate(targets)]
     xmin, xmax, ymin, ymax = bounds
     for label, (x, y) in spots:
         if x is None or y is None or world.clearance(x, y) > 0:
             continue
         if not (xmin < x < xmax and ymin < y < ymax):
-            where.problem(f"{label} ({x:g}, {y:g}) is outside the walls (x in [{xmin:g}, {xmax:g}], "
-                          f"y in [{ymin:g}, {ymax:g}])")
+            where.problem(f"{label} ({x:g}, {y:g}) is outside the walls (x strictly between {xmin:g} and "
+                          f"{xmax:g}, y between {ymin:g} and {ymax:g})")
         else:
             inside = [name for name, o in zip(labels, obstacles, strict=True) if o.distance(x, y) <= 0]
             where.problem(f"{label} ({x:g}, {y:g}) is inside {', '.join(inside) or 'an obstacle'}")

@@ -4,7 +4,8 @@ beta.Child with script X (X's own steps separated by `;`) and continues with `ex
 `to:module.request:X:R` sends that request (script X, steps separated by `;`; `-` for a request
 without input) and returns R; `write:P` writes poster P by hand and continues with `exec`;
 `copy` copies the SDI's value into `copied` and continues with `exec`; `mode:M` sets the SDI's enum
-field `mode` to the text M and continues with `exec`."""
+field `mode` to the text M and continues with `exec`; `badtrace` writes a number into the string
+output `trace` and ends."""
 
 def play(state, sdi, request):
     script = [s for s in request.script.split(",") if s]
@@ -40,4 +41,7 @@ def play(state, sdi, request):
     if outcome.startswith("mode:"):
         sdi.mode = outcome[5:]
         return "exec"
+    if outcome == "badtrace":  # an output of the wrong type, and the activity ends
+        request.trace = 7
+        return "ether"
     return outcome

@@ -21,6 +21,10 @@ def hold(sdi, request, *rest):
         return "anything"  # a nested function's returns are its own
     if sdi.read_poster("arm.State") is None or sdi.read_poster("hnad.Grip") is None:  # arm exports none; a typo
         return "exec"
+    if sdi.stuck:
+        sdi.send_request("arm.Grab")  # a request Grip's `sends:` does not list
+        sdi.send_request("arm.Grap")  # no module has it
+        return "exec" if sdi.busy else "ehter"  # a typo on one side of a conditional
     return "SLIP" if inner() else "ether"
 
 
