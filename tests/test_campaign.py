@@ -179,6 +179,18 @@ def test_an_experiment_is_a_pure_function_wherever_it_runs(tmp_path: Path) -> No
     assert dask.measures == local[ONE].measures
 
 
+def record_m1(store: ResultStore, configuration: str, mutant: str, world: str, success: bool | None) -> None:
+    """An experiment of M1 in `world`, seed 0: every goal met or none (measures as a run gives
+    them), or, for `success` None, one that crashed."""
+    goals = {"asked": 1, "met": 1 if success else 0}
+    measures = None if success is None else {
+        "configuration": configuration, "mission": "M1", "world": world, "seed": 0,
+        "goals": [{"kind": kind, **goals} for kind in "pch"], "kappa": 0, "replannings": 0,
+        "activity_time": 10.0, "distance": 5.0, "mission_time": 100.0, "planner_failures": 0, "believed": goals}
+    store.record(Outcome(Experiment(configuration, mutant, "M1", world, 0),
+                         "done" if success is not None else "crashed", measures, 1.0))
+
+
 def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path: Path) -> None:
     with ResultStore(tmp_path / "r.sqlite") as store:
         store.describe({"robot": "atrv", "domain": "model1", "configurations": ["Robot1", "Robot1/2"],
@@ -186,21 +198,13 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
         store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
         store.judge([("model1-0001", KEPT, "")])
 
-        def one(configuration: str, mutant: str, world: str, success: bool) -> None:
-            goals = {"asked": 1, "met": 1 if success else 0}
-            store.record(Outcome(Experiment(configuration, mutant, "M1", world, 0), "done", {
-                "configuration": configuration, "mission": "M1", "world": world, "seed": 0,
-                "goals": [{"kind": kind, **goals} for kind in "pch"], "kappa": 0, "replannings": 0,
-                "activity_time": 10.0, "distance": 5.0, "mission_time": 100.0, "planner_failures": 0,
-                "believed": goals}, 1.0))
-
         for configuration in ("Robot1", "Robot1/2"):
             for world in ("W1", "W4"):
-                one(configuration, ORIGINAL, world, True)
-        one("Robot1", "model1-0001", "W1", False)
-        one("Robot1", "model1-0001", "W4", False)
-        one("Robot1/2", "model1-0001", "W1", True)
-        one("Robot1/2", "model1-0001", "W4", False)
+                record_m1(store, configuration, ORIGINAL, world, True)
+        record_m1(store, "Robot1", "model1-0001", "W1", False)
+        record_m1(store, "Robot1", "model1-0001", "W4", False)
+        record_m1(store, "Robot1/2", "model1-0001", "W1", True)
+        record_m1(store, "Robot1/2", "model1-0001", "W4", False)
         report = build_report(store)
     without_w4 = next(h for h in report.headlines if h.worlds == "W* \\ W4")
     assert (without_w4.faulty, without_w4.fault_free) == ((0.0, 1.0), (1.0, 1.0))
@@ -236,23 +240,13 @@ def test_the_configurations_are_compared_on_the_experiments_each_finished(tmp_pa
         store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
         store.judge([("model1-0001", KEPT, "")])
 
-        def one(configuration: str, mutant: str, world: str, success: bool | None) -> None:
-            goals = {"asked": 1, "met": 1 if success else 0}
-            measures = None if success is None else {
-                "configuration": configuration, "mission": "M1", "world": world, "seed": 0,
-                "goals": [{"kind": kind, **goals} for kind in "pch"], "kappa": 0, "replannings": 0,
-                "activity_time": 10.0, "distance": 5.0, "mission_time": 100.0, "planner_failures": 0,
-                "believed": goals}
-            store.record(Outcome(Experiment(configuration, mutant, "M1", world, 0),
-                                 "done" if success is not None else "crashed", measures, 1.0))
-
         for configuration in ("Robot1", "Robot1/2"):
             for world in ("W1", "W4"):
-                one(configuration, ORIGINAL, world, True)
-        one("Robot1", "model1-0001", "W1", True)
-        one("Robot1", "model1-0001", "W4", False)
-        one("Robot1/2", "model1-0001", "W1", True)
-        one("Robot1/2", "model1-0001", "W4", None)  # crashed
+                record_m1(store, configuration, ORIGINAL, world, True)
+        record_m1(store, "Robot1", "model1-0001", "W1", True)
+        record_m1(store, "Robot1", "model1-0001", "W4", False)
+        record_m1(store, "Robot1/2", "model1-0001", "W1", True)
+        record_m1(store, "Robot1/2", "model1-0001", "W4", None)  # crashed
         report = build_report(store)
     every = next(h for h in report.headlines if h.worlds == "W*")
     assert every.faulty == (1.0, 1.0)  # W1 alone, for both: not (0.5, 1.0)

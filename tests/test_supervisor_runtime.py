@@ -652,6 +652,14 @@ def test_exec_request_interrupts_a_zombie_and_returns_the_final_reply(executive:
     assert after.bindings == {"$RESULT": "OK"}
 
 
+def test_a_supervisor_on_another_kernel_than_its_executive_s_is_refused(executive: Any) -> None:
+    """Its intentions would wait for replies that come on the executive's clock only."""
+    library, functions = exec_request_library(TWO_ARCS)
+    with pytest.raises(ValueError, match="the supervisor runs on its executive's kernel"):
+        Supervisor(library, functions, kernel=Kernel(), executive=executive)
+    assert Supervisor(library, functions, kernel=executive.kernel, executive=executive).kernel is executive.kernel
+
+
 def test_the_supervisor_s_request_ids_are_none_another_client_gave(executive: Any) -> None:
     """A program's own request with id 1 (refused: BAD-SERVICE) before the supervisor's first:
     the supervisor's request gets an id of its own, and its reply, not the program's."""

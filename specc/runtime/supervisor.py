@@ -456,6 +456,9 @@ class Supervisor:
         self.functions = dict(functions or {})
         self.executive = executive
         # Replies come from the executive's kernel: running on another clock would stall them.
+        if kernel is not None and executive is not None and kernel is not executive.kernel:
+            raise ValueError("the supervisor runs on its executive's kernel: give `kernel=` the executive's "
+                             "(`executive.kernel`), or leave it out")
         self.kernel = kernel if kernel is not None else executive.kernel if executive is not None else None
         self.steps_per_turn = steps_per_turn
         self.database = Database(library.predicates)
