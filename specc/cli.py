@@ -649,12 +649,17 @@ def export_problem(paths: PathsArg,
 
 @app.command(name="rules")
 def rules_report(paths: PathsArg,
-                 limit: Annotated[int, typer.Option(help="Findings shown per rule base (0: all).")] = 20) -> None:
+                 limit: Annotated[int, typer.Option(help="Findings shown per rule base (0: all).")] = 20,
+                 strict: Annotated[bool, typer.Option(help="Exit 1 when a rule base or controller leaves some "
+                                                           "input configuration unsettled.")] = False) -> None:
     """Compile every Kheops rule base and every executive's resource controller: domains,
     decision-graph depth, and the input configurations that leave an attribute without value
-    (inconsistent) or an output undetermined (incomplete).
+    (inconsistent) or an output undetermined (incomplete). Exit 0 (with --strict: 1 when some
+    configuration is unsettled), 1 when the specs have errors.
 
     Example: specc rules examples/generic
+
+    Example: specc rules examples/tug --strict   # for CI: fails on an unsettled case
     """
     from specc.analysis import kheops
     from specc.analysis.kheops import describe, tally, worst_first
@@ -667,6 +672,7 @@ def rules_report(paths: PathsArg,
     items = [i for i in loaded.program.items if isinstance(i, (m.RuleBase, m.Executive))]
     if not items:
         out.print("no rules or executive block in these specs", markup=False)
+    unsettled = False
     for item in items:
         try:
             if isinstance(item, m.RuleBase):
@@ -695,10 +701,13 @@ def rules_report(paths: PathsArg,
         if len(shown) < len(findings):
             out.print(f"  ... {len(findings) - len(shown)} more (--limit 0 shows all)", markup=False)
         if findings:
+            unsettled = True
             out.print(f"  {compiled.findings_count()} case(s) of inputs unsettled: {tally(findings)}"
                       + (" (the listing stops there)" if compiled.findings_cut else ""), markup=False)
         else:
             out.print("  complete and consistent for every input", markup=False)
+    if strict and unsettled:
+        raise typer.Exit(1)
 
 
 @app.command()

@@ -549,6 +549,8 @@ def test_a_codel_stuck_in_a_loop_is_stopped_by_the_wall_clock_limit(tmp_path: Pa
     result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "--wall-limit", "3", "--no-pictures")
     assert result.returncode == 1 and "Traceback" not in result.stderr
     assert "wall-clock limit of 3 s" in result.stderr
+    # ... and where it stood: the codel stuck in its loop, by its file and line.
+    assert "(--wall-limit) (in step, cart_codels/drive.py:" in result.stderr, result.stderr
     report = json.loads((tmp_path / "run" / "report.json").read_text())
     assert report["outcome"] == "interrupted" and "wall-clock limit" in report["why"]
     assert "wall-clock limit" in (tmp_path / "run" / "summary.txt").read_text()
@@ -571,7 +573,7 @@ def test_a_run_stopped_by_sigterm_leaves_its_report(tmp_path: Path) -> None:
     _, stderr = run.communicate(timeout=60)
     assert run.returncode == 130 and "Traceback" not in stderr, stderr
     report = json.loads((tmp_path / "run" / "report.json").read_text())
-    assert report["outcome"] == "interrupted" and report["why"] == "stopped by SIGTERM"
+    assert report["outcome"] == "interrupted" and report["why"].startswith("stopped by SIGTERM (in step, ")
 
 
 def test_a_start_where_the_body_overlaps_an_obstacle_is_refused_before_the_run(cart: Path) -> None:

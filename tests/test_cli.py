@@ -342,9 +342,13 @@ def test_unsettled_inputs_are_counted_per_kind_and_the_inconsistent_ones_shown_f
     warning = next(line for line in compiled.stderr.splitlines() if "[rules-unsettled]" in line)
     assert "2 case(s) of inputs unsettled (1 inconsistent, 1 incomplete), e.g. inconsistent:" in warning
     assert "when speed=fast, load=4 | 5 (rules fired: r2, r3)" in warning
-    listed = specc("rules", str(spec), "--limit", "1").stdout.splitlines()
+    shown = specc("rules", str(spec), "--limit", "1")
+    listed = shown.stdout.splitlines()
     assert listed[listed.index("  ... 1 more (--limit 0 shows all)") - 1].startswith("  inconsistent: ")
     assert "  2 case(s) of inputs unsettled: 1 inconsistent, 1 incomplete" in listed
+    # A report by default (exit 0); with --strict, for CI, an unsettled case fails.
+    assert shown.returncode == 0 and specc("rules", str(spec), "--strict").returncode == 1
+    assert specc("rules", str(EXAMPLES / "tug"), "--strict").returncode == 0
 
 
 def test_verify_procedures_reports_findings_traces_queries_and_pnml(tmp_path: Path) -> None:

@@ -75,13 +75,16 @@ def stoppable(wall_limit: float | None) -> Iterator[None]:
         yield
         return
 
+    from specc.runtime.functional import where_running
+
     def on_signal(number: int, frame: Any) -> None:
-        del frame
-        raise Stopped(f"stopped by {signal.Signals(number).name}", 130)
+        raise Stopped(f"stopped by {signal.Signals(number).name}{where_running(frame)}", 130)
 
     def on_limit(number: int, frame: Any) -> None:
-        del number, frame
-        raise Stopped(f"stopped: the run took longer than its wall-clock limit of {wall_limit:g} s (--wall-limit)", 1)
+        del number
+        # Where the run stood: most often a codel stuck in a loop, which the reason then names.
+        raise Stopped(f"stopped: the run took longer than its wall-clock limit of {wall_limit:g} s (--wall-limit)"
+                      f"{where_running(frame)}", 1)
 
     before = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
     before_alarm = signal.signal(signal.SIGALRM, on_limit)

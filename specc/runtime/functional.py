@@ -19,10 +19,11 @@ import functools
 import itertools
 import math
 import os
+import sys
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from types import ModuleType
+from types import FrameType, ModuleType
 from typing import Any, Generic, TypeVar
 
 from specc.runtime.hints import did_you_mean
@@ -1284,6 +1285,20 @@ def where_raised(exc: BaseException) -> str:
 
 
 _SPECC_FOLDER = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep  # specc/, with its separator
+
+
+def where_running(frame: FrameType | None) -> str:
+    """` (in FUNCTION, file:line)`: the innermost place of the user's code a live `frame` stands
+    in (a codel stuck in a loop when a run is stopped), neither specc's nor Python's own nor an
+    installed library's; empty when there is none."""
+    installed = tuple(os.path.abspath(p) + os.sep for p in {sys.prefix, sys.base_prefix, sys.exec_prefix})
+    while frame is not None:
+        name = frame.f_code.co_filename
+        path = os.path.abspath(name)
+        if not name.startswith("<") and not path.startswith(_SPECC_FOLDER) and not path.startswith(installed):
+            return f" (in {frame.f_code.co_name}, {_shown(path)}:{frame.f_lineno})"
+        frame = frame.f_back
+    return ""
 
 
 def _shown(path: str) -> str:
