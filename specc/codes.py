@@ -57,6 +57,8 @@ CODES: dict[str, Code] = {
     "undefined-codel": Code("a codel function the codel module does not define", "codel exec: stpe;"),
     "bad-codel-signature": Code("a user function cannot be called with the arguments the runtime passes it",
                                 "def watch(sdi, request): ...   (an exec task's codel gets (sdi))"),
+    "incomplete-reply-domain": Code("the procedures' REPLY result domain lacks a fail code a service they name may "
+                                    "answer (warning)", "predicate event REPLY(id: int, result: {OK, ERROR});"),
     "undeclared-send": Code("a codel sends a request (`sdi.send_request`) its request's `sends:` does not list "
                             "(warning): the incompatibility graph and `specc verify` leave it out",
                             'sdi.send_request("ptu.Sweep")   (no sends: ptu.Sweep;)'),

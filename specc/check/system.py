@@ -52,6 +52,8 @@ def check(ctx: Context) -> None:
             check_service_actions(ctx, supervisor, [executive] if executive is not None else [], without)
             check_executive_goals(ctx, supervisor, [executive] if executive is not None else [], without,
                                   system.missions)
+            if executive is not None:
+                check_reply_domain(ctx, supervisor, executive)
     # Procedures no system runs: their services are looked for in every executive.
     supervised = {s.supervisor.text for s in systems if s.supervisor is not None}
     for procedures in ctx.items(m.Procedures):
@@ -60,6 +62,29 @@ def check(ctx: Context) -> None:
             check_service_actions(ctx, procedures, executives, "no executive offers services: declare one")
             check_executive_goals(ctx, procedures, executives, "no system connects these procedures to an "
                                   "executive: add 'supervisor:' and 'executive:' to a system block")
+
+
+def check_reply_domain(ctx: Context, procedures: m.Procedures, executive: m.Executive) -> None:
+    """A finite result domain of the procedures' `REPLY(id, result)` holds every fail code the
+    modules may answer for the services the procedures name: a reply carrying another reaches them
+    outside what `specc verify --goal` assumes (the run notes an incident when it happens)."""
+    reply = next((p for p in procedures.predicates if p.name == "REPLY" and len(p.params) == 2), None)
+    allowed = Domains(procedures).values(reply.params[1].domain) if reply is not None else None
+    if reply is None or allowed is None:
+        return
+    named = {a.binding.service for a in procedures.actions if isinstance(a.binding, m.ServiceBinding)}
+    named |= {v for n in walk(procedures) if isinstance(n, m.SymbolSet) for v in n.values}
+    missing: dict[str, list[str]] = {}
+    for service in executive.services:
+        request = ctx.symbols.service_request(service) if service.name in named else None
+        for code in request.fail if request is not None else ():
+            if code.text not in allowed:
+                missing.setdefault(code.text, []).append(service.name)
+    if missing:
+        said = ", ".join(f"{code} ({', '.join(services)})" for code, services in sorted(missing.items()))
+        ctx.warn("incomplete-reply-domain", f"REPLY's result domain lacks fail code(s) the services the procedures "
+                 f"name may answer: {said}; a reply carrying one reaches the procedures outside the domain "
+                 "`specc verify --goal` assumes (a run notes an incident): add them to it", reply.params[1].span)
 
 
 def check_blocks(ctx: Context, system: m.System) -> None:
