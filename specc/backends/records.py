@@ -28,9 +28,22 @@ def _literal(value: Any, positional: tuple[type, ...], indent: int, prefix: int)
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         items = [f"{name}={_literal(v, positional, indent + 4, len(name) + 1)}" for name, v in _fields(value)]
         return f"{type(value).__name__}(\n" + "".join(f"{pad}{item},\n" for item in items) + " " * indent + ")"
+    if isinstance(value, tuple) and value and all(_scalar(v) for v in value):
+        # A long run of plain values (a domain's 30 symbols) fills its lines rather than taking one each.
+        lines = [""]
+        for item in (f"{_flat(v, positional)}," for v in value):
+            if lines[-1] and len(pad) + len(lines[-1]) + 1 + len(item) > WIDTH:
+                lines.append(item)
+            else:
+                lines[-1] = f"{lines[-1]} {item}" if lines[-1] else item
+        return "(\n" + "".join(f"{pad}{line}\n" for line in lines) + " " * indent + ")"
     if isinstance(value, tuple) and value:
         return "(\n" + "".join(f"{pad}{_literal(v, positional, indent + 4, 0)},\n" for v in value) + " " * indent + ")"
     return flat
+
+
+def _scalar(value: Any) -> bool:
+    return value is None or isinstance(value, (str, int, float, bool))
 
 
 def _fields(record: Any) -> list[tuple[str, Any]]:
