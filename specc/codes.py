@@ -203,6 +203,8 @@ CODES: dict[str, Code] = {
     "shared-variable": Code("parallel branches sharing a variable the net cannot follow", "parallel { ... }"),
     "unbounded-variable": Code("a KA variable over an unbounded domain (int, string): no finite net",
                                "predicate event REPLY(id: int, ...)"),
+    "answer-without-ok": Code("a service's answer is received in a domain without OK, the word it answers when "
+                              "it works: the net would have no answer for it", "type RESULTS = {TIMEOUT, ERROR};"),
     "unsupported-goal": Code("a goal kind the net translation does not represent", "#(X)"),
     "unsupported-meta": Code("a meta KA (choosing among KAs): a Petri net cannot represent it (seed 000 §4.4.10)",
                              "ka Pick { property: meta; ... }"),

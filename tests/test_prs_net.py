@@ -639,3 +639,4 @@ def test_an_answer_domain_without_ok_is_refused_not_a_deadlock(tmp_path: Path) -
     with pytest.raises(TranslationError) as raised:
         check(text, "!(CHECK)", tmp_path)
     assert any("service SPRAY answers OK when it works" in d.message for d in raised.value.diagnostics)
+    assert "answer-without-ok" in {d.code for d in raised.value.diagnostics}

@@ -1524,7 +1524,7 @@ class Translator:
             answers = [r for r in results if self.executive.may_fail(name) or _success(r, service)]
             if not answers:  # it would never answer: a deadlock of the model, not of the robot
                 self._reject(ka, f"service {name} answers OK when it works, which the domain of {head}'s answer "
-                             f"({', '.join(map(str, results))}) lacks: add OK to it", "unbounded-variable")
+                             f"({', '.join(map(str, results))}) lacks: add OK to it", "answer-without-ok")
                 continue
             self.result.environment.add(f"{origin} answers")
             for result in answers:

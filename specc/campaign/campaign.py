@@ -72,7 +72,7 @@ def judge(outcomes: Iterable[Outcome], configuration: str, mutants: Sequence[str
     for outcome in outcomes:
         if outcome.experiment.configuration == configuration:
             mine.setdefault(outcome.experiment.mutant, []).append(outcome)
-    original = {_activity(o.experiment): o.measures for o in mine.get(ORIGINAL, []) if o.status == "done"}
+    original = {activity(o.experiment): o.measures for o in mine.get(ORIGINAL, []) if o.status == "done"}
     verdicts = {}
     for mutant in mutants:
         results = mine.get(mutant, [])
@@ -84,16 +84,17 @@ def judge(outcomes: Iterable[Outcome], configuration: str, mutants: Sequence[str
                                              and o.measures["activity_time"] == 0 for o in done):
             verdicts[mutant] = Verdict(mutant, NEVER_PLANS, "no plan in any mission (κ = 1 before any action, "
                                                             "in every experiment)")
-        elif len(done) == len(results) and all(original.get(_activity(o.experiment)) == o.measures for o in done):
+        elif len(done) == len(results) and all(original.get(activity(o.experiment)) == o.measures for o in done):
             verdicts[mutant] = Verdict(mutant, EQUIVALENT, "every measure equals the original model's")
         else:
-            differing = sum(1 for o in results if o.status != "done" or original.get(_activity(o.experiment))
+            differing = sum(1 for o in results if o.status != "done" or original.get(activity(o.experiment))
                             != o.measures)
             verdicts[mutant] = Verdict(mutant, KEPT, f"{differing} of {len(results)} experiments differ")
     return verdicts
 
 
-def _activity(e: Experiment) -> tuple[str, str, int]:
+def activity(e: Experiment) -> tuple[str, str, int]:
+    """An experiment's activity: its mission, world and seed (what a mutant and the original share)."""
     return e.mission, e.world, e.seed
 
 

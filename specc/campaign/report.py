@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED
+from specc.campaign.campaign import EQUIVALENT, KEPT, NEVER_PLANS, UNJUDGED, activity
 from specc.campaign.experiments import ORIGINAL, Outcome
 from specc.campaign.store import MutantRecord, ResultStore
 from specc.run.measures import MeanMeasures, Measures, aggregate, kinds_of
@@ -155,8 +155,7 @@ def build_report(store: ResultStore) -> CampaignReport:
 
 def _paired(o: Outcome) -> tuple[str, str, str, int]:
     """An experiment's mutant and activity: what the configurations are compared on."""
-    e = o.experiment
-    return e.mutant, e.mission, e.world, e.seed
+    return (o.experiment.mutant, *activity(o.experiment))
 
 
 def world_subsets(description: dict[str, Any]) -> tuple[tuple[str, frozenset[str]], ...]:
