@@ -640,8 +640,8 @@ def test_a_reaction_loop_at_run_time_ends_in_the_error_state(tmp_path: Path, mon
     """A reflex starting SWEEP again on every reply, and a module whose validate codel refuses
     it at once: each refusal is a reply, each reply a new start, at one instant. Instead of
     holding the robot at that instant for ever, the running executive enters its ERROR state,
-    which refuses every request and so ends the loop, saying why. (`specc verify`'s modules do
-    not refuse at a validate codel: this loop is one it does not see.)"""
+    which refuses every request and so ends the loop, saying why. (`specc verify` finds the
+    same loop: the next test.)"""
     import importlib
 
     from specc.runtime import executive as rx
@@ -662,3 +662,54 @@ def test_a_reaction_loop_at_run_time_ends_in_the_error_state(tmp_path: Path, mon
     executive.request("SWEEP", 1)
     registry.kernel.run_for(0.5)
     assert executive.error is not None and "500 cycles at 0 s with no time passing" in executive.error
+
+
+def test_verify_sees_a_validate_codel_refuse_and_finds_the_loop_it_makes(tmp_path: Path) -> None:
+    """The robot of the test above: `specc verify`'s modules accept or refuse each request with a
+    validate codel, as the running ones may, so the loop the running executive ends in ERROR is
+    a refuted `settles`, with the refusals in its trace."""
+    (tmp_path / "ptu_codels.py").write_text("def sweep(sdi, request):\n    return 'ether'\n\n\n"
+                                            "def refuse(sdi, request):\n    return 'NO'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text(REFUSED_AGAIN)
+    result = run([spec], "e", 1)
+    assert result.complete and set(result.violations) == {"settles"}, result.violations
+    violation = result.violations["settles"]
+    assert violation.trace[0].startswith("task: RQST EXEC SWEEP (ptu.Sweep refused by its validate codel with NO")
+    assert "requests to validate codels" in violation.message
+
+
+def test_a_refusal_interrupts_nothing_in_verify_as_at_run_time(tmp_path: Path) -> None:
+    """A validate codel's refusal comes before the module interrupts what the request conflicts
+    with (specc.runtime.functional): in the model too, a refused Point leaves Sweep running."""
+    from specc.analysis.verify import Choices, explorer_for
+
+    (tmp_path / "ptu_codels.py").write_text("def sweep(sdi, request):\n    return 'exec'\n\n\n"
+                                            "def check(sdi, request):\n    return 'end'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text("""
+module ptu {
+  codels: "ptu_codels";
+  request Point { type: exec; task: Axes; validate: check; incompatible_with: Sweep; codel exec: sweep; }
+  request Sweep { type: exec; task: Axes; incompatible_with: Point; codel exec: sweep; }
+  exec_task Axes { period: 100 ms; }
+}
+executive e {
+  service POINT { request: ptu.Point; }
+  service SWEEP { request: ptu.Sweep; }
+}
+""")
+    loaded = load([spec])
+    assert loaded.program is not None and not loaded.errors
+    executive = next(i for i in loaded.program.items if isinstance(i, m.Executive))
+    states = {}
+    for refused in (0, 1):
+        explorer = explorer_for(loaded.program, executive)
+        world = explorer.initial()
+        world.executive.request("SWEEP", 1)
+        world.registry.choices = Choices((refused,))
+        world.executive.request("POINT", 2)
+        module = world.registry.modules["ptu"]
+        states[refused] = sorted((a.spec.name, a.state) for a in module.activities.values())
+    assert states[0] == [("Point", "INIT"), ("Sweep", "INTER")]
+    assert states[1] == [("Sweep", "EXEC")]

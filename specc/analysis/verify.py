@@ -3,7 +3,8 @@
 The executive that runs is the real one (`specc.runtime.executive`) deciding with the compiled
 controller; only its surroundings are abstract. Modules are models of the functional level
 (requests, physical incompatibilities, intermediate replies when an activity starts, final
-replies, ZOMBIE, aborts, as in `specc.runtime.functional`), whose activities may end, fail or
+replies, ZOMBIE, aborts, as in `specc.runtime.functional`), whose validate codels may accept or
+refuse each request (a refusal interrupts nothing), whose activities may end, fail or
 freeze at any moment, and send once, at any moment, each request their codels send (`sends:`)
 that the executive can observe (see `observable_requests`: a sent request whose activity can
 reach neither a module the executive uses nor a reflex is left out, and said so);
@@ -62,6 +63,10 @@ PROPERTIES = {
 # few (the request, the starts asked again, a reflex or two); a reflex restarting on every reply a
 # service its frozen module answers at once takes them without end, and so would the robot.
 DECISIONS_PER_EVENT = 10_000
+# Requests to validate codels one event may make: each may be accepted or refused, and the
+# explorer replays the event for every sequence, so a loop of refusals is cut here, not at
+# DECISIONS_PER_EVENT (quadratic in the replays).
+CHOICES_PER_EVENT = 100
 
 
 class Unsettled(Exception):
@@ -109,6 +114,43 @@ class ModelActivity:
     sent_by_codel: bool = False  # it is itself such a request: it counts as an outstanding one
 
 
+class Choices:
+    """The choices made inside one event, which the explorer enumerates: a step is replayed
+    once for each sequence of options (`given` sets the first ones, every later one takes its
+    first option), as a request a validate codel may accept or refuse is met deep inside the
+    executive's handling of an event, not between events."""
+
+    def __init__(self, given: tuple[int, ...] = ()):
+        self.given = given
+        self.made: list[int] = []
+        self.options: list[int] = []  # how many options each choice made had
+        self.said: list[str] = []  # the options taken other than the first, for the trace
+
+    def choose(self, options: Sequence[str]) -> int:
+        position = len(self.made)
+        if position >= CHOICES_PER_EVENT:
+            raise Unsettled(f"the executive's handling of this event sent {CHOICES_PER_EVENT} requests to validate "
+                            f"codels (the last: {options[1].split(' refused')[0]}) with no time passing: a reaction "
+                            "loop while they refuse, as a reflex starting again on every refusal makes")
+        picked = self.given[position] if position < len(self.given) else 0
+        self.made.append(picked)
+        self.options.append(len(options))
+        if picked:
+            self.said.append(options[picked])
+        return picked
+
+    def description(self) -> str:
+        """The options taken other than the first, a run of the same one said once with its count."""
+        runs = [(said, len(list(group))) for said, group in itertools.groupby(self.said)]
+        return "; ".join(said if count == 1 else f"{said}, {count} times" for said, count in runs)
+
+    def others(self) -> Iterator[tuple[int, ...]]:
+        """The sequences that depart from this one at a choice after those it was given."""
+        for position in range(len(self.given), len(self.made)):
+            for option in range(1, self.options[position]):
+                yield (*self.made[:position], option)
+
+
 class ModelModule:
     """A module as its clients see it: what `specc.runtime.functional.Module` does on a request
     or an abort, with the activities' own endings left to the explorer."""
@@ -139,6 +181,10 @@ class ModelModule:
             self.emit(sink, self.reply(rqst_id, request, Status.CS_ERROR, "UNKNOWN_REQUEST"))
             return rqst_id
         if spec.kind == "control":
+            refusal = self.validated(spec)
+            if refusal is not None:
+                self.emit(sink, self.reply(rqst_id, request, Status.FINAL_ERROR, refusal))
+                return rqst_id
             for other in list(self.activities.values()):
                 if other.state in ("INIT", "EXEC") and spec.conflicts_with(other.spec):
                     self.interrupt(other, request)
@@ -146,6 +192,10 @@ class ModelModule:
             return rqst_id
         if self.zombies:
             self.emit(sink, self.reply(rqst_id, request, Status.ZOMBIE, "MODULE_FROZEN"))
+            return rqst_id
+        refusal = self.validated(spec)
+        if refusal is not None:  # before it interrupts anything, as the runtime's validate
+            self.emit(sink, self.reply(rqst_id, request, Status.FINAL_ERROR, refusal))
             return rqst_id
         activity = ModelActivity(rqst_id, spec, sink)
         conflicting = [o for o in self.activities.values()
@@ -157,6 +207,18 @@ class ModelModule:
                 self.interrupt(other, request)
         self.try_start(activity)
         return rqst_id
+
+    def validated(self, spec: RequestSpec) -> str | None:
+        """A request with a validate codel is accepted or refused, which the explorer chooses:
+        None when accepted, else the code it is refused with. The codes are those the request
+        may fail with (`fail:`, any when it says none) that a reflex looks for, and one other."""
+        if spec.validate is None:
+            return None
+        others = sorted(set(spec.fail) - set(self.codes)) if spec.fail else ["FAILED"]
+        codes = [*others[:1], *(c for c in self.codes if not spec.fail or c in spec.fail)]
+        options = ["accepted", *(f"{self.name}.{spec.name} refused by its validate codel with {c}" for c in codes)]
+        picked = self.registry.choices.choose(options)
+        return codes[picked - 1] if picked else None
 
     def abort(self, target: int, sink: Callable[[Reply], None] | None = None) -> int:
         rqst_id = self.registry.new_id()
@@ -256,6 +318,7 @@ class ModelRegistry:
     def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]], codes: tuple[str, ...] = ()):
         self.kernel = ModelKernel()
         self._ids = itertools.count(1)
+        self.choices = Choices()
         self.modules = ModelModules(lambda name: ModelModule(name, modules[name], self, codes), modules)
 
     def new_id(self) -> int:
@@ -596,28 +659,38 @@ class Explorer:
         while queue:
             index = queue.popleft()
             key = states[index]
-            listed = self.world(key)
-            for number, event in enumerate(self.events(listed)):
-                after = self.step(listed if number == 0 else self.world(key), event)
-                transitions += 1
-                for prop, message in after.problems:
-                    if prop not in violations:
-                        violations[prop] = Violation(prop, message, self.trace(parents, index) + [event.label])
-                reached = self.key(after)
-                self.check_pass(after, reached)
-                target = keys.get(reached)
-                if target is None:
-                    if len(states) >= limit:
-                        complete = False
-                        unfinished.add(index)
-                        continue
-                    target = len(states)
-                    keys[reached] = target
-                    states.append(reached)
-                    parents.append((index, event.label))
-                    edges.append([])
-                    queue.append(target)
-                edges[index].append((target, event.helped))
+            first = self.world(key)
+            listed: World | None = first  # stepped by the first event; the others rebuild the key
+            for event in self.events(first):
+                choices: list[tuple[int, ...]] = [()]  # each sequence of choices inside the event is a transition
+                while choices:
+                    world = listed or self.world(key)
+                    listed = None
+                    world.registry.choices = made = Choices(choices.pop())
+                    after = self.step(world, event)
+                    choices += made.others()
+                    label = f"{event.label} ({made.description()})" if made.said else event.label
+                    transitions += 1
+                    for prop, message in after.problems:
+                        if prop not in violations:
+                            violations[prop] = Violation(prop, message, self.trace(parents, index) + [label])
+                    if any(prop == "settles" for prop, _ in after.problems):
+                        continue  # the event never ends: no state comes after it
+                    reached = self.key(after)
+                    self.check_pass(after, reached)
+                    target = keys.get(reached)
+                    if target is None:
+                        if len(states) >= limit:
+                            complete = False
+                            unfinished.add(index)
+                            continue
+                        target = len(states)
+                        keys[reached] = target
+                        states.append(reached)
+                        parents.append((index, label))
+                        edges.append([])
+                        queue.append(target)
+                    edges[index].append((target, event.helped))
             if progress is not None and index % 1000 == 0:
                 progress(len(states))
         self.liveness(states, edges, parents, violations, unfinished)
@@ -853,6 +926,8 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
     compiled = controller.compile()
     spec = executive_spec(program, controller)
     modules = {name: {r.name: RequestSpec(r.name, r.kind or "exec",
+                                          validate=r.validate.text if r.validate is not None else None,
+                                          fail=tuple(x.text for x in r.fail),
                                           incompatible=tuple(x.text for x in r.incompatible_with),
                                           sends=tuple(x.text for x in r.sends))
                       for r in declared.values()}
