@@ -17,6 +17,7 @@ from rich.console import Console
 
 from specc.check.symbols import symbols_of
 from specc.diagnostics import did_you_mean, error, render
+from specc.files import write_text_atomically
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.pipeline import Loaded, load
@@ -34,8 +35,15 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-err = Console(stderr=True, highlight=False, soft_wrap=True)
-out = Console(highlight=False, soft_wrap=True)
+# A command that judges something other than the specs (verify, graph, plan, export, run, table,
+# campaign...) exits 2 when it cannot do what is asked (a bad option, specs with errors, an unknown
+# name, a file it cannot write), so that a script tells that apart from its negative verdict (1: a
+# property refuted, no plan, a mission failed). check, fmt, compile, rules and skeleton judge the
+# specs: their errors are that verdict (1). docs/reference.md, "Exit codes".
+BAD_INPUT = 2
+CANNOT_VERIFY = BAD_INPUT
+err = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)  # `:100:` is a line number
+out = Console(highlight=False, soft_wrap=True, emoji=False)
 
 # readable=False: an unreadable spec is reported gcc-style by the pipeline, not by click's usage error.
 PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders searched for *.spec files.",
@@ -45,7 +53,13 @@ PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders sea
 def refuse_unwritable(path: Path | None, what: str, option: str, example: str, picture: bool = False) -> None:
     """Exit at once, before any planning or drawing, when the file `path` cannot be written
     (`specc.run.writable_file`; '-' is the standard output)."""
-    if path is None or str(path) == "-":
+    if path is None:
+        return
+    if str(path) == "-":
+        if picture:
+            err.print(f"error: {option} -: a picture cannot go to the standard output; give a file name, e.g. "
+                      f"{option} {example}", markup=False)
+            raise typer.Exit(BAD_INPUT)
         return
     from specc.run import RunError, writable_file
 
@@ -53,7 +67,7 @@ def refuse_unwritable(path: Path | None, what: str, option: str, example: str, p
         writable_file(path, option, "a file name", f"the folder of {what}", example, picture)
     except RunError as error:
         err.print(f"error: {error}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(BAD_INPUT) from None
 
 
 def report(loaded: Loaded) -> int:
@@ -89,15 +103,30 @@ def explain(code: Annotated[Optional[str], typer.Argument(help="A diagnostic's c
 
 @app.command()
 def check(paths: PathsArg,
-          quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing when all is well.")] = False
+          quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print nothing when all is well.")] = False,
+          strict: Annotated[bool, typer.Option(help="Exit 1 on warnings too (for CI).")] = False,
+          json_output: Annotated[bool, typer.Option("--json", help="Print the diagnostics as one JSON document "
+                                                    "on the standard output (format: docs/reference.md).")] = False,
           ) -> None:
-    """Parse and check specs; report every problem at once.
+    """Parse and check specs; report every problem at once. Exit 1 when there is an error (with
+    --strict, any diagnostic).
 
     Example: specc check examples/tug examples/generic/diagnosis.spec
     """
     started = time.perf_counter()
     loaded = load(paths)
+    if json_output:
+        import json
+
+        errors = len(loaded.errors)
+        document = {"format": "specc-diagnostics/1", "files": sorted(loaded.sources), "errors": errors,
+                    "warnings": len(loaded.diagnostics) - errors,
+                    "diagnostics": [d.as_data() for d in loaded.diagnostics]}
+        sys.stdout.write(json.dumps(document, indent=2) + "\n")
+        raise typer.Exit(1 if errors or (strict and loaded.diagnostics) else 0)
     code = report(loaded)
+    if strict and loaded.diagnostics:
+        raise typer.Exit(1)
     if code == 0 and not quiet:
         count = len(loaded.sources)
         items = len(loaded.program.items) if loaded.program else 0
@@ -185,14 +214,14 @@ def fmt(paths: PathsArg,
                 f"{source.path} (now)", f"{source.path} (formatted)"))
         if write:
             try:
-                loaded.paths[source.path].write_text(formatted, encoding="utf-8")
+                write_text_atomically(loaded.paths[source.path], formatted)  # never a half-written spec
             except OSError as exc:
                 changed.pop()
                 unwritable.append(error("unwritable-file", f"cannot rewrite '{source.path}': {exc.strerror}",
                                         Span.unknown(source.path)))
     verb = "reformatted" if write else "would reformat"
-    for path in changed:
-        out.print(f"{verb} {path}", markup=False)
+    for path in changed:  # after a --diff, on stderr: the standard output is then the patch alone
+        (err if diff else out).print(f"{verb} {path}", markup=False)
     for problem in unwritable:
         err.print(render(problem, {}), markup=False)
     if not changed and not unwritable:
@@ -252,10 +281,6 @@ def graph(paths: PathsArg,
     out.print(f"wrote {picture}", markup=False)
 
 
-# `specc verify` and `specc graph` exit 2 when they cannot do what is asked (a bad option, specs
-# with errors, procedures no net can stand for, a file they cannot write), so that a script tells
-# that apart from a property refuted or a finding (1).
-CANNOT_VERIFY = 2
 
 
 def choose_executive(program: m.Program, name: str | None) -> m.Executive:
@@ -354,7 +379,7 @@ def verify(paths: PathsArg,
         out.print(line, markup=False)
     out.print(f"{result.states} states, {result.transitions} transitions, at most {requests} outstanding "
               f"request(s), in {time.perf_counter() - started:.1f} s", markup=False)
-    if not result.complete:
+    if result.limited:
         err.print(f"warning: stopped at {max_states} states; raise --max-states to explore them all", markup=False)
     raise typer.Exit(0 if result.ok else 1)
 
@@ -544,14 +569,14 @@ def plan(paths: PathsArg,
     refuse_unwritable(json_path, "the JSON file", "--json", "plan.json")
     loaded = load(paths)
     if report(loaded):
-        raise typer.Exit(1)
+        raise typer.Exit(BAD_INPUT)
     assert loaded.program is not None
     try:
         outcome = solve(loaded.program, problem, domain, horizon, now, fact or [], goal, nodes, exact,
                         controllability.value, improve)
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(BAD_INPUT) from None
     if json_path is not None:
         import json
 
@@ -566,7 +591,7 @@ def plan(paths: PathsArg,
                 json_path.write_text(text, encoding="utf-8")
             except OSError as exc:
                 err.print(f"error: cannot write '{json_path}': {exc} [unwritable-file]", markup=False)
-                raise typer.Exit(1) from None
+                raise typer.Exit(BAD_INPUT) from None
     if str(json_path) != "-":
         # A file or pipe gets the whole tables, not ones squeezed into 80 columns.
         print_result(outcome, table_out())
@@ -579,8 +604,8 @@ def plan(paths: PathsArg,
             written = draw_timeline(outcome.result.plan, outcome.problem, picture)
         except (OSError, ValueError) as exc:
             err.print(f"error: cannot draw '{picture}': {exc}", markup=False)
-            raise typer.Exit(1) from None
-        out.print(f"wrote {written}", markup=False)
+            raise typer.Exit(BAD_INPUT) from None
+        (err if str(json_path) == "-" else out).print(f"wrote {written}", markup=False)  # stdout: the JSON alone
     if not outcome.useful or outcome.violations:
         raise typer.Exit(1)
 
@@ -610,13 +635,13 @@ def export_problem(paths: PathsArg,
 
     loaded = load(paths)
     if report(loaded):
-        raise typer.Exit(1)
+        raise typer.Exit(BAD_INPUT)
     assert loaded.program is not None
     try:
         chosen = choose_problem(loaded.program, problem, domain)
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
-        raise typer.Exit(1) from None
+        raise typer.Exit(BAD_INPUT) from None
     block = domain_block(loaded.program, chosen)
     exported = export(domain_model(loaded.program, block), problem_model(loaded.program, chosen),
                       constant_set_names(loaded.program, block), compact=not keep_markers)
@@ -628,7 +653,7 @@ def export_problem(paths: PathsArg,
             written = write_pddl(exported, output)
         except OSError as exc:
             err.print(f"error: cannot write into '{output}': {exc}", markup=False)
-            raise typer.Exit(1) from None
+            raise typer.Exit(BAD_INPUT) from None
         for path in written:
             out.print(f"wrote {path}", markup=False)
     for note in exported.unsupported:
@@ -672,8 +697,15 @@ def rules_report(paths: PathsArg,
     items = [i for i in loaded.program.items if isinstance(i, (m.RuleBase, m.Executive))]
     if not items:
         out.print("no rules or executive block in these specs", markup=False)
+    # A base an executive joins to its controller decides only where it applies: the controller
+    # completes it, and is what is judged (as `specc check` does).
+    joined = {ref.text: e.name for e in loaded.program.items if isinstance(e, m.Executive) for ref in e.rules}
     unsettled = False
     for item in items:
+        if isinstance(item, m.RuleBase) and item.name in joined:
+            out.print(f"rules {item.name}: joined to the resource controller of executive '{joined[item.name]}' "
+                      "(below), judged with it", markup=False)
+            continue
         try:
             if isinstance(item, m.RuleBase):
                 title, normal = f"rules {item.name}", kheops.normalise(item)
@@ -757,7 +789,7 @@ MISSION_COLUMNS = 7  # mission, world, configuration, seeds, succeeded, success 
 def table_out() -> Console:
     """Where a table goes: the terminal as it is, or a file or pipe whole (not squeezed into 80
     columns, which cuts its cells)."""
-    return out if out.is_terminal else Console(highlight=False, soft_wrap=True, width=TABLE_WIDTH)
+    return out if out.is_terminal else Console(highlight=False, soft_wrap=True, width=TABLE_WIDTH, emoji=False)
 
 
 def _run_error(error: Exception, code: int = 1) -> typer.Exit:
@@ -1033,6 +1065,11 @@ def mutants_command(
 
     if not specs.exists():
         raise _run_error(ValueError(f"no such file or folder: '{specs}'"), 2)
+    robot_folder = specs.resolve() if specs.is_dir() else specs.resolve().parent
+    if output is not None and output.resolve().is_relative_to(robot_folder):
+        raise _run_error(ValueError(f"--output {output} is inside the robot's folder {specs}: every mutant written "
+                                    "there would be read as one of its specs (`specc check` would find each "
+                                    "planning domain twice); give a folder outside it, e.g. -o build/mutants"), 2)
     started = time.perf_counter()
     if show is not None and domain is None and "-" in show:
         domain = show.rsplit("-", 1)[0]  # an id names its domain: warehouse_slow-0001

@@ -15,7 +15,7 @@ CODES: dict[str, Code] = {
     # ---------------------------------------------------------------- reading the files
     "no-spec-files": Code("a folder or a list of paths holds no .spec file", "specc check empty_folder/"),
     "missing-file": Code("a path given on the command line does not exist", "specc check nowhere.spec"),
-    "unreadable-file": Code("a spec file exists but cannot be read (permissions, a folder named .spec)",
+    "unreadable-file": Code("a spec file or codel module exists but cannot be read (permissions, a folder .spec)",
                             "specc check locked.spec"),
     "unreadable-folder": Code("a folder cannot be listed", "specc check locked_folder/"),
     "bad-encoding": Code("a spec file is not UTF-8 text", "a .spec saved as Latin-1 with an accented comment"),
@@ -59,6 +59,8 @@ CODES: dict[str, Code] = {
                                 "def watch(sdi, request): ...   (an exec task's codel gets (sdi))"),
     "incomplete-reply-domain": Code("the procedures' REPLY result domain lacks a fail code a service they name may "
                                     "answer (warning)", "predicate event REPLY(id: int, result: {OK, ERROR});"),
+    "computed-send": Code("a codel sends a request whose name it computes, which no analysis can follow",
+                          "sdi.send_request(\"arm.\" + name)"),
     "undeclared-send": Code("a codel sends a request (`sdi.send_request`) its request's `sends:` does not list "
                             "(warning): the incompatibility graph and `specc verify` leave it out",
                             'sdi.send_request("ptu.Sweep")   (no sends: ptu.Sweep;)'),
@@ -116,6 +118,8 @@ CODES: dict[str, Code] = {
                                     'outputs o; ... r: x > 1 ==> restrict oo == "a";'),
     "comparison-never-holds": Code("a rule compares a numeric attribute with a number outside its declared range",
                                    "inputs x: [0, 10]; ... r: x > 20 ==> ..."),
+    "comparison-always-holds": Code("a rule compares a numeric attribute with a threshold every value passes",
+                                    "inputs x: [0, 10]; ... r: x < 20 ==> ..."),
     "rule-never-applies": Code("an executive's hand-written rule a declared or sends-derived wait always overrides",
                                'START MOVE, @MotionState == "REACH" ==> ... (MOVE waits for REACH)'),
     "reflex-loop": Code("reflexes that restart a service on every reply it gives, directly or through others",

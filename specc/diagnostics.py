@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from specc.model.span import Span
 from specc.runtime.hints import did_you_mean as did_you_mean  # re-exported: the checks name it here
@@ -33,6 +34,14 @@ class Diagnostic:
 
     def headline(self) -> str:
         return f"{self.span}: {self.severity}: {self.message} [{self.code}]"
+
+    def as_data(self) -> dict[str, object]:
+        """The diagnostic as `specc check --json` writes it (docs/reference.md, "Exit codes")."""
+        return {"file": self.span.file, "line": self.span.line, "column": self.span.column,
+                "end_line": self.span.end_line, "end_column": self.span.end_column, "severity": self.severity,
+                "code": self.code, "message": self.message,
+                "notes": [{"file": span.file, "line": span.line, "column": span.column, "message": text}
+                          for span, text in self.notes]}
 
 
 def error(code: str, message: str, span: Span, *notes: tuple[Span, str]) -> Diagnostic:
@@ -82,3 +91,11 @@ def _excerpt(span: Span, sources: dict[str, str]) -> list[str]:
 def sort_key(diagnostic: Diagnostic) -> tuple[str, int, int, str]:
     s = diagnostic.span
     return (s.file, s.line, s.column, diagnostic.code)
+
+
+def display_path(path: Path) -> str:
+    """A file as diagnostics name it: relative to the current folder when inside it."""
+    try:
+        return str(path.resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)

@@ -19,6 +19,8 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from specc.files import write_bytes_atomically
+
 ENTRY_SUFFIX = ".pickle"
 ENTRIES_KEPT = 2000  # per kind; past it, the older half goes
 MISSING = object()  # what `read` gives when nothing usable is kept
@@ -28,8 +30,10 @@ def root() -> Path | None:
     """specc's cache folder: $XDG_CACHE_HOME/specc (default ~/.cache/specc); when that cannot be
     made, a folder of this user's own in the temporary folder; None when neither can (no cache).
     An entry is a pickle, which runs code as it loads: a folder others may write in is refused."""
+    configured = os.environ.get("XDG_CACHE_HOME", "")
     try:
-        folder = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "specc"
+        # A relative XDG_CACHE_HOME is to be ignored (the XDG base directory specification).
+        folder = (Path(configured) if os.path.isabs(configured) else Path.home() / ".cache") / "specc"
         folder.mkdir(parents=True, exist_ok=True)
         return folder
     except (OSError, RuntimeError):  # RuntimeError: a user without a home folder
@@ -96,16 +100,9 @@ def keep(kind: str, name: str, value: object) -> None:
     place = folder(kind)
     if place is None:
         return
-    temporary: str | None = None
     try:
-        handle, temporary = tempfile.mkstemp(dir=place, suffix=".tmp")
-        with os.fdopen(handle, "wb") as stream:
-            pickle.dump(value, stream, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(temporary, place / (name + ENTRY_SUFFIX))
+        write_bytes_atomically(place / (name + ENTRY_SUFFIX), pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
     except (OSError, pickle.PicklingError, RecursionError):
-        if temporary is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(temporary)
         return
     _prune(place)
 

@@ -6,10 +6,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from specc.check import check_program
-from specc.diagnostics import Diagnostic, error, sort_key, warning
+from specc.diagnostics import Diagnostic, display_path, error, sort_key, warning
 from specc.model import nodes as m
+from specc.model.span import Span
 from specc.syntax.parsed import Comment
-from specc.syntax.parser import display_path, parse_text, read_source, spec_files
+from specc.syntax.parser import parse_text, read_source, spec_files
 
 
 @dataclass
@@ -50,7 +51,8 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
         loaded.program = m.Program(files=tuple(sources))
     if check and parsed_all and loaded.program is not None:
         base_dirs = {shown: path.resolve().parent for shown, path in loaded.paths.items()}
-        found = check_program(loaded.program, base_dirs) + _controller_naming_diagnostics(loaded.program)
+        found = check_program(loaded.program, base_dirs)
+        found += _controller_naming_diagnostics(loaded.program, [d for d in found if d.severity == "error"])
         if not any(d.severity == "error" for d in found):
             found += _rule_base_diagnostics(loaded.program)
         loaded.diagnostics.extend(d for d in found if not _already_reported(d, loaded.diagnostics))
@@ -58,18 +60,29 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
     return loaded
 
 
-def _controller_naming_diagnostics(program: m.Program) -> list[Diagnostic]:
+def _controller_naming_diagnostics(program: m.Program, errors: list[Diagnostic]) -> list[Diagnostic]:
     """How each executive's own rule bases name its service groups (seed 000 Fig 5.6 calls the
     pilo group ExecTrajState): what they get wrong, from the incompatibility graph (an analysis,
-    so reported here, after the check passes, and before anything is compiled)."""
-    from specc.analysis.controller import naming, rules_waits_override
+    so reported here, after the check passes, and before anything is compiled). Not for an
+    executive whose services or modules have errors (`errors`): a misspelt request changes the
+    groups, and the rules would be blamed for it."""
+    from specc.analysis.controller import naming, rules_waits_override, unread_deductions
 
+    modules = [item.span for item in program.items if isinstance(item, m.Module)]
     found = []
     for executive in (e for e in program.items if isinstance(e, m.Executive)):
+        if any(_inside(d.span, block) for d in errors for block in (executive.span, *modules)):
+            continue
         named = naming(program, executive)
         found += [error(p.code, p.message, p.node.span) for p in named.problems]
         found += [warning(p.code, p.message, p.node.span) for p in rules_waits_override(executive, named)]
+        found += [warning(p.code, p.message, p.node.span) for p in unread_deductions(named)]
     return found
+
+
+def _inside(span: Span, block: Span) -> bool:
+    return span.file == block.file and (block.line, block.column) <= (span.line, span.column) <= (
+        block.end_line, block.end_column)
 
 
 def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:

@@ -69,6 +69,7 @@ class FunctionShape:
     defined_in: str = ""  # where a re-exported function is written (its package's folder / file)
     posters: tuple[tuple[str, int], ...] = ()  # the names it reads posters by (`x.read_poster("m.P")`), with lines
     sends: tuple[tuple[str, int], ...] = ()  # the requests it sends by name (`x.send_request("m.R")`), with lines
+    computed_sends: tuple[int, ...] = ()  # the lines sending a request whose name is computed (`"m." + r`)
 
     def accepts(self, count: int) -> bool:
         return self.least <= count and (self.most is None or count <= self.most)
@@ -87,6 +88,7 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
         most = -1
     returns: list[tuple[str, int]] = []
     named: dict[str, list[tuple[str, int]]] = {"read_poster": [], "send_request": []}
+    computed: list[int] = []
     stack: list[ast.AST] = list(node.body)
     while stack:
         current = stack.pop()
@@ -95,13 +97,16 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
         if isinstance(current, ast.Return) and current.value is not None:
             returns += [(value, current.lineno) for value in _strings_returned(current.value)]
         if (isinstance(current, ast.Call) and isinstance(current.func, ast.Attribute)
-                and current.func.attr in named and current.args
-                and isinstance(current.args[0], ast.Constant) and isinstance(current.args[0].value, str)):
-            named[current.func.attr].append((current.args[0].value, current.lineno))
+                and current.func.attr in named and current.args):
+            if isinstance(current.args[0], ast.Constant) and isinstance(current.args[0].value, str):
+                named[current.func.attr].append((current.args[0].value, current.lineno))
+            elif current.func.attr == "send_request":
+                computed.append(current.lineno)
         stack.extend(ast.iter_child_nodes(current))
     return FunctionShape(node.lineno, least, most, tuple(sorted(returns, key=lambda r: r[1])),
                          posters=tuple(sorted(named["read_poster"], key=lambda r: r[1])),
-                         sends=tuple(sorted(named["send_request"], key=lambda r: r[1])))
+                         sends=tuple(sorted(named["send_request"], key=lambda r: r[1])),
+                         computed_sends=tuple(sorted(computed)))
 
 
 def _strings_returned(value: ast.expr) -> list[str]:
@@ -126,15 +131,16 @@ class _Imported:
 PYTHON_NAMES = "python"  # the disk cache's kind of entry: a module's top-level names
 
 
-def _top_level(path: Path) -> Mapping[str, FunctionShape | _Imported | None] | SyntaxError:
+def _top_level(path: Path) -> Mapping[str, FunctionShape | _Imported | None] | SyntaxError | OSError:
     """The names a module defines at top level: a plain function's shape, where a `from ... import`
-    takes a name from, or None (an assignment, a decorated function); or why it cannot be read.
-    Read back from the disk cache when this code read the same file before: parsing the codels is
-    most of a `specc check` of a robot whose specs are cached."""
+    takes a name from, or None (an assignment, a decorated function); or why it cannot be read
+    (OSError: the file; SyntaxError: its text). Read back from the disk cache when this code read
+    the same file before: parsing the codels is most of a `specc check` of a robot whose specs are
+    cached."""
     try:
         data = path.read_bytes()
     except OSError as exc:
-        return _unreadable(path, exc).error()
+        return exc
     return _names_in(data, str(path))
 
 
@@ -214,14 +220,14 @@ def _source_of(imported: _Imported, path: Path) -> Path | None:
     return find_module(imported.module, path.parent) if imported.module else None
 
 
-def top_level_functions(path: Path) -> Mapping[str, FunctionShape | None] | SyntaxError:
+def top_level_functions(path: Path) -> Mapping[str, FunctionShape | None] | SyntaxError | OSError:
     """The names a module defines at top level, each with its shape when it is a plain function
     (None for an assignment, a decorated function or an import from outside the robot's
     folders), or why it cannot be read. A name a `from ... import` re-exports from a module of
     the robot (`from .drive import stop`, `from tug_codels.drive import stop`) has the shape of
     the function it names there."""
     found = _top_level(path)
-    if isinstance(found, SyntaxError):
+    if isinstance(found, (SyntaxError, OSError)):
         return found
     return {name: _follow(entry, path, 0) for name, entry in found.items()}
 
@@ -236,7 +242,7 @@ def _follow(entry: FunctionShape | _Imported | None, path: Path, depth: int) -> 
     if source is None:
         return None
     names = _top_level(source)
-    if isinstance(names, SyntaxError):
+    if isinstance(names, (SyntaxError, OSError)):
         return None
     found = _follow(names.get(entry.name), source, depth + 1)
     if found is None or found.defined_in:

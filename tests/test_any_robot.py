@@ -266,6 +266,24 @@ def test_a_goal_the_robot_cannot_reach_fails_with_the_modules_reason(cart: Path)
 
 
 
+def test_a_test_goal_is_posted_and_the_first_goal_failing_ends_the_mission(tmp_path: Path) -> None:
+    """A mission (or --goal) may test the database, `?(P ...)` of a declared predicate; the
+    mission fails as soon as one of its goals fails (docs/language.md), with that goal's reason,
+    not at the horizon for the goals still running."""
+    spec = SPEC.replace("goal: !(GO 3 4); }", "goal: ?(REPLY 1 OK); goal: !(GO 3 4); }")
+    robot = write_robot(tmp_path, spec)
+    assert specc(tmp_path, "check", robot).returncode == 0
+    result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 1, result.stderr
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "failed" and report["why"].startswith("?(REPLY 1 OK) failed"), report["why"]
+    assert report["simulated_time"] < 1.0
+    tested = specc(tmp_path, "run", robot, "--goal", "?(REPLY 1 OK)", "--folder", tmp_path / "tested", "-q")
+    assert tested.returncode == 1, tested.stderr  # posted and run: the fact is not there
+    unknown = specc(tmp_path, "run", robot, "--goal", "?(REPLI 1 OK)", "--folder", tmp_path / "unknown", "-q")
+    assert unknown.returncode == 2 and "declare no predicate REPLI (did you mean 'REPLY'?)" in unknown.stderr
+
+
 def test_a_goal_failed_by_a_function_that_raised_says_what_it_raised(tmp_path: Path) -> None:
     """A procedure's action bound to the user's Python (a rule base's `decide` refusing an input
     outside its domain, say) raises: the run's why is that exception, not only the KA that failed."""
@@ -599,7 +617,7 @@ def test_a_goal_from_the_command_line_is_held_to_its_predicate_s_domains(tmp_pat
     folder = tmp_path / "never"
     result = specc(tmp_path, "run", cart, "--goal", "!(GO 9 4)", "--folder", folder, "-q")
     assert result.returncode == 2, result.stderr
-    assert "--goal !(GO 9 4): 9 is not in the domain of 'x' of GO (0, 1, 2, 3, 4, 5)" in result.stderr
+    assert "--goal !(GO 9 4): '9' is not in the domain of GO's 'x' (0, 1, 2, 3, 4, 5)" in result.stderr
     assert "Traceback" not in result.stderr and not folder.exists()
 
 

@@ -42,6 +42,22 @@ def test_check_reports_gcc_style_with_source_line_and_marker(tmp_path: Path) -> 
     assert "Traceback" not in result.stderr + result.stdout
 
 
+def test_verify_stopped_by_the_state_limit_says_so_and_which_parts_it_never_explored() -> None:
+    result = specc("verify", str(EXAMPLES / "atrv"), "--requests", "2", "--max-states", "20")
+    assert result.returncode == 1, result.stderr  # nothing proved
+    assert "INCOMPLETE: the state limit stopped the exploration at 20 states" in result.stdout
+    assert "parts not explored at all: PTU-MOVE, PTU-INIT | PICTURE | COMMUNICATE" in result.stdout
+
+
+def test_a_diagnostic_on_line_100_says_100_for_every_problem_matcher(tmp_path: Path) -> None:
+    """`:100:` is rich's emoji code for 💯: the consoles must print the line number."""
+    spec = tmp_path / "long.spec"
+    spec.write_text("\n" * 99 + BROKEN.replace("\n", " ", 2))
+    result = specc("check", str(spec))
+    assert f"{spec}:100:" in result.stderr and "\N{HUNDRED POINTS SYMBOL}" not in result.stderr
+    assert re.search(r"^(.+):(\d+):(\d+): error: .* \[undefined-exec-task\]$", result.stderr, re.MULTILINE)
+
+
 def test_syntax_error_is_one_labelled_message(tmp_path: Path) -> None:
     spec = tmp_path / "bad.spec"
     spec.write_text("module loco {\n  number 700;\n}\n")
@@ -121,6 +137,29 @@ def test_compile_of_a_broken_spec_writes_nothing(tmp_path: Path) -> None:
     assert not (tmp_path / "out").exists()
 
 
+def test_check_strict_fails_on_a_warning_for_ci(tmp_path: Path) -> None:
+    spec = tmp_path / "rules.spec"
+    spec.write_text('rules r {\n  inputs a: [0, 1], unused: [0, 1];\n  outputs o: {"x"};\n'
+                    '  r1: a > 0.5 ==> restrict o == "x";\n}\n')
+    plain, strict = specc("check", str(spec)), specc("check", "--strict", str(spec))
+    assert "[input-never-read]" in plain.stderr and plain.returncode == 0
+    assert "[input-never-read]" in strict.stderr and strict.returncode == 1
+
+
+def test_check_json_gives_every_diagnostic_as_data(tmp_path: Path) -> None:
+    import json
+
+    spec = tmp_path / "loco.spec"
+    spec.write_text(BROKEN)
+    result = specc("check", "--json", "loco.spec", cwd=tmp_path)
+    assert result.returncode == 1 and result.stderr == ""
+    document = json.loads(result.stdout)
+    assert document["format"] == "specc-diagnostics/1" and document["files"] == ["loco.spec"]
+    found = next(d for d in document["diagnostics"] if d["code"] == "undefined-exec-task")
+    assert (found["file"], found["line"], found["column"], found["severity"]) == ("loco.spec", 3, 37, "error")
+    assert document["errors"] == sum(d["severity"] == "error" for d in document["diagnostics"]) >= 1
+
+
 def test_fmt_check_reports_and_fmt_rewrites(tmp_path: Path) -> None:
     spec = tmp_path / "loco.spec"
     spec.write_text("module loco{number:700; // the number\n}\n")
@@ -128,7 +167,8 @@ def test_fmt_check_reports_and_fmt_rewrites(tmp_path: Path) -> None:
     assert result.returncode == 1 and result.stdout == f"would reformat {spec}\n"  # the files, not the diff
     assert spec.read_text() == "module loco{number:700; // the number\n}\n"
     shown = specc("fmt", "--diff", str(spec))  # shows the change, makes none
-    assert shown.returncode == 0 and "+  number: 700;" in shown.stdout and "would reformat" in shown.stdout
+    assert shown.returncode == 0 and "+  number: 700;" in shown.stdout and "would reformat" in shown.stderr
+    assert shown.stdout.splitlines()[-1].startswith(" }")  # the patch alone: `patch -p0` reads it
     assert spec.read_text() == "module loco{number:700; // the number\n}\n"
     assert specc("fmt", str(spec)).returncode == 0
     assert spec.read_text() == "module loco {\n  number: 700;  // the number\n}\n"
@@ -175,6 +215,23 @@ def test_unreadable_file_and_folder_are_gcc_style_errors(tmp_path: Path) -> None
     assert "Traceback" not in result.stderr
 
 
+def test_an_unreadable_codel_module_is_unreadable_not_a_syntax_error(tmp_path: Path) -> None:
+    (tmp_path / "bot_codels").mkdir()
+    codels = tmp_path / "bot_codels" / "drive.py"
+    codels.write_text("def stop(sdi, request):\n    return 'ether'\n")
+    (tmp_path / "drive.spec").write_text('module drive {\n  codels: "bot_codels.drive";\n'
+                                         "  request Stop { type: exec; task: T; codel exec: stop; }\n"
+                                         "  exec_task T { period: 100 ms; }\n}\n")
+    codels.chmod(0)
+    try:
+        result = specc_unprivileged("check", "drive.spec", cwd=tmp_path)
+    finally:
+        codels.chmod(0o644)
+    assert result.returncode == 1 and "[unreadable-file]" in result.stderr, result.stderr
+    assert "cannot read Python module 'bot_codels.drive' (bot_codels/drive.py)" in result.stderr
+    assert "[python-syntax-error]" not in result.stderr and str(tmp_path) not in result.stderr
+
+
 def test_fmt_of_a_read_only_file_is_an_error_not_a_traceback(tmp_path: Path) -> None:
     spec = tmp_path / "ro.spec"
     spec.write_text("module a {number: 1;}\n")
@@ -205,6 +262,58 @@ def test_compile_never_deletes_outside_the_package_whatever_the_old_manifest_say
     result = specc("compile", str(spec), "-o", str(tmp_path / "out"))
     assert result.returncode == 0, result.stderr
     assert victim.read_text() == "mine" and (tmp_path / "out" / "a" / "sub").is_dir()
+
+
+def test_compile_writes_the_same_package_from_any_folder(tmp_path: Path) -> None:
+    """The package names the specs from the robot's folder: compiled from the repository's root,
+    from examples/ or from the robot's own folder, the files are the same, byte for byte (a CI
+    diffing generated code must not depend on where it runs)."""
+    trees = []
+    for number, (cwd, given) in enumerate([(ROOT, "examples/tug"), (EXAMPLES, "tug"), (EXAMPLES / "tug", ".")]):
+        output = tmp_path / f"out{number}"
+        result = specc("compile", given, "-o", str(output), cwd=cwd)
+        assert result.returncode == 0, result.stderr
+        trees.append({p.relative_to(output): p.read_bytes() for p in sorted(output.rglob("*.py")) + sorted(
+            output.rglob("*.json"))})
+    assert trees[0] == trees[1] == trees[2]
+    assert b'"tug/planning.spec"' in trees[0][Path("tug/__init__.py")]
+
+
+def test_a_package_whose_modules_all_went_leaves_no_folder_to_import(tmp_path: Path) -> None:
+    """Compiling again without the rule bases removes rules/ whole: an empty folder left there
+    would still import (a namespace package), and a codel importing it would not fail where it
+    should."""
+    (tmp_path / "a.spec").write_text("module a { number: 1; }\n")
+    rules = tmp_path / "r.spec"
+    rules.write_text('rules r {\n  inputs x: [0, 1];\n  outputs o: {"y"};\n  r1: x > 0.5 ==> restrict o == "y";\n}\n')
+    first = specc("compile", str(tmp_path / "a.spec"), str(rules), "-o", str(tmp_path / "out"), "--robot", "bot")
+    assert first.returncode == 0 and (tmp_path / "out" / "bot" / "rules").is_dir(), first.stderr
+    (tmp_path / "out" / "bot" / "rules" / "__pycache__").mkdir(exist_ok=True)
+    second = specc("compile", str(tmp_path / "a.spec"), "-o", str(tmp_path / "out"), "--robot", "bot")
+    assert second.returncode == 0, second.stderr
+    assert not (tmp_path / "out" / "bot" / "rules").exists()
+    assert not list((tmp_path / "out").rglob("*.tmp"))
+
+
+def test_files_are_replaced_whole_and_a_read_only_one_is_refused(tmp_path: Path) -> None:
+    from specc.files import write_text_atomically
+
+    kept = tmp_path / "kept.txt"
+    kept.write_text("old")
+    kept.chmod(0o640)
+    write_text_atomically(kept, "new")
+    assert kept.read_text() == "new" and kept.stat().st_mode & 0o777 == 0o640
+    locked = tmp_path / "locked.txt"
+    locked.write_text("mine")
+    locked.chmod(0o444)
+    result = subprocess.run(
+        [*(["setpriv", "--bounding-set=-dac_override,-dac_read_search", "--inh-caps=-dac_override,-dac_read_search"]
+           if os.geteuid() == 0 and shutil.which("setpriv") else []), sys.executable, "-c",
+         "import sys; from pathlib import Path; from specc.files import write_text_atomically\n"
+         "try:\n    write_text_atomically(Path(sys.argv[1]), 'x')\nexcept PermissionError:\n    sys.exit(3)",
+         str(locked)], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 3, result.stderr
+    assert locked.read_text() == "mine" and sorted(p.name for p in tmp_path.iterdir()) == ["kept.txt", "locked.txt"]
 
 
 @pytest.mark.parametrize(("name", "content", "expected"), [
@@ -323,6 +432,11 @@ def test_compile_warns_about_rule_bases_that_leave_inputs_unsettled(tmp_path: Pa
     listed = specc("rules", str(EXAMPLES / "generic"))
     assert "executive generic: resource controller" in listed.stdout
     assert listed.stdout.count("complete and consistent for every input") == 2
+    # A base an executive joins is judged with the controller it completes, not alone: --strict
+    # passes on Hilare, whose own rules decide only where they apply.
+    strict = specc("rules", "--strict", str(EXAMPLES / "hilare"))
+    assert strict.returncode == 0, strict.stdout
+    assert "rules hilare_controller: joined to the resource controller of executive 'hilare'" in strict.stdout
 
 
 def test_unsettled_inputs_are_counted_per_kind_and_the_inconsistent_ones_shown_first(tmp_path: Path) -> None:
@@ -470,7 +584,7 @@ def test_plan_replans_from_facts_given_on_the_command_line() -> None:
 ])
 def test_plan_bad_input_is_one_clear_error(args: tuple[str, ...], message: str) -> None:
     result = specc("plan", str(EXAMPLES / "atrv"), *args)
-    assert result.returncode == 1
+    assert result.returncode == 2  # bad input, not "no plan" (1)
     assert message in result.stderr and "Traceback" not in result.stderr
 
 
@@ -556,10 +670,23 @@ def test_an_output_that_cannot_be_written_stops_plan_and_graph_before_any_work(t
     ]
     for arguments, said in cases:
         result = specc(*arguments)
-        assert result.returncode == 1 and said in result.stderr, result.stderr
+        assert result.returncode == 2 and said in result.stderr, result.stderr
         assert "Traceback" not in result.stderr and "partial plans" not in result.stdout + result.stderr
         assert "group(s)" not in result.stdout
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken"]
+
+
+def test_plan_json_on_stdout_is_the_document_alone_even_with_a_picture(tmp_path: Path) -> None:
+    import json
+
+    picture = tmp_path / "plan.png"
+    result = specc("plan", str(EXAMPLES / "tug"), "--problem", "shuttle", "--json", "-", "-o", str(picture))
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout)["plan"]["actions"] and picture.is_file()
+    assert f"wrote {picture}" in result.stderr
+    refused = specc("plan", str(EXAMPLES / "tug"), "--problem", "shuttle", "-o", "-", cwd=tmp_path)
+    assert refused.returncode == 2 and "a picture cannot go to the standard output" in refused.stderr
+    assert list(tmp_path.iterdir()) == [picture]
 
 
 def test_plan_printed_to_a_pipe_keeps_its_tables_whole() -> None:

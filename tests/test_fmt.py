@@ -109,6 +109,13 @@ PLACEMENT = [
     ("blank lines above comments are kept even when two comments read the same",
      "module a {\n  number: 1;\n  // same\n  codels: \"x\";\n\n  // same\n  doc: \"y\";\n}\n",
      "module a {\n  number: 1;\n  // same\n  codels: \"x\";\n\n  // same\n  doc: \"y\";\n}\n"),
+    ("a comment above a section with no node of its own stays above it",
+     "module a {\n  number: 1;\n  // the data\n  internal_data {\n    x: double;\n  }\n}\n",
+     "module a {\n  number: 1;\n  // the data\n  internal_data {\n    x: double;\n  }\n}\n"),
+    ("a block comment above a conflicts section stays above it",
+     "executive e {\n  service S {\n    request: m.R;\n    /* who waits */\n    conflicts { T: wait; }\n  }\n}\n",
+     "executive e {\n  service S {\n    request: m.R;\n    /* who waits */\n    conflicts {\n      T: wait;\n    }\n"
+     "  }\n}\n"),
     ("a file of comments only",
      "// one\n\n/* two\n   three */\n",
      "// one\n\n/* two\n   three */\n"),

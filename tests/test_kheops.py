@@ -475,6 +475,34 @@ def test_a_generated_decision_refuses_what_its_inputs_cannot_be_and_names_the_in
         guard.decide({"soc": "50", "estop": False})
 
 
+STATEFUL = """
+rules door {
+  inputs request: bool;
+  outputs command: {"open", "hold"};
+  init @command = "hold";
+  opening: request, @command == "hold" ==> restrict command == "open";
+  held: else restrict command == "hold";
+}
+"""
+
+
+def test_a_generated_decision_reads_the_init_of_a_previous_value_not_given(tmp_path: Path) -> None:
+    """`init @command = "hold"` is what the first cycle reads as @command: the caller may leave it
+    out, and the decision is the interpreter's with the init given."""
+    from tests.functional.conftest import compiled_module
+
+    spec = tmp_path / "door.spec"
+    spec.write_text(STATEFUL)
+    door = compiled_module(spec, tmp_path / "out", "rules.door")
+    assert door.INITIAL == {"@command": "hold"}
+    assert door.decide({"request": True}).outputs == {"command": "open"}
+    assert door.decide({"request": True, "@command": "open"}).outputs == {"command": "hold"}
+    base = base_from(STATEFUL)
+    for request in (True, False):
+        assert dict(door.decide({"request": request}).outputs) == k.interpret(
+            base, {"request": request, "@command": "hold"}).outputs
+
+
 def test_a_listing_of_unsettled_inputs_cut_at_its_limit_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
     base = base_from(SHARED_STATES)
     full = k.compile_base(base)

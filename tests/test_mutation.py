@@ -440,6 +440,13 @@ def test_the_command_counts_lists_and_writes_the_kept_mutants(tiny: Path, tiny_s
     assert parse_text(first, "tiny.spec").source is not None and first != TINY
 
 
+def test_mutants_are_not_written_where_they_would_be_read_as_the_robot_s_specs(tiny: Path) -> None:
+    inside = tiny / "mutants" if tiny.is_dir() else tiny.parent / "mutants"
+    result = specc("mutants", tiny, "--domain", "tiny", "--workers", "1", "-o", inside)
+    assert result.returncode == 2 and "inside the robot's folder" in result.stderr, result.stderr
+    assert not inside.exists()
+
+
 def test_the_command_samples_and_shows_a_mutant(tiny: Path) -> None:
     sampled = specc("mutants", tiny, "--domain", "tiny", "--class", "deletion", "--class", "value", "--sample",
                     "4", "--seed", "2")

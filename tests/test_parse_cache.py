@@ -126,3 +126,13 @@ def test_a_check_of_specs_seen_before_does_not_load_lark(tmp_path: Path) -> None
     runs = [subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True,
                            env=environment, timeout=300) for _ in range(2)]
     assert [r.stdout.strip() for r in runs] == ["True", "False"], [r.stderr for r in runs]
+
+
+def test_a_relative_xdg_cache_home_is_ignored(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The XDG specification: a relative path there is invalid and ignored (no `relative/` made
+    in whatever folder a command runs from)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.setenv("XDG_CACHE_HOME", "relative/cache")
+    assert disk_cache.root() == tmp_path / "home" / ".cache" / "specc"
+    assert not (tmp_path / "relative").exists()

@@ -142,5 +142,5 @@ def test_specc_plan_stops_at_the_check_and_prints_no_plan(tmp_path: Path, change
     shown = subprocess.run([sys.executable, "-m", "specc.cli", "plan", str(tmp_path), "--problem", "p"],
                            capture_output=True, text=True, timeout=120)
     output = shown.stdout + shown.stderr
-    assert shown.returncode == 1, output
+    assert shown.returncode == 2, output  # specs with errors: bad input to plan
     assert f"[{code}]" in output and "controllable" not in output and "REJECTS" not in output

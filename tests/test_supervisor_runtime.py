@@ -529,6 +529,35 @@ def test_a_kernel_turn_runs_at_most_steps_per_turn_steps() -> None:
     assert all(b - a <= 5 for a, b in zip([0, *counts], counts, strict=False))
 
 
+def test_a_loop_that_never_waits_is_abandoned_and_time_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    """On a kernel, a KA looping without ever waiting would hold the robot's time at one instant
+    for ever (a `specc run` that never ends). Past STEPS_PER_INSTANT steps at one instant its
+    intention is abandoned, saying where it stood; another intention and the clock go on."""
+    from specc.runtime import supervisor as rp
+
+    monkeypatch.setattr(rp, "STEPS_PER_INSTANT", 300)
+    kernel = Kernel()
+    s = supervisor(ka("Spin", "!(SPIN)", While(goal("?(= 1 1)", 7), (step("=>(~ (IDLE))", 8),)), line=6),
+                   ka("Chores", "!(CHORES)", *(step(f"=>(CHORE {n})") for n in range(10))), kernel=kernel)
+    spin, chores = s.post("!(SPIN)"), s.post("!(CHORES)")
+    kernel.call_later(5.0, lambda: None)
+    kernel.run_for(10.0)
+    assert chores.status == "succeeded" and spin.status == "failed" and kernel.now == 10.0
+    said = spin.lines()[-1]
+    assert said.startswith("top:0: abandoned: it ran 300 steps at 0 s with no time passing (at Spin:")
+    assert "a loop that never waits" in said
+
+
+def test_a_failed_goal_says_why_each_applicable_ka_failed() -> None:
+    s = supervisor(ka("Count", "!(COUNT)", Assign(Var("@N"), parse_term("(+ @N 1)"), 71), line=70),
+                   ka("Other", "!(COUNT)", Fail(81), line=80))
+    failed = done(s, "!(COUNT)")
+    assert failed.status == "failed"
+    last = failed.lines()[-1]
+    assert "every applicable KA failed (" in last and "Count: line 71: " in last and "@N" in last
+    assert "Other: line 81: fail" in last
+
+
 # ---------------------------------------------------------------- primitive KAs
 
 
@@ -548,6 +577,21 @@ def test_a_primitive_that_raises_or_lacks_an_argument_fails_its_ka() -> None:
     assert crushed.status == "failed" and "Grip:8: (GRIP 30) raised OverflowError: too hard" in crushed.lines()
     unbound = done(s, "!(GRIP $F $S)")
     assert unbound.status == "failed" and "Grip:8: (GRIP $F): $F is unbound" in unbound.lines()
+
+
+def test_a_primitive_returning_outside_its_result_domain_fails_its_ka() -> None:
+    """`action GRIP(force: int) -> {HELD, SLIPPED}`: `specc verify --goal` assumes one of those two,
+    so the supervisor refuses anything else (a typo in the Python) instead of running on it."""
+    def grip(ctx: Any, force: int) -> str:
+        return "HELD" if force < 5 else "HLED"
+
+    s = supervisor(ka("Grip", "!(GRIP $F $STATE)", action="(GRIP $F)", result="$STATE", line=8),
+                   primitives=(Primitive("GRIP", 1, "arm.grip", returns=True, domain=("HELD", "SLIPPED")),),
+                   functions={"arm.grip": grip})
+    assert done(s, "!(GRIP 3 $S)").bindings == {"$S": "HELD"}
+    typo = done(s, "!(GRIP 7 $S)")
+    assert typo.status == "failed"
+    assert "Grip:8: (GRIP 7) returned 'HLED', which is not in the domain of its result (HELD, SLIPPED)" in typo.lines()
 
 
 # ---------------------------------------------------------------- Fig 4.3 against the executive

@@ -713,3 +713,32 @@ executive e {
         states[refused] = sorted((a.spec.name, a.state) for a in module.activities.values())
     assert states[0] == [("Point", "INIT"), ("Sweep", "INTER")]
     assert states[1] == [("Sweep", "EXEC")]
+
+
+RESTARTED_CONTROL = """
+module ptu {
+  codels: "ptu_codels";
+  request Home { type: control; validate: check; }
+}
+executive e {
+  service HOME { request: ptu.Home; }
+  reflex again on reply HOME => start HOME;
+}
+"""
+
+
+def test_a_loop_through_a_validate_codel_on_every_answer_ends_refuted_and_incomplete(tmp_path: Path) -> None:
+    """Accepted or refused, every reply starts HOME again: each sequence of answers loops, and
+    there are 2^CHOICES_PER_EVENT of them. The exploration ends: `settles` refuted, the event's
+    other sequences left out and said (incomplete, so nothing else is claimed proved)."""
+    from specc.analysis.verify import SEQUENCES_PER_EVENT, describe
+
+    (tmp_path / "ptu_codels.py").write_text("def check(sdi, request):\n    return 'end'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text(RESTARTED_CONTROL)
+    result = run([spec], "e", 1)
+    assert "settles" in result.violations and not result.complete and not result.limited
+    assert result.cut and result.cut[0] == "task: RQST EXEC HOME"
+    said = "\n".join(describe(result))
+    assert f"not every way they may answer was explored ({SEQUENCES_PER_EVENT} at most)" in said
+    assert "exclusion: holds in the states explored" in said

@@ -3,15 +3,15 @@
 
 ROBOT = "tug"
 SOURCES = (
-    "examples/tug/executive.spec",
-    "examples/tug/ftplan.spec",
-    "examples/tug/modules/drive.spec",
-    "examples/tug/modules/lift.spec",
-    "examples/tug/modules/scanner.spec",
-    "examples/tug/planning.spec",
-    "examples/tug/procedures.spec",
-    "examples/tug/rules.spec",
-    "examples/tug/tug.spec",
+    "tug/executive.spec",
+    "tug/ftplan.spec",
+    "tug/modules/drive.spec",
+    "tug/modules/lift.spec",
+    "tug/modules/scanner.spec",
+    "tug/planning.spec",
+    "tug/procedures.spec",
+    "tug/rules.spec",
+    "tug/tug.spec",
 )
 MODULES = ("drive", "lift", "scanner")
 EXECUTIVES = ("tug",)

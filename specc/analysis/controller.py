@@ -30,7 +30,9 @@ from typing import Any
 from specc.analysis import kheops as k
 from specc.analysis.incompat import Group, IncompatibilityGraph, build_graph, service_groups
 from specc.check.symbols import symbols_of
+from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
+from specc.model.visitor import walk
 
 EVENTS = ("START", "INTERM", "END", "ABORT", "ZOMBIE")
 STATUSES = ("OK", "WAIT", "REFUSE", "ERROR")
@@ -447,6 +449,35 @@ def rules_waits_override(executive: m.Executive, named: Naming) -> list[Problem]
                     f"rule '{rule.name}' never applies: where it does, {service} waits for what runs in group "
                     f"{group} (a declared `wait`, or one a `sends:` adds), and no hand-written rule takes a wait "
                     "over; drop the rule, or declare that conflict an interrupt"), nodes[rule.name]))
+    return found
+
+
+def unread_deductions(named: Naming) -> list[Problem]:
+    """What an executive's hand-written rules deduce that nothing reads: an attribute they restrict
+    that is none of the controller's (`status`, a group's state), not declared, and that no rule of
+    the base tests (`restrict statu == "WAIT"`, a typo): the rule then decides nothing."""
+    if named.problems:
+        return []
+    known = {"status", *named.names.values(), *(state_attribute(g) for g in named.groups)}
+    # The bases are joined into one: what one deduces, another may test.
+    declared = {a.name for base in named.hand for a in base.attributes}
+    tested = {n.name for base in named.hand for rule in walk(base) if isinstance(rule, m.Rule)
+              and rule.condition is not None for n in walk(rule.condition) if isinstance(n, m.AttrRef)}
+    found = []
+    said: set[str] = set()
+    for base in named.hand:
+        for rule in (r for r in walk(base) if isinstance(r, m.Rule)):
+            for action in (a for a in rule.actions if isinstance(a, m.Restrict)):
+                name = action.restriction.attr.name
+                if name in known | declared | tested | said:
+                    continue
+                said.add(name)
+                outputs = sorted(known)
+                problem = Problem("intermediate-never-read", (
+                    f"rules deduce '{name}', which is none of the executive controller's outputs, not declared, "
+                    f"and no rule tests: rule '{rule.name}' decides nothing"
+                    f"{did_you_mean(name, outputs) or ' (a misspelt output?)'}"), action)
+                found.append(problem)
     return found
 
 

@@ -381,6 +381,8 @@ def convert_atom(node: Any, constants: Mapping[str, Any], loop: Mapping[str, Any
     if value.op != "const":
         raise KheopsError("Kheops compares an attribute with a constant; compute the other side with "
                           "`do {x = ...}` first", node.value)
+    if node.op not in ("==", "!=") and not isinstance(value.args[0], (int, float)):
+        raise KheopsError(f"'{key}' {node.op} {value.args[0]!r}: an ordering compares numbers", node.value)
     return Atom(key, node.op, value.args[0])
 
 

@@ -73,10 +73,11 @@ def ka(node: m.KA) -> rp.KA:
     )
 
 
-def primitive(node: m.ActionDecl) -> rp.Primitive:
+def primitive(node: m.ActionDecl, domains: Domains) -> rp.Primitive:
     if isinstance(node.binding, m.ServiceBinding):
         return rp.Primitive(node.name, len(node.params), "", node.result is not None, service=node.binding.service)
-    return rp.Primitive(node.name, len(node.params), node.binding.value, node.result is not None)
+    domain = domains.values(node.result) if node.result is not None else None
+    return rp.Primitive(node.name, len(node.params), node.binding.value, node.result is not None, domain=domain)
 
 
 def predicate_kind(node: m.PredicateDecl) -> str:
@@ -97,7 +98,7 @@ def library(node: m.Procedures) -> rp.Library:
     return rp.Library(
         name=node.name,
         predicates=tuple(predicate(p, domains) for p in node.predicates),
-        primitives=tuple(primitive(a) for a in node.actions),
+        primitives=tuple(primitive(a, domains) for a in node.actions),
         kas=tuple(ka(k) for k in node.kas),
         source=node.span.file,
     )

@@ -64,9 +64,14 @@ PROPERTIES = {
 # service its frozen module answers at once takes them without end, and so would the robot.
 DECISIONS_PER_EVENT = 10_000
 # Requests to validate codels one event may make: each may be accepted or refused, and the
-# explorer replays the event for every sequence, so a loop of refusals is cut here, not at
-# DECISIONS_PER_EVENT (quadratic in the replays).
-CHOICES_PER_EVENT = 100
+# explorer replays the event for every sequence, so a loop through them is cut here, not at
+# DECISIONS_PER_EVENT.
+CHOICES_PER_EVENT = 32
+# Sequences of choices one event is replayed for: an event meets one or two validate codels, so a
+# few; a reaction loop through them meets CHOICES_PER_EVENT on every sequence, 2^32 of them. Past
+# this many, the event's other sequences are not explored, and the exploration is incomplete (the
+# verdicts hold "in the states explored"): nothing is proved, nothing falsely refuted.
+SEQUENCES_PER_EVENT = 256
 
 
 class Unsettled(Exception):
@@ -215,7 +220,7 @@ class ModelModule:
         if spec.validate is None:
             return None
         others = sorted(set(spec.fail) - set(self.codes)) if spec.fail else ["FAILED"]
-        codes = [*others[:1], *(c for c in self.codes if not spec.fail or c in spec.fail)]
+        codes = list(dict.fromkeys([*others[:1], *(c for c in self.codes if not spec.fail or c in spec.fail)]))
         options = ["accepted", *(f"{self.name}.{spec.name} refused by its validate codel with {c}" for c in codes)]
         picked = self.registry.choices.choose(options)
         return codes[picked - 1] if picked else None
@@ -380,13 +385,16 @@ class Verification:
     requests: int
     states: int
     transitions: int
-    complete: bool  # False when the state limit stopped the exploration
+    complete: bool  # False when the state limit (`limited`) or the choices' limit (`cut`) left states out
     violations: dict[str, Violation]
     left_out: tuple[str, ...] = ()  # the sends the model leaves out ("module.request sends module.request")
     parts: tuple[tuple[str, ...], ...] = ()  # the independent parts explored one by one (services), if several
     # Conflicts declared by one side only: (source, policy, target), the target starting beside a
     # running source unhindered; exclusion, which reads the arcs as written, allows it.
     one_way: tuple[tuple[str, str, str], ...] = ()
+    limited: bool = False  # the state limit stopped the exploration
+    unexplored: tuple[tuple[str, ...], ...] = ()  # the parts the state limit kept from being explored
+    cut: tuple[str, ...] = ()  # events not replayed for every sequence of choices (SEQUENCES_PER_EVENT)
 
     @property
     def ok(self) -> bool:
@@ -555,7 +563,11 @@ class Explorer:
         # A pass only asks again for the starts of WAIT activities: with none, it changes nothing.
         if (self.check_passes and not self.passes_matter and executive.error is None
                 and any(a.state is rx.Phase.WAIT for a in executive.activities.values())):
-            executive._post(_nothing)  # a cycle with no event
+            try:
+                executive._post(_nothing)  # a cycle with no event
+            except Unsettled:  # the pass itself loops: every cycle counts, as when it changes a state
+                self.passes_matter = True
+                return
             if self.key(world) != reached:
                 self.passes_matter = True
 
@@ -633,7 +645,7 @@ class Explorer:
                     return results[-1]  # `explore` starts again with every request kept
                 if self.parts_interact or "no-error" in results[-1].violations:
                     return self._explore(limit, progress)
-                if not results[-1].complete:
+                if results[-1].limited:
                     break  # the state limit: the parts left are not explored either
             violations: dict[str, Violation] = {}
             for result in results:  # the shortest trace of any part, as the whole's exploration finds first
@@ -642,7 +654,9 @@ class Explorer:
                         violations[prop] = violation
             return Verification(self.spec.name, self.requests, sum(r.states for r in results),
                                 sum(r.transitions for r in results), all(r.complete for r in results)
-                                and len(results) == len(self.parts), violations, self.left_out, self.parts)
+                                and len(results) == len(self.parts), violations, self.left_out, self.parts,
+                                limited=any(r.limited for r in results), unexplored=self.parts[len(results):],
+                                cut=tuple(label for r in results for label in r.cut))
         return self._explore(limit, progress)
 
     def _explore(self, limit: int, progress: Callable[[int], None] | None) -> Verification:
@@ -654,8 +668,9 @@ class Explorer:
         violations: dict[str, Violation] = {}
         queue = deque([0])
         transitions = 0
-        complete = True
+        complete, limited = True, False
         unfinished: set[int] = set()  # states with a successor the limit kept out
+        cut: list[str] = []  # events whose sequences of choices were not all replayed (SEQUENCES_PER_EVENT)
         while queue:
             index = queue.popleft()
             key = states[index]
@@ -663,7 +678,14 @@ class Explorer:
             listed: World | None = first  # stepped by the first event; the others rebuild the key
             for event in self.events(first):
                 choices: list[tuple[int, ...]] = [()]  # each sequence of choices inside the event is a transition
+                replays = 0
                 while choices:
+                    if replays == SEQUENCES_PER_EVENT:
+                        cut.append(event.label)
+                        complete = False
+                        unfinished.add(index)
+                        break
+                    replays += 1
                     world = listed or self.world(key)
                     listed = None
                     world.registry.choices = made = Choices(choices.pop())
@@ -681,7 +703,7 @@ class Explorer:
                     target = keys.get(reached)
                     if target is None:
                         if len(states) >= limit:
-                            complete = False
+                            complete, limited = False, True
                             unfinished.add(index)
                             continue
                         target = len(states)
@@ -695,7 +717,7 @@ class Explorer:
                 progress(len(states))
         self.liveness(states, edges, parents, violations, unfinished)
         return Verification(self.spec.name, self.requests, len(states), transitions, complete, violations,
-                            self.left_out)
+                            self.left_out, limited=limited, cut=tuple(cut))
 
     def liveness(self, states: list[Key], edges: list[list[tuple[int, bool]]],
                  parents: list[tuple[int, str] | None], violations: dict[str, Violation],
@@ -978,3 +1000,13 @@ def describe(result: Verification) -> Iterator[str]:
         yield (f"conflicts declared one way only, which the states explored show running together (exclusion "
                f"reads them as written): {said}; for two services never to run together, give each a conflict "
                "with the other")
+    if result.limited:
+        skipped = (f"; parts not explored at all: {' | '.join(', '.join(part) for part in result.unexplored)}"
+                   if result.unexplored else "")
+        yield (f"INCOMPLETE: the state limit stopped the exploration at {result.states:,} states (raise "
+               f"--max-states){skipped}: what holds, holds only in the states explored")
+    if result.cut:
+        events = list(dict.fromkeys(result.cut))
+        yield (f"INCOMPLETE: {len(events)} event(s) met so many requests to validate codels that not every way "
+               f"they may answer was explored ({SEQUENCES_PER_EVENT} at most), the first: {events[0]}: a reaction "
+               "loop through them, if `settles` is refuted")

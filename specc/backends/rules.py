@@ -98,6 +98,18 @@ class DecisionView:
         return [Code(line) for line in self.body(self.compiled.root, 2, root=True)]  # under `try:`
 
     @property
+    def initial(self) -> dict[str, Any]:
+        """The previous-cycle values (`@x`) the base's `init` gives: what `decide` reads when the
+        caller gives none (the first cycle)."""
+        return {name: a.init for name, a in self.base.attributes.items() if a.role == "previous" and a.init is not None}
+
+    def read(self, attribute: str) -> str:
+        """The Python reading `attribute` in the inputs: with its `init` when the caller may leave it out."""
+        if attribute in self.initial:
+            return f"a.get({attribute!r}, {literal(self.initial[attribute])})"
+        return f"a[{attribute!r}]"
+
+    @property
     def numeric_inputs(self) -> list[str]:
         return [name for name in self.base.inputs if self.base.attributes[name].kind == "number"]
 
@@ -120,14 +132,14 @@ class DecisionView:
             lines = []
             for action in node.actions:
                 if isinstance(action, k.Assign):
-                    lines.append(f"{pad}a[{action.target!r}] = {action.expr.python(read)}")
+                    lines.append(f"{pad}a[{action.target!r}] = {action.expr.python(self.read)}")
                 else:
-                    args = ", ".join(arg.python(read) for arg in action.args)
+                    args = ", ".join(arg.python(self.read) for arg in action.args)
                     lines.append(f"{pad}calls({action.function!r}, ({args}{',' if len(action.args) == 1 else ''}))")
             return lines + self.body(node.next, depth)
         assert isinstance(node, k.Test)
         attribute = self.base.attributes[node.attribute]
-        lines = [f"{pad}v = a[{node.attribute!r}]"]
+        lines = [f"{pad}v = {self.read(node.attribute)}"]
         # Values leading to the same subgraph share one test: `if v in ('A', 'B'):`.
         grouped: dict[int, tuple[k.Node, list[Any]]] = {}
         for value, child in node.branches:
@@ -155,10 +167,6 @@ def children(node: k.Node) -> list[k.Node]:
     if isinstance(node, k.Do):
         return [node.next]
     return []
-
-
-def read(attribute: str) -> str:
-    return f"a[{attribute!r}]"
 
 
 def literal(value: Any) -> str:

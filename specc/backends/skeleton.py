@@ -150,6 +150,8 @@ def write_stubs(wanted: Needs, spec_dir: Path, robot_dir: Path | None = None) ->
             package_init.write_text("")
         path.write_text(f'"""Functions of {wanted.owner} (stubs written by `specc skeleton`)."""\n')
     existing = top_level_functions(path)
+    if isinstance(existing, OSError):
+        raise existing
     if isinstance(existing, SyntaxError):
         raise SyntaxError(f"{path}:{existing.lineno}: cannot add functions to a file with a syntax error: "
                           f"{existing.msg}")

@@ -24,7 +24,9 @@ def robot_folder(program: m.Program) -> str:
     """The folder of the robot's specs as the spans name it: the deepest one holding them all.
     Paths the package records are relative to it, and `specc.run` resolves them against the
     same folder of the specs it runs (`specc.syntax.parser.spec_root`)."""
-    return posixpath.commonpath([posixpath.dirname(f.path) or "." for f in program.files]) if program.files else "."
+    # `or "."`: the common path of "." and "sub" is "".
+    return (posixpath.commonpath([posixpath.dirname(f.path) or "." for f in program.files]) or ".") if program.files \
+        else "."
 
 
 @dataclass(frozen=True)

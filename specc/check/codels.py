@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from specc.check.context import Context
-from specc.diagnostics import did_you_mean
+from specc.diagnostics import did_you_mean, display_path
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.pysource import FunctionShape, find_module, top_level_functions
@@ -84,6 +84,12 @@ def check_sends(ctx: Context, module: m.Module, request: m.Request, functions: M
     said: set[str] = set()
     for name, span in codels:
         shape = functions.get(name)
+        for line in shape.computed_sends if shape is not None else ():
+            assert shape is not None
+            ctx.warn("computed-send", f"codel '{name}' sends a request whose name it computes "
+                     f"({place(shape, where, line)}): neither the incompatibility graph nor `specc verify` can "
+                     "tell which, so what they prove may not hold of the robot; write the name as a string "
+                     "(`sdi.send_request(\"module.Request\")`) and list it in the request's 'sends:'", span)
         for target, line in shape.sends if shape is not None else ():
             if target in declared or target in said:
                 continue
@@ -94,7 +100,9 @@ def check_sends(ctx: Context, module: m.Module, request: m.Request, functions: M
                 known = [f"{o}.{r}" for o, names in requests.items() for r in names]
                 ctx.warn("undefined-request", f"codel '{name}' sends '{target}' ({place(shape, where, line)}), but no "
                          f"module has that request{did_you_mean(target, known)}: the send fails at run time", span)
-            else:
+            elif all(sent in requests.get(other, ())
+                     for other, _, sent in (ref.text.partition(".") for ref in request.sends)):
+                # (With an entry of `sends:` naming no request, that error is the one to fix first.)
                 ctx.warn("undeclared-send", f"codel '{name}' of request {module.name}.{request.name} sends '{target}' "
                          f"({place(shape, where, line)}), which the request's 'sends:' does not list: the "
                          f"incompatibility graph and `specc verify` leave that send out, so what they prove may not "
@@ -167,9 +175,13 @@ def python_functions(ctx: Context, dotted: m.String) -> Mapping[str, FunctionSha
                    "skeleton` writes it with a stub for every codel the specs name", dotted.span)
         return None
     functions = top_level_functions(path)
+    if isinstance(functions, OSError):
+        ctx.report("unreadable-file", f"cannot read Python module '{dotted.value}' ({display_path(path)}): "
+                   f"{functions.strerror or functions}; give the file read permission", dotted.span)
+        return None
     if isinstance(functions, SyntaxError):
         ctx.report("python-syntax-error",
-                   f"{path}:{functions.lineno}: Python syntax error in '{dotted.value}': {functions.msg}",
+                   f"{display_path(path)}:{functions.lineno}: Python syntax error in '{dotted.value}': {functions.msg}",
                    dotted.span)
         return None
     return functions

@@ -29,6 +29,7 @@ class ProcedureVisitor(Visitor):
         # Primitive actions are called from a KA's `action:` only, in a namespace of their own
         # (Fig. 4.2: goal SEND-REQUEST $REQUEST $ID is achieved by action SEND-REQUEST $REQUEST).
         self.actions = {a.name: a.params for a in procedures.actions}
+        self.returning = {a.name for a in procedures.actions if a.result is not None}
         # A goal achieved by a KA needs no predicate declaration: its invocation declares it, and
         # the number of arguments it takes (the KAs invoked by one head may take several).
         self.invoked: dict[str, set[int]] = {}
@@ -64,7 +65,16 @@ class ProcedureVisitor(Visitor):
 
     def visit_SExp(self, node: m.SExp) -> None:
         if node.head not in BUILTIN_HEADS:
-            if node.head not in self.signatures:
+            if node.head not in self.signatures and node.head in self.actions:
+                # An action is called from a primitive KA's `action:`, never achieved as a goal.
+                params = "".join(f" ${p.name.upper()}" for p in self.actions[node.head])
+                result = (" $ID", " -> $ID") if node.head in self.returning else ("", "")
+                self.ctx.report("undefined-predicate",
+                                f"'{node.head}' is an action, not a goal: a primitive KA carries it out, e.g. `ka "
+                                f"Do{node.head.title().replace('-', '')} {{ invocation: !(DO-{node.head}{params}"
+                                f"{result[0]}); action: ({node.head}{params}){result[1]}; }}`, and a body achieves "
+                                f"that KA's goal", node.span)
+            elif node.head not in self.signatures:
                 self.ctx.report("undefined-predicate",
                                 f"unknown predicate or goal '{node.head}'{did_you_mean(node.head, self.signatures)};"
                                 f" declare it with 'predicate {node.head}(...);' or write a KA invoked by it",
@@ -174,6 +184,29 @@ def check_ka(ctx: Context, ka: m.KA) -> None:
             if isinstance(var, m.LogicVar) and var.name not in bound:
                 ctx.report("unbound-variable",
                            f"'{var.name}' appears first in the effects, so it is never bound", var.span)
+    check_concluded_once(ctx, ka)
+
+
+def check_concluded_once(ctx: Context, ka: m.KA) -> None:
+    """A `=>` in the body concludes a fact of values: a variable it names that nothing else in the
+    KA names (not the invocation, the context, another statement) can have none when it runs, and
+    the KA fails there at run time, after what it did before (a move made for nothing). A warning:
+    the KA still runs, and fails where the net (`verify --goal`) says it does. (A retraction `~>`
+    with a variable no one binds is a pattern: it retracts whatever value the fact has.)"""
+    from specc.model.visitor import walk
+
+    if ka.body is None:
+        return
+    named: dict[str, int] = {}
+    for part in (ka.invocation, ka.context, ka.body, ka.action, *ka.effects):
+        for var in _variables(part):
+            named[var.name] = named.get(var.name, 0) + 1
+    for goal in (n for n in walk(ka.body) if isinstance(n, m.Goal) and n.op == "=>"):
+        for var in _variables(goal):
+            if isinstance(var, m.LogicVar) and named[var.name] == 1:
+                ctx.warn("unbound-variable", f"'{var.name}' has no value when {goal.op}({goal.body.head} ...) "
+                           f"runs: nothing else in KA '{ka.name}' names it; bind it first (a test `?(...)` or a "
+                           "goal's result) or write the value", var.span)
 
 
 def _variables(node: m.Node | None) -> list[m.LogicVar | m.ProgramVar]:

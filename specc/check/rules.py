@@ -17,6 +17,28 @@ from specc.model import nodes as m
 from specc.model.visitor import Visitor
 
 BOOL_WORDS = ("true", "false")  # what a bool is compared with by mistake
+ARITHMETIC = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+              "/": lambda a, b: a / b if b else None}
+
+
+def literal(expr: m.KExpr | None, constants: dict[str, m.KExpr], depth: int = 0) -> float | str | None:
+    """The value of a rule base's expression made of literals and constants only (`-30`,
+    `SLOW`, `LIMIT * 2`), or None when it reads an attribute (or is circular)."""
+    if isinstance(expr, (m.Number, m.String)):
+        return expr.value
+    if depth > len(constants):
+        return None
+    if isinstance(expr, m.KNegate):
+        inner = literal(expr.operand, constants, depth + 1)
+        return -inner if isinstance(inner, (int, float)) else None
+    if isinstance(expr, m.AttrRef) and expr.index is None and not expr.previous and expr.name in constants:
+        return literal(constants[expr.name], constants, depth + 1)
+    if isinstance(expr, m.KBinary) and expr.op in ARITHMETIC:
+        left, right = literal(expr.left, constants, depth + 1), literal(expr.right, constants, depth + 1)
+        if isinstance(left, (int, float)) and isinstance(right, (int, float)):
+            result: float | None = ARITHMETIC[expr.op](left, right)
+            return result
+    return None
 
 
 class RuleVisitor(Visitor):
@@ -25,7 +47,7 @@ class RuleVisitor(Visitor):
     def __init__(self, ctx: Context, base: m.RuleBase):
         self.ctx = ctx
         self.declared = {a.name: a for a in base.attributes}
-        self.constants = {c.name for c in base.constants}
+        self.constants: dict[str, m.KExpr] = {c.name: c.value for c in base.constants}
         self.inits = {i.name for i in base.inits}
         self.loop_vars: list[str] = []
         self.restricted: set[str] = set()
@@ -87,20 +109,35 @@ class RuleVisitor(Visitor):
         range (`x > 20` with x in [0, 10]): the rule testing it never fires, a typo the likeliest cause."""
         if self.in_action or id(node) not in self.conjuncts:
             return  # under `!` or `|` a comparison that never holds may leave the rule firing
-        declared = self.declared.get(node.attr.name)
+        declared = self.declared_of(node.attr)
         domain = declared.domain if declared is not None else None
-        if not (isinstance(domain, m.NumericDomain) and isinstance(node.value, m.Number)
-                and math.isfinite(node.value.value)):  # a number too large is an error of its own
+        value = literal(node.value, self.constants)
+        if not (isinstance(domain, m.NumericDomain) and isinstance(value, (int, float))
+                and math.isfinite(value)):  # a number too large is an error of its own
             return
-        low = domain.low.value if isinstance(domain.low, m.Number) else -math.inf
-        high = domain.high.value if isinstance(domain.high, m.Number) else math.inf
-        value = node.value.value
+        low, high = self.numeric_bounds(domain)
+        if low > high:
+            return  # an empty domain, said once (`empty-domain`)
         never = {"<": low >= value, "<=": low > value, ">": high <= value, ">=": high < value,
                  "==": not low <= value <= high}.get(node.op, False)
+        # Only a threshold outside the domain (`battery < 180` on [0, 100], a typo): `x <= 10` on
+        # [0, 10] is a rule written to cover every value, on purpose.
+        always = {"<": high < value, "<=": high < value, ">": low > value, ">=": low > value,
+                  "!=": not low <= value <= high}.get(node.op, False)
         if never:
             self.ctx.warn("comparison-never-holds", f"{node.attr.name} {node.op} {value:g} never holds: "
                           f"'{node.attr.name}' lies in [{low:g}, {high:g}]; the rule testing it never fires",
                           node.span)
+        elif always:
+            self.ctx.warn("comparison-always-holds", f"{node.attr.name} {node.op} {value:g} always holds: "
+                          f"'{node.attr.name}' lies in [{low:g}, {high:g}], so it tests nothing (a threshold "
+                          "outside the domain: a typo?)", node.span)
+
+    def numeric_bounds(self, domain: m.NumericDomain) -> tuple[float, float]:
+        """A numeric domain's bounds, infinite where it gives none (or none known before run time)."""
+        low, high = literal(domain.low, self.constants), literal(domain.high, self.constants)
+        return (low if isinstance(low, (int, float)) else -math.inf,
+                high if isinstance(high, (int, float)) else math.inf)
 
     def check_together(self, parts: list[m.Node]) -> None:
         """Comparisons of one numeric attribute with numbers that no value satisfies together
@@ -108,10 +145,11 @@ class RuleVisitor(Visitor):
         # (attribute, of the previous cycle) -> low, low included, high, high included
         bounds: dict[tuple[str, bool], tuple[float, bool, float, bool]] = {}
         for part in parts:
-            if not (isinstance(part, m.KCompare) and isinstance(part.value, m.Number) and part.attr.index is None
-                    and math.isfinite(part.value.value) and part.op in ("<", "<=", ">", ">=", "==")):
+            value = literal(part.value, self.constants) if isinstance(part, m.KCompare) else None
+            if not (isinstance(part, m.KCompare) and isinstance(value, (int, float)) and part.attr.index is None
+                    and math.isfinite(value) and part.op in ("<", "<=", ">", ">=", "==")):
                 continue  # an indexed attribute's comparisons may each be of another element
-            name, value, op = part.attr.name, part.value.value, part.op
+            name, op = part.attr.name, part.op
             key = (name, part.attr.previous)
             low, low_in, high, high_in = bounds.get(key, (-math.inf, False, math.inf, False))
             if op in (">", ">=", "==") and (value > low or value == low and op == ">"):
@@ -126,7 +164,7 @@ class RuleVisitor(Visitor):
                 return
 
     def is_bool(self, attr: m.AttrRef) -> bool:
-        declared = self.declared.get(attr.name)
+        declared = self.declared_of(attr)
         return declared is not None and isinstance(declared.domain, m.BoolDomain)
 
     def visit_KMember(self, node: m.KMember) -> None:
@@ -146,23 +184,38 @@ class RuleVisitor(Visitor):
             return
         self.use(node)
 
+    def elements(self, attr: m.AttrRef) -> list[str]:
+        """The attributes a reference may name: `level[i]` in a foreach names each declared
+        `level[1]`, `level[2]`...; a plain reference, or one to no declared element, its name."""
+        if attr.index is not None:
+            declared = [name for name in self.declared if name.startswith(attr.name + "[")]
+            if declared:
+                return declared
+        return [attr.name]
+
+    def declared_of(self, attr: m.AttrRef) -> m.AttrDecl | None:
+        """The declaration of the attribute a reference names (of its first element, indexed)."""
+        return self.declared.get(self.elements(attr)[0])
+
     def use(self, attr: m.AttrRef) -> None:
         if attr.index is not None:
             self.check_index(attr.index, attr.span)
+        names = self.elements(attr)
         if attr.previous:
-            self.tested.add(attr.name)
-            if attr.name not in self.inits:
+            self.tested.update(names)
+            if not any(name in self.inits for name in names):
                 self.ctx.report("missing-init",
-                                f"'@{attr.name}' reads the previous cycle's value: add 'init @{attr.name} = ...;'",
+                                f"'@{attr.name}' reads the previous cycle's value: add 'init @{names[0]} = ...;'",
                                 attr.span)
             return
-        if self.in_action:
-            self.restricted.add(attr.name)
-            self.first_set.setdefault(attr.name, attr)
-            self.check_not_input(attr.name, attr.span)
-        else:
-            self.tested.add(attr.name)
-            self.first_read.setdefault(attr.name, attr)
+        for name in names:
+            if self.in_action:
+                self.restricted.add(name)
+                self.first_set.setdefault(name, attr)
+                self.check_not_input(name, attr.span)
+            else:
+                self.tested.add(name)
+                self.first_read.setdefault(name, attr)
 
     def check_not_input(self, name: str, span: object) -> None:
         declared = self.declared.get(name)
@@ -177,10 +230,11 @@ class RuleVisitor(Visitor):
                             span)
 
     def check_value(self, attr: m.AttrRef, value: m.KExpr, numeric: bool) -> None:
-        declared = self.declared.get(attr.name)
+        declared = self.declared_of(attr)
         if declared is None or declared.domain is None:
             return
         domain = declared.domain
+        constant = literal(value, self.constants)
         if isinstance(domain, m.SymbolDomain):
             if numeric:
                 self.ctx.report("type-mismatch",
@@ -198,9 +252,10 @@ class RuleVisitor(Visitor):
                 shown = value.value if isinstance(value, (m.String, m.Number)) else getattr(value, "name", "")
                 self.ctx.report("type-mismatch", f"'{attr.name}' is a bool: test it as '{attr.name}' (true) or "
                                 f"'!{attr.name}' (false), not against {shown!r}", value.span)
-        elif isinstance(domain, m.NumericDomain) and isinstance(value, m.String):
-            self.ctx.report("type-mismatch", f"'{attr.name}' is numeric; it cannot equal the string {value.value!r}",
-                            value.span)
+        elif isinstance(domain, m.NumericDomain) and isinstance(constant, str):
+            named = "" if isinstance(value, m.String) else f" ({getattr(value, 'name', 'a constant')})"
+            self.ctx.report("type-mismatch", f"'{attr.name}' is numeric; it cannot be compared with the string "
+                            f"{constant!r}{named}", value.span)
 
 
 def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:
@@ -210,7 +265,7 @@ def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> Non
     for name, ref in visitor.first_read.items():
         if name in inputs or name in visitor.restricted or name in visitor.inits:
             continue
-        known = inputs | visitor.restricted | visitor.constants
+        known = inputs | visitor.restricted | set(visitor.constants)
         ctx.report("undefined-attribute", f"'{name}' is tested, but it is no input, has no init and no rule sets "
                    f"it: the rule can never fire (a misspelt input or constant?){did_you_mean(name, known)}",
                    ref.span)
@@ -262,13 +317,40 @@ def check(ctx: Context) -> None:
         check_never_read(ctx, base, visitor)
         for attr in base.attributes:
             domain = attr.domain
-            if isinstance(domain, m.NumericDomain) and isinstance(domain.low, m.Number) \
-                    and isinstance(domain.high, m.Number) and domain.low.value > domain.high.value:
-                ctx.report("empty-domain", f"[{domain.low.value:g}, {domain.high.value:g}] holds no value of "
-                           f"'{attr.name}': write the low bound first", domain.span)
+            low, high = visitor.numeric_bounds(domain) if isinstance(domain, m.NumericDomain) else (0, 0)
+            if low > high and domain is not None:
+                ctx.report("empty-domain", f"[{low:g}, {high:g}] holds no value of '{attr.name}': write the low "
+                           "bound first", domain.span)
             if attr.role == "outputs" and attr.name not in visitor.restricted and base.name not in completed:
                 ctx.report("output-never-set", f"no rule deduces output '{attr.name}'", attr.span)
         for init in base.inits:
             declared = visitor.declared.get(init.name)
             if declared is None:
                 ctx.warn("init-undeclared", f"'init @{init.name}' for an attribute that is not declared", init.span)
+            else:
+                check_init_value(ctx, visitor, declared, init)
+
+
+def check_init_value(ctx: Context, visitor: RuleVisitor, declared: m.AttrDecl, init: m.InitDecl) -> None:
+    """The value `init @x = ...` gives is one `x` may take: the first cycle reads it as `@x`."""
+    domain = declared.domain
+    value = literal(init.value, visitor.constants)
+    if isinstance(init.value, m.AttrRef) and init.value.name.lower() in BOOL_WORDS:
+        value = init.value.name.lower() == "true"
+    if domain is None or value is None and not isinstance(domain, m.BoolDomain):
+        return
+    if isinstance(domain, m.SymbolDomain):
+        allowed = [v.value for v in domain.values if isinstance(v, (m.String, m.Number))]
+        if value not in allowed:
+            ctx.report("value-outside-domain", f"{value!r} is not a value of '{declared.name}' (domain: "
+                       f"{', '.join(repr(a) for a in allowed)}){did_you_mean(str(value), [str(a) for a in allowed])}",
+                       init.value.span)
+    elif isinstance(domain, m.BoolDomain):
+        if not isinstance(value, bool):
+            ctx.report("type-mismatch", f"'{declared.name}' is a bool: its init is true or false, not {value!r}",
+                       init.value.span)
+    else:
+        low, high = visitor.numeric_bounds(domain)
+        if not isinstance(value, (int, float)) or not low <= value <= high:
+            ctx.report("value-outside-domain", f"{value!r} is not a value of '{declared.name}', which lies in "
+                       f"[{low:g}, {high:g}]", init.value.span)

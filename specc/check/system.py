@@ -6,7 +6,7 @@ service exactly the inputs it takes, with values of their types."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from specc.check.codels import check_call, python_functions
@@ -232,7 +232,7 @@ def check_missions(ctx: Context, system: m.System, worlds: dict[str, m.Setting])
                 ctx.report("goal-without-supervisor", f"mission '{mission.name}' posts a goal, but system "
                            f"'{system.name}' has no supervisor to achieve it: give it 'supervisor: NAME;'", goal.span)
             elif supervisor is not None:
-                check_mission_goal(ctx, goal, goals, supervisor.name)
+                check_mission_goal(ctx, goal, goals, supervisor.name, supervisor.predicates)
                 check_goal_values(ctx, goal, supervisor, needs)
 
 
@@ -419,7 +419,8 @@ def achievable_goals(procedures: m.Procedures) -> dict[str, int]:
     return goals
 
 
-def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], procedures: str) -> None:
+def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], procedures: str,
+                       predicates: Sequence[m.PredicateDecl] = ()) -> None:
     if goal.op not in MISSION_GOAL_OPS:
         ctx.report("bad-mission-goal", f"a mission asks to achieve '!(...)' or test '?(...)', not '{goal.op}(...)'",
                    goal.span)
@@ -428,6 +429,15 @@ def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], proced
         if isinstance(node, m.LogicVar | m.ProgramVar):
             ctx.report("unbound-variable", f"'{node.name}' has no value in a mission: give a constant", node.span)
     body = goal.body
+    if goal.op == "?":  # a test reads the database: a predicate the procedures declare, or a goal's
+        declared = {p.name: len(p.params) for p in predicates} | goals
+        if body.head not in declared:
+            ctx.report("undefined-predicate", f"procedures '{procedures}' declare no predicate '{body.head}' for "
+                       f"'?({body.head} ...)' to test{did_you_mean(body.head, declared)}", body.span)
+        elif declared[body.head] != len(body.args):
+            ctx.report("arity-mismatch", f"'{body.head}' takes {declared[body.head]} argument(s), {len(body.args)} "
+                       "given", body.span)
+        return
     if goal.op == "!" and body.head not in goals:
         ctx.report("undefined-goal", f"no KA of procedures '{procedures}' is invoked by '!({body.head} ...)'"
                    f"{did_you_mean(body.head, goals)}", body.span)
@@ -443,7 +453,12 @@ def check_goal_values(ctx: Context, goal: m.Goal, procedures: m.Procedures,
     number (a whole number): `needs`, the procedures' `numeric_positions`."""
     for position, arg in enumerate(goal.body.args):
         value = arg.value if isinstance(arg, m.Number | m.String) else arg.text if isinstance(arg, m.Ref) else None
-        problem = goal_argument_problem(procedures, needs, goal.body.head, position, value)
+        shown = f'"{arg.value}"' if isinstance(arg, m.String) else None  # a string, not the symbol it spells
+        outside = argument_outside(procedures, goal.body.head, position, value, shown)
+        if outside is not None:  # the same words and code as the same mistake in a KA
+            ctx.report("value-outside-domain", outside, arg.span)
+            continue
+        problem = number_problem(needs, goal.body.head, position, value, shown)
         if problem is not None:
             ctx.report("bad-argument", problem, arg.span)
 
@@ -457,9 +472,11 @@ def goal_argument_problem(procedures: m.Procedures, needs: Mapping[tuple[str, in
     return argument_outside(procedures, head, position, value) or number_problem(needs, head, position, value)
 
 
-def argument_outside(procedures: m.Procedures, head: str, position: int, value: object) -> str | None:
-    """Why `value`, at `position` among the arguments of a goal `head`, lies outside the finite
-    domain the predicate declares there (None when it lies inside, or nothing says)."""
+def argument_outside(procedures: m.Procedures, head: str, position: int, value: object,
+                     shown: str | None = None) -> str | None:
+    """Why `value` (written `shown`), at `position` among the arguments of a goal `head`, lies
+    outside the finite domain the predicate declares there (None when it lies inside, or nothing
+    says); in the words a KA's argument outside it gets."""
     declared = next((p for p in procedures.predicates if p.name == head), None)
     if declared is None or position >= len(declared.params) or value is None:
         return None
@@ -467,22 +484,24 @@ def argument_outside(procedures: m.Procedures, head: str, position: int, value: 
     allowed = Domains(procedures).values(param.domain)
     if allowed is None or value in allowed:
         return None
-    shown = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
-    return f"{value} is not in the domain of '{param.name}' of {declared.name} ({shown})"
+    listed = ", ".join(str(v) for v in allowed) if len(allowed) <= 12 else describe_domain(param.domain)
+    return (f"'{shown or value}' is not in the domain of {declared.name}'s '{param.name}' ({listed})"
+            f"{did_you_mean(str(value), [str(v) for v in allowed])}")
 
 
 def number_problem(needs: Mapping[tuple[str, int], NumberNeed], head: str, position: int,
-                   value: object) -> str | None:
-    """Why `value` cannot go where the goal's KAs pass argument `position` on to a number: a
-    symbol, or a number with a fraction where a whole one is needed (None when it can)."""
+                   value: object, shown: str | None = None) -> str | None:
+    """Why `value` (written `shown`) cannot go where the goal's KAs pass argument `position` on to
+    a number: a symbol or a string, or a number with a fraction where a whole one is needed (None
+    when it can)."""
     need = needs.get((head, position))
     if need is None or value is None:
         return None
     where = f"argument {position + 1} of {head} reaches {need.reason}"
     if not isinstance(value, int | float) or isinstance(value, bool):
-        return f"{value} is not a number: {where}"
+        return f"{shown or value} is not a number: {where}"
     if need.whole and not float(value).is_integer():
-        return f"{value} is not a whole number: {where}"
+        return f"{shown or value} is not a whole number: {where}"
     return None
 
 

@@ -401,7 +401,9 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
                 if intention.status != "running" and k not in ended:
                     ended.add(k)
                     journal.emit(kernel.now, "goal", goal=goal, status=intention.status)
-            return any(i.status == "running" for _, i in intentions)
+            # One goal failed: so has the mission (docs/language.md), whatever the others do.
+            return any(i.status == "running" for _, i in intentions) and not any(
+                i.status == "failed" for _, i in intentions)
 
         if setup is not None:
             planning.append(_plan_and_execute(robot, setup, timing, journal, parts, limit))
@@ -523,13 +525,13 @@ def _plan_and_execute(robot: Robot, setup: Any, timing: str, journal: FtplanJour
 
 def _outcome(intentions: list[tuple[str, Any]], horizon: float,
              events: Iterable[Mapping[str, Any]]) -> tuple[str, str]:
+    failed = [(goal, intention) for goal, intention in intentions if intention.status == "failed"]
+    if failed:  # the mission ends there: a goal still running would not change the verdict
+        goal, intention = failed[0]
+        return "failed", f"{goal} failed: {why_failed(intention.trace, list(events))}"
     running = [goal for goal, intention in intentions if intention.status == "running"]
     if running:
         return "horizon", f"{', '.join(running)} still running at the {horizon:g} s horizon" + waiting_on(events)
-    failed = [(goal, intention) for goal, intention in intentions if intention.status == "failed"]
-    if failed:
-        goal, intention = failed[0]
-        return "failed", f"{goal} failed: {why_failed(intention.trace, list(events))}"
     return "succeeded", f"every goal achieved ({len(intentions)})"
 
 
@@ -632,7 +634,8 @@ def why_failed(trace: Iterable[Any], events: list[Mapping[str, Any]]) -> str:
     which made it fail), and the last service reply that was a failure before it (what the
     procedures most likely reacted to)."""
     failure = next((entry for entry in trace if " failed" in entry.text or " raised " in entry.text
-                    or entry.text == "fail"), None)  # `fail;`: the statement itself is the reason
+                    or entry.text == "fail"  # `fail;`: the statement itself is the reason
+                    or entry.text.startswith("abandoned: ")), None)
     if failure is None:
         return "no applicable KA succeeded"
     refused = next((e for e in reversed(events) if e["kind"] == "reply" and e["t"] <= failure.time

@@ -331,6 +331,16 @@ def _checked_goal(robot: Any, text: str, specs: Path) -> str:
     head = goal.expr.head
     if goal.op not in ("!", "?") or _has_variables(goal.expr):
         raise RunError(f"--goal {text}: post an achieve '!(...)' or test '?(...)' goal of constants")
+    if goal.op == "?":  # a test reads the database: a predicate the procedures declare (or a goal's)
+        declared = {p.name: p.arity for p in library.predicates} | invoked
+        if head not in declared:
+            from specc.diagnostics import did_you_mean
+
+            raise RunError(f"--goal {text}: procedures '{library.name}' declare no predicate {head}"
+                           f"{did_you_mean(head, declared)}")
+        if declared[head] != len(goal.expr.args):
+            raise RunError(f"--goal {text}: {head} takes {declared[head]} argument(s), {len(goal.expr.args)} given")
+        return text
     if head not in invoked:
         from specc.diagnostics import did_you_mean
 
@@ -338,13 +348,6 @@ def _checked_goal(robot: Any, text: str, specs: Path) -> str:
                        f"{did_you_mean(head, invoked)}")
     if invoked[head] != len(goal.expr.args):
         raise RunError(f"--goal {text}: {head} takes {invoked[head]} argument(s), {len(goal.expr.args)} given")
-    from specc.runtime.supervisor import match
-
-    triggers = [ka.trigger for ka in library.kas if ka.goal_invoked and ka.trigger.head == head]
-    if not any(match(trigger, goal.expr, {}) for trigger in triggers):  # `!(GO-PLACE E)`, no KA for E
-        shown = ", ".join(f"!{trigger}" for trigger in triggers)
-        raise RunError(f"--goal {text}: no KA of procedures '{library.name}' is invoked by it (they are invoked by "
-                       f"{shown})")
     procedures = _procedures_of(specs, library.name)
     if procedures is not None:  # the domains and numbers the goal's KAs need, as check holds a mission's goals to
         from specc.check.system import goal_argument_problem, numeric_positions
@@ -354,6 +357,13 @@ def _checked_goal(robot: Any, text: str, specs: Path) -> str:
             problem = goal_argument_problem(procedures, needs, head, position, value)
             if problem is not None:
                 raise RunError(f"--goal {text}: {problem}")
+    from specc.runtime.supervisor import match
+
+    triggers = [ka.trigger for ka in library.kas if ka.goal_invoked and ka.trigger.head == head]
+    if not any(match(trigger, goal.expr, {}) for trigger in triggers):  # `!(GO-PLACE E)`, no KA for E
+        shown = ", ".join(dict.fromkeys(f"!{trigger}" for trigger in triggers))
+        raise RunError(f"--goal {text}: no KA of procedures '{library.name}' is invoked by it (they are invoked by "
+                       f"{shown})")
     return text
 
 

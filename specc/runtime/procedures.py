@@ -183,6 +183,9 @@ class Primitive:
     binding: str  # "python.module.function", called as function(ctx, *args); "" for a service
     returns: bool = False
     service: str = ""  # an executive service requested with the arguments; the value is the request's id
+    # The values its result may take when the spec gives a finite domain (`-> {OK, BLOCKED}`): what
+    # `specc verify --goal` assumes it returns, so the supervisor refuses any other.
+    domain: tuple[Any, ...] | None = None
 
 
 @dataclass(frozen=True)

@@ -19,11 +19,14 @@ class Decision(NamedTuple):
     def ok(self) -> bool:
         return not (self.inconsistent or self.incomplete or self.impossible)
 
-    def keeping(self, kept: tuple[str, ...], inputs: Mapping[str, Any]) -> Decision:
-        """This decision with the outputs it left as they were at their previous-cycle value (`@name`)."""
+    def keeping(self, kept: tuple[str, ...], inputs: Mapping[str, Any],
+                initial: Mapping[str, Any] | None = None) -> Decision:
+        """This decision with the outputs it left as they were at their previous-cycle value
+        (`@name`; its `init`, in `initial`, when the inputs leave it out)."""
         outputs = dict(self.outputs)  # a fresh mapping for each call: the leaf's own stays shared and read-only
         for name in kept:
-            outputs[name] = inputs["@" + name]
+            previous = "@" + name
+            outputs[name] = inputs[previous] if initial is None or previous in inputs else initial[previous]
         return Decision(outputs, self.inconsistent, self.incomplete, self.impossible)
 
 

@@ -70,6 +70,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import math
 import random
 from collections import deque
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
@@ -312,6 +313,9 @@ def _discard(facts: list[tuple[Any, ...]], args: tuple[Any, ...]) -> bool:
 
 
 TRACE_LENGTH = 10_000  # trace entries kept per intention
+# Steps one intention may run at one kernel instant: a KA's goal takes one step, and a task
+# reacting to an event takes tens; a loop that never waits takes them without end.
+STEPS_PER_INSTANT = 100_000
 
 
 class TraceEntry(NamedTuple):
@@ -350,6 +354,7 @@ class _Frame:
     env: dict[str, Any]
     intention: Intention
     guards: list[Goal] = field(default_factory=list)  # #C and %C, until the KA ends
+    said: str = ""  # the last thing the trace recorded of it since it started: why it failed, when it did
 
     @property
     def name(self) -> str:
@@ -384,6 +389,8 @@ class _Thread:
     pending: _GuardBroken | None = None  # to raise in the body when it next runs
     outcome: bool | None = None
     detached: bool = False  # a sibling branch failed: nobody waits for this one any more
+    failure: str = ""  # why the KA that last ended on this thread failed (`line N: what`)
+    at: tuple[str, Goal] | None = None  # the KA and the goal it pursues now
 
 
 class PrimitiveContext:
@@ -475,6 +482,8 @@ class Supervisor:
         self._blocked: dict[_Thread, None] = {}  # insertion-ordered, so waking keeps turns fair
         self._version = 0  # counts database changes and thread ends
         self._steps = 0
+        self._instant = -math.inf  # the kernel time `_spent` counts at
+        self._spent: dict[int, int] = {}  # steps each intention (by id) ran at that instant
         self._turn_pending = False
         if executive is not None:
             executive.listeners.append(self._on_message)
@@ -531,7 +540,27 @@ class Supervisor:
         if not self._runnable:
             return False
         self._steps += 1
-        self._advance(self._runnable.popleft())
+        thread = self._runnable.popleft()
+        if self.kernel is None or not self._spinning(thread):
+            self._advance(thread)
+        return True
+
+    def _spinning(self, thread: _Thread) -> bool:
+        """Has the thread's intention run STEPS_PER_INSTANT steps at this instant? Then it is a
+        loop that never waits (`while ?(>= @N 0) { assign ...; }`), which would hold the kernel
+        at this instant for ever (the robot's time stops): the intention is abandoned, saying
+        where it stood, and the robot goes on."""
+        assert self.kernel is not None
+        now = self.kernel.now
+        if now != self._instant:
+            self._instant, self._spent = now, {}
+        intention = thread.intention
+        spent = self._spent[id(intention)] = self._spent.get(id(intention), 0) + 1
+        if spent <= STEPS_PER_INSTANT:
+            return False
+        where = f" (at {thread.at[0]}:{thread.at[1].line}: {thread.at[1]})" if thread.at is not None else ""
+        self.abandon(intention, f"it ran {STEPS_PER_INSTANT:,} steps at {now:g} s with no time passing{where}: a "
+                                "loop that never waits; let it wait for something (`^(...)`, a service's reply)")
         return True
 
     def run(self, max_steps: int = 100_000) -> None:
@@ -643,6 +672,7 @@ class Supervisor:
         when = self.kernel.now if self.kernel is not None else float(self._steps)
         frame.intention.trace.append(TraceEntry(when, frame.name, line, text))
         frame.intention.traced += 1
+        frame.said = f"line {line}: {text}"
 
     # ------------------------------------------------------------ running KAs
     def _run_top(self, thread: _Thread, frame: _Frame, goal: Goal) -> _Body:
@@ -659,6 +689,7 @@ class Supervisor:
         frame = _Frame(ka, env, thread.intention)
         thread.frames.append(frame)
         self._record(frame, ka.line, f"started for {why}")
+        frame.said = ""
         try:
             if ka.action is not None:
                 succeeded = self._act(frame, ka.action)
@@ -678,6 +709,7 @@ class Supervisor:
             succeeded = False
         finally:
             thread.frames.remove(frame)
+        thread.failure = "" if succeeded else frame.said or f"line {ka.line}: failed"
         self._record(frame, ka.line, "succeeded" if succeeded else "failed")
         return succeeded
 
@@ -782,6 +814,7 @@ class Supervisor:
     # ------------------------------------------------------------ goals
     def _pursue(self, thread: _Thread, frame: _Frame, goal: Goal) -> _Pursuit:
         """Achieve, test, wait for, conclude or retract: why it failed, or None."""
+        thread.at = (frame.name, goal)
         yield None  # one goal per step: what bounds the work of a step
         try:
             op, expr = goal.op, goal.expr
@@ -837,12 +870,12 @@ class Supervisor:
             env = self._context(frame, goal, ka, invoked)
             if env is None:
                 self._record(frame, goal.line, f"{ka.name}: context no longer holds")
-                tried.append(ka.name)
+                tried.append(f"{ka.name}: its context no longer holds")
                 continue
             if (yield from self._run_ka(thread, ka, env, str(instance))):
                 return self._give_back(frame, expr, ka, env)
-            tried.append(ka.name)
-        return f"every applicable KA failed ({', '.join(tried)})"
+            tried.append(f"{ka.name}: {thread.failure}")  # why each failed: the cause, however deep
+        return f"every applicable KA failed ({'; '.join(tried)})"
 
     def _applicable(self, frame: _Frame, goal: Goal, instance: Compound) -> list[tuple[KA, dict[str, Any]]]:
         """The KAs whose invocation matches and whose context holds, in the order to try them.
@@ -1164,6 +1197,9 @@ class Supervisor:
             value = function(PrimitiveContext(self, frame, action.line, candidates), *args)
         except Exception as exc:
             raise ExecutionError(f"{resolve(call, env)} raised {type(exc).__name__}: {exc}", action.line) from None
+        if primitive.domain is not None and not any(_same(value, allowed) for allowed in primitive.domain):
+            raise ExecutionError(f"{resolve(call, env)} returned {value!r}, which is not in the domain of its result "
+                                 f"({', '.join(map(show, primitive.domain))})", action.line)
         self._record(frame, action.line, f"{resolve(call, env)}" + (f" -> {value!r}" if primitive.returns else ""))
         return value
 

@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 
 from specc import disk_cache
-from specc.diagnostics import Diagnostic, error
+from specc.diagnostics import Diagnostic, display_path, error
 from specc.model.span import Span
 from specc.resources import grammar_path
 from specc.syntax.parsed import ParseResult
@@ -98,13 +98,6 @@ def _specs_in(folder: Path) -> tuple[list[Path], list[Diagnostic]]:
              for root, _, names in os.walk(folder, onerror=report)
              for name in names if name.endswith(SPEC_SUFFIX)]
     return sorted(p for p in found if p.is_file()), unreadable
-
-
-def display_path(path: Path) -> str:
-    try:
-        return str(path.resolve().relative_to(Path.cwd()))
-    except ValueError:
-        return str(path)
 
 
 def read_source(path: Path) -> tuple[str | None, Diagnostic | None]:

@@ -7,6 +7,7 @@ each is written back before (or at the end of the line of) the element it preced
 from __future__ import annotations
 
 import bisect
+import re
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -369,14 +370,37 @@ class Printer:
 
     @contextmanager
     def block(self, header: str, anchor: Span | None, footer: str = "}") -> Iterator[None]:
-        """A `header {` ... `footer` block. Sections with no node of their own pass no anchor:
-        their first element's comments then stay with that element, and the comments after
-        their last one go with whatever follows the section."""
+        """A `header {` ... `footer` block, its comments kept where the source has them."""
         self.line(header + " {", anchor)
         self.depth += 1
         yield
         self.depth -= 1
         self.closing(footer, anchor)
+
+    @contextmanager
+    def section(self, keyword: str, first: Span | None) -> Iterator[None]:
+        """A `keyword {` ... `}` section with no node of its own (`internal_data`, `conflicts`):
+        the keyword, found in the source just before the section's first element, anchors the
+        comments written above it; the comments after its last element go with whatever
+        follows the section."""
+        self.line(keyword + " {", self._keyword_before(keyword, first))
+        self.depth += 1
+        yield
+        self.depth -= 1
+        self.out.append(INDENT * self.depth + "}")
+
+    def _keyword_before(self, keyword: str, first: Span | None) -> Span | None:
+        """Where `keyword {` is written last before `first`, as a span of the keyword."""
+        if first is None or first.file == "<unknown>" or not 1 <= first.line <= len(self.source_lines):
+            return None
+        before = "\n".join(self.source_lines[:first.line - 1] + [self.source_lines[first.line - 1][:first.column - 1]])
+        matches = list(re.finditer(rf"(?<![\w-]){re.escape(keyword)}\s*\{{", before))
+        if not matches:
+            return None
+        found = matches[-1]
+        line = before.count("\n", 0, found.start()) + 1
+        column = found.start() - (before.rfind("\n", 0, found.start()) + 1) + 1
+        return Span(first.file, line, column, line, column + len(keyword))
 
     def props(self, node: Any) -> None:
         for f in property_fields(type(node)):
@@ -411,7 +435,7 @@ class Printer:
             for e in node.enums:
                 self.line(f"enum {e.name} {{ {', '.join(e.values)} }}", e.span)
             if node.internal_data:
-                with self.block("internal_data", None):
+                with self.section("internal_data", node.internal_data[0].span):
                     self.fields(node.internal_data)
             for r in node.requests:
                 with self.block(f"request {r.name}", r.span):
@@ -449,14 +473,14 @@ class Printer:
     def service(self, s: m.Service) -> None:
         self.props(s)
         if s.args:
-            with self.block("args", None):
+            with self.section("args", s.args[0].span):
                 for a in s.args:
                     self.line(f"{a.name}: {prop_value(a.value)};", a.span)
         if s.timeout is not None:
             with self.block("timeout", s.timeout.span):
                 self.props(s.timeout)
         if s.conflicts:
-            with self.block("conflicts", None):
+            with self.section("conflicts", s.conflicts[0].span):
                 for c in s.conflicts:
                     self.line(f"{c.service}: {c.policy};", c.span)
 
@@ -534,7 +558,7 @@ class Printer:
             with self.block("body", ka.body.span):
                 self.statements(ka.body)
         if ka.effects:
-            with self.block("effects", None):
+            with self.section("effects", ka.effects[0].span):
                 for g in ka.effects:
                     self.line(goal(g) + ";", g.span)
         if ka.documentation is not None:
@@ -631,14 +655,14 @@ class Printer:
                 with self.block(f"planner {p.name}", p.span):
                     self.props(p)
                     if p.view:
-                        with self.block("view", None):
+                        with self.section("view", p.view[0].span):
                             self.correspondences(p.view)
             if node.analyzer:
-                with self.block("analyzer", None):
+                with self.section("analyzer", node.analyzer[0].span):
                     for rule in node.analyzer:
                         self.analyzer_rule(rule)
             if node.state_updates:
-                with self.block("state", None):
+                with self.section("state", node.state_updates[0].span):
                     for update in node.state_updates:
                         self.state_update(update)
             for mission in node.missions:
@@ -719,7 +743,7 @@ def print_source(source: m.SourceFile) -> str:
 
 def format_source(source: m.SourceFile, text: str, comments: list[Comment]) -> str:
     """Canonical text of one file, keeping its comments (what `specc fmt` writes)."""
-    dry = Printer()
+    dry = Printer(None, text)
     dry.source_file(source)
     placed = _place_comments(comments, dry.anchors, text)
     printer = Printer(placed, text)

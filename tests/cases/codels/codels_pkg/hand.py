@@ -24,6 +24,7 @@ def hold(sdi, request, *rest):
     if sdi.stuck:
         sdi.send_request("arm.Grab")  # a request Grip's `sends:` does not list
         sdi.send_request("arm.Grap")  # no module has it
+        sdi.send_request("arm." + sdi.next)  # a name no analysis can follow
         return "exec" if sdi.busy else "ehter"  # a typo on one side of a conditional
     return "SLIP" if inner() else "ether"
 
