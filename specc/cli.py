@@ -41,6 +41,8 @@ app = typer.Typer(
 # property refuted, no plan, a mission failed). check, fmt, compile, rules and skeleton judge the
 # specs: their errors are that verdict (1). docs/reference.md, "Exit codes".
 BAD_INPUT = 2
+MOST_WORKERS = 256  # processes: more than any machine runs usefully (a larger count overflows a semaphore)
+MOST_PARTIAL_PLANS = 10_000_000  # a search budget past which a planning takes hours, not an answer
 CANNOT_VERIFY = BAD_INPUT
 err = Console(stderr=True, highlight=False, soft_wrap=True, emoji=False)  # `:100:` is a line number
 out = Console(highlight=False, soft_wrap=True, emoji=False)
@@ -549,16 +551,16 @@ def plan(paths: PathsArg,
          json_path: Annotated[Optional[Path], typer.Option("--json", help="Write the plan, its schedule, "
                                                            "partial order and goals as JSON (format: "
                                                            "docs/planning.md); '-' prints it.")] = None,
-         nodes: Annotated[int, typer.Option(min=1, help="Partial plans each search may expand (one for every "
-                                                        "goal at once, then one per goal added).")] = 300,
+         nodes: Annotated[int, typer.Option(max=MOST_PARTIAL_PLANS, min=1, help=(
+             "Partial plans each search may expand (one for every goal at once, then one per goal added)."))] = 300,
          exact: Annotated[bool, typer.Option(help="Exact durations by CasADi (else the interval "
                                                   "enclosures the search computed).")] = True,
          controllability: Annotated[Controllability, typer.Option(
              help="strong: the plan holds whatever nature does; pseudo (IxTeT's): the problem's contingent "
                   "instants one at a time, each anywhere in its bounds.")] = Controllability.strong,
-         improve: Annotated[int, typer.Option(min=0, help="Partial plans spent improving the first plan (goals "
-                                                          "it dropped, then its worst-case makespan); 0: the "
-                                                          "first plan.")] = 300) -> None:
+         improve: Annotated[int, typer.Option(max=MOST_PARTIAL_PLANS, min=0, help=(
+             "Partial plans spent improving the first plan (goals it dropped, then its worst-case makespan); 0: "
+             "the first plan."))] = 300) -> None:
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
     checked by the independent validator.
 
@@ -1043,8 +1045,8 @@ def mutants_command(
                                                          "<domain>-NNNN, e.g. warehouse-0020).")] = None,
         output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write each kept (or sampled) "
                                                        "mutant's spec file and diff into this folder.")] = None,
-        workers: Annotated[Optional[int], typer.Option(min=1, help="Processes checking mutants (default: one "
-                                                                   "per CPU, at most 8).")] = None,
+        workers: Annotated[Optional[int], typer.Option(min=1, max=MOST_WORKERS, help=(
+            "Processes checking mutants (default: one per CPU, at most 8)."))] = None,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
     """Mutate a planning domain on its model (seed 004 §4.1.3), print each mutant back as spec text and
     keep those that pass specc check: a table of counts per class, then the kept mutants.
@@ -1160,8 +1162,8 @@ def campaign(
         domain: Annotated[Optional[str], typer.Option(help="The planning model faults are injected into (default: "
                                                            "the first planner's).")] = None,
         seed: Annotated[int, typer.Option(help="Draws the mutants.")] = 0,
-        workers: Annotated[Optional[int], typer.Option(min=1, help="Experiments at once (default: one per "
-                                                                   "CPU).")] = None,
+        workers: Annotated[Optional[int], typer.Option(min=1, max=MOST_WORKERS, help=(
+            "Experiments at once (default: one per CPU)."))] = None,
         scheduler: Annotated[Optional[str], typer.Option(help="Run on Dask distributed: a scheduler's address "
                                                               "(tcp://host:8786), or 'local' for a local "
                                                               "cluster.")] = None,

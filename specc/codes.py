@@ -169,6 +169,11 @@ CODES: dict[str, Code] = {
                                       "(t_o - t_start) in [10, 20];  (t_c - t_start) in [50, 60];  t_c < t_o;"),
     "event-without-transition": Code("an event that does not change the value", "event(AT(): (A, A), t);"),
     "hold-transition": Code("a hold given a transition", "hold(AT(): (A, B), (t1, t2));"),
+    "bad-goal": Code("a problem goal's priority or weight is not a finite number",
+                     "hold(AT(): DOCK, (t1, t_end)) goal(2, NaN);"),
+    "statement-outside-problem": Code("a fragment a domain includes holds a statement (a constraint, an "
+                                      "assertion): a domain declares, a problem states",
+                                      "fragment rel { ?x in [0, 1]; }  domain d { include rel; }"),
     "goal-outside-problem": Code("a goal in a task: goals belong to a problem (or a fragment it includes)",
                                  "hold(AT(): DOCK, (t1, t2)) goal(1, 0);   (inside a task)"),
     "no-goals": Code("a problem with no goal", "problem quiet for d { ... }"),

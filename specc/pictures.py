@@ -12,6 +12,23 @@ from specc.analysis import petri
 from specc.analysis.incompat import IncompatibilityGraph, service_groups, state_count
 
 GROUP_COLOURS = ("#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c")
+# For the service groups of a large executive: twenty colours told apart, the first eight as above.
+MANY_COLOURS = (*GROUP_COLOURS, "#ccb974", "#64b5cd", "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                "#8c564b", "#e377c2", "#bcbd22", "#17becf", "#393b79")
+
+
+def incompatibility_layout(graph: IncompatibilityGraph) -> tuple[list[str], dict[str, str], list[str]]:
+    """The services in their order round the circle, each one's colour, and each group's colour.
+    A group's services sit side by side (its arcs short, the group one stretch of the circle),
+    the services of no group after them, each in the order the executive lists them; groups get
+    colours of their own (twenty before one repeats)."""
+    groups = service_groups(graph)
+    palette = GROUP_COLOURS if len(groups) <= len(GROUP_COLOURS) else MANY_COLOURS
+    group_colour = [palette[i % len(palette)] for i in range(len(groups))]
+    colour = {s: group_colour[i] for i, g in enumerate(groups) for s in g.services}
+    rank = {s: i for i, g in enumerate(groups) for s in g.services}
+    ordered = sorted(graph.services, key=lambda s: (rank.get(s, len(groups)), graph.services.index(s)))
+    return ordered, colour, group_colour
 
 
 def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title: str) -> Path:
@@ -22,43 +39,54 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
     from matplotlib.patches import FancyArrowPatch
 
     groups = service_groups(graph)
-    colour = {s: GROUP_COLOURS[i % len(GROUP_COLOURS)] for i, g in enumerate(groups) for s in g.services}
-    count = len(graph.services)
+    ordered, colour, group_colour = incompatibility_layout(graph)
+    count = len(ordered)
     radius = 1.0
-    position = {s: (radius * math.cos(2 * math.pi * i / count + math.pi / 2),
-                    radius * math.sin(2 * math.pi * i / count + math.pi / 2))
-                for i, s in enumerate(graph.services)}
+    angle = {s: 2 * math.pi * i / count + math.pi / 2 for i, s in enumerate(ordered)}
+    position = {s: (radius * math.cos(a), radius * math.sin(a)) for s, a in angle.items()}
     size = max(6.0, 0.45 * count + 4)
+    labels = {s: s + (" (control)" if s in graph.control else "") for s in ordered}
+    longest = max((len(label) for label in labels.values()), default=0)
+    # Room for the labels along the radius: a 9 pt character is about 5.4 pt wide, in data units
+    # that depend on the room itself (two rounds settle it).
+    reach = 1.2 + 0.018 * longest
+    for _ in range(2):
+        reach = 1.15 + longest * 5.4 / 72 * (2 * reach + 0.1) / (0.75 * size)
+    # A node's marker radius in data units (420 pt² markers; the axes take about 3/4 of the width).
+    marker = math.sqrt(420 / math.pi) / 72 * (2 * reach + 0.1) / (0.75 * size)
     figure, axes = plt.subplots(figsize=(size, size))
     for arc in graph.arcs:
         start, end = position[arc.source], position[arc.target]
         style = "-" if arc.policy == "interrupt" else "--"
-        if arc.source == arc.target:  # a loop on the inner side of the node, clear of its marker
+        if arc.source == arc.target:  # a loop on the inner side of the node, touching its marker
             x, y = start
             ux, uy = x / radius, y / radius  # the node's direction from the centre
             tx, ty = -uy, ux
-            inner = (x - 0.12 * ux, y - 0.12 * uy)
-            axes.add_patch(FancyArrowPatch((inner[0] + 0.06 * tx, inner[1] + 0.06 * ty),
-                                           (inner[0] - 0.06 * tx, inner[1] - 0.06 * ty),
-                                           connectionstyle="arc3,rad=1.6", arrowstyle="-|>", mutation_scale=10,
-                                           linestyle=style, color="#555555", zorder=4))
+            inner = (x - 0.9 * marker * ux, y - 0.9 * marker * uy)
+            axes.add_patch(FancyArrowPatch((inner[0] + 0.6 * marker * tx, inner[1] + 0.6 * marker * ty),
+                                           (inner[0] - 0.6 * marker * tx, inner[1] - 0.6 * marker * ty),
+                                           connectionstyle="arc3,rad=2.2", arrowstyle="-|>", mutation_scale=9,
+                                           linestyle=style, color="#555555", zorder=2))
             continue
         axes.add_patch(FancyArrowPatch(start, end, connectionstyle="arc3,rad=0.08", arrowstyle="-|>",
                                        mutation_scale=12, shrinkA=14, shrinkB=14, linestyle=style,
                                        color="#555555", linewidth=0.9))
     for service, (x, y) in position.items():
         shade = colour.get(service, "#ffffff")
-        kind = " (control)" if service in graph.control else ""
         axes.scatter([x], [y], s=420, color=shade, edgecolors="black", zorder=3)
-        axes.annotate(service + kind, (x, y), xytext=(x * 1.18, y * 1.18), ha="center", va="center", fontsize=9)
+        # Along the radius, outwards from its node: labels of neighbours never overlap.
+        degrees = math.degrees(angle[service]) % 360
+        left = 90 < degrees < 270
+        axes.text(x * 1.1, y * 1.1, labels[service], rotation=degrees - 180 if left else degrees,
+                  rotation_mode="anchor", ha="right" if left else "left", va="center", fontsize=9)
     legend = [f"{g.name}: {' | '.join(g.states)}" for g in groups]
     plural = "" if len(groups) == 1 else "s"
     axes.set_title(f"{title}\n{len(groups)} service group{plural}, {state_count(groups)} controller states "
                    "(solid: interrupt, dashed: wait)", fontsize=11)
     for i, line in enumerate(legend):
-        axes.text(-1.45, -1.35 - 0.09 * i, line, fontsize=9, color=GROUP_COLOURS[i % len(GROUP_COLOURS)])
-    axes.set_xlim(-1.5, 1.5)
-    axes.set_ylim(-1.45 - 0.09 * len(legend), 1.4)
+        axes.text(-reach, -reach - 0.09 * i, line, fontsize=9, color=group_colour[i])
+    axes.set_xlim(-reach - 0.05, reach + 0.05)
+    axes.set_ylim(-reach - 0.1 - 0.09 * len(legend), reach)
     axes.set_aspect("equal")
     axes.axis("off")
     target.parent.mkdir(parents=True, exist_ok=True)

@@ -384,6 +384,7 @@ def test_codels_that_cannot_be_imported_are_bad_input_said_before_anything_runs(
     (("--goal", "!(GO A 1)"), "A is not a number: argument 1 of GO reaches 'x' (float) of action GOTO"),
     (("--goal", "!(GO 1 2)", "--mission", "deliver"), "give --mission or --goal, not both"),
     (("--config", "Robot1"), "--config: mission deliver of robot 'cart' is not planned"),
+    (("--wall-limit", "1e308"), "--wall-limit 1e+308: give a positive number of seconds, at most 3.1536e+07"),
 ])
 def test_bad_run_options_are_one_clear_message_and_leave_no_run_folder(cart: Path, args: tuple[str, ...],
                                                                         message: str) -> None:

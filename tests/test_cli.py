@@ -364,6 +364,10 @@ def test_compile_refuses_a_package_name_python_cannot_import(tmp_path: Path) -> 
     result = specc("compile", "class.spec", "-o", "out", cwd=tmp_path)
     assert result.returncode == 1 and "not a valid Python package name" in result.stderr
     assert not (tmp_path / "out").exists()
+    for shadowed in ("sys", "specc"):  # importable names, but another module answers to them
+        named = specc("compile", "class.spec", "-o", "out", "--robot", shadowed, cwd=tmp_path)
+        assert named.returncode == 1 and f"'{shadowed}' names a module Python imports first" in named.stderr
+    assert not (tmp_path / "out").exists()
 
 
 def python(script: str, cwd: Path) -> subprocess.CompletedProcess[str]:
@@ -667,6 +671,7 @@ def test_an_output_that_cannot_be_written_stops_plan_and_graph_before_any_work(t
         (("plan", tug, "--problem", "shuttle", "-o", str(tmp_path / "plan.txt")), "matplotlib writes no '.txt'"),
         (("plan", tug, "--problem", "shuttle", "--json", str(tmp_path / "taken")), "is a folder: give a file name"),
         (("graph", "--incompat", tug, "-o", str(tmp_path / "graph.docx")), "end the name with .png, .svg or .pdf"),
+        (("plan", tug, "--problem", "shuttle", "-o", str(tmp_path / "noext")), "end the picture's name with .png"),
     ]
     for arguments, said in cases:
         result = specc(*arguments)

@@ -149,3 +149,31 @@ def test_a_nets_without_marked_places_still_draws(tmp_path: Path) -> None:
     net.transition("from nowhere", [], [Arc("LONELY")])
     labels = svg_texts(draw_net(net, tmp_path / "cycle.svg", "cycle"))
     assert {"A", "B", "C", "LONELY", "ab", "bc", "ca", "from nowhere"} <= set(labels)
+
+
+def test_the_incompatibility_graph_puts_each_group_together_in_a_colour_of_its_own(tmp_path: Path) -> None:
+    """Twenty services in ten groups, declared interleaved: round the circle each group's services
+    sit side by side, and no two groups share a colour (eight colours once made the ninth group
+    look like the first); the picture is written."""
+    from specc.analysis.incompat import build_graph
+    from specc.pictures import draw_incompatibility_graph, incompatibility_layout
+    from specc.pipeline import load
+
+    pairs = [(f"A{k}", f"B{k}") for k in range(10)]
+    request = "  request {} {{ type: exec; task: T; codel exec: go; incompatible_with: A, B; }}\n"
+    modules = "\n".join(f"module m{k} {{\n" + request.format("A") + request.format("B")
+                        + "  exec_task T { period: 100 ms; }\n}" for k in range(10))
+    services = "\n".join(f"  service {a} {{ request: m{k}.A; }}" for k, (a, _) in enumerate(pairs)) + "\n" + "\n".join(
+        f"  service {b} {{ request: m{k}.B; }}" for k, (_, b) in enumerate(pairs))
+    spec = tmp_path / "robot.spec"
+    spec.write_text(modules + f"\nexecutive e {{\n{services}\n}}\n")
+    (tmp_path / "codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    loaded = load([spec], check=False)
+    assert loaded.program is not None
+    executive = next(i for i in loaded.program.items if type(i).__name__ == "Executive")
+    graph = build_graph(loaded.program, executive)
+    ordered, colour, group_colours = incompatibility_layout(graph)
+    assert len(set(group_colours)) == len(group_colours) == 10
+    for a, b in pairs:
+        assert abs(ordered.index(a) - ordered.index(b)) == 1 and colour[a] == colour[b]
+    assert draw_incompatibility_graph(graph, tmp_path / "incompat.png", "e").stat().st_size > 0

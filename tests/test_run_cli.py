@@ -296,6 +296,7 @@ def test_a_failed_mission_says_each_reason_once_and_its_summary_cuts_it_short() 
     assert brief_why("every goal achieved (9)") == "every goal achieved (9)"
     run = MissionRun("tug", "shuttle", "blocked", 0, "failed", why, (), 893.0, 29.0, 8.6, 51, {}, (), ())
     assert run.summary().splitlines()[0] == f"tug's mission shuttle in blocked (seed 0): failed: {brief}"
+    assert run.summary().splitlines()[-1] == "  893 s of mission in 29.0 s of wall time (31x real time)"
     report = {"mission": "shuttle", "world": "blocked", "outcome": "failed", "why": why, "measures": {}}
     table = SweepResult("tug", [RunOutcome(Path("runs/tug-shuttle-blocked-s0"), "tug", report, run.summary())])
     assert f"- tug-shuttle-blocked-s0 (failed): {brief}\n" in table.markdown()

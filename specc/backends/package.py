@@ -13,6 +13,7 @@ from pathlib import Path
 from specc.backends.env import render
 from specc.backends.manifest import Output, describe_sources, header
 from specc.model import nodes as m
+from specc.pysource import shadowed_by_the_standard_library
 
 BACKEND = "package"
 
@@ -57,6 +58,10 @@ def package_name(program: m.Program, specs: Path, robot: str | None = None) -> s
     if not name.isidentifier() or keyword.iskeyword(name):  # `import class` cannot be written
         raise ValueError(f"'{name}' is not a valid Python package name; pass --robot NAME or rename the system "
                          "block")
+    if shadowed_by_the_standard_library(name) or name == "specc":  # `import sys` would never reach it
+        owner = "specc" if name == "specc" else "the standard library's"
+        raise ValueError(f"'{name}' names a module Python imports first ({owner}): the package would never be "
+                         "imported; pass --robot NAME or rename the system block")
     return name
 
 

@@ -7,6 +7,7 @@ attributes and macros known with the right arity, symbolic values inside their d
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -164,6 +165,22 @@ class Scope:
     goals_allowed: bool = False
 
 
+def constant_number(expr: Any) -> float | None:
+    """The finite value of an IxTeT expression of numbers alone (`2`, `-1`, `3 * 60`), else None."""
+    if isinstance(expr, m.Number):
+        return expr.value if math.isfinite(expr.value) else None
+    if isinstance(expr, m.IxUnary) and expr.op == "-":
+        inner = constant_number(expr.operand)
+        return None if inner is None else -inner
+    if isinstance(expr, m.IxBinary) and expr.op in ("+", "-", "*", "/"):
+        left, right = constant_number(expr.left), constant_number(expr.right)
+        if left is None or right is None or (expr.op == "/" and right == 0):
+            return None
+        value = {"+": left + right, "-": left - right, "*": left * right}.get(expr.op, left / right)
+        return value if math.isfinite(value) else None
+    return None
+
+
 class ScopeChecker(Visitor):
     def __init__(self, ctx: Context, domain: DomainTables):
         self.ctx = ctx
@@ -202,6 +219,12 @@ class ScopeChecker(Visitor):
             if goal is not None and not scope.goals_allowed:
                 self.ctx.report("goal-outside-problem",
                                 "goals belong to a problem (or a fragment it includes), not to a task", goal.span)
+            elif goal is not None:
+                for what, part in (("priority", goal.priority), ("weight", goal.weight)):
+                    if constant_number(part) is None:
+                        self.ctx.report("bad-goal", f"a goal's {what} is a finite number (goal(priority, "
+                                        "weight), e.g. goal(2, 0)): the planner keeps the goals of highest "
+                                        "priority first", part.span)
             self.visit(statement)
         if scope.kind in ("task", "problem"):
             for statement in body:
@@ -419,9 +442,18 @@ def check_members(ctx: Context, tables_: DomainTables) -> None:
 
 def check(ctx: Context) -> None:
     domains: dict[str, DomainTables] = {}
+    misplaced: set[int] = set()  # statements said misplaced already (a fragment several domains include)
     for domain in ctx.items(m.Domain):
         domains[domain.name] = tables(ctx, domain.members)
         check_members(ctx, domains[domain.name])
+        for member in domains[domain.name].members:  # what a fragment it includes brings
+            if not isinstance(member, (m.Constant, m.Attribute, m.Resource, m.Macro, m.Task)) \
+                    and id(member) not in misplaced:
+                misplaced.add(id(member))
+                ctx.report("statement-outside-problem", f"domain '{domain.name}' includes this statement (through "
+                           "a fragment), but a domain declares constants, attributes, resources, macros and "
+                           "tasks only: a statement belongs to a problem, or to a fragment only problems include",
+                           member.span)
     for problem in ctx.items(m.Problem):
         target = ctx.lookup(m.Domain, problem.domain, problem.domain.span, "undefined-domain")
         if target is None:

@@ -46,7 +46,10 @@ def writable_file(path: Path, option: str, file: str, folder: str, example: str,
     what is asked for ("the table's file", "the table's folder"); `example` a file name to give."""
     if path.is_dir():
         raise RunError(f"{option} '{path}' is a folder: give {file}, e.g. {path / example}")
-    if picture and path.suffix:
+    if picture and not path.suffix:  # matplotlib would write NAME.png, not the file named
+        raise RunError(f"{option} '{path}': end the picture's name with .png, .svg or .pdf, e.g. "
+                       f"{path.with_name(path.name + '.png')}")
+    if picture:
         from matplotlib.backend_bases import FigureCanvasBase
 
         formats = FigureCanvasBase.get_supported_filetypes()

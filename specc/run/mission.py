@@ -238,7 +238,8 @@ class MissionRun:
                      f"{len(self.incidents)} incident(s)")
         lines += [f"  incident: {text}" for text in self.incidents[:5]]
         lines += self._measure_lines()
-        lines.append(f"  {self.simulated_time:.0f} s of mission in {self.wall_time:.1f} s of wall time")
+        factor = f" ({self.simulated_time / self.wall_time:.0f}x real time)" if self.wall_time > 0 else ""
+        lines.append(f"  {self.simulated_time:.0f} s of mission in {self.wall_time:.1f} s of wall time{factor}")
         return "\n".join(lines)
 
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import re
 import signal
 import threading
@@ -65,6 +64,9 @@ class Stopped(BaseException):
         super().__init__(why)
         self.why = why
         self.exit_code = exit_code
+
+
+LONGEST_WALL_LIMIT = 365 * 24 * 3600.0  # s: longer, the operating system's timer cannot hold it
 
 
 @contextlib.contextmanager
@@ -178,8 +180,9 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
     RunError when one is wrong. Nothing is written."""
     from specc.run.mission import load_robot
 
-    if request.wall_limit is not None and not (request.wall_limit > 0 and math.isfinite(request.wall_limit)):
-        raise RunError(f"--wall-limit {request.wall_limit:g}: give a positive number of seconds")
+    if request.wall_limit is not None and not 0 < request.wall_limit <= LONGEST_WALL_LIMIT:
+        raise RunError(f"--wall-limit {request.wall_limit:g}: give a positive number of seconds, at most "
+                       f"{LONGEST_WALL_LIMIT:g} (a year)")
     plan = _plan_system(load_robot(request.generated, request.specs, robot), request)
     if request.folder is not None:
         return PlannedRun(robot, request, plan, request.folder)
