@@ -52,6 +52,20 @@ PathsArg = Annotated[list[Path], typer.Argument(help="Spec files, or folders sea
                                                 show_default=False, readable=False)]
 
 
+def finite(value: float | None) -> float | None:
+    """A float option's check: `nan` passes a `min=` and `inf` reads as a number; neither is one."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"{value} is not a finite number of seconds")
+    return value
+
+
+def a_folder(value: Path | None) -> Path | None:
+    """A folder option's check: '-' is the standard output elsewhere, and no folder here."""
+    if value is not None and str(value) == "-":
+        raise typer.BadParameter("'-' names no folder (the standard output is not one): give a folder, e.g. build/out")
+    return value
+
+
 def refuse_unwritable(path: Path | None, what: str, option: str, example: str, picture: bool = False) -> None:
     """Exit at once, before any planning or drawing, when the file `path` cannot be written
     (`specc.run.writable_file`; '-' is the standard output)."""
@@ -139,7 +153,8 @@ def check(paths: PathsArg,
 
 @app.command()
 def compile(paths: PathsArg,
-            output: Annotated[Path, typer.Option("--output", "-o", help="Folder receiving the robot package.")]
+            output: Annotated[Path, typer.Option("--output", "-o", callback=a_folder,
+                                                 help="Folder receiving the robot package.")]
             = Path("generated"),
             robot: Annotated[Optional[str], typer.Option(help="Package name (default: the system block's name).")]
             = None) -> None:
@@ -370,10 +385,16 @@ def verify(paths: PathsArg,
         raise typer.Exit(CANNOT_VERIFY)
     chosen = choose_executive(loaded.program, executive)
     started = time.perf_counter()
+    heartbeat = Heartbeat()  # in a log, where the status line does not show
+
+    def progress(states: int) -> None:
+        status.update(f"exploring: {states} states")
+        if not err.is_terminal and heartbeat.due():
+            err.print(f"... exploring: {states:,} states", markup=False)
+
     with Status("compiling the controller", console=err) as status:
         try:
-            result = explore(loaded.program, chosen, requests, max_states,
-                             lambda states: status.update(f"exploring: {states} states"))
+            result = explore(loaded.program, chosen, requests, max_states, progress)
         except kheops.KheopsError as exc:
             err.print(exc.headline(), markup=False)
             raise typer.Exit(CANNOT_VERIFY) from None
@@ -616,8 +637,8 @@ def plan(paths: PathsArg,
 def export_problem(paths: PathsArg,
                    problem: Annotated[str, typer.Option(help="The problem to export: its name, or a prefix with "
                                                              "--domain.")],
-                   output: Annotated[Path, typer.Option("--output", "-o", help="Folder receiving domain.pddl and "
-                                                        "problem.pddl.")],
+                   output: Annotated[Path, typer.Option("--output", "-o", callback=a_folder,
+                                                        help="Folder receiving domain.pddl and problem.pddl.")],
                    domain: Annotated[Optional[str], typer.Option(help="Keep the problems of this domain.")] = None,
                    keep_markers: Annotated[bool, typer.Option(
                        help="Keep the values that only mark a task in progress (MOVE's AT_ROBOT_X = 1000), which "
@@ -826,7 +847,8 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to (compiled "
                                                 "first when stale).")] = Path("generated"),
         runs: Annotated[Path, typer.Option(help="Where run folders go.")] = Path("runs"),
-        folder: Annotated[Optional[Path], typer.Option("--folder", "-o", help="The run folder (default: "
+        folder: Annotated[Optional[Path], typer.Option("--folder", "-o", callback=a_folder,
+                                                       help="The run folder (default: "
                                                        "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>; with "
                                                        "--goal, 'goal' for the mission and the goals and a digest "
                                                        "of them after the seed).")] = None,
@@ -872,20 +894,54 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         raise typer.Exit(1)
 
 
+HEARTBEAT = 60.0  # s between two progress lines when stderr is a log, not a terminal
+
+
+class Heartbeat:
+    """Progress for a log (CI, a pipe): a live line cannot be redrawn there, so a line is printed
+    at most every HEARTBEAT seconds, for work long enough that a reader wonders whether it hangs."""
+
+    def __init__(self) -> None:
+        self.last = time.monotonic()
+
+    def due(self) -> bool:
+        """Is a line due? (Asked first, so that a run's frequent progress builds no text for nothing.)"""
+        now = time.monotonic()
+        if now - self.last < HEARTBEAT:
+            return False
+        self.last = now
+        return True
+
+    def __call__(self, text: str) -> None:
+        if self.due():
+            err.print(f"... {text}", markup=False)
+
+
 class ProgressDisplay:
     """A live line on stderr: how far (mission time, or runs done; against the total when there
-    is one) and the latest step; nothing when quiet or when stderr is not a terminal."""
+    is one) and the latest step; when stderr is not a terminal, a line every HEARTBEAT seconds
+    (`Heartbeat`; `heartbeat=False`: nothing, the caller says each step itself); nothing when quiet."""
 
-    def __init__(self, quiet: bool, clock: Callable[[float], str] = lambda now: f"t = {now:7.1f} s") -> None:
+    def __init__(self, quiet: bool, clock: Callable[[float], str] = lambda now: f"t = {now:7.1f} s",
+                 heartbeat: bool = True) -> None:
         from rich.progress import BarColumn, Progress, TextColumn
 
         self.live = not quiet and err.is_terminal
+        self.heartbeat = Heartbeat() if heartbeat and not quiet and not err.is_terminal else None
         self.clock = clock
         self.progress = Progress(TextColumn("[bold]{task.fields[clock]}"), BarColumn(),
                                  TextColumn("{task.description}"), console=err, transient=True)
         self.task = self.progress.add_task("starting", total=None, clock=clock(0.0))
 
     def __enter__(self) -> Callable[[float, float | None, str], None] | None:
+        if self.heartbeat is not None:
+            beat = self.heartbeat
+
+            def say(now: float, total: float | None, what: str) -> None:
+                if beat.due():
+                    err.print(f"... {self.clock(now)}{f' of {total:g}' if total else ''}: {what}", markup=False)
+
+            return say
         if not self.live:
             return None
         self.progress.start()
@@ -906,11 +962,12 @@ def replay(run_path: Annotated[Path, typer.Argument(metavar="RUN", help="A run f
                                                                   "pose samples only when named).")] = None,
            start: Annotated[Optional[float], typer.Option("--from", help="From this mission time (s).")] = None,
            end: Annotated[Optional[float], typer.Option("--to", help="Up to this mission time (s).")] = None,
-           speed: Annotated[float, typer.Option(min=0.0, help="Play back at this many simulated seconds per "
-                                                              "second (0: at once).")] = 0.0,
+           speed: Annotated[float, typer.Option(min=0.0, callback=finite, help=(
+               "Play back at this many simulated seconds per second (0: at once)."))] = 0.0,
            render: Annotated[bool, typer.Option(help="Draw the pictures again from the log.")] = True,
-           output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Where the pictures go "
-                                                          "(default: the run folder).")] = None) -> None:
+           output: Annotated[Optional[Path], typer.Option("--output", "-o", callback=a_folder,
+                                                          help="Where the pictures go (default: the run folder).")]
+           = None) -> None:
     """Play a run's event log back, then draw its pictures again from the log alone.
 
     Example: specc replay runs/tug-shuttle-crowded-Robot1-2-s0 --kind action --kind ftplan --to 60"""
@@ -992,7 +1049,7 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
             writable_file(output, "--output", "the table's file", "the table's folder", "table.md")
         robot = compile_robot(specs, generated, lambda text: err.print(text, markup=False))
         base = RunRequest(specs, generated=generated, runs=runs, pictures=pictures)
-        with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} run(s) done") as progress:
+        with ProgressDisplay(quiet, clock=lambda done: f"{done:.0f} run(s) done", heartbeat=False) as progress:
             def step(done: int, total: int, label: str) -> None:
                 if progress is not None:
                     progress(done, total, label)
@@ -1043,8 +1100,8 @@ def mutants_command(
         show: Annotated[Optional[str], typer.Option(help="Print this mutant's description, verdict and diff "
                                                          "(its id, as the listing gives it: "
                                                          "<domain>-NNNN, e.g. warehouse-0020).")] = None,
-        output: Annotated[Optional[Path], typer.Option("--output", "-o", help="Write each kept (or sampled) "
-                                                       "mutant's spec file and diff into this folder.")] = None,
+        output: Annotated[Optional[Path], typer.Option("--output", "-o", callback=a_folder, help=(
+            "Write each kept (or sampled) mutant's spec file and diff into this folder."))] = None,
         workers: Annotated[Optional[int], typer.Option(min=1, max=MOST_WORKERS, help=(
             "Processes checking mutants (default: one per CPU, at most 8)."))] = None,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
@@ -1167,8 +1224,8 @@ def campaign(
         scheduler: Annotated[Optional[str], typer.Option(help="Run on Dask distributed: a scheduler's address "
                                                               "(tcp://host:8786), or 'local' for a local "
                                                               "cluster.")] = None,
-        timeout: Annotated[float, typer.Option(min=1.0, help="Hard timeout of one experiment (s): past it, its "
-                                                             "process is killed.")] = 120.0,
+        timeout: Annotated[float, typer.Option(min=1.0, callback=finite, help=(
+            "Hard timeout of one experiment (s): past it, its process is killed."))] = 120.0,
         store: Annotated[Optional[Path], typer.Option(help="The results store (SQLite); an interrupted campaign "
                                                            "resumes from it. Default: campaigns/<robot>-<domain>"
                                                            "-<mutants>.sqlite")] = None,

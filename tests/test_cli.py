@@ -49,6 +49,22 @@ def test_verify_stopped_by_the_state_limit_says_so_and_which_parts_it_never_expl
     assert "parts not explored at all: PTU-MOVE, PTU-INIT | PICTURE | COMMUNICATE" in result.stdout
 
 
+@pytest.mark.parametrize(("arguments", "said"), [
+    (("compile", "{tug}", "-o", "-"), "'-' names no folder"),
+    (("export", "{tug}", "--problem", "shuttle", "-o", "-"), "'-' names no folder"),
+    (("run", "{tug}", "--folder", "-"), "'-' names no folder"),
+    (("campaign", "{tug}", "--timeout", "nan"), "nan is not a finite number"),
+    (("plan", "{tug}", "--problem", "shuttle", "--improve", "99999999999"), "not in the range"),
+])
+def test_option_values_that_name_nothing_are_usage_errors(tmp_path: Path, arguments: tuple[str, ...],
+                                                          said: str) -> None:
+    """'-' given for a folder, a NaN for a duration, a budget no planning ends in: said at once
+    (exit 2), nothing made (no folder named '-')."""
+    result = specc(*(a.format(tug=EXAMPLES / "tug") for a in arguments), cwd=tmp_path)
+    assert result.returncode == 2 and said in result.stderr, result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_diagnostic_on_line_100_says_100_for_every_problem_matcher(tmp_path: Path) -> None:
     """`:100:` is rich's emoji code for 💯: the consoles must print the line number."""
     spec = tmp_path / "long.spec"
@@ -715,3 +731,22 @@ def test_a_reader_that_left_does_not_change_the_exit_status() -> None:
     finally:
         os.close(write_end)
     assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
+
+
+def test_long_work_in_a_log_says_it_is_alive_at_most_once_a_heartbeat(monkeypatch: pytest.MonkeyPatch,
+                                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """stderr a log (CI, a pipe): no live line can be drawn there, so a verification or a run that
+    takes minutes prints a progress line every HEARTBEAT seconds, not at every step."""
+    import specc.cli as cli
+
+    beat = cli.Heartbeat()
+    beat("exploring: 1,000 states")  # under a heartbeat since it began: nothing yet
+    monkeypatch.setattr(cli, "HEARTBEAT", 0.0)
+    beat("exploring: 2,000 states")
+    assert capsys.readouterr().err == "... exploring: 2,000 states\n"
+    with cli.ProgressDisplay(quiet=False, clock=lambda done: f"{done:.0f} checked") as progress:
+        assert progress is not None  # captured stderr is no terminal
+        progress(3, 10, "checking warehouse's mutants")
+    assert capsys.readouterr().err == "... 3 checked of 10: checking warehouse's mutants\n"
+    with cli.ProgressDisplay(quiet=True) as silent:
+        assert silent is None
