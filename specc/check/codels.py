@@ -82,6 +82,10 @@ def check_sends(ctx: Context, module: m.Module, request: m.Request, functions: M
     if request.validate is not None:
         codels.append((request.validate.text, request.validate.span))
     said: set[str] = set()
+    # With an entry of `sends:` naming no request, that error is the one to fix first: no
+    # undeclared-send for the request it meant.
+    declared_resolve = all(sent in requests.get(other, ())
+                           for other, _, sent in (ref.text.partition(".") for ref in request.sends))
     for name, span in codels:
         shape = functions.get(name)
         for line in shape.computed_sends if shape is not None else ():
@@ -100,9 +104,7 @@ def check_sends(ctx: Context, module: m.Module, request: m.Request, functions: M
                 known = [f"{o}.{r}" for o, names in requests.items() for r in names]
                 ctx.warn("undefined-request", f"codel '{name}' sends '{target}' ({place(shape, where, line)}), but no "
                          f"module has that request{did_you_mean(target, known)}: the send fails at run time", span)
-            elif all(sent in requests.get(other, ())
-                     for other, _, sent in (ref.text.partition(".") for ref in request.sends)):
-                # (With an entry of `sends:` naming no request, that error is the one to fix first.)
+            elif declared_resolve:
                 ctx.warn("undeclared-send", f"codel '{name}' of request {module.name}.{request.name} sends '{target}' "
                          f"({place(shape, where, line)}), which the request's 'sends:' does not list: the "
                          f"incompatibility graph and `specc verify` leave that send out, so what they prove may not "
