@@ -305,6 +305,79 @@ def test_two_uses_of_a_unary_resource_never_overlap() -> None:
     assert second.dispatch >= first.dispatch + 5 - 1e-6
 
 
+# A robot that must look at a place before it picks an object up there: each place's look, the
+# object's place and the robot's are variables one link binds, the case a search binding them
+# by the first event at hand (the robot seen where it stands, at the dock) got lost in: the object
+# put down at the dock to be picked up there, which needs it picked up first, and so on.
+PICK_AND_PLACE_DOMAIN = """
+domain fetch {
+  constant PLACES = {DOCK, A, B};
+  attribute AT() { ?value in PLACES; }
+  attribute SEEN(?p) { ?p in PLACES; ?value in {NO, YES}; }
+  attribute OBJ_AT(?o) { ?o in {OBJ1, OBJ2}; ?value in {DOCK, A, B, HAND}; }
+  resource BASE() { ?value in [0, 1]; }
+  task MOVE(?from, ?to) (t_start, t_end) {
+    ?from in PLACES; ?to in PLACES;
+    event(AT(): (?from, ?to), t_end);
+    use(BASE(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [3, 90];
+  } nonPreemptive
+  task LOOK(?p) (t_start, t_end) {
+    ?p in PLACES;
+    hold(AT(): ?p, (t_start, t_end));
+    event(SEEN(?p): (NO, YES), t_end);
+    contingent (t_end - t_start) in [1, 15];
+  } nonPreemptive
+  task PICK(?o, ?p) (t_start, t_end) {
+    ?o in {OBJ1, OBJ2}; ?p in PLACES;
+    hold(AT(): ?p, (t_start, t_end));
+    hold(SEEN(?p): YES, (t_start, t_end));
+    event(OBJ_AT(?o): (?p, HAND), t_end);
+    use(BASE(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [2, 30];
+  } nonPreemptive
+  task PLACE(?o, ?p) (t_start, t_end) {
+    ?o in {OBJ1, OBJ2}; ?p in PLACES;
+    hold(AT(): ?p, (t_start, t_end));
+    event(OBJ_AT(?o): (HAND, ?p), t_end);
+    contingent (t_end - t_start) in [2, 30];
+  } nonPreemptive
+}
+"""
+FETCH_START = """
+  explained event(AT(): (A, DOCK), t_start);
+  explained event(SEEN(A): (YES, NO), t_start);
+  explained event(SEEN(B): (YES, NO), t_start);
+  explained event(SEEN(DOCK): (YES, NO), t_start);
+  explained event(OBJ_AT(OBJ1): (DOCK, A), t_start);
+  explained event(OBJ_AT(OBJ2): (A, B), t_start);
+  (t_end - t_start) in [0, 1200];
+"""
+FETCH_GOALS = {  # problem -> (object, where it must be) for each goal
+    "in_hand": (("OBJ1", "HAND"),),
+    "carried": (("OBJ1", "B"),),
+    "swapped": (("OBJ1", "B"), ("OBJ2", "DOCK")),
+}
+
+
+@pytest.mark.parametrize("name", sorted(FETCH_GOALS))
+def test_pick_and_place_plans_bind_each_place_where_the_object_is(name: str) -> None:
+    """Each goal is kept in a plan the validator accepts, and the plan wastes nothing: one pick up
+    for each object, never a move to where the robot stands, never an object put down only to be
+    picked up again."""
+    goals = FETCH_GOALS[name]
+    holds = "\n".join(f"  timepoint t{i};\n  hold(OBJ_AT({obj}): {where}, (t{i}, t_end)) goal(1, 0);"
+                      for i, (obj, where) in enumerate(goals))
+    domain, problem = from_text(PICK_AND_PLACE_DOMAIN + f"problem {name} for fetch {{{FETCH_START}{holds}\n}}\n")
+    result = Planner(domain, exact=False).plan(problem)
+    checked(domain, problem, result)
+    assert result.plan is not None and not result.dropped, result.goals
+    actions = [(a.task, a.args) for a in result.plan.ordered()]
+    assert sorted(args[0] for task, args in actions if task == "PICK") == sorted(obj for obj, _ in goals)
+    assert all(args[0] != args[1] for task, args in actions if task == "MOVE"), actions
+    assert sum(task == "PLACE" for task, _ in actions) == sum(where != "HAND" for _, where in goals), actions
+
+
 # ---------------------------------------------------------------- controllability
 
 RADIO_SPEC = """

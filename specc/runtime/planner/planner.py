@@ -16,7 +16,7 @@ import random
 import re
 import time
 from collections import Counter
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 
 from specc.runtime.planner import model as pm
@@ -49,6 +49,7 @@ from specc.runtime.planner.search import (
     is_var,
     producers_of,
     restoring_events,
+    same_value,
     task_constraints,
     translate,
 )
@@ -1242,17 +1243,84 @@ def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
                 if node.assertions[k.consumer].owner == need.owner and need.owner != "problem"} - {"problem"}
     changers = node.changers(need)
 
-    def clobbered(producer: Assertion) -> bool:
-        """May an event change the value between the producer and the need? A link to a value
-        set long ago (the pan-tilt unit STRAIGHT at the start) often may, and a new task giving
-        it afresh is the better bet."""
-        return any(e.id != producer.id and not node.surely_before(e.start, producer.start, EPS) for e in changers)
+    def risky(producer: Assertion) -> bool:
+        """Does the link leave the plan worse off than a new task would? With the arguments the
+        link binds: an event may change the value between the producer and the need (a link to a
+        value set long ago, the pan-tilt unit STRAIGHT at the start, often may, and a new task
+        giving it afresh is the better bet), or another need could then be given by no event of
+        the plan although it could before (a robot to look at a place, linked to the dock where it
+        stands, binds the place to the dock, where the object it is to pick up is not: a move
+        there, then the look, is the better bet; a search trying the link first sinks into
+        putting the object down at the dock, which needs it picked up first...)."""
+        pairs = [*zip(producer.args, need.args, strict=False), (producer.value, need.wanted)]
+        resolve = node.bindings.resolve
+        linked, bound = node.bindings, set[str]()
+        if any(resolve(a) != resolve(b) for a, b in pairs):  # else the link binds nothing: no copy
+            linked = node.bindings.copy()
+            try:
+                bound = {v for a, b in pairs for v in linked.unify(a, b)}
+            except DeadEnd:
+                return False  # the link fails when applied, and is counted there
+        possibly_equal = linked.possibly_equal
+        if any(e.id != producer.id and all(possibly_equal(x, y) for x, y in zip(e.args, need.args, strict=False))
+               and not node.surely_before(e.start, producer.start, EPS) for e in changers):
+            return True
+        for i in node.open if bound else ():
+            other = node.assertions[i]
+            if i != need.id and any(t in bound for t in (*other.args, other.wanted)) and (
+                    node.producers(other) and not node.producers(other, linked)
+                    and not _one_task_gives(node, other, linked)):
+                return True
+        return False
 
-    ranked = sorted((clobbered(e), e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id, e.id)
+    ranked = sorted((risky(e), e.owner not in siblings, -node.bounds("origin", e.start)[0], -e.id, e.id)
                     for e in existing)
     links = [(r[0], Resolver("link", need=need.id, producer=r[-1])) for r in ranked]
     # Safe links first, then new tasks, then links something may undo, then tasks giving it back.
     return [r for risky, r in links if not risky] + inserts + [r for risky, r in links if risky] + restorers
+
+
+def _one_task_gives(node: Node, need: Assertion, bindings: Bindings) -> bool:
+    """Could one new task give `need` (with `bindings`), each of the task's own needs given by an
+    event of the plan that may come before `need`? A move to where the robot must stand can (it
+    drives from wherever the robot is); putting an object down where it must be cannot when the
+    plan picks it up only later (the put-down needs it in hand first): a link leaving a need to
+    such a task sends the search a long way."""
+    wanted = [bindings.resolve(t) for t in (*need.args, need.wanted)]
+    for task, index in node.ctx.producers.get(need.attribute, []):
+        gives = task.assertions[index]
+        assert isinstance(gives, pm.Event)
+        known: dict[str, Term] = {}  # the task's variables the need's values fix
+        fits = True
+        for expr, term in zip((*gives.args, gives.after), wanted, strict=True):
+            if is_var(term):
+                continue
+            if isinstance(expr, pm.Var):
+                fits = fits and same_value(known.setdefault(expr.name, term), term)
+            elif isinstance(expr, (pm.Sym, pm.Num)):
+                fits = fits and same_value(expr.name if isinstance(expr, pm.Sym) else expr.value, term)
+        if fits and all(_given_before(node, a, known, need, bindings) for a in task.assertions
+                        if not isinstance(a, pm.Use)):
+            return True
+    return False
+
+
+def _given_before(node: Node, need: pm.Hold | pm.Event, known: Mapping[str, Term], before: Assertion,
+                  bindings: Bindings) -> bool:
+    """Could an event of the plan that may come before the assertion `before` give a new task's
+    `need`, its variables valued as `known` says (the others free)?"""
+    def term(expr: pm.Expr) -> Term | None:
+        if isinstance(expr, pm.Sym):
+            return expr.name
+        if isinstance(expr, pm.Num):
+            return expr.value
+        return known.get(expr.name) if isinstance(expr, pm.Var) else None
+
+    terms = [term(x) for x in (*need.args, need.before if isinstance(need, pm.Event) else need.value)]
+    possibly_equal = bindings.possibly_equal
+    return any(event_id != before.id and node.allows(e.start, before.start, 0.0)
+               and all(t is None or possibly_equal(x, t) for x, t in zip((*e.args, e.value), terms, strict=False))
+               for event_id in node.events.get(need.attribute, ()) for e in (node.assertions[event_id],))
 
 
 def unbound(node: Node) -> list[Resolver] | None:

@@ -292,6 +292,13 @@ class Assertion:
     line: int
     goal: pm.GoalMark | None = None
 
+    @property
+    def wanted(self) -> Term:
+        """The value a need reads: an event's value before it, a hold's value."""
+        wanted = self.before if self.kind == "event" else self.value
+        assert wanted is not None
+        return wanted
+
     def text(self, bindings: Bindings | None = None) -> str:
         show = (lambda t: t) if bindings is None else bindings.resolve
 
@@ -599,9 +606,7 @@ class Node:
         changed: list[str] = []
         for a, b in zip(producer.args, consumer.args, strict=False):
             changed += self.bindings.unify(a, b)
-        needed = consumer.before if consumer.kind == "event" else consumer.value
-        assert needed is not None
-        changed += self.bindings.unify(producer.value, needed)
+        changed += self.bindings.unify(producer.value, consumer.wanted)
         self.require(producer.start, consumer.start, EPS if consumer.kind == "event" else 0.0)
         self.links.append(Link(producer.id, consumer.id))
         k = len(self.links) - 1
@@ -729,15 +734,16 @@ class Node:
         for producer, consumer in pairs:
             if (consumer.id in self.open and producer.kind == "event" and producer is not consumer
                     and producer.attribute == consumer.attribute and producer.args == consumer.args
-                    and producer.value == (consumer.before if consumer.kind == "event" else consumer.value)
+                    and producer.value == consumer.wanted
                     and producer.start == instance.start and consumer.start in (instance.start, instance.end)
                     and not (consumer.kind == "event" and consumer.start == producer.start)):
                 self.link(producer, consumer)
 
     # ------------------------------------------------------------ flaws
-    def _alike(self, need: Assertion) -> list[Assertion]:
-        """The other events on the need's attribute whose arguments may be the need's."""
-        possibly_equal = self.bindings.possibly_equal
+    def _alike(self, need: Assertion, bindings: Bindings | None = None) -> list[Assertion]:
+        """The other events on the need's attribute whose arguments may be the need's (with the
+        plan's bindings, or with `bindings`)."""
+        possibly_equal = (bindings or self.bindings).possibly_equal
         found = []
         for event_id in self.events.get(need.attribute, ()):
             e = self.assertions[event_id]
@@ -746,13 +752,13 @@ class Node:
                 found.append(e)
         return found
 
-    def producers(self, need: Assertion) -> list[Assertion]:
-        """The events that may give the need its value, oldest first."""
-        wanted = need.before if need.kind == "event" else need.value
-        assert wanted is not None
+    def producers(self, need: Assertion, bindings: Bindings | None = None) -> list[Assertion]:
+        """The events that may give the need its value, oldest first (with the plan's bindings, or
+        with `bindings`: those a resolver would leave)."""
+        wanted, possibly_equal = need.wanted, (bindings or self.bindings).possibly_equal
         gap = EPS if need.kind == "event" else 0.0
-        return [e for e in self._alike(need)
-                if self.bindings.possibly_equal(e.value, wanted) and self.allows(e.start, need.start, gap)]
+        return [e for e in self._alike(need, bindings)
+                if possibly_equal(e.value, wanted) and self.allows(e.start, need.start, gap)]
 
     def changers(self, need: Assertion) -> list[Assertion]:
         """The events that may change the value the need reads before it ends, oldest first."""
@@ -760,8 +766,7 @@ class Node:
         return [e for e in self._alike(need) if not self.surely_before(need.end, e.start, gap)]
 
     def insertions(self, need: Assertion) -> list[tuple[pm.Task, int]]:
-        wanted = need.before if need.kind == "event" else need.value
-        assert wanted is not None
+        wanted = need.wanted
         options = []
         for task, index in self.ctx.producers.get(need.attribute, []):
             event = task.assertions[index]
