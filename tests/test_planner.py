@@ -308,13 +308,15 @@ def test_two_uses_of_a_unary_resource_never_overlap() -> None:
 # A robot that must look at a place before it picks an object up there: each place's look, the
 # object's place and the robot's are variables one link binds, the case a search binding them
 # by the first event at hand (the robot seen where it stands, at the dock) got lost in: the object
-# put down at the dock to be picked up there, which needs it picked up first, and so on.
+# put down at the dock to be picked up there, which needs it picked up first, and so on; or, with
+# a third object, put down and picked up again where it lies, round trip after round trip.
 PICK_AND_PLACE_DOMAIN = """
 domain fetch {
-  constant PLACES = {DOCK, A, B};
+  constant PLACES = {DOCK, A, B, C};
+  constant OBJECTS = {OBJ1, OBJ2, OBJ3};
   attribute AT() { ?value in PLACES; }
   attribute SEEN(?p) { ?p in PLACES; ?value in {NO, YES}; }
-  attribute OBJ_AT(?o) { ?o in {OBJ1, OBJ2}; ?value in {DOCK, A, B, HAND}; }
+  attribute OBJ_AT(?o) { ?o in OBJECTS; ?value in {DOCK, A, B, C, HAND}; }
   resource BASE() { ?value in [0, 1]; }
   task MOVE(?from, ?to) (t_start, t_end) {
     ?from in PLACES; ?to in PLACES;
@@ -329,7 +331,7 @@ domain fetch {
     contingent (t_end - t_start) in [1, 15];
   } nonPreemptive
   task PICK(?o, ?p) (t_start, t_end) {
-    ?o in {OBJ1, OBJ2}; ?p in PLACES;
+    ?o in OBJECTS; ?p in PLACES;
     hold(AT(): ?p, (t_start, t_end));
     hold(SEEN(?p): YES, (t_start, t_end));
     event(OBJ_AT(?o): (?p, HAND), t_end);
@@ -337,7 +339,7 @@ domain fetch {
     contingent (t_end - t_start) in [2, 30];
   } nonPreemptive
   task PLACE(?o, ?p) (t_start, t_end) {
-    ?o in {OBJ1, OBJ2}; ?p in PLACES;
+    ?o in OBJECTS; ?p in PLACES;
     hold(AT(): ?p, (t_start, t_end));
     event(OBJ_AT(?o): (HAND, ?p), t_end);
     contingent (t_end - t_start) in [2, 30];
@@ -348,15 +350,18 @@ FETCH_START = """
   explained event(AT(): (A, DOCK), t_start);
   explained event(SEEN(A): (YES, NO), t_start);
   explained event(SEEN(B): (YES, NO), t_start);
+  explained event(SEEN(C): (YES, NO), t_start);
   explained event(SEEN(DOCK): (YES, NO), t_start);
   explained event(OBJ_AT(OBJ1): (DOCK, A), t_start);
   explained event(OBJ_AT(OBJ2): (A, B), t_start);
+  explained event(OBJ_AT(OBJ3): (A, C), t_start);
   (t_end - t_start) in [0, 1200];
 """
 FETCH_GOALS = {  # problem -> (object, where it must be) for each goal
     "in_hand": (("OBJ1", "HAND"),),
     "carried": (("OBJ1", "B"),),
     "swapped": (("OBJ1", "B"), ("OBJ2", "DOCK")),
+    "three_moved": (("OBJ1", "B"), ("OBJ2", "DOCK"), ("OBJ3", "A")),
 }
 
 

@@ -1233,10 +1233,18 @@ def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
     serves the need as well, and inserted first it only adds an action (a probe of a plot the plan
     has no goal for, whose free coordinates the insertion binds to where the robot is)."""
     restoring = node.ctx.restoring
+    # A task whose change the needing task's own change undoes (an object put down, for the pick
+    # up that needs it there, from the hand the pick up puts it back in): the two are a round
+    # trip, which only pays when nothing else gives the value; tried first, each round trip
+    # needs another, and the plan fills with put-downs and pick-ups until the search gives up.
+    undone = node.bindings.value(need.value) if need.kind == "event" else None
+    round_trips = {(task.name, index) for task, index in insertions
+                   if isinstance(event := task.assertions[index], pm.Event) and isinstance(event.before, pm.Sym)
+                   and undone is not None and event.before.name == undone}
     inserts = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions
-               if (task.name, index) not in restoring]
+               if (task.name, index) not in restoring and (task.name, index) not in round_trips]
     restorers = [Resolver("insert", need=need.id, task=task, index=index) for task, index in insertions
-                 if (task.name, index) in restoring]
+                 if (task.name, index) in restoring or (task.name, index) in round_trips]
     if not existing:
         return inserts + restorers
     siblings = {node.assertions[k.producer].owner for k in node.links
