@@ -581,7 +581,11 @@ def plan(paths: PathsArg,
                   "instants one at a time, each anywhere in its bounds.")] = Controllability.strong,
          improve: Annotated[int, typer.Option(max=MOST_PARTIAL_PLANS, min=0, help=(
              "Partial plans spent improving the first plan (goals it dropped, then its worst-case makespan); 0: "
-             "the first plan."))] = 300) -> None:
+             "the first plan."))] = 300,
+         planner: Annotated[Optional[str], typer.Option(help=(
+             "Plan as this planner of the ftplan block does in a run: its heuristics, controllability, "
+             "improvement and node limit (--nodes, --improve and --controllability are then its own)."))] = None,
+         ) -> None:
     """Plan a problem: the partially ordered plan, its schedule, the goals kept or dropped (and why),
     checked by the independent validator.
 
@@ -596,7 +600,7 @@ def plan(paths: PathsArg,
     assert loaded.program is not None
     try:
         outcome = solve(loaded.program, problem, domain, horizon, now, fact or [], goal, nodes, exact,
-                        controllability.value, improve)
+                        controllability.value, improve, planner)
     except ValueError as exc:
         err.print(f"error: {exc}", markup=False)
         raise typer.Exit(BAD_INPUT) from None

@@ -158,6 +158,9 @@ CODES: dict[str, Code] = {
                         'action LOG(t: string) = "log";'),
     "unbound-variable": Code("a variable with no value where one is needed", "goal: !(GO $X 2);"),
     "bad-argument": Code("a goal's argument outside the domain its predicate declares", "goal: !(CARRY 7 BOX);"),
+    "bypasses-executive": Code("a binding sends a request straight to a module the executive's services use: the "
+                               "executive's conflicts do not apply to it, and `specc verify` does not cover it",
+                               "PICK(?o) => request arm.Pick(?o);"),
     "bad-argument-type": Code("a binding's argument does not fit the input's type", "=> service GOTO(A, B);"),
     # ---------------------------------------------------------------- planning (IxTeT) and FTplan
     "include-cycle": Code("fragments that include each other", "fragment a { include b; } fragment b { include a; }"),
@@ -182,7 +185,8 @@ CODES: dict[str, Code] = {
     "domain-mismatch": Code("an ftplan mission's problem for a domain its planner does not plan in",
                             "p1: M1_model2;"),
     "bad-rule-argument": Code("an FTplan rule or requirement given what it cannot hold (an expression, a transition "
-                              "where one value is meant)", "requires PTU(): ?o * 2;"),
+                              "where one value is meant, a task's parameter none of whose values the attribute "
+                              "holds there)", "requires PTU(): ?o * 2;"),
     "unknown-heuristic": Code("a planner heuristic that does not exist", "heuristic: fastest;"),
     "unusable-correspondence": Code("a view correspondence that can neither read FTplan's state nor be written by a "
                                     "report", "PTU(): ?p <=> PTU_POS(): ?q;"),

@@ -56,12 +56,38 @@ def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Probl
     raise ValueError(f"problem '{name}' is ambiguous ({names}); add --domain, e.g. --domain {found[0].domain.text}")
 
 
+def ftplan_planner(program: m.Program, name: str, domain: pm.PlanningDomain) -> Planner:
+    """The planner `name` of the program's ftplan block as a run of the robot plans with it
+    (`specc plan --planner`): its heuristics, controllability and improvement, and the node
+    limit FTplan's deterministic timing gives it (what its watchdog pays for under the cost
+    model). ValueError when no ftplan block has it, or it plans in another domain."""
+    from specc.analysis.ftplan import ftplan_config
+    from specc.runtime.ftplan.component import planners_as_run
+    from specc.runtime.ftplan.planners import standard_planner
+
+    found = [(block, config) for block in program.items if isinstance(block, m.FtPlan)
+             for config in planners_as_run(ftplan_config(block, program), "model") if config.name == name]
+    if not found:
+        known = sorted(p.name for block in program.items if isinstance(block, m.FtPlan) for p in block.planners)
+        raise ValueError(f"no FTplan planner '{name}'{did_you_mean(name, known)} "
+                         f"(planners: {', '.join(known) or 'none'})")
+    if len(found) > 1:
+        raise ValueError(f"planner '{name}' is in ftplan blocks {', '.join(b.name for b, _ in found)}: rename one")
+    block, config = found[0]
+    if config.domain != domain.name:
+        raise ValueError(f"planner '{name}' of ftplan '{block.name}' plans in domain '{config.domain}', and the "
+                         f"problem is for '{domain.name}': name one of its problems, or another planner")
+    return standard_planner(config, {domain.name: domain})
+
+
 def solve(program: m.Program, name: str, domain_name: str | None, horizon: float | None, now: float,
           facts: list[str], goals: list[int] | None, nodes: int, exact: bool,
-          controllability: str = "strong", improve: int = 0) -> Outcome:
+          controllability: str = "strong", improve: int = 0, planner_name: str | None = None) -> Outcome:
     chosen = choose_problem(program, name, domain_name)
     model = domain_model(program, domain_block(program, chosen))
     problem = problem_model(program, chosen)
+    planner = ftplan_planner(program, planner_name, model) if planner_name is not None else Planner(
+        model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability, improve=improve)
     own = math.inf
     if horizon is not None:
         if not (math.isfinite(horizon) and horizon > 0):
@@ -78,8 +104,7 @@ def solve(program: m.Program, name: str, domain_name: str | None, horizon: float
                              f"(goal lines: {', '.join(map(str, sorted(lines)))})")
         parsed = checked_facts(model, [Fact.parse(f) for f in facts])
         problem = replanning_problem(problem, parsed, lines if goals is None else goals, now)
-    result = Planner(model, nodes=nodes, goal_nodes=nodes, exact=exact, controllability=controllability,
-                     improve=improve).plan(problem, now=now)
+    result = planner.plan(problem, now=now)
     if horizon is not None and horizon > own:
         result = replace(result, notes=(*result.notes, f"--horizon {horizon:g} s is later than the problem's own end "
                                         f"(at most {own:g} s after its start): the problem's bound stays"))

@@ -95,3 +95,53 @@ def test_the_variables_of_dropped_goals_are_said_free_not_given_a_made_up_value(
     free = document["plan"]["free"]
     assert sorted(free) == sorted(f"?{axis}{k[-1]}" for k in photos for axis in "xy")
     assert not set(free) & set(document["plan"]["bindings"]) and len(document["plan"]["bindings"]) == 4
+
+
+def test_the_planner_option_plans_as_that_ftplan_planner_does_in_a_run(tmp_path: Path) -> None:
+    """`--planner careful`: the tug's second planner, given a flaw order and an improvement here,
+    plans with them and with the node limit FTplan's deterministic timing gives it, the plan a
+    run would get; a planner no block has, or one planning another domain, is bad input."""
+    import shutil
+
+    from specc.analysis.ftplan import ftplan_config
+    from specc.analysis.planning import domain_block, domain_model, problem_model
+    from specc.model import nodes as m
+    from specc.pipeline import load
+    from specc.plan_report import choose_problem
+    from specc.runtime.ftplan.component import planners_as_run
+    from specc.runtime.ftplan.planners import standard_planner
+
+    robot = tmp_path / "tug"
+    shutil.copytree(EXAMPLES / "tug", robot)
+    ftplan = robot / "ftplan.spec"
+    ftplan.write_text(ftplan.read_text().replace("    domain: warehouse_slow;\n",
+                                                 "    domain: warehouse_slow;\n    flaws: oldest-task-first;\n"
+                                                 "    improve: 40;\n", 1))
+
+    def plan(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "specc.cli", "plan", str(robot), *args],
+                              capture_output=True, text=True, timeout=300)
+
+    shown = plan("--problem", "shuttle_slow", "--planner", "careful", "--json", "-")
+    assert shown.returncode == 0, shown.stderr
+    document = json.loads(shown.stdout)
+    program = load([robot]).program
+    assert program is not None
+    chosen = choose_problem(program, "shuttle_slow", None)
+    model, problem = domain_model(program, domain_block(program, chosen)), problem_model(program, chosen)
+    block = next(i for i in program.items if isinstance(i, m.FtPlan))
+    config = next(c for c in planners_as_run(ftplan_config(block, program), "model") if c.name == "careful")
+    assert config.flaws == "oldest-task-first" and config.improve == 40 and config.node_limit is not None
+    expected = standard_planner(config, {model.name: model}).plan(problem)
+    assert expected.plan is not None
+    assert document["search"]["partial_plans"] == expected.nodes
+    assert sorted((a["task"], a["args"]) for a in document["plan"]["actions"]) == sorted(
+        (a.task, list(a.args)) for a in expected.plan.actions)
+    default = json.loads(plan("--problem", "shuttle_slow", "--json", "-").stdout)
+    # the command's own defaults search otherwise
+    assert default["search"]["partial_plans"] != document["search"]["partial_plans"]
+
+    misspelt = plan("--problem", "shuttle_slow", "--planner", "carefull")
+    assert misspelt.returncode == 2 and "no FTplan planner 'carefull' (did you mean 'careful'?)" in misspelt.stderr
+    elsewhere = plan("--problem", "shuttle", "--planner", "careful")
+    assert elsewhere.returncode == 2 and "plans in domain 'warehouse_slow'" in elsewhere.stderr

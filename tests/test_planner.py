@@ -22,6 +22,7 @@ from specc.runtime.planner import model as pm
 from specc.runtime.planner.numeric import Closure, Empty, duration_of, exact_duration
 from specc.runtime.planner.planner import Setup
 from specc.runtime.planner.replan import Fact, replanning_problem
+from specc.runtime.planner.search import Limits
 from specc.runtime.planner.validate import validate
 from tests.conftest import ROOT
 
@@ -381,6 +382,155 @@ def test_pick_and_place_plans_bind_each_place_where_the_object_is(name: str) -> 
     assert sorted(args[0] for task, args in actions if task == "PICK") == sorted(obj for obj, _ in goals)
     assert all(args[0] != args[1] for task, args in actions if task == "MOVE"), actions
     assert sum(task == "PLACE" for task, _ in actions) == sum(where != "HAND" for _, where in goals), actions
+
+
+# FTplan's replanning after a failed move (a trial robot's): the robot somewhere between places,
+# the cup still in its one-object gripper, the box to bring back to the shelf. The depth-first
+# search reached its first plan through 18 put-down-and-pick-up-again pairs of the box at the
+# shelf (41 actions, and FTplan's planners do not improve their plans).
+GRIPPER_SPEC = """
+domain lab {
+  constant PLACES = {SHELF, BIN};
+  constant SPOTS = {SHELF, BIN, AWAY};
+  constant OBJS = {CUP, BOX};
+  attribute ROBOT_AT() { ?value in SPOTS; }
+  attribute OBJ_AT(?o) { ?o in OBJS; ?value in {SHELF, BIN, GRIPPER}; }
+  attribute GRIPPER() { ?value in {EMPTY, FULL}; }
+  resource BODY() { ?value in [0, 1]; }
+  task MOVE(?from, ?to) (t_start, t_end) {
+    ?from in SPOTS; ?to in PLACES; ?from != ?to;
+    event(ROBOT_AT(): (?from, ?to), t_end);
+    use(BODY(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [5, 40];
+  } nonPreemptive
+  task PICK(?o, ?p) (t_start, t_end) {
+    ?o in OBJS; ?p in PLACES;
+    hold(ROBOT_AT(): ?p, (t_start, t_end));
+    event(OBJ_AT(?o): (?p, GRIPPER), t_end);
+    event(GRIPPER(): (EMPTY, FULL), t_end);
+    use(BODY(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [3, 8];
+  } nonPreemptive
+  task PLACE(?o, ?p) (t_start, t_end) {
+    ?o in OBJS; ?p in PLACES;
+    hold(ROBOT_AT(): ?p, (t_start, t_end));
+    event(OBJ_AT(?o): (GRIPPER, ?p), t_end);
+    event(GRIPPER(): (FULL, EMPTY), t_end);
+    use(BODY(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [3, 8];
+  } nonPreemptive
+}
+problem swap_after_failed_move for lab {
+  explained event(ROBOT_AT(): (SHELF, AWAY), t_start);
+  explained event(GRIPPER(): (EMPTY, FULL), t_start);
+  explained event(OBJ_AT(CUP): (SHELF, GRIPPER), t_start);
+  explained event(OBJ_AT(BOX): (SHELF, BIN), t_start);
+  timepoint t1, t2;
+  hold(OBJ_AT(CUP): BIN, (t1, t_end)) goal(2, 0);
+  hold(OBJ_AT(BOX): SHELF, (t2, t_end)) goal(2, 0);
+  (t_end - t_start) in [0, 900];
+}
+"""
+
+
+def test_a_first_plan_puts_nothing_down_to_pick_it_up_again() -> None:
+    """Without improvement (FTplan's planners): the plan keeps both goals, the validator accepts
+    it, and no action is undone by the next one on the same object and place."""
+    from specc.runtime.planner.planner import round_trips
+
+    domain, problem = from_text(GRIPPER_SPEC)
+    result = Planner(domain, exact=False, improve=0).plan(problem)
+    checked(domain, problem, result)
+    assert result.plan is not None and not result.dropped, result.goals
+    actions = [(a.task, a.args) for a in result.plan.ordered() if a.task != "MOVE"]
+    assert len(actions) == len(set(actions)), actions  # no PLACE(BOX, SHELF) twice, no PICK after it
+    assert ("PICK", ("BOX", "BIN")) in actions and ("PLACE", ("CUP", "BIN")) in actions
+    # The detection itself, on a partial plan that has one: its pair is found, its twin is not.
+    setup = Setup(domain, problem, 0.0, Limits())
+    node = setup.root(setup.goals)
+    place = node.insert(domain.task("PLACE"))
+    pick = node.insert(domain.task("PICK"))
+    for local, value in (("?o", "BOX"), ("?p", "SHELF")):
+        node.bound(node.bindings.unify(place.var(local), value) + node.bindings.unify(pick.var(local), value))
+    for attribute in ("OBJ_AT", "GRIPPER"):
+        given = next(a for a in node.assertions if a.owner == place.id and a.attribute == attribute)
+        needing = next(a for a in node.assertions if a.owner == pick.id and a.attribute == attribute)
+        node.link(given, needing)
+    assert round_trips(node) == [(place.id, pick.id)]
+
+
+# A key on a roof no task goes to (a trial robot's): before the relaxed reachability, the search
+# spent its whole budget and said a larger one might find a plan.
+LOST_KEY_SPEC = """
+domain keys {
+  constant PLACES = {DOCK, BENCH};
+  attribute ROBOT_AT() { ?value in PLACES; }
+  resource BODY() { ?value in [0, 1]; }
+  attribute OBJ_AT(?o) { ?o in {KEY}; ?value in {DOCK, BENCH, ROOF, GRIPPER}; }
+  task MOVE(?from, ?to) (t_start, t_end) {
+    ?from in PLACES; ?to in PLACES; ?from != ?to;
+    event(ROBOT_AT(): (?from, ?to), t_end);
+    use(BODY(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [5, 40];
+  } nonPreemptive
+  task PICK(?o, ?p) (t_start, t_end) {
+    ?p in PLACES;
+    hold(ROBOT_AT(): ?p, (t_start, t_end));
+    event(OBJ_AT(?o): (?p, GRIPPER), t_end);
+    use(BODY(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [3, 8];
+  } nonPreemptive
+  task PLACE(?o, ?p) (t_start, t_end) {
+    ?p in PLACES;
+    hold(ROBOT_AT(): ?p, (t_start, t_end));
+    event(OBJ_AT(?o): (GRIPPER, ?p), t_end);
+    use(BODY(): 1, (t_start, t_end));
+    contingent (t_end - t_start) in [3, 8];
+  } nonPreemptive
+}
+problem lost_key for keys {
+  explained event(ROBOT_AT(): (BENCH, DOCK), t_start);
+  explained event(OBJ_AT(KEY): (DOCK, ROOF), t_start);
+  timepoint t1, t2;
+  hold(OBJ_AT(KEY): BENCH, (t1, t_end)) goal(3, 0);
+  hold(ROBOT_AT(): BENCH, (t2, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 600];
+}
+"""
+
+
+def test_a_goal_no_task_can_reach_is_dropped_as_impossible_without_searching() -> None:
+    domain, problem = from_text(LOST_KEY_SPEC)
+    result = Planner(domain, exact=False).plan(problem)
+    checked(domain, problem, result)
+    key, robot = result.goals
+    assert not key.kept and key.reason.startswith("impossible: no task ever makes OBJ_AT(KEY) = BENCH")
+    assert robot.kept  # the other goal is planned as usual
+    assert result.nodes < 100  # no search spent on the key (it used to take the whole budget, 300 and more)
+    # What `specc export` leaves out of the PDDL problem (which would have no plan with it).
+    assert set(Planner(domain).impossible_goals(problem)) == {key.line}
+
+
+def test_no_goal_a_plan_meets_is_ever_judged_unreachable() -> None:
+    """The relaxation reaches at least what any plan reaches: on every example problem, the
+    goals the planner keeps are all reachable by it."""
+    from specc.runtime.planner.reachable import impossible_goal, reach
+
+    cases = [models(name) for name in MISSIONS] + [from_text(GRIPPER_SPEC)]
+    cases += [from_text(PICK_AND_PLACE_DOMAIN + f"problem {name} for fetch {{{FETCH_START}" + "\n".join(
+        f"  timepoint t{i};\n  hold(OBJ_AT({obj}): {where}, (t{i}, t_end)) goal(1, 0);"
+        for i, (obj, where) in enumerate(goals)) + "\n}\n") for name, goals in sorted(FETCH_GOALS.items())]
+    judged = 0
+    for domain, problem in cases:
+        found = reach(domain, problem)
+        assert found is not None
+        result = Planner(domain, exact=False).plan(problem)
+        kept = {g.line for g in result.goals if g.kept}
+        for assertion in problem.assertions:
+            if isinstance(assertion, (pm.Hold, pm.Event)) and assertion.goal is not None and assertion.line in kept:
+                assert impossible_goal(found, assertion) is None, assertion
+                judged += assertion.attribute not in found.open
+    assert judged >= 10  # symbolic goals were judged, not only left open
 
 
 # ---------------------------------------------------------------- controllability

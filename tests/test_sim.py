@@ -33,6 +33,14 @@ def world(**extra):
 # ---------------------------------------------------------------- worlds
 
 
+def test_a_world_keeps_its_own_name_and_its_targets_and_windows_theirs():
+    loaded = world(world={"name": "shop"},
+                   targets=[{"name": "A", "x": 1.0, "y": 1.0}, {"name": "B", "x": 2.0, "y": 1.0}],
+                   windows=[{"name": "W1", "start": 0.0, "end": 5.0}])
+    assert loaded.name == "shop"
+    assert [t.name for t in loaded.targets] == ["A", "B"] and [w.name for w in loaded.windows] == ["W1"]
+
+
 def test_room_world_loads():
     room = load_world(ROOM)
     assert room.bounds == (0.0, 12.0, 0.0, 9.0)
@@ -64,6 +72,11 @@ def test_room_world_loads():
      "obstacles[1] lies wholly outside the walls"),
     ({**EMPTY, "obstacles": [{"polygon": [[2, 2], [4, 4], [4, 2], [2, 4]]}]},  # a bow tie
      "obstacles[0]: the polygon crosses itself (its edges from corner 0 and from corner 2"),
+    ({**EMPTY, "targets": [{"name": "A", "x": 1.0, "y": 1.0}, {"name": "B", "x": 2.0, "y": 1.0},
+                           {"name": "A", "x": 3.0, "y": 1.0}]},
+     "targets[2]: a second one named 'A' (targets[0] is the first)"),
+    ({**EMPTY, "windows": [{"name": "W1", "start": 0.0, "end": 5.0}, {"name": "W1", "start": 6.0, "end": 9.0}]},
+     "windows[1]: a second one named 'W1'"),
 ])
 def test_bad_worlds_say_where_and_what(data, fragment):
     with pytest.raises(WorldError) as error:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from specc.check.context import Context
 from specc.check.expressions import NotConstant, bound, term
-from specc.check.planning import DomainTables, tables
+from specc.check.planning import VALUE_VAR, DomainTables, tables
 from specc.model import nodes as m
 from specc.runtime.ftplan.config import FLAW_ORDERS, HEURISTICS
 
@@ -46,6 +46,7 @@ def check(ctx: Context) -> None:
         for found in (known, *own.values()):
             everything.tasks.update(found.tasks)
             everything.attributes.update(found.attributes)
+            everything.constants.update(found.constants)
         for ref in ftplan.order:
             if ref.text not in planners:
                 ctx.unknown("undefined-planner", "planner", ref.text, planners, ref.span)
@@ -71,6 +72,8 @@ def check(ctx: Context) -> None:
                 else:
                     check_terms(ctx, (*rule.args, *rule.requirement.args, value))
                     check_bound(ctx, rule.args, (*rule.requirement.args, value), f"task '{rule.task}'")
+                    check_variable_domains(ctx, (known, *own.values()), rule.task, rule.args, known,
+                                           rule.requirement.attribute, (*rule.requirement.args, value))
         for update in ftplan.state_updates:
             vocabulary = known
             if update.report != "report":
@@ -82,6 +85,9 @@ def check(ctx: Context) -> None:
                 check_terms(ctx, (*fact.args, fact.value))
                 check_value(ctx, vocabulary, fact.attribute, fact.value)
                 check_bound(ctx, update.args, (*fact.args, fact.value), f"{update.report} '{update.task}'")
+                if update.report != "report":
+                    check_variable_domains(ctx, (vocabulary,), update.task, update.args, vocabulary, fact.attribute,
+                                           (*fact.args, fact.value))
             check_terms(ctx, update.args)
         for planner in ftplan.planners:
             check_view(ctx, planner.view, own.get(planner.name), known)
@@ -208,6 +214,36 @@ def planner_tables(ctx: Context, ftplan: m.FtPlan) -> dict[str, DomainTables]:
 def _quiet(ctx: Context) -> Context:
     """A context whose reports go nowhere: the domains are checked on their own already."""
     return Context(ctx.program, ctx.base_dirs)
+
+
+def check_variable_domains(ctx: Context, domains: tuple[DomainTables, ...], task_name: str,
+                           binders: tuple[m.IxExpr, ...], attributes: DomainTables, attribute_name: str,
+                           terms: tuple[m.IxExpr, ...]) -> None:
+    """A task's parameter given as an attribute's argument or value (`PICK(?o, ?p) requires
+    SEEN(?o): YES`) must be able to take one of the values the attribute holds there: with no
+    value in common (?o an object, SEEN's argument a place) the rule names a fact FTplan's state
+    never has, and it refuses every plan with such an action, or writes what no planner reads.
+    The task as each of `domains` declares it (planners' models may give it other domains)."""
+    declared = [(found, found.tasks[task_name]) for found in domains if task_name in found.tasks]
+    attribute = attributes.attributes.get(attribute_name)
+    if not declared or attribute is None or len(terms) != len(attribute.params) + 1:
+        return
+    names = [b.name if isinstance(b, m.IxVar) else None for b in binders]
+    slots = [*(p.name for p in attribute.params), VALUE_VAR]
+    for written, slot in zip(terms, slots, strict=True):
+        if not isinstance(written, m.IxVar) or written.name not in names:
+            continue
+        position = names.index(written.name)
+        given: set[str] | None = set()
+        for found, task in declared:
+            said = found.value_domain(task, task.params[position].name) if position < len(task.params) else None
+            given = None if said is None or given is None else given | said
+        held = attributes.value_domain(attribute, slot)
+        if given is not None and held is not None and not given & held:
+            where = "value" if slot == VALUE_VAR else f"argument {slot}"
+            ctx.report("bad-rule-argument", f"{written.name} of task '{task_name}' is one of "
+                       f"{', '.join(sorted(given))}, none of which {attribute_name}'s {where} holds "
+                       f"({', '.join(sorted(held))}): name the task's parameter meant there", written.span)
 
 
 def check_task(ctx: Context, known: DomainTables, name: str, span: m.Span, args: tuple[m.IxExpr, ...] | None) -> None:

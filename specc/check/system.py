@@ -288,7 +288,7 @@ def check_planning(ctx: Context, system: m.System, supervisor: m.Procedures | No
             check_bound(ctx, binders, (where.value,), f"task '{binding.task}'")
         check_terms(ctx, (*binding.args, *plain, *inner))
         check_bound(ctx, binders, (*plain, *inner), f"task '{binding.task}'")
-        check_binding_target(ctx, system, binding, goals, services)
+        check_binding_target(ctx, system, binding, goals, services, domains)
         if binding.kind == "goal" and supervisor is not None:
             check_goal_binding_values(ctx, domains, supervisor, binding)
         if binding.report is not None:
@@ -336,7 +336,7 @@ def task_parameter_values(domains: Mapping[str, DomainTables], task_name: str, p
 
 
 def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goals: dict[str, int],
-                         services: Mapping[str, m.Service]) -> None:
+                         services: Mapping[str, m.Service], domains: Mapping[str, DomainTables]) -> None:
     target, given = binding.target, len(binding.target_args)
     if binding.kind == "goal":
         if system.supervisor is None:
@@ -359,40 +359,65 @@ def check_binding_target(ctx: Context, system: m.System, binding: m.Binding, goa
                        f"({', '.join(t.text for t in service.takes) or 'none'}), {given} given", target.span)
         else:
             inputs = request_inputs(ctx, service)
-            check_constant_inputs(ctx, binding.target_args, [inputs.get(t.text) for t in service.takes],
-                                  f"service '{service.name}'", service.request.parts[0] if service.request else "")
+            check_constant_inputs(ctx, binding, [inputs.get(t.text) for t in service.takes],
+                                  f"service '{service.name}'", service.request.parts[0] if service.request else "",
+                                  domains)
     else:
         request = resolve_request(ctx, target)
+        module_name = target.parts[0]
+        users = sorted(name for name, service in services.items()
+                       if service.request is not None and service.request.parts[0] == module_name)
+        if request is not None and users:
+            ctx.warn("bypasses-executive", f"'{target.text}' goes to module '{module_name}' past the executive, "
+                     f"whose service(s) {', '.join(users)} use that module: their conflicts do not hold against "
+                     "this request, and `specc verify` does not cover it; bind a service of the executive instead "
+                     "(=> service NAME(...))", target.span)
         if request is not None and len(request.inputs) != given:
             ctx.report("arity-mismatch", f"request '{target.text}' takes {len(request.inputs)} input(s) "
                        f"({', '.join(i.name for i in request.inputs) or 'none'}), {given} given", target.span)
         elif request is not None:
-            check_constant_inputs(ctx, binding.target_args, list(request.inputs), f"request '{target.text}'",
-                                  target.parts[0])
+            check_constant_inputs(ctx, binding, list(request.inputs), f"request '{target.text}'",
+                                  target.parts[0], domains)
 
 
-def check_constant_inputs(ctx: Context, args: tuple[m.IxExpr, ...], inputs: list[m.TypedName | None],
-                          target: str, module_name: str) -> None:
-    """A binding's constant argument (`service REPORT(FAST)`) must be a value of the input it
-    gives: the request refuses it at run time, at every replanning. Enums are the request's
-    module's (two modules may each have an enum of one name)."""
+def check_constant_inputs(ctx: Context, binding: m.Binding, inputs: list[m.TypedName | None],
+                          target: str, module_name: str, domains: Mapping[str, DomainTables]) -> None:
+    """Each value a binding's argument may give must be one of the input it gives: a constant
+    (`service REPORT(FAST)`), or each symbol a task's parameter may take in the planners' domains
+    (`LOOK(?p) => service SET-LEVEL(?p)`, ?p a place, the input a number). The request refuses
+    it at run time, at every replanning. Enums are the request's module's (two modules may each
+    have an enum of one name)."""
     enums = module_enums(ctx, module_name)
-    for arg, typed in zip(args, inputs, strict=False):
-        if typed is None or typed.type.size is not None or not isinstance(arg, m.Number | m.IxName):
+    names = [a.name if isinstance(a, m.IxVar) else None for a in binding.args]
+    for arg, typed in zip(binding.target_args, inputs, strict=False):
+        if typed is None or typed.type.size is not None:
             continue
-        kind, value = typed.type.name, arg.value if isinstance(arg, m.Number) else arg.name
+        if isinstance(arg, m.IxVar) and arg.name in names:
+            # A task parameter's symbols (numbers, or a domain not written as symbols, pass).
+            values: list[str | float] = sorted(task_parameter_values(domains, binding.task, names.index(arg.name))
+                                               or ())
+            subject = f"{arg.name} of task '{binding.task}' may be "
+        elif isinstance(arg, m.Number | m.IxName):
+            values, subject = [arg.value if isinstance(arg, m.Number) else arg.name], ""
+        else:
+            continue
+        kind = typed.type.name
+        refused: list[str | float]
         if kind in NUMERIC_INPUTS:
-            refused = isinstance(value, str)
+            refused = [v for v in values if isinstance(v, str)]
         elif kind in WHOLE_INPUTS:
-            refused = isinstance(value, str) or not float(value).is_integer()
+            refused = [v for v in values if isinstance(v, str) or not float(v).is_integer()]
         elif kind in enums:
-            refused = value not in enums[kind]
+            refused = [v for v in values if v not in enums[kind]]
         else:
             continue  # text or a structure: the runtime reads what it is given
         if refused:
             allowed = f" ({', '.join(sorted(enums[kind]))})" if kind in enums else ""
-            ctx.report("bad-argument-type", f"{value} cannot be input '{typed.name}' of {target}, of type "
-                       f"{kind}{allowed}", arg.span)
+            shown = ", ".join(str(v) for v in refused)
+            ctx.report("bad-argument-type", f"{subject}{shown}, which cannot be input '{typed.name}' of {target}, "
+                       f"of type {kind}{allowed}: pass a parameter whose domain holds only such values, or a "
+                       "constant" if subject else
+                       f"{shown} cannot be input '{typed.name}' of {target}, of type {kind}{allowed}", arg.span)
 
 
 def check_binding_report(ctx: Context, report: m.BindingReport, reports: dict[str, int]) -> None:

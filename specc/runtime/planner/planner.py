@@ -31,11 +31,13 @@ from specc.runtime.planner.heuristics import (
 )
 from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult, Repair
+from specc.runtime.planner.reachable import impossible_goal, reach
 from specc.runtime.planner.search import (
     CONTROLLABILITIES,
     EPS,
     PSEUDO,
     STRONG,
+    TOLERANCE,
     Assertion,
     Bindings,
     Context,
@@ -58,6 +60,9 @@ from specc.runtime.stn import STN, Inconsistent
 INF = math.inf
 IMPROVEMENT = 0.5  # s: a plan must end this much earlier to count as better (not a rounding's worth)
 REORDER_TRIAL = 400  # partial plans at most for one goal order tried by the improvement (Setup.reorder)
+# Partial plans at most for searching a plan again without its round trips (`round_trips`), after
+# the first plan and whatever the improvement's budget.
+ROUND_TRIP_TRIAL = 300
 WAYPOINT_TRIAL = 300  # partial plans at most for one move split at one waypoint (Setup.waypoints)
 
 
@@ -165,9 +170,12 @@ class Planner:
                               seconds=time.perf_counter() - started)
         candidates: list[Goal] = []
         alone: dict[int, Attempt] = {}  # each goal's search alone: the first of those below, if it comes to them
+        reached = reach(self.domain, setup.problem)  # a goal no task can ever reach needs no search to drop
         for goal in goals:
-            alone[goal.index] = attempt([goal], self.goal_nodes)
-            impossible = impossible_alone(alone[goal.index], goal, setup.problem)
+            impossible = impossible_goal(reached, goal.hold) if reached is not None else None
+            if impossible is None:
+                alone[goal.index] = attempt([goal], self.goal_nodes)
+                impossible = impossible_alone(alone[goal.index], goal, setup.problem)
             if impossible is not None:
                 outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, impossible)
             else:
@@ -194,10 +202,15 @@ class Planner:
                     outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False,
                                                        f"{why}: {explain(tried)}")
         assert best.node is not None
-        plan, notes = setup.extract(best.node, self.exact)
+        # Not an improvement (which FTplan's planners leave at 0): a plan that puts an object down
+        # only to pick it up again is one no robot should carry out.
+        allowance = ROUND_TRIP_TRIAL if self.node_limit is None else min(ROUND_TRIP_TRIAL, self.node_limit - total)
+        straight, spent = setup.without_round_trips(kept, best.node, allowance)
+        total += spent
+        plan, notes = setup.extract(straight, self.exact)
         if self.improve:
             budget = self.improve if self.node_limit is None else min(self.improve, self.node_limit - total)
-            plan, notes, kept, spent = self._improve(setup, best.node, plan, notes, kept, candidates, budget)
+            plan, notes, kept, spent = self._improve(setup, straight, plan, notes, kept, candidates, budget)
             total += spent
         for goal in kept:
             outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, True)
@@ -285,8 +298,11 @@ class Planner:
         except PlanningInputError:
             return {}
         found = {}
+        reached = reach(self.domain, setup.problem)
         for goal in setup.goals:
-            why = impossible_alone(setup.search([goal], self.goal_nodes), goal, problem)
+            why = impossible_goal(reached, goal.hold) if reached is not None else None
+            if why is None:
+                why = impossible_alone(setup.search([goal], self.goal_nodes), goal, problem)
             if why is not None:
                 found[goal.hold.line] = why
         return found
@@ -862,6 +878,26 @@ class Setup:
             found.append(node)
         return ([found[-1]] if found and found[-1].worst_end() < bound - IMPROVEMENT else []), nodes
 
+    def without_round_trips(self, active: list[Goal], node: Node, budget: int) -> tuple[Node, int]:
+        """`node`'s plan without the pairs of actions the second of which only undoes the first
+        (`round_trips`: an object put down and picked up again, nothing else using it
+        meanwhile), searched as a repair of the plan within `budget` partial plans, when the
+        repaired plan has fewer actions and ends no later at worst; and the partial plans spent.
+        A depth-first search reaches such plans when a need's other producers lie down a
+        longer path: each round trip it inserts needs another before it, until one links."""
+        pairs = round_trips(node)
+        if not pairs or budget <= 0:
+            return node, 0
+        plan, _ = self.extract(node, exact=False)
+        dropped = {ident for pair in pairs for ident in pair}
+        tried = self.search(active, budget, True, None,
+                            Repair(plan, tuple(a.id for a in plan.actions if a.id not in dropped)))
+        better = tried.node
+        if (better is None or len(better.instances) >= len(node.instances)
+                or better.worst_end() > node.worst_end() + TOLERANCE):
+            return node, tried.nodes
+        return better, tried.nodes
+
     def merge_drive_throughs(self, active: list[Goal], node: Node, budget: int) -> tuple[Node, int]:
         """`node`'s plan with each waypoint the robot drives through without stopping merged
         back into one move (`waypoints.drive_throughs`), where the plan is no worse for it: a
@@ -999,6 +1035,43 @@ class Setup:
         plan = Plan(self.domain.name, self.problem.name, tuple(actions), tuple(orderings), causal, schedule,
                     uncontrolled, bindings, self.context.controllability, self.now, assumed, free=free)
         return plan, tuple(notes)
+
+
+def round_trips(node: Node) -> list[tuple[str, str]]:
+    """The pairs (first, second) of the plan's task instances where the second only undoes the
+    first: each event of the second gives back, on the same attribute instance, the value an event
+    of the first changed, linked from it, and nothing but the second needs what the first gives
+    (an object put down, then picked up again from where it was put, the gripper emptied and
+    filled again)."""
+    resolve = node.bindings.resolve
+    events: dict[str, list[Assertion]] = {}
+    for a in node.assertions:
+        if a.kind == "event" and a.owner != "problem":
+            events.setdefault(a.owner, []).append(a)
+    linked = {(link.producer, link.consumer) for link in node.links}
+    needers: dict[str, set[str]] = {}  # task instance -> the others its events give a value to
+    for link in node.links:
+        producer, consumer = node.assertions[link.producer], node.assertions[link.consumer]
+        if producer.owner != consumer.owner:
+            needers.setdefault(producer.owner, set()).add(consumer.owner)
+
+    def undoes(later: Assertion, earlier: Assertion) -> bool:
+        return (later.attribute == earlier.attribute and (earlier.id, later.id) in linked
+                and [resolve(x) for x in later.args] == [resolve(x) for x in earlier.args]
+                and later.before is not None and earlier.before is not None
+                and resolve(later.before) == resolve(earlier.value) and resolve(later.value) == resolve(earlier.before))
+
+    found: list[tuple[str, str]] = []
+    for first, changes in events.items():
+        users = needers.get(first, set())
+        if len(users) != 1:
+            continue
+        (second,) = users
+        undoing = events.get(second, [])
+        if (len(undoing) == len(changes) and second not in {a for pair in found for a in pair}
+                and all(any(undoes(later, earlier) for earlier in changes) for later in undoing)):
+            found.append((first, second))
+    return found
 
 
 def _chosen(value: Term | None) -> float | str:

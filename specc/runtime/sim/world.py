@@ -327,6 +327,13 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
             if not 0 <= opens < closes:
                 where.problem(f"{label}: needs 0 <= start < end")
             windows.append(Window(where.text(w, "name", label, f"W{k + 1}"), opens, closes))
+    # Codels and missions find a target or a window by its name: a second one of a name is never
+    # found, and which one a lookup meets depends on the file's order.
+    for kind, names in (("targets", [n for n, _, _ in targets]), ("windows", [w.name for w in windows])):
+        for k, repeated in enumerate(names):
+            if repeated in names[:k]:
+                where.problem(f"{kind}[{k}]: a second one named '{repeated}' ({kind}[{names.index(repeated)}] is the "
+                              "first): give each its own name")
     if bounds is None:  # nothing can be placed without walls
         raise WorldError(*where.problems)
     # Built from what could be read, so that what stands in the way is said with the rest.
