@@ -201,7 +201,7 @@ CODES: dict[str, Code] = {
     "missing-world": Code("a world file that does not exist", 'nowhere: "worlds/nowhere.toml";'),
     "goal-without-supervisor": Code("a mission or binding posts a goal, but the system has no supervisor",
                                     "goal: !(GO 1 2);   (no supervisor:)"),
-    "bad-mission-goal": Code("a mission's goal that is not !(...) or ?(...)", "goal: ^(GO 1 2);"),
+    "bad-mission-goal": Code("a mission's goal that is not !(...), ?(...) or a fact =>(...)", "goal: ^(GO 1 2);"),
     "missing-binding": Code("a task of the planners' domains without a binding", "bindings { }   (DROP unbound)"),
     "arity-mismatch": Code("a call with more or fewer arguments than what it calls takes", "goal: !(GO 1);"),
     # ---------------------------------------------------------------- procedures as Petri nets (specc verify --goal)

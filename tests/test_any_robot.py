@@ -284,6 +284,26 @@ def test_a_test_goal_is_posted_and_the_first_goal_failing_ends_the_mission(tmp_p
     assert unknown.returncode == 2 and "declare no predicate REPLI (did you mean 'REPLY'?)" in unknown.stderr
 
 
+def test_a_mission_states_what_its_supervisor_knows_from_the_start(tmp_path: Path) -> None:
+    """`goal: =>(FACT ...);` in a mission is concluded before its goals are posted (a robot that
+    knows where the objects lie): the test goal that failed without it succeeds, and the fact is
+    no goal of the run. A fact of an undeclared predicate, of another arity or outside its
+    predicate's domain is refused by check."""
+    spec = SPEC.replace("goal: !(GO 3 4); }", "goal: =>(REPLY 1 OK); goal: ?(REPLY 1 OK); }")
+    robot = write_robot(tmp_path, spec)
+    assert specc(tmp_path, "check", robot).returncode == 0
+    result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "-q")
+    assert result.returncode == 0, result.stdout + result.stderr
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert report["outcome"] == "succeeded", report["why"]
+    start = read_events(tmp_path / "run" / "events.jsonl")[0]
+    assert start["goals"] == ["?(REPLY 1 OK)"] and start["facts"] == ["=>(REPLY 1 OK)"]
+    for wrong, code in (("=>(REPLI 1 OK)", "undefined-predicate"), ("=>(REPLY 1)", "arity-mismatch")):
+        bad = write_robot(tmp_path / code, SPEC.replace("goal: !(GO 3 4); }", f"goal: {wrong}; }}"))
+        checked = specc(tmp_path, "check", bad)
+        assert checked.returncode == 1 and f"[{code}]" in checked.stdout + checked.stderr, checked.stdout
+
+
 def test_a_goal_failed_by_a_function_that_raised_says_what_it_raised(tmp_path: Path) -> None:
     """A procedure's action bound to the user's Python (a rule base's `decide` refusing an input
     outside its domain, say) raises: the run's why is that exception, not only the KA that failed."""

@@ -799,3 +799,17 @@ def test_a_horizon_later_than_the_problems_own_end_is_said_not_silently_ignored(
     assert any("--horizon 1000 s is later than the problem's own end (at most 800 s" in n for n in later.result.notes)
     earlier = solve(program(), "M1_model1", None, 500.0, 0.0, [], None, 300, False)
     assert not any("--horizon" in n for n in earlier.result.notes)
+
+
+def test_a_generated_domain_answers_an_unknown_problem_with_a_reason(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The compiled planning package's `plan("name")`, as docs/reference.md shows it: a name it
+    does not have is bad input, answered with the reason and its problems, as the planner answers,
+    not a KeyError."""
+    import importlib
+
+    monkeypatch.syspath_prepend(str(ROOT / "generated"))
+    warehouse = importlib.import_module("tug.planner.warehouse")
+    result = warehouse.plan("shutle")
+    assert result.plan is None and result.reason == (
+        "no problem 'shutle' for domain 'warehouse' (problems: fetch_b, shuttle)")
+    assert warehouse.plan("shuttle", improve=0).plan is not None

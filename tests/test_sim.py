@@ -41,6 +41,11 @@ def test_a_world_keeps_its_own_name_and_its_targets_and_windows_theirs():
     assert [t.name for t in loaded.targets] == ["A", "B"] and [w.name for w in loaded.windows] == ["W1"]
 
 
+def test_a_world_without_start_puts_the_robot_in_the_middle_of_its_walls():
+    assert parse_world({"room": {"width": 10.0, "height": 6.0}}).start == (5.0, 3.0, 0.0)  # (0, 0): a wall
+    assert world().start == (0.0, 0.0, 0.0)  # the middle of [-10, 10] x [-10, 10]
+
+
 def test_room_world_loads():
     room = load_world(ROOM)
     assert room.bounds == (0.0, 12.0, 0.0, 9.0)

@@ -33,7 +33,9 @@ TEXT_DOMAINS = frozenset({"string", "symbol"})
 # (docs/reference.md, "A robot's extension module").
 EXTENSION_HOOKS = {"prepare": ("world", "setup"), "attach": ("run",), "measure": ("events",),
                    "judge": ("events", "measures", "outcome", "why")}
-MISSION_GOAL_OPS = ("!", "?")  # achieve or test: what a mission can ask of the supervisor
+# Achieve, test, or a fact the supervisor's database holds from the start (what the robot knows
+# of its world before it starts: where the objects are): what a mission can give the supervisor.
+MISSION_GOAL_OPS = ("!", "?", "=>")
 
 
 def check(ctx: Context) -> None:
@@ -447,13 +449,23 @@ def achievable_goals(procedures: m.Procedures) -> dict[str, int]:
 def check_mission_goal(ctx: Context, goal: m.Goal, goals: dict[str, int], procedures: str,
                        predicates: Sequence[m.PredicateDecl] = ()) -> None:
     if goal.op not in MISSION_GOAL_OPS:
-        ctx.report("bad-mission-goal", f"a mission asks to achieve '!(...)' or test '?(...)', not '{goal.op}(...)'",
-                   goal.span)
+        ctx.report("bad-mission-goal", f"a mission asks to achieve '!(...)', tests '?(...)' or states a fact its "
+                   f"supervisor knows from the start '=>(...)', not '{goal.op}(...)'", goal.span)
         return
     for node in walk(goal):
         if isinstance(node, m.LogicVar | m.ProgramVar):
             ctx.report("unbound-variable", f"'{node.name}' has no value in a mission: give a constant", node.span)
     body = goal.body
+    if goal.op == "=>":  # a fact: of a predicate the procedures declare
+        declared = {p.name: len(p.params) for p in predicates}
+        if body.head not in declared:
+            ctx.report("undefined-predicate", f"procedures '{procedures}' declare no predicate '{body.head}' for "
+                       f"'=>({body.head} ...)' to state{did_you_mean(body.head, declared)}: declare it with "
+                       "'predicate'", body.span)
+        elif declared[body.head] != len(body.args):
+            ctx.report("arity-mismatch", f"'{body.head}' takes {declared[body.head]} argument(s), {len(body.args)} "
+                       "given", body.span)
+        return
     if goal.op == "?":  # a test reads the database: a predicate the procedures declare, or a goal's
         declared = {p.name: len(p.params) for p in predicates} | goals
         if body.head not in declared:

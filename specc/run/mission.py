@@ -59,6 +59,7 @@ from specc.runtime.system import DEFAULT_HORIZON, MissionSpec, SystemSpec
 ROBOT_MOVING = 0.005  # m/s at the wheel rims: slower than this, the robot stands still
 SAMPLE_PRIORITY = 1000  # the motion sampler runs after the physics and codels of its instant
 PROGRESS_PERIOD = 10.0  # s of simulated time between two progress reports
+FACT_OP = "=>"  # a mission's `goal: =>(FACT ...);`: concluded before the goals are posted, not one of them
 # Characters a one-line summary keeps of one reason, and of what a bracket in it holds: a goal's
 # reason may hold every planner's diagnostics, a page of them; the run's report.json keeps it whole.
 REASON_WIDTH = 300
@@ -370,8 +371,10 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         parts = assemble(robot, ground, world_path, seed, log=lambda text: recorder.operator(text))
         registry, sim, executive, supervisor = parts.registry, parts.sim, parts.executive, parts.supervisor
         kernel = registry.kernel
-        recorder = Recorder(journal, sim, registry, executive, limit, len(mission.goals) + bool(mission.plan),
-                            progress)
+        # `goal: =>(FACT ...);` states what the supervisor knows from the start; the rest are goals.
+        facts = [g for g in mission.goals if g.startswith(FACT_OP)]
+        posted = [g for g in mission.goals if not g.startswith(FACT_OP)]
+        recorder = Recorder(journal, sim, registry, executive, limit, len(posted) + bool(mission.plan), progress)
         if supervisor is not None:
             recorder.watch_facts(supervisor.database)
         setup = checked.planning
@@ -380,14 +383,18 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
                    "planners": [f"{p.name} ({p.domain})" for p in setup.config.planners],
                    "planned_goals": [[g.attribute, list(g.args), g.value] for g in goals_planned]} if setup else {}
         journal.emit(kernel.now, "mission-start", robot=robot.name, mission=mission.name, seed=seed,
-                     goals=list(mission.goals), horizon=limit, body=dataclasses.asdict(system.body),
-                     objects=[list(o) for o in sim.objects], **planned, **world_fields(ground))
+                     goals=posted, horizon=limit, body=dataclasses.asdict(system.body),
+                     objects=[list(o) for o in sim.objects], **planned, **world_fields(ground),
+                     **({"facts": facts} if facts else {}))
         context = RunContext(robot, mission, seed, ground, sim, registry, executive, supervisor, journal)
         attach = robot.hook("attach")
         if attach is not None:
             attach(context)
+        for fact in facts:
+            assert supervisor is not None  # check_mission: goals need a supervisor
+            supervisor.conclude(fact[len(FACT_OP):])
         intentions = []
-        for goal in mission.goals:
+        for goal in posted:
             assert supervisor is not None  # check_mission: goals need a supervisor
             intentions.append((goal, supervisor.post(goal)))
             journal.emit(kernel.now, "goal", goal=goal, status="posted")

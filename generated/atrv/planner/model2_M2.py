@@ -1128,5 +1128,8 @@ PROBLEMS = {
 def plan(problem: str | Problem, now: float = 0.0, **options: Any) -> PlanResult:
     """Plan for one of PROBLEMS (by name) or for a problem built at run time (a replanning, with
     the mission time `now` before which nothing starts)."""
+    if isinstance(problem, str) and problem not in PROBLEMS:  # bad input: a result saying why, as the planner's
+        return PlanResult(None, reason=f"no problem {problem!r} for domain {DOMAIN.name!r} (problems: "
+                          f"{', '.join(sorted(PROBLEMS)) or 'none'})")
     chosen = PROBLEMS[problem] if isinstance(problem, str) else problem
     return Planner(DOMAIN, **options).plan(chosen, now=now)

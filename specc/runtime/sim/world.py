@@ -13,7 +13,7 @@ xmin = -20.0                 # (seed 004, note 3: far walls at 20 m keep the las
 xmax = 20.0
 ymin = -20.0
 ymax = 20.0
-[start]                      # the robot's pose at t = 0 (default: 0, 0, 0)
+[start]                      # the robot's pose at t = 0 (default: the middle of the walls, heading 0)
 x = 0.0
 y = 0.0
 theta = 0.0
@@ -298,7 +298,9 @@ def parse_world(data: Mapping[str, Any], source: str = "<world>", default_name: 
         bounds = None
     said = len(where.problems)
     start_table = where.table(data, "start", ("x", "y", "theta")) or {}
-    start = (where.number(start_table, "x", "start", 0.0), where.number(start_table, "y", "start", 0.0),
+    # Without [start], the middle of the walls: (0, 0) is a corner of every [room], on its walls.
+    middle = ((bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2) if bounds is not None else (0.0, 0.0)
+    start = (where.number(start_table, "x", "start", middle[0]), where.number(start_table, "y", "start", middle[1]),
              where.number(start_table, "theta", "start", 0.0))
     # A [start] already found wrong (`xx = 1.5`) is not placed again from its defaults: one error.
     start_read = len(where.problems) == said
