@@ -172,6 +172,19 @@ def test_evaluable_predicates_call_their_function_with_bound_arguments() -> None
     assert "Check:3: ?(NEAR $X 5) failed: evaluable predicate (NEAR $X 5): $X is unbound" in unbound.lines()
 
 
+def test_a_function_given_for_no_binding_is_refused_with_the_bindings_there_are() -> None:
+    """`create(functions={...})` with a misspelt key used to import the real module in its
+    place without a word (a test's stub never called)."""
+    from specc.runtime.procedures import load_functions
+
+    library = Library("test", predicates=(Predicate("NEAR", "evaluable", 2, "robot.near"),), kas=())
+    near = lambda ctx, x, limit: True  # noqa: E731
+    assert load_functions(library, {"robot.near": near}) == {"robot.near": near}
+    with pytest.raises(ValueError, match=r"functions= gives 'robot.naer', which no action or evaluable predicate "
+                                         r"is bound to \(did you mean 'robot.near'\?\) \(bound: robot.near\)"):
+        load_functions(library, {"robot.naer": near})
+
+
 def test_achieve_first_tests_the_database() -> None:
     s = supervisor(ka("Open", "!(DOOR $STATE)", step("=>(DOOR OPEN)")))
     s.conclude("(DOOR SHUT)")

@@ -242,11 +242,19 @@ def bindings(library: Library) -> list[str]:
 
 def load_functions(library: Library, given: Mapping[str, Callable[..., Any]] | None = None
                    ) -> dict[str, Callable[..., Any]]:
-    """The Python function behind every binding: from `given` when it has it, else imported."""
+    """The Python function behind every binding: from `given` when it has it, else imported.
+    ValueError for a key of `given` no binding has (a misspelt one would leave the real function
+    in its place, imported, without a word)."""
     from specc.runtime.functional import import_user_module
+    from specc.runtime.hints import did_you_mean
 
+    known = bindings(library)
+    unused = sorted(set(given or ()) - set(known))
+    if unused:
+        raise ValueError(f"procedures '{library.name}': functions= gives '{unused[0]}', which no action or evaluable "
+                         f"predicate is bound to{did_you_mean(unused[0], known)} (bound: {', '.join(known) or 'none'})")
     functions: dict[str, Callable[..., Any]] = {}
-    for binding in bindings(library):
+    for binding in known:
         if given is not None and binding in given:
             functions[binding] = given[binding]
             continue

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any, NamedTuple
 
 
@@ -37,7 +37,7 @@ def no_calls(function: str, args: tuple[Any, ...]) -> None:
     """The default for `do {f(...)}` actions: nothing to call."""
 
 
-def check_numbers(numeric: tuple[str, ...], inputs: Mapping[str, Any], error: TypeError) -> None:
+def check_numbers(numeric: Iterable[str], inputs: Mapping[str, Any], error: TypeError) -> None:
     """After a decision raised `error`: a TypeError naming the numeric input given something other
     than a number (`soc='50'`), if one was; else nothing (the caller raises `error` itself)."""
     for name in numeric:

@@ -29,11 +29,14 @@ from specc.runtime.rules import Calls, Decision, no_calls
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
-INPUTS = ["pres1", "pres2", "deltaP", "temp", "drain", "level", "valve"]
-NUMERIC_INPUTS = ["pres1", "pres2", "deltaP", "temp"]
-OUTPUTS = ["proced"]
+INPUTS: list[str] = ["pres1", "pres2", "deltaP", "temp", "drain", "level", "valve"]
+NUMERIC_INPUTS: list[str] = ["pres1", "pres2", "deltaP", "temp"]
+OUTPUTS: list[str] = ["proced"]
 DEPTH = 8
 FINDINGS = 13
+# The previous-cycle values before the first cycle (the base's `init`), read when not given
+# (empty: the base reads no previous-cycle value, or gives none an `init`).
+INITIAL: dict[str, Any] = {}
 
 _LEAF_0 = Decision(MappingProxyType({'proced': 'a3'}), (), (), None)
 _LEAF_1 = Decision(MappingProxyType({'proced': 'a23'}), (), (), None)

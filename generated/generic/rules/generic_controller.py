@@ -37,13 +37,14 @@ from specc.runtime.rules import Calls, Decision, no_calls
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
-INPUTS = ["service", "event", "@ABCstate", "@EFGstate"]
-NUMERIC_INPUTS = []
-OUTPUTS = ["status", "ABCstate", "EFGstate"]
+INPUTS: list[str] = ["service", "event", "@ABCstate", "@EFGstate"]
+NUMERIC_INPUTS: list[str] = []
+OUTPUTS: list[str] = ["status", "ABCstate", "EFGstate"]
 DEPTH = 4
 FINDINGS = 30
-# The previous-cycle values before the first cycle (the base's `init`), read when not given.
-INITIAL = {"@ABCstate": "IDLE", "@EFGstate": "IDLE"}
+# The previous-cycle values before the first cycle (the base's `init`), read when not given
+# (empty: the base reads no previous-cycle value, or gives none an `init`).
+INITIAL: dict[str, Any] = {"@ABCstate": "IDLE", "@EFGstate": "IDLE"}
 
 _LEAF_0 = Decision(MappingProxyType({'status': None, 'ABCstate': None, 'EFGstate': None}), (), ('status', 'ABCstate', 'EFGstate'), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ABCstate': 'IDLE', 'EFGstate': None}), (), ('EFGstate',), None)

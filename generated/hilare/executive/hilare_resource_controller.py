@@ -14,13 +14,14 @@ from specc.runtime.rules import Calls, Decision, no_calls
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
-INPUTS = ["service", "event", "@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate", "@READ_OBST_SEARCH_OBJstate", "@ExecTrajState", "@ARM_OBJ_ARM_BACKstate", "@CALC_OBJstate", "@CALC_GOALstate"]
-NUMERIC_INPUTS = []
-OUTPUTS = ["status", "READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate", "READ_OBST_SEARCH_OBJstate", "ExecTrajState", "ARM_OBJ_ARM_BACKstate", "CALC_GOALstate", "CALC_OBJstate"]
+INPUTS: list[str] = ["service", "event", "@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate", "@READ_OBST_SEARCH_OBJstate", "@ExecTrajState", "@ARM_OBJ_ARM_BACKstate", "@CALC_OBJstate", "@CALC_GOALstate"]
+NUMERIC_INPUTS: list[str] = []
+OUTPUTS: list[str] = ["status", "READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate", "READ_OBST_SEARCH_OBJstate", "ExecTrajState", "ARM_OBJ_ARM_BACKstate", "CALC_GOALstate", "CALC_OBJstate"]
 DEPTH = 6
 FINDINGS = 0
-# The previous-cycle values before the first cycle (the base's `init`), read when not given.
-INITIAL = {"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate": "IDLE", "@READ_OBST_SEARCH_OBJstate": "IDLE", "@ExecTrajState": "IDLE", "@ARM_OBJ_ARM_BACKstate": "IDLE", "@CALC_OBJstate": "IDLE", "@CALC_GOALstate": "IDLE"}
+# The previous-cycle values before the first cycle (the base's `init`), read when not given
+# (empty: the base reads no previous-cycle value, or gives none an `init`).
+INITIAL: dict[str, Any] = {"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate": "IDLE", "@READ_OBST_SEARCH_OBJstate": "IDLE", "@ExecTrajState": "IDLE", "@ARM_OBJ_ARM_BACKstate": "IDLE", "@CALC_OBJstate": "IDLE", "@CALC_GOALstate": "IDLE"}
 # One decision per value of service: the tests on its longest path (seed 000
 # §3.7's bound, per decision), and the outputs it keeps as they were (each its previous-cycle value,
 # copied without a test); it decides the others.

@@ -20,13 +20,14 @@ from specc.runtime.rules import Calls, Decision, no_calls
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
-INPUTS = ["service", "event", "@ExecTrajState"]
-NUMERIC_INPUTS = []
-OUTPUTS = ["status", "ExecTrajState"]
+INPUTS: list[str] = ["service", "event", "@ExecTrajState"]
+NUMERIC_INPUTS: list[str] = []
+OUTPUTS: list[str] = ["status", "ExecTrajState"]
 DEPTH = 3
 FINDINGS = 4
-# The previous-cycle values before the first cycle (the base's `init`), read when not given.
-INITIAL = {"@ExecTrajState": "IDLE"}
+# The previous-cycle values before the first cycle (the base's `init`), read when not given
+# (empty: the base reads no previous-cycle value, or gives none an `init`).
+INITIAL: dict[str, Any] = {"@ExecTrajState": "IDLE"}
 
 _LEAF_0 = Decision(MappingProxyType({'status': None, 'ExecTrajState': None}), (), ('status', 'ExecTrajState'), None)
 _LEAF_1 = Decision(MappingProxyType({'status': 'OK', 'ExecTrajState': None}), (), ('ExecTrajState',), None)

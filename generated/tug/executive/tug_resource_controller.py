@@ -14,13 +14,14 @@ from specc.runtime.rules import Calls, Decision, no_calls
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
-INPUTS = ["service", "event", "@GOTO_HITCH_UNHITCHstate"]
-NUMERIC_INPUTS = []
-OUTPUTS = ["status", "GOTO_HITCH_UNHITCHstate"]
+INPUTS: list[str] = ["service", "event", "@GOTO_HITCH_UNHITCHstate"]
+NUMERIC_INPUTS: list[str] = []
+OUTPUTS: list[str] = ["status", "GOTO_HITCH_UNHITCHstate"]
 DEPTH = 3
 FINDINGS = 0
-# The previous-cycle values before the first cycle (the base's `init`), read when not given.
-INITIAL = {"@GOTO_HITCH_UNHITCHstate": "IDLE"}
+# The previous-cycle values before the first cycle (the base's `init`), read when not given
+# (empty: the base reads no previous-cycle value, or gives none an `init`).
+INITIAL: dict[str, Any] = {"@GOTO_HITCH_UNHITCHstate": "IDLE"}
 # One decision per value of service: the tests on its longest path (seed 000
 # §3.7's bound, per decision), and the outputs it keeps as they were (each its previous-cycle value,
 # copied without a test); it decides the others.

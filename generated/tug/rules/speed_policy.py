@@ -14,11 +14,14 @@ from specc.runtime.rules import Calls, Decision, no_calls
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
-INPUTS = ["load", "clearance"]
-NUMERIC_INPUTS = ["load", "clearance"]
-OUTPUTS = ["speed"]
+INPUTS: list[str] = ["load", "clearance"]
+NUMERIC_INPUTS: list[str] = ["load", "clearance"]
+OUTPUTS: list[str] = ["speed"]
 DEPTH = 2
 FINDINGS = 0
+# The previous-cycle values before the first cycle (the base's `init`), read when not given
+# (empty: the base reads no previous-cycle value, or gives none an `init`).
+INITIAL: dict[str, Any] = {}
 
 _LEAF_0 = Decision(MappingProxyType({'speed': 'crawl'}), (), (), None)
 _LEAF_1 = Decision(MappingProxyType({'speed': 'slow'}), (), (), None)
