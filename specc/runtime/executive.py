@@ -51,7 +51,16 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from specc.runtime.functional import HISTORY, Registry, Reply, Status, build_record, check_record, check_value
+from specc.runtime.functional import (
+    HISTORY,
+    Registry,
+    Reply,
+    Status,
+    build_record,
+    check_record,
+    check_value,
+    where_raised,
+)
 from specc.runtime.kernel import Timer
 from specc.runtime.rules import Decision
 
@@ -368,7 +377,7 @@ class Executive:
         try:
             activity.input = self._input(service, inputs)
         except Exception as exc:  # the user's input function: report it, keep running
-            self._end(activity, "ERROR", f"input of {name}: {type(exc).__name__}: {exc}")
+            self._end(activity, "ERROR", f"input of {name}: {type(exc).__name__}: {exc}{where_raised(exc)}")
             return
         if service.start_timeout is not None:
             activity.timers.append(self.kernel.call_later(

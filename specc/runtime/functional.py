@@ -20,6 +20,7 @@ import itertools
 import math
 import os
 import sys
+import sysconfig
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -1279,12 +1280,16 @@ def where_raised(exc: BaseException) -> str:
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if not f.filename.startswith("<")]
     if isinstance(exc, SyntaxError) and exc.filename:
         return f" ({_shown(exc.filename)}:{exc.lineno})"
-    users = [f for f in frames if not os.path.abspath(f.filename).startswith(_SPECC_FOLDER)]
+    users = [f for f in frames if not os.path.abspath(f.filename).startswith(_NOT_THE_USERS)]
     shown = (users or frames)[-1:]
     return f" ({_shown(shown[0].filename)}:{shown[0].lineno})" if shown else ""
 
 
 _SPECC_FOLDER = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep  # specc/, with its separator
+# Frames never the user's mistake: specc's own, and Python's library (pathlib refusing the None a
+# user's function passed it is to be shown at the user's line).
+_NOT_THE_USERS = (_SPECC_FOLDER,
+                  *{os.path.abspath(sysconfig.get_paths()[k]) + os.sep for k in ("stdlib", "platstdlib")})
 
 
 def where_running(frame: FrameType | None) -> str:

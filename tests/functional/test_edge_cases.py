@@ -398,3 +398,17 @@ def test_codels_given_as_an_object_without_a_codel_are_named_in_the_error(script
     assert final.report.code == "CODEL_ERROR"
     assert final.report.detail.endswith("is not defined in the codels given to module 'alpha' (SimpleNamespace)")
     assert "functional.py" not in final.report.detail
+
+
+def _opens_nothing(path: Any) -> None:
+    Path(path)  # the user's line: pathlib refuses the None given to it
+
+
+def test_an_error_raised_inside_python_s_library_is_placed_at_the_user_s_line() -> None:
+    """What `specc run` and the executive say of a user function that passed a wrong value to the
+    standard library (an input function's `Path(None)`): the line of the user's call, not
+    pathlib's own."""
+    with pytest.raises(TypeError) as raised:
+        _opens_nothing(None)
+    place = rt.where_raised(raised.value)
+    assert place.endswith(f"test_edge_cases.py:{_opens_nothing.__code__.co_firstlineno + 1})"), place
