@@ -389,8 +389,8 @@ def verify(paths: PathsArg,
 
     def progress(states: int) -> None:
         status.update(f"exploring: {states} states")
-        if not err.is_terminal and heartbeat.due():
-            err.print(f"... exploring: {states:,} states", markup=False)
+        if not err.is_terminal:
+            heartbeat(f"exploring: {states:,} states")
 
     with Status("compiling the controller", console=err) as status:
         try:

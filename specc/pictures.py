@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from specc.analysis import petri
-from specc.analysis.incompat import IncompatibilityGraph, service_groups, state_count
+from specc.analysis.incompat import Group, IncompatibilityGraph, service_groups, state_count
 
 GROUP_COLOURS = ("#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c")
 # For the service groups of a large executive: twenty colours told apart, the first eight as above.
@@ -17,12 +17,13 @@ MANY_COLOURS = (*GROUP_COLOURS, "#ccb974", "#64b5cd", "#1f77b4", "#ff7f0e", "#2c
                 "#8c564b", "#e377c2", "#bcbd22", "#17becf", "#393b79")
 
 
-def incompatibility_layout(graph: IncompatibilityGraph) -> tuple[list[str], dict[str, str], list[str]]:
+def incompatibility_layout(graph: IncompatibilityGraph, groups: list[Group] | None = None
+                           ) -> tuple[list[str], dict[str, str], list[str]]:
     """The services in their order round the circle, each one's colour, and each group's colour.
     A group's services sit side by side (its arcs short, the group one stretch of the circle),
     the services of no group after them, each in the order the executive lists them; groups get
-    colours of their own (twenty before one repeats)."""
-    groups = service_groups(graph)
+    colours of their own (twenty before one repeats). `groups`: the graph's, when worked out already."""
+    groups = service_groups(graph) if groups is None else groups
     palette = GROUP_COLOURS if len(groups) <= len(GROUP_COLOURS) else MANY_COLOURS
     group_colour = [palette[i % len(palette)] for i in range(len(groups))]
     colour = {s: group_colour[i] for i, g in enumerate(groups) for s in g.services}
@@ -39,7 +40,7 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
     from matplotlib.patches import FancyArrowPatch
 
     groups = service_groups(graph)
-    ordered, colour, group_colour = incompatibility_layout(graph)
+    ordered, colour, group_colour = incompatibility_layout(graph, groups)
     count = len(ordered)
     radius = 1.0
     angle = {s: 2 * math.pi * i / count + math.pi / 2 for i, s in enumerate(ordered)}

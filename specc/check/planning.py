@@ -165,22 +165,6 @@ class Scope:
     goals_allowed: bool = False
 
 
-def constant_number(expr: Any) -> float | None:
-    """The finite value of an IxTeT expression of numbers alone (`2`, `-1`, `3 * 60`), else None."""
-    if isinstance(expr, m.Number):
-        return expr.value if math.isfinite(expr.value) else None
-    if isinstance(expr, m.IxUnary) and expr.op == "-":
-        inner = constant_number(expr.operand)
-        return None if inner is None else -inner
-    if isinstance(expr, m.IxBinary) and expr.op in ("+", "-", "*", "/"):
-        left, right = constant_number(expr.left), constant_number(expr.right)
-        if left is None or right is None or (expr.op == "/" and right == 0):
-            return None
-        value = {"+": left + right, "-": left - right, "*": left * right}.get(expr.op, left / right)
-        return value if math.isfinite(value) else None
-    return None
-
-
 class ScopeChecker(Visitor):
     def __init__(self, ctx: Context, domain: DomainTables):
         self.ctx = ctx
@@ -221,7 +205,8 @@ class ScopeChecker(Visitor):
                                 "goals belong to a problem (or a fragment it includes), not to a task", goal.span)
             elif goal is not None:
                 for what, part in (("priority", goal.priority), ("weight", goal.weight)):
-                    if constant_number(part) is None:
+                    value = constant_value(part)
+                    if value is None or not math.isfinite(value):
                         self.ctx.report("bad-goal", f"a goal's {what} is a finite number (goal(priority, "
                                         "weight), e.g. goal(2, 0)): the planner keeps the goals of highest "
                                         "priority first", part.span)

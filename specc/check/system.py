@@ -398,9 +398,10 @@ def check_constant_inputs(ctx: Context, binding: m.Binding, inputs: list[m.Typed
             # A task parameter's symbols (numbers, or a domain not written as symbols, pass).
             values: list[str | float] = sorted(task_parameter_values(domains, binding.task, names.index(arg.name))
                                                or ())
-            subject = f"{arg.name} of task '{binding.task}' may be "
+            said, fix = f"{arg.name} of task '{binding.task}' may be {{}}, which", (
+                ": pass a parameter whose domain holds only such values, or a constant")
         elif isinstance(arg, m.Number | m.IxName):
-            values, subject = [arg.value if isinstance(arg, m.Number) else arg.name], ""
+            values, said, fix = [arg.value if isinstance(arg, m.Number) else arg.name], "{}", ""
         else:
             continue
         kind = typed.type.name
@@ -415,11 +416,9 @@ def check_constant_inputs(ctx: Context, binding: m.Binding, inputs: list[m.Typed
             continue  # text or a structure: the runtime reads what it is given
         if refused:
             allowed = f" ({', '.join(sorted(enums[kind]))})" if kind in enums else ""
-            shown = ", ".join(str(v) for v in refused)
-            ctx.report("bad-argument-type", f"{subject}{shown}, which cannot be input '{typed.name}' of {target}, "
-                       f"of type {kind}{allowed}: pass a parameter whose domain holds only such values, or a "
-                       "constant" if subject else
-                       f"{shown} cannot be input '{typed.name}' of {target}, of type {kind}{allowed}", arg.span)
+            shown = said.format(", ".join(str(v) for v in refused))
+            ctx.report("bad-argument-type", f"{shown} cannot be input '{typed.name}' of {target}, of type "
+                       f"{kind}{allowed}{fix}", arg.span)
 
 
 def check_binding_report(ctx: Context, report: m.BindingReport, reports: dict[str, int]) -> None:

@@ -390,14 +390,14 @@ def run_mission(robot: Robot, mission: MissionSpec, seed: int = 0, *, world: str
         attach = robot.hook("attach")
         if attach is not None:
             attach(context)
-        for fact in facts:
-            assert supervisor is not None  # check_mission: goals need a supervisor
-            supervisor.conclude(fact[len(FACT_OP):])
         intentions = []
-        for goal in posted:
+        if mission.goals:
             assert supervisor is not None  # check_mission: goals need a supervisor
-            intentions.append((goal, supervisor.post(goal)))
-            journal.emit(kernel.now, "goal", goal=goal, status="posted")
+            for fact in facts:
+                supervisor.conclude(fact[len(FACT_OP):])
+            for goal in posted:
+                intentions.append((goal, supervisor.post(goal)))
+                journal.emit(kernel.now, "goal", goal=goal, status="posted")
         planning: list[Any] = []  # FTplan's result, once it has run
         recorder.start(lambda: sum(1 for _, i in intentions if i.status != "running") + len(planning))
         PoseRecorder(journal.emit, sim).start()

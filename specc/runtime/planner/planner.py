@@ -31,7 +31,7 @@ from specc.runtime.planner.heuristics import (
 )
 from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult, Repair
-from specc.runtime.planner.reachable import impossible_goal, reach
+from specc.runtime.planner.reachable import impossible_goal, reach, valued
 from specc.runtime.planner.search import (
     CONTROLLABILITIES,
     EPS,
@@ -1062,15 +1062,17 @@ def round_trips(node: Node) -> list[tuple[str, str]]:
                 and resolve(later.before) == resolve(earlier.value) and resolve(later.value) == resolve(earlier.before))
 
     found: list[tuple[str, str]] = []
+    paired: set[str] = set()
     for first, changes in events.items():
         users = needers.get(first, set())
         if len(users) != 1:
             continue
         (second,) = users
         undoing = events.get(second, [])
-        if (len(undoing) == len(changes) and second not in {a for pair in found for a in pair}
+        if (len(undoing) == len(changes) and second not in paired
                 and all(any(undoes(later, earlier) for earlier in changes) for later in undoing)):
             found.append((first, second))
+            paired.update((first, second))
     return found
 
 
@@ -1323,6 +1325,7 @@ def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
     siblings = {node.assertions[k.producer].owner for k in node.links
                 if node.assertions[k.consumer].owner == need.owner and need.owner != "problem"} - {"problem"}
     changers = node.changers(need)
+    givable: dict[int, bool] = {}  # open need -> may an event give it with the plan's bindings (asked once)
 
     def risky(producer: Assertion) -> bool:
         """Does the link leave the plan worse off than a new task would? With the arguments the
@@ -1348,9 +1351,11 @@ def need_resolvers(node: Node, need: Assertion, existing: list[Assertion],
             return True
         for i in node.open if bound else ():
             other = node.assertions[i]
-            if i != need.id and any(t in bound for t in (*other.args, other.wanted)) and (
-                    node.producers(other) and not node.producers(other, linked)
-                    and not _one_task_gives(node, other, linked)):
+            if i == need.id or not any(t in bound for t in (*other.args, other.wanted)):
+                continue
+            if i not in givable:
+                givable[i] = bool(node.producers(other))
+            if givable[i] and not node.producers(other, linked) and not _one_task_gives(node, other, linked):
                 return True
         return False
 
@@ -1378,8 +1383,8 @@ def _one_task_gives(node: Node, need: Assertion, bindings: Bindings) -> bool:
                 continue
             if isinstance(expr, pm.Var):
                 fits = fits and same_value(known.setdefault(expr.name, term), term)
-            elif isinstance(expr, (pm.Sym, pm.Num)):
-                fits = fits and same_value(expr.name if isinstance(expr, pm.Sym) else expr.value, term)
+            elif (constant := valued(expr)) is not None:
+                fits = fits and same_value(constant, term)
         if fits and all(_given_before(node, a, known, need, bindings) for a in task.assertions
                         if not isinstance(a, pm.Use)):
             return True
@@ -1390,14 +1395,7 @@ def _given_before(node: Node, need: pm.Hold | pm.Event, known: Mapping[str, Term
                   bindings: Bindings) -> bool:
     """Could an event of the plan that may come before the assertion `before` give a new task's
     `need`, its variables valued as `known` says (the others free)?"""
-    def term(expr: pm.Expr) -> Term | None:
-        if isinstance(expr, pm.Sym):
-            return expr.name
-        if isinstance(expr, pm.Num):
-            return expr.value
-        return known.get(expr.name) if isinstance(expr, pm.Var) else None
-
-    terms = [term(x) for x in (*need.args, need.before if isinstance(need, pm.Event) else need.value)]
+    terms = [valued(x, known) for x in (*need.args, need.before if isinstance(need, pm.Event) else need.value)]
     possibly_equal = bindings.possibly_equal
     return any(event_id != before.id and node.allows(e.start, before.start, 0.0)
                and all(t is None or possibly_equal(x, t) for x, t in zip((*e.args, e.value), terms, strict=False))

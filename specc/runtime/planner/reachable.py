@@ -76,7 +76,7 @@ def reach(domain: pm.PlanningDomain, problem: pm.Problem) -> Reach | None:
             found.open.add(name)  # numbers: not enumerated
     for a in problem.assertions:
         if isinstance(a, pm.Event) and a.kind in ("explained", "contingent") and a.attribute in attributes:
-            found.add(a.attribute, tuple(_constant(x) for x in (*a.args, a.after)), {})
+            found.add(a.attribute, tuple(valued(x) for x in (*a.args, a.after)), {})
     instances = list(itertools.islice(_instances(domain), MOST_ASSIGNMENTS + 1))
     if len(instances) > MOST_ASSIGNMENTS:
         return None
@@ -134,11 +134,15 @@ def _choices(event: pm.Event, finite: Mapping[str, frozenset[str]], chosen: Mapp
     return found
 
 
-def _constant(expr: pm.Expr) -> Value | None:
+def valued(expr: pm.Expr, chosen: Mapping[str, Value] | None = None) -> Value | None:
+    """What a task's (or the problem's) term stands for: a symbol's name, a number, a variable's
+    value in `chosen`; ANY for a variable `chosen` does not value, or an expression."""
     if isinstance(expr, pm.Sym):
         return expr.name
     if isinstance(expr, pm.Num):
         return expr.value
+    if isinstance(expr, pm.Var) and chosen is not None:
+        return chosen.get(expr.name, ANY)
     return ANY
 
 
@@ -146,19 +150,13 @@ def _pattern(a: pm.Hold | pm.Event, chosen: Mapping[str, Value], need: bool) -> 
     """The assertion's arguments and the value it needs (`need`: a hold's, an event's value
     before) or gives (an event's value after), with the task's parameters as `chosen`."""
     value = a.value if isinstance(a, pm.Hold) else a.before if need else a.after
-
-    def term(expr: pm.Expr) -> Value | None:
-        if isinstance(expr, pm.Var):
-            return chosen.get(expr.name, ANY)
-        return _constant(expr)
-
-    return tuple(term(x) for x in (*a.args, value))
+    return tuple(valued(x, chosen) for x in (*a.args, value))
 
 
 def impossible_goal(found: Reach, goal: pm.Hold | pm.Event) -> str | None:
     """Why no plan can meet `goal`, or None: its value is never reached."""
     value = goal.value if isinstance(goal, pm.Hold) else goal.after
-    pattern = tuple(_constant(x) for x in (*goal.args, value))
+    pattern = tuple(valued(x) for x in (*goal.args, value))
     if found.holds(goal.attribute, pattern):
         return None
     shown = ", ".join(pm.describe(x) for x in goal.args)
