@@ -57,8 +57,9 @@ CODES: dict[str, Code] = {
     "undefined-codel": Code("a codel function the codel module does not define", "codel exec: stpe;"),
     "bad-codel-signature": Code("a user function cannot be called with the arguments the runtime passes it",
                                 "def watch(sdi, request): ...   (an exec task's codel gets (sdi))"),
-    "incomplete-reply-domain": Code("the procedures' REPLY result domain lacks a fail code a service they name may "
-                                    "answer (warning)", "predicate event REPLY(id: int, result: {OK, ERROR});"),
+    "incomplete-reply-domain": Code("the procedures' REPLY result domain lacks a result a service they name may "
+                                    "answer: a fail code, or FINAL_ERROR for a codel that raises (warning)",
+                                    "predicate event REPLY(id: int, result: {OK, ERROR});"),
     "computed-send": Code("a codel sends a request whose name it computes, which no analysis can follow",
                           "sdi.send_request(\"arm.\" + name)"),
     "undeclared-send": Code("a codel sends a request (`sdi.send_request`) its request's `sends:` does not list "
@@ -161,7 +162,9 @@ CODES: dict[str, Code] = {
     "bypasses-executive": Code("a binding sends a request straight to a module the executive's services use: the "
                                "executive's conflicts do not apply to it, and `specc verify` does not cover it",
                                "PICK(?o) => request arm.Pick(?o);"),
-    "bad-argument-type": Code("a binding's argument does not fit the input's type", "=> service GOTO(A, B);"),
+    "bad-argument-type": Code("a value given to a service's or request's input does not fit its type: a planning "
+                              "task's binding, or a procedure action's parameter (`action MOVE(bed: string)` for a "
+                              "service whose input is an int)", "=> service GOTO(A, B);"),
     # ---------------------------------------------------------------- planning (IxTeT) and FTplan
     "include-cycle": Code("fragments that include each other", "fragment a { include b; } fragment b { include a; }"),
     "undeclared-variable": Code("a task uses a ?variable it does not declare", "?y in PLACES;   (no ?y)"),
@@ -184,6 +187,12 @@ CODES: dict[str, Code] = {
                                      "use(BASE(): 1, t1);"),
     "domain-mismatch": Code("an ftplan mission's problem for a domain its planner does not plan in",
                             "p1: M1_model2;"),
+    "mission-ends-differ": Code("an ftplan mission's problems let it end at different times, and FTplan counts "
+                                "the goals met by its own problem's", "careful: rounds_slow;   (rounds ends by 30 s, "
+                                "rounds_slow by 900 s)"),
+    "planners-share-domain": Code("an ftplan mission makes planners declared with different domains plan in one "
+                                  "(a problem for another planner's domain): they are no longer diverse",
+                                  "careful: rounds;   (rounds is for fast's domain)"),
     "bad-rule-argument": Code("an FTplan rule or requirement given what it cannot hold (an expression, a transition "
                               "where one value is meant, a task's parameter none of whose values the attribute "
                               "holds there)", "requires PTU(): ?o * 2;"),

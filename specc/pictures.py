@@ -53,8 +53,11 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
     reach = 1.2 + 0.018 * longest
     for _ in range(2):
         reach = 1.15 + longest * 5.4 / 72 * (2 * reach + 0.1) / (0.75 * size)
-    # A node's marker radius in data units (420 pt² markers; the axes take about 3/4 of the width).
-    marker = math.sqrt(420 / math.pi) / 72 * (2 * reach + 0.1) / (0.75 * size)
+    # Data units per point (the axes take about 3/4 of the width), for a node's marker radius (420
+    # pt² markers) and a legend line (9 pt text, 13 pt apart).
+    per_point = (2 * reach + 0.1) / (0.75 * size * 72)
+    marker = math.sqrt(420 / math.pi) * per_point
+    line_height = 13 * per_point
     figure, axes = plt.subplots(figsize=(size, size))
     for arc in graph.arcs:
         start, end = position[arc.source], position[arc.target]
@@ -78,16 +81,18 @@ def draw_incompatibility_graph(graph: IncompatibilityGraph, target: Path, title:
         # Along the radius, outwards from its node: labels of neighbours never overlap.
         degrees = math.degrees(angle[service]) % 360
         left = 90 < degrees < 270
-        axes.text(x * 1.1, y * 1.1, labels[service], rotation=degrees - 180 if left else degrees,
+        # Past the marker's edge, not on it.
+        away = 1 + (marker + 4 * per_point) / radius
+        axes.text(x * away, y * away, labels[service], rotation=degrees - 180 if left else degrees,
                   rotation_mode="anchor", ha="right" if left else "left", va="center", fontsize=9)
     legend = [f"{g.name}: {' | '.join(g.states)}" for g in groups]
     plural = "" if len(groups) == 1 else "s"
     axes.set_title(f"{title}\n{len(groups)} service group{plural}, {state_count(groups)} controller states "
                    "(solid: interrupt, dashed: wait)", fontsize=11)
     for i, line in enumerate(legend):
-        axes.text(-reach, -reach - 0.09 * i, line, fontsize=9, color=group_colour[i])
+        axes.text(-reach, -reach - line_height * i, line, fontsize=9, color=group_colour[i])
     axes.set_xlim(-reach - 0.05, reach + 0.05)
-    axes.set_ylim(-reach - 0.1 - 0.09 * len(legend), reach)
+    axes.set_ylim(-reach - 0.1 - line_height * len(legend), reach)
     axes.set_aspect("equal")
     axes.axis("off")
     target.parent.mkdir(parents=True, exist_ok=True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -55,6 +56,7 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
         found += _controller_naming_diagnostics(loaded.program, [d for d in found if d.severity == "error"])
         if not any(d.severity == "error" for d in found):
             found += _rule_base_diagnostics(loaded.program)
+            found += _mission_end_diagnostics(loaded.program)
         loaded.diagnostics.extend(d for d in found if not _already_reported(d, loaded.diagnostics))
     loaded.diagnostics.sort(key=sort_key)
     return loaded
@@ -113,6 +115,40 @@ def _rule_base_diagnostics(program: m.Program) -> list[Diagnostic]:
                                        f"'{executive.name}'", executive)
         except KheopsError as exc:
             found.append(exc.diagnostic())
+    return found
+
+
+def _mission_end_diagnostics(program: m.Program) -> list[Diagnostic]:
+    """FTplan counts a planned mission's goals met or missed by its own statement of the mission
+    (the problem of its first planner without a view): a planner whose problem lets the mission
+    end at another time plans for a deadline FTplan does not count by (a plan ending past
+    FTplan's misses goals it met, one ending sooner leaves time unused)."""
+    from specc.analysis.ftplan import state_planner
+    from specc.analysis.planning import problem_model
+    from specc.runtime.planner.model import latest_end
+
+    problems = {p.name: p for p in program.items if isinstance(p, m.Problem)}
+    found = []
+    for block in (b for b in program.items if isinstance(b, m.FtPlan)):
+        judge = state_planner(block)
+        for mission in block.missions:
+            named = {e.planner.text: e for e in mission.problems if e.problem.text in problems}
+            if judge is None or judge.name not in named or len({e.problem.text for e in named.values()}) < 2:
+                continue
+            own = named[judge.name].problem.text
+            ends = {name: latest_end(problem_model(program, problems[name]))
+                    for name in {e.problem.text for e in named.values()}}
+            for planner, entry in named.items():
+                there = ends[entry.problem.text]
+                if there != ends[own]:
+                    said = {math.inf: "has no latest end"}
+                    found.append(warning(
+                        "mission-ends-differ",
+                        f"mission '{mission.name}': planner '{planner}''s problem '{entry.problem.text}' "
+                        f"{said.get(there, f'ends by {there:g} s at the latest')}, and FTplan counts the goals met "
+                        f"by planner '{judge.name}''s problem '{own}' (its first planner without a view), which "
+                        f"{said.get(ends[own], f'ends by {ends[own]:g} s')}: give both one latest end "
+                        "(`(t_end - t_start) in [0, N];`)", entry.problem.span))
     return found
 
 

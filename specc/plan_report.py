@@ -31,10 +31,15 @@ class Outcome:
 
     @property
     def useful(self) -> bool:
-        """Is there a plan, meeting some goal when the problem has any? (A plan dropping every goal
-        does nothing: the problem is unsolvable as it stands.)"""
-        goals = self.result.goals
-        return self.result.plan is not None and (not goals or any(g.kept for g in goals))
+        """Is there a plan, meeting some goal when the problem has any? A plan dropping every goal
+        does nothing: the problem is unsolvable as it stands; nor does one with no action that
+        drops goals (those it keeps held without it)."""
+        goals, plan = self.result.goals, self.result.plan
+        if plan is None:
+            return False
+        if not plan.actions and any(not g.kept for g in goals):
+            return False
+        return not goals or any(g.kept for g in goals)
 
 
 def choose_problem(program: m.Program, name: str, domain: str | None) -> m.Problem:
@@ -126,7 +131,9 @@ def print_result(outcome: Outcome, out: Console) -> None:
             goals.add_row("kept" if g.kept else "DROPPED", g.description, g.reason)
         out.print(goals)
     if not outcome.useful:
-        out.print(f"no plan: {result.reason or 'every goal is dropped, for the reasons above'}", markup=False)
+        dropped = "every goal that needs an action is" if any(g.kept for g in result.goals) else "every goal is"
+        why = result.reason or f"{dropped} dropped, for the reasons above"
+        out.print(f"no plan: {why}", markup=False)
         return
     assert result.plan is not None
     plan = result.plan

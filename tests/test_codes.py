@@ -14,7 +14,8 @@ from specc.codes import CODES
 SPECC = Path(__file__).resolve().parents[1] / "specc"
 CODE = re.compile(r"^[a-z]+(-[a-z]+)+$")
 # The calls that take a diagnostic code as one of their arguments.
-CALLS = {"error", "report", "warn", "unknown", "Diagnostic", "resolve_member", "_reject", "Problem", "lookup"}
+CALLS = {"error", "warning", "report", "warn", "unknown", "Diagnostic", "resolve_member", "_reject", "Problem",
+         "lookup"}
 
 
 def reported_codes() -> dict[str, str]:

@@ -4,6 +4,7 @@ functions of a codel module (specc.pysource), and a command on files seen before
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -42,6 +43,21 @@ def test_a_file_parsed_again_is_read_back_and_equal_to_a_parse(cache: Path) -> N
     assert again is not first  # read back, not the same object
     assert again.source == fresh(SPEC, "drive.spec").source == first.source
     assert again.comments == first.comments == fresh(SPEC, "drive.spec").comments != []
+
+
+def test_the_model_parsed_or_read_back_is_frozen(cache: Path) -> None:
+    """The model's classes are frozen by their base class (specc.model.nodes.Node), not by
+    dataclass(frozen=True): no field is set again, none deleted, no attribute added, on a
+    parse as on what the cache reads back; `dataclasses.replace` makes the changed copy."""
+    for result in (parser.parse_text(SPEC, "drive.spec"), parser.parse_text(SPEC, "drive.spec")):
+        assert result.source is not None
+        module = result.source.items[0]
+        for change in (lambda: setattr(module, "name", "other"), lambda: delattr(module, "name"),
+                       lambda: setattr(module, "added", 1)):
+            with pytest.raises(dataclasses.FrozenInstanceError):
+                change()
+        renamed = dataclasses.replace(module, name="other")
+        assert (renamed.name, module.name) == ("other", "drive") and renamed != module
 
 
 def test_a_changed_text_or_path_is_parsed_anew(cache: Path) -> None:

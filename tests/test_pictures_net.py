@@ -3,6 +3,8 @@ marking it shows, and that a net of a couple of hundred places draws."""
 
 from __future__ import annotations
 
+import itertools
+import math
 import re
 from pathlib import Path
 from types import SimpleNamespace
@@ -11,6 +13,7 @@ import pytest
 
 from specc.analysis.petri import Arc, Net
 from specc.pictures import draw_net
+from tests.conftest import EXAMPLES
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -177,3 +180,56 @@ def test_the_incompatibility_graph_puts_each_group_together_in_a_colour_of_its_o
     for a, b in pairs:
         assert abs(ordered.index(a) - ordered.index(b)) == 1 and colour[a] == colour[b]
     assert draw_incompatibility_graph(graph, tmp_path / "incompat.png", "e").stat().st_size > 0
+
+
+@pytest.mark.parametrize("robot", ["small", "hilare"])
+def test_the_incompatibility_graph_keeps_its_labels_off_the_nodes_and_its_legend_lines_apart(
+        robot: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A small executive (three groups and a control service, the smallest figure) and Hilare's
+    21 services in six groups: measured in the figure as drawn, no service label starts on a node
+    and no two legend lines overlap (on small figures both did: labels began inside their
+    markers, and the legend's spacing was fixed in data units)."""
+    import matplotlib.figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.collections import PathCollection
+    from matplotlib.text import Text
+
+    from specc.analysis.incompat import build_graph
+    from specc.pictures import draw_incompatibility_graph
+    from specc.pipeline import load
+
+    if robot == "small":
+        request = "  request {} {{ type: exec; task: T; codel exec: go; incompatible_with: {}; }}\n"
+        (tmp_path / "robot.spec").write_text(
+            "module arm {\n" + request.format("MoveToBed", "MoveToBed") + request.format("Image", "Image")
+            + request.format("Spray", "Spray") + "  request Humidity { type: control; }\n"
+            + "  exec_task T { period: 100 ms; }\n}\nexecutive e {\n"
+            + "".join(f"  service {s.upper()} {{ request: arm.{s}; }}\n" for s in ("MoveToBed", "Image", "Spray",
+                                                                                    "Humidity")) + "}\n")
+        (tmp_path / "codels.py").write_text("def go(sdi, request):\n    return 'ether'\n")
+    loaded = load([tmp_path / "robot.spec" if robot == "small" else EXAMPLES / "hilare"], check=False)
+    assert loaded.program is not None
+    executive = next(i for i in loaded.program.items if type(i).__name__ == "Executive")
+    drawn: list[matplotlib.figure.Figure] = []
+    save = matplotlib.figure.Figure.savefig
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig",
+                        lambda self, *args, **kwargs: (drawn.append(self), save(self, *args, **kwargs))[1])
+    graph = build_graph(loaded.program, executive)
+    draw_incompatibility_graph(graph, tmp_path / "incompat.png", robot)
+    figure = drawn[0]
+    renderer = FigureCanvasAgg(figure).get_renderer()  # the figure is closed: a canvas of its own
+    axes = figure.axes[0]
+    texts = [t for t in axes.texts if isinstance(t, Text)]
+    legend = [t.get_window_extent(renderer) for t in texts if ": " in t.get_text()]
+    labels = [t for t in texts if ": " not in t.get_text()]
+    assert len(legend) == (3 if robot == "small" else 6) and len(labels) == len(graph.services)
+    assert not any(a.overlaps(b) for a, b in itertools.combinations(legend, 2))
+    radius = (420 / math.pi) ** 0.5 * figure.dpi / 72  # the markers' radius in pixels
+    centres = [axes.transData.transform(xy) for c in axes.collections if isinstance(c, PathCollection)
+               for xy in c.get_offsets()]
+    assert len(centres) == len(graph.services)
+    # A label runs outwards along its node's radius from where it is anchored: that point is the
+    # label's nearest to its node, and lies past the node's edge.
+    for label in labels:
+        anchor = axes.transData.transform(label.get_position())
+        assert min(math.dist(anchor, centre) for centre in centres) > radius, label.get_text()

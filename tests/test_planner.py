@@ -749,7 +749,9 @@ def test_a_goal_impossible_alone_names_the_constraints_on_its_dates() -> None:
     (goal,) = result.goals
     line = next(c.line for c in problem.constraints if "ta" in pm.timepoints_of(c))
     assert not goal.kept and goal.reason.startswith("impossible even alone")
-    assert goal.reason.endswith(f"the goal's dates: (ta - t_start) in [0, 3] (line {line})")
+    end = next(c.line for c in problem.constraints if "ta" not in pm.timepoints_of(c))
+    assert goal.reason.endswith(f"the goal's dates: (ta - t_start) in [0, 3] (line {line}); the mission ends by "
+                                f"100 s at the latest (line {end})")
 
 
 EUCLIDEAN_SPEC = """

@@ -309,10 +309,10 @@ def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
     assert_clean_failure(result, 2, "error: robot 'atrv' has no mission 'M7'")
     assert not any(tmp_path.iterdir())  # every name is checked before the first run
     assert_clean_failure(specc("table", HILARE, "--world", "W1"), 2, "robot 'hilare' has no world 'W1'")
-    assert_clean_failure(specc("table", HILARE, "--config", "Robot1"), 2, "--config: robot 'hilare' has no planned "
-                         "mission (a mission with 'plan:') to run it on")
+    assert_clean_failure(specc("table", HILARE, "--config", "Robot1"), 2, "--config: no mission of robot 'hilare' "
+                         "is planned (a mission with 'plan:'), and a configuration is FTplan's: run without --config")
     assert_clean_failure(specc("table", HILARE, "--mission", "hunt", "--config", "Robot1"), 2,
-                         "--config: mission hunt of robot 'hilare' is not planned")
+                         "--config: no mission named is planned")
 
 
 def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:

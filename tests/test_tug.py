@@ -207,6 +207,17 @@ def test_codels_beside_the_module_specs_instead_of_the_robot_s_folder_are_found_
     assert "it is in modules/tug_codels: move tug_codels/ up into the robot's folder" in result.stderr
 
 
+def test_a_table_naming_a_goal_mission_beside_a_configuration_runs_it_once_without(tmp_path: Path) -> None:
+    # `deliver` posts a goal (no FTplan): named with --config it runs once, without any, instead
+    # of stopping the table; the planned `shuttle` runs with each configuration.
+    result = specc("table", TUG, "--mission", "deliver", "--mission", "shuttle", "--config", "Robot1",
+                   "--config", "Robot2", "--runs", tmp_path, "--quiet")
+    assert result.returncode == 0, result.stderr
+    data = json.loads((tmp_path / "tug-table.json").read_text())
+    assert sorted((row["mission"], row["configuration"] or "") for row in data["missions"]) == [
+        ("deliver", ""), ("shuttle", "Robot1"), ("shuttle", "Robot2")]
+
+
 def test_a_table_for_one_configuration_runs_the_planned_missions_alone(tmp_path: Path) -> None:
     # --config is FTplan's: without --mission, the missions it plans (not `deliver`, which only
     # posts a goal and used to stop the table with "mission deliver is not planned").

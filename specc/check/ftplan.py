@@ -99,6 +99,7 @@ def check_mission(ctx: Context, mission: m.Mission, planners: dict[str, m.Planne
                   domains: dict[str, tuple[m.Domain, DomainTables]], own: dict[str, DomainTables],
                   known: DomainTables) -> None:
     named: set[str] = set()
+    planned_in: dict[str, tuple[str, m.MissionProblem]] = {}  # planner -> the domain it plans the mission in
     for entry in mission.problems:
         planner = entry.planner.text
         if planner not in planners:
@@ -112,12 +113,14 @@ def check_mission(ctx: Context, mission: m.Mission, planners: dict[str, m.Planne
         if problem is None or planner not in domains:
             continue
         domain, found = domains[planner]
+        planned_in[planner] = (problem.domain.text, entry)
         if problem.domain.text != domain.name:
             other = ctx.lookup(m.Domain, problem.domain, problem.domain.span, "undefined-domain")
             if other is not None and set(tables(_quiet(ctx), other.members).tasks) != set(found.tasks):
                 ctx.report("domain-mismatch", f"problem '{problem.name}' is for domain '{other.name}', whose tasks "
                            f"are not those of planner '{planner}''s domain '{domain.name}': name a problem for "
                            f"'{domain.name}' or a domain with the same tasks", entry.problem.span)
+    check_diversity(ctx, mission, planners, planned_in)
     for planner in planners:
         if planner not in named:
             ctx.report("missing-property", f"mission '{mission.name}' names no problem for planner '{planner}': "
@@ -127,6 +130,25 @@ def check_mission(ctx: Context, mission: m.Mission, planners: dict[str, m.Planne
             ctx.unknown("undefined-planner", "planner", view.planner.text, planners, view.planner.span)
             continue
         check_view(ctx, view.correspondences, own.get(view.planner.text), known)
+
+
+def check_diversity(ctx: Context, mission: m.Mission, planners: dict[str, m.Planner],
+                    planned_in: dict[str, tuple[str, m.MissionProblem]]) -> None:
+    """A planner plans a mission in its problem's domain (a domain with its own domain's tasks:
+    Modele2's per-mission places). One given a problem for the domain another planner of the
+    block declares plans on that planner's model: two planners declared diverse are not, in
+    this mission (a user meant the problem written for its own model)."""
+    declared = {name: p.domain.text for name, p in planners.items() if p.domain is not None}
+    for planner, (domain, entry) in planned_in.items():
+        own = declared.get(planner)
+        others = sorted(other for other, (there, _) in planned_in.items()
+                        if other != planner and there == domain and declared.get(other) not in (None, own))
+        if own is None or domain == own or not others:
+            continue
+        ctx.warn("planners-share-domain", f"planner '{planner}' (domain '{own}') plans mission '{mission.name}' in "
+                 f"domain '{domain}', as planner '{others[0]}' does: problem '{entry.problem.text}' is for "
+                 f"'{domain}', so the two plan on one model and are not diverse here; name a problem for "
+                 f"'{own}'", entry.problem.span)
 
 
 def check_view(ctx: Context, correspondences: tuple[m.Correspondence, ...], planner: DomainTables | None,

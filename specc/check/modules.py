@@ -170,7 +170,13 @@ def check_request(ctx: Context, module: m.Module, request: m.Request, requests: 
         ctx.report("missing-property", f"request '{request.name}' needs 'type: control;' or 'type: exec;'",
                    request.span)
     for other in request.incompatible_with:
-        if other.text != "all" and other.text not in requests:
+        if len(other.parts) > 1:
+            # A module only knows its own requests; two modules' requests kept apart is the
+            # executive's business.
+            ctx.report("undefined-request", f"incompatible_with names requests of module '{module.name}' only, not "
+                       f"'{other.text}': to keep two modules' requests from running together, give the executive "
+                       "services that run them a conflict (`conflicts { SERVICE: interrupt; }`, or wait)", other.span)
+        elif other.text != "all" and other.text not in requests:
             ctx.unknown("undefined-request", "request", other.text, requests, other.span,
                         f" in module '{module.name}'")
     if request.kind == "control":

@@ -68,8 +68,10 @@ def check(ctx: Context) -> None:
 
 def check_reply_domain(ctx: Context, procedures: m.Procedures, executive: m.Executive) -> None:
     """A finite result domain of the procedures' `REPLY(id, result)` holds every fail code the
-    modules may answer for the services the procedures name: a reply carrying another reaches them
-    outside what `specc verify --goal` assumes (the run notes an incident when it happens)."""
+    modules may answer for the services the procedures name, and the statuses a broken codel
+    ends a request with (FINAL_ERROR; SERVER_ERROR for one that sends requests): a reply carrying
+    another reaches them outside what `specc verify --goal` assumes (the run notes an incident
+    when it happens)."""
     reply = next((p for p in procedures.predicates if p.name == "REPLY" and len(p.params) == 2), None)
     allowed = Domains(procedures).values(reply.params[1].domain) if reply is not None else None
     if reply is None or allowed is None:
@@ -79,12 +81,18 @@ def check_reply_domain(ctx: Context, procedures: m.Procedures, executive: m.Exec
     missing: dict[str, list[str]] = {}
     for service in executive.services:
         request = ctx.symbols.service_request(service) if service.name in named else None
-        for code in request.fail if request is not None else ():
-            if code.text not in allowed:
-                missing.setdefault(code.text, []).append(service.name)
+        if request is None:
+            continue
+        # Its fail codes, and the module's status when a codel breaks: one that raises (or a
+        # validate codel refusing) ends the request FINAL_ERROR, a child's error SERVER_ERROR.
+        runs_codels = request.kind != "control" or request.validate is not None
+        breaks = (["FINAL_ERROR"] if runs_codels else []) + (["SERVER_ERROR"] if request.sends else [])
+        for code in [c.text for c in request.fail] + breaks:
+            if code not in allowed:
+                missing.setdefault(code, []).append(service.name)
     if missing:
         said = ", ".join(f"{code} ({', '.join(services)})" for code, services in sorted(missing.items()))
-        ctx.warn("incomplete-reply-domain", f"REPLY's result domain lacks fail code(s) the services the procedures "
+        ctx.warn("incomplete-reply-domain", f"REPLY's result domain lacks result(s) the services the procedures "
                  f"name may answer: {said}; a reply carrying one reaches the procedures outside the domain "
                  "`specc verify --goal` assumes (a run notes an incident): add them to it", reply.params[1].span)
 

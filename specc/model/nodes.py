@@ -7,8 +7,9 @@ Blocks written as GenoM-style `key: value;` properties declare those keys in fie
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
-from typing import Any, Literal, Union
+from collections.abc import Callable
+from dataclasses import FrozenInstanceError, dataclass, field, fields
+from typing import TYPE_CHECKING, Any, Literal, TypeVar, Union
 
 from specc.model.span import NO_SPAN, Span
 
@@ -33,16 +34,38 @@ def property_fields(node_type: type) -> list[Any]:
     return [f for f in fields(node_type) if "key" in f.metadata]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+NodeType = TypeVar("NodeType", bound=type)
+
+if TYPE_CHECKING:  # what the classes are: frozen keyword-only dataclasses
+    from typing_extensions import dataclass_transform
+
+    @dataclass_transform(kw_only_default=True, frozen_default=True, eq_default=False, field_specifiers=(field,))
+    def node(cls: NodeType) -> NodeType: ...
+else:
+    # How they are made: frozen by Node's own __setattr__ (below), not by a __setattr__ and a
+    # __delattr__ `dataclass(frozen=True)` would generate for each of the model's classes.
+    node: Callable[[NodeType], NodeType] = dataclass(kw_only=True, eq=False, repr=False)
+
+
+@node
 class Node:
     """The base of every construct: where it was written (spans never take part in equality)."""
 
     span: Span = span_field()
 
-    # Equality, hash and repr are written once here, from each class's fields, where `dataclass`
-    # would generate them for every class (eq=False, repr=False on each): generating them for the
-    # model's 129 classes was 20 ms of every command's start. They mean what the generated ones
-    # do: same class and same compared fields; a hash of those; the repr fields by name.
+    # Equality, hash, repr and frozenness are written once here, from each class's fields, where
+    # `dataclass` would generate them for every class (eq=False, repr=False and not frozen on each,
+    # see `node`): generating them for the model's 129 classes was 50 ms of every command's start.
+    # They mean what the generated ones do: same class and same compared fields; a hash of those;
+    # the repr fields by name; each field set once, by __init__, and nothing set or deleted after.
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in self.__dict__ or name not in self.__dataclass_fields__:
+            raise FrozenInstanceError(f"cannot assign to field {name!r}")
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+
     def __eq__(self, other: object) -> bool:
         if other.__class__ is not self.__class__:
             return NotImplemented
@@ -90,7 +113,7 @@ class Word(str):
         return word
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Ref(Node):
     """A name, possibly dotted (`pilo.execPosterTraj`)."""
 
@@ -101,14 +124,14 @@ class Ref(Node):
         return ".".join(self.parts)
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Number(Node):
     """A number as written (`3`, `0.25`)."""
 
     value: int | float
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Duration(Node):
     """A number with its unit of time (`50 ms`, `2 min`)."""
 
@@ -122,14 +145,14 @@ class Duration(Node):
         return float(self.value) * self.SCALE[self.unit]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class String(Node):
     """A double-quoted string (`"tug_codels"`)."""
 
     value: str
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class TypeRef(Node):
     """A GenoM type (`double`, `char[32]`, a struct or enum of the module)."""
 
@@ -137,7 +160,7 @@ class TypeRef(Node):
     size: int | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class TypedName(Node):
     """`name: type`, in a request's `input:` or `output:`."""
 
@@ -151,7 +174,7 @@ PropValue = Union[Ref, Number, Duration, String, TypedName]
 # ---------------------------------------------------------------- module (GenoM)
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Field(Node):
     """A field of a struct or of a module's internal data (`x: double;`)."""
 
@@ -159,7 +182,7 @@ class Field(Node):
     type: TypeRef
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class StructDecl(Node):
     """`struct NAME { field: type; ... }` in a module."""
 
@@ -167,7 +190,7 @@ class StructDecl(Node):
     fields: tuple[Field, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class EnumDecl(Node):
     """`enum NAME { A, B, ... }` in a module."""
 
@@ -175,7 +198,7 @@ class EnumDecl(Node):
     values: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Codel(Node):
     """`codel <state>: <function> [-> next, states];` — the codel run in that activity state."""
 
@@ -184,7 +207,7 @@ class Codel(Node):
     yields: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Request(Node):
     """`request NAME { type: control|exec; ... }`: what a module offers (GenoM), with its codels."""
 
@@ -202,7 +225,7 @@ class Request(Node):
     codels: tuple[Codel, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ExecTask(Node):
     """`exec_task NAME { period: ...; }`: the periodic task that runs a module's activities."""
 
@@ -216,7 +239,7 @@ class ExecTask(Node):
     codels: tuple[Codel, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Poster(Node):
     """`poster NAME { data: ...; }`: data a module publishes for others to read."""
 
@@ -227,7 +250,7 @@ class Poster(Node):
     doc: String | None = prop("doc", "string")
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Module(Node):
     """`module NAME { ... }`: a GenoM functional module (seed 000 ch. 2)."""
 
@@ -246,7 +269,7 @@ class Module(Node):
 # ---------------------------------------------------------------- executive
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Timeouts(Node):
     """`timeout { start: ...; interm: ...; final: ...; }` of a service: how long each reply may take."""
 
@@ -255,7 +278,7 @@ class Timeouts(Node):
     final: Duration | None = prop("final", "duration")
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Conflict(Node):
     """`SERVICE: interrupt;` or `SERVICE: wait;` in a service's `conflicts { }`: what happens when both are asked."""
 
@@ -263,7 +286,7 @@ class Conflict(Node):
     policy: str  # "interrupt" | "wait"
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Argument(Node):
     """A constant input of the service's request (`args { speed: 0.3; }`)."""
 
@@ -271,7 +294,7 @@ class Argument(Node):
     value: PropValue
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Service(Node):
     """`service NAME { request: module.REQUEST; ... }`: a request the executive runs for the task level."""
 
@@ -286,7 +309,7 @@ class Service(Node):
     conflicts: tuple[Conflict, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Comparison(Node):
     """`OP value` in a reflex's trigger (`> 0.5`)."""
 
@@ -294,7 +317,7 @@ class Comparison(Node):
     value: PropValue
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ReflexAction(Node):
     """`request|abort|start TARGET` in a reflex: what it does when triggered."""
 
@@ -302,7 +325,7 @@ class ReflexAction(Node):
     target: Ref
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Reflex(Node):
     """`reflex [NAME] on reply|warning|interm SOURCE [OP value] => actions;`: the executive's own
     reaction."""
@@ -314,7 +337,7 @@ class Reflex(Node):
     actions: tuple[ReflexAction, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Parameter(Node):
     """A GET-PARAM / SET-PARAM parameter of the executive (seed 000 §4.2.2)."""
 
@@ -324,7 +347,7 @@ class Parameter(Node):
     doc: String | None = prop("doc", "string")
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Executive(Node):
     """`executive NAME { service ...; reflex ...; }`: the services and their incompatibilities (seed 000 ch. 3)."""
 
@@ -340,7 +363,7 @@ class Executive(Node):
 # ---------------------------------------------------------------- rules (Kheops)
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AttrRef(Node):
     """An attribute of a rule base as a rule reads it (`speed`; `@speed`, its previous value; `range[i]`)."""
 
@@ -349,7 +372,7 @@ class AttrRef(Node):
     index: str | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KBinary(Node):
     """`left OP right`: arithmetic in a rule base."""
 
@@ -358,7 +381,7 @@ class KBinary(Node):
     right: KExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KNegate(Node):
     """`-operand` in a rule base."""
 
@@ -368,7 +391,7 @@ class KNegate(Node):
 KExpr = Union[Number, String, AttrRef, KBinary, KNegate]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KRange(Node):
     """`low..high` in a rule base's list of values."""
 
@@ -379,14 +402,14 @@ class KRange(Node):
 KItem = Union[String, Number, Ref, KRange]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SymbolDomain(Node):
     """`{"fast", "slow"}`: the symbols an attribute of a rule base takes."""
 
     values: tuple[KItem, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class NumericDomain(Node):
     """`[low, high]` or `number`: the numbers an attribute of a rule base takes."""
 
@@ -394,7 +417,7 @@ class NumericDomain(Node):
     high: KExpr | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class BoolDomain(Node):
     """`bool`: a true/false attribute of a rule base."""
 
@@ -402,7 +425,7 @@ class BoolDomain(Node):
 AttrDomain = Union[SymbolDomain, NumericDomain, BoolDomain]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AttrDecl(Node):
     """`inputs|outputs|intermediate name: domain, ...;` in a rule base."""
 
@@ -411,7 +434,7 @@ class AttrDecl(Node):
     domain: AttrDomain | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ConstDecl(Node):
     """`const NAME = value;` in a rule base."""
 
@@ -419,7 +442,7 @@ class ConstDecl(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class InitDecl(Node):
     """`init @NAME = value;` in a rule base: an attribute's previous value at the first decision."""
 
@@ -427,7 +450,7 @@ class InitDecl(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KCompare(Node):
     """`attr OP value` in a rule's condition."""
 
@@ -436,7 +459,7 @@ class KCompare(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KMember(Node):
     """`attr oneof|noneof [items]` in a rule's condition."""
 
@@ -445,42 +468,42 @@ class KMember(Node):
     items: tuple[KItem, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KTrue(Node):
     """`attr` alone in a rule's condition or restriction: a bool attribute that holds."""
 
     attr: AttrRef
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KFalse(Node):
     """`!attr` in a restriction: a bool attribute that does not hold."""
 
     attr: AttrRef
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KNot(Node):
     """`!condition` in a rule's condition."""
 
     operand: Cond
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KAnd(Node):
     """Conditions that must all hold (`a, b`)."""
 
     operands: tuple[Cond, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KOr(Node):
     """Conditions of which one must hold (`a | b`)."""
 
     operands: tuple[Cond, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KForeach(Node):
     """`foreach VAR in [items] (condition)`: the condition for each item."""
 
@@ -493,14 +516,14 @@ Cond = Union[KCompare, KMember, KTrue, KNot, KAnd, KOr, KForeach]
 Restriction = Union[KCompare, KMember, KTrue, KFalse]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Restrict(Node):
     """`restrict RESTRICTION` in a rule's actions: it narrows an output's values."""
 
     restriction: Restriction
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class DoAssign(Node):
     """`target = value` in a rule's `do { }`."""
 
@@ -508,7 +531,7 @@ class DoAssign(Node):
     value: KExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class DoCall(Node):
     """`function(args)` in a rule's `do { }`."""
 
@@ -516,7 +539,7 @@ class DoCall(Node):
     args: tuple[KExpr, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class DoAction(Node):
     """`do { target = value; function(args) }` in a rule's actions."""
 
@@ -526,7 +549,7 @@ class DoAction(Node):
 Action = Union[Restrict, DoAction]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Rule(Node):
     """`NAME: condition ==> actions;` in a rule base (or an `impossible` / `else` rule)."""
 
@@ -537,7 +560,7 @@ class Rule(Node):
     actions: tuple[Action, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class RuleForeach(Node):
     """`foreach VAR in [items] { rules }`: rules written once for each item."""
 
@@ -546,7 +569,7 @@ class RuleForeach(Node):
     rules: tuple[Rule, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class RuleBase(Node):
     """`rules NAME { ... }`: a Kheops rule base (seed 000 §3.7), compiled to a decision of bounded depth."""
 
@@ -560,21 +583,21 @@ class RuleBase(Node):
 # ---------------------------------------------------------------- procedures (PRS)
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SymbolSet(Node):
     """`{A, B, C}`: the values of a PRS type or parameter."""
 
     values: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class DomainRef(Node):
     """A named PRS type used as a domain."""
 
     name: str
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IntRange(Node):
     """`low..high`: the bounded integers a Petri-net translation can enumerate (§4.4.10)."""
 
@@ -585,7 +608,7 @@ class IntRange(Node):
 PDomain = Union[SymbolSet, IntRange, DomainRef]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class TypeDecl(Node):
     """`type NAME = domain;` in procedures."""
 
@@ -593,7 +616,7 @@ class TypeDecl(Node):
     domain: PDomain
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class PParam(Node):
     """`name: domain`, a parameter of a PRS predicate or action."""
 
@@ -601,7 +624,7 @@ class PParam(Node):
     domain: PDomain
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class PredicateDecl(Node):
     """`predicate [kinds] NAME(params) [-> result];` in procedures: a fact of the database."""
 
@@ -612,7 +635,7 @@ class PredicateDecl(Node):
     binding: String | None = None  # the Python function an evaluable predicate calls
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ServiceBinding(Node):
     """`action GOTO(x: float, y: float) -> int = service GOTO;`: the action requests the executive's
     service with its arguments (the service's `takes:` inputs) and its value is the request's id."""
@@ -620,7 +643,7 @@ class ServiceBinding(Node):
     service: str
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ActionDecl(Node):
     """`action NAME(params) [-> result] = ...;` in procedures: what a primitive KA may do."""
 
@@ -630,21 +653,21 @@ class ActionDecl(Node):
     binding: String | ServiceBinding
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class LogicVar(Node):
     """`$X`: a PRS logical variable."""
 
     name: str  # with its leading $
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ProgramVar(Node):
     """`@X`: a PRS program variable."""
 
     name: str  # with its leading @
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SExp(Node):
     """`(HEAD args...)`: a PRS expression, fact or call."""
 
@@ -655,7 +678,7 @@ class SExp(Node):
 SArg = Union[LogicVar, ProgramVar, Ref, Number, String, SExp]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Goal(Node):
     """`!(...)`, `?(...)`, `^(...)`, `=>(...)`, `~>(...)`, `#(...)` or `%(...)`: a PRS goal (achieve,
     test, wait, conclude, retract, preserve, maintain)."""
@@ -664,21 +687,21 @@ class Goal(Node):
     body: SExp
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Block(Node):
     """`{ statements }` in a KA's body."""
 
     statements: tuple[Stmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class GoalStmt(Node):
     """A goal as a statement of a KA's body (`!(GO 2 5);`)."""
 
     goal: Goal
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IfStmt(Node):
     """`if (goal) { ... } else { ... }` in a KA's body."""
 
@@ -687,7 +710,7 @@ class IfStmt(Node):
     orelse: Block | IfStmt | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class WhileStmt(Node):
     """`while (goal) { ... }` in a KA's body."""
 
@@ -695,21 +718,21 @@ class WhileStmt(Node):
     body: Block
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ParallelStmt(Node):
     """`parallel { ... } { ... }` in a KA's body: branches run together."""
 
     branches: tuple[Block, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ChooseStmt(Node):
     """`choose { ... } { ... }` in a KA's body: the first branch that succeeds."""
 
     branches: tuple[Block, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AssignStmt(Node):
     """`assign @X = value;` in a KA's body."""
 
@@ -717,7 +740,7 @@ class AssignStmt(Node):
     value: SArg
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class FailStmt(Node):
     """`fail;` in a KA's body: the KA fails here."""
 
@@ -725,7 +748,7 @@ class FailStmt(Node):
 Stmt = Union[GoalStmt, IfStmt, WhileStmt, ParallelStmt, ChooseStmt, AssignStmt, FailStmt]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KAAction(Node):
     """`action: (CALL args) [-> $RESULT];`: a primitive KA's action."""
 
@@ -733,7 +756,7 @@ class KAAction(Node):
     result: LogicVar | ProgramVar | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class KA(Node):
     """`ka NAME { invocation: ...; body { } }`: a PRS knowledge area (seed 000 ch. 4)."""
 
@@ -747,7 +770,7 @@ class KA(Node):
     properties: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Procedures(Node):
     """`procedures NAME { ... }`: a PRS database's types, predicates and actions, and its KAs."""
 
@@ -761,26 +784,26 @@ class Procedures(Node):
 # ---------------------------------------------------------------- domain / problem (IxTeT)
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Infinity(Node):
     """`oo`: an unbounded end of an IxTeT interval."""
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IxVar(Node):
     """`?x`: an IxTeT variable."""
 
     name: str  # with its leading ?
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IxName(Node):
     """A constant symbol or a timepoint in IxTeT (`DOCK`, `t_start`)."""
 
     name: str
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IxCall(Node):
     """`FUNCTION(args)` in an IxTeT expression."""
 
@@ -788,7 +811,7 @@ class IxCall(Node):
     args: tuple[IxExpr, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IxBinary(Node):
     """`left OP right` in an IxTeT expression."""
 
@@ -797,7 +820,7 @@ class IxBinary(Node):
     right: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class IxUnary(Node):
     """`-operand` (or another prefix operator) in an IxTeT expression."""
 
@@ -808,7 +831,7 @@ class IxUnary(Node):
 IxExpr = Union[Number, Infinity, IxVar, IxName, IxCall, IxBinary, IxUnary]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Interval(Node):
     """`[low, high]` in IxTeT."""
 
@@ -816,21 +839,21 @@ class Interval(Node):
     high: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SetLiteral(Node):
     """`{A, B}` in IxTeT."""
 
     values: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SetRef(Node):
     """A named constant set in IxTeT (`PLACES`)."""
 
     name: str
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SetUnion(Node):
     """Sets joined with `|`, or one set, in IxTeT."""
 
@@ -840,7 +863,7 @@ class SetUnion(Node):
 DomainValue = Union[Interval, SetUnion]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Transition(Node):
     """`(before, after)`: the value an event changes an attribute from and to."""
 
@@ -848,7 +871,7 @@ class Transition(Node):
     after: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AttrValue(Node):
     """`ATTRIBUTE(args): value` in IxTeT, the value a transition or a single value."""
 
@@ -857,7 +880,7 @@ class AttrValue(Node):
     value: IxExpr | Transition
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class GoalMark(Node):
     """`goal(priority, weight)` after an assertion of a problem: it is a goal to meet."""
 
@@ -865,7 +888,7 @@ class GoalMark(Node):
     weight: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Hold(Node):
     """`hold(ATTR(args): value, (start, end))`: the attribute keeps its value over the interval."""
 
@@ -875,7 +898,7 @@ class Hold(Node):
     goal: GoalMark | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Event(Node):
     """`event(ATTR(args): (before, after), time)`: the attribute changes at that time."""
 
@@ -885,7 +908,7 @@ class Event(Node):
     goal: GoalMark | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Window(Node):
     """`(start, end)`: the interval a resource is used over."""
 
@@ -893,7 +916,7 @@ class Window(Node):
     end: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ResourceUse(Node):
     """`use|consume|produce(RESOURCE(args): amount, when)`."""
 
@@ -903,21 +926,21 @@ class ResourceUse(Node):
     goal: GoalMark | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class VariableDecl(Node):
     """`variable ?a, ?b;` in an IxTeT task."""
 
     names: tuple[IxVar, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class TimepointDecl(Node):
     """`timepoint t1, t2;` in an IxTeT task or problem."""
 
     names: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class InConstraint(Node):
     """`expr in domain;` (possibly `contingent`): an IxTeT constraint."""
 
@@ -926,7 +949,7 @@ class InConstraint(Node):
     contingent: bool = False
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class RelConstraint(Node):
     """`left OP right;` (possibly `contingent`): an IxTeT constraint."""
 
@@ -936,7 +959,7 @@ class RelConstraint(Node):
     contingent: bool = False
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Implication(Node):
     """`condition => consequence;`: a constraint that holds only when the condition does."""
 
@@ -944,7 +967,7 @@ class Implication(Node):
     consequence: InConstraint | RelConstraint
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class MacroCall(Node):
     """`NAME(args);`: a macro's statements written in place."""
 
@@ -952,7 +975,7 @@ class MacroCall(Node):
     args: tuple[IxExpr, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Include(Node):
     """`include NAME;`: a fragment's statements written in place."""
 
@@ -965,7 +988,7 @@ TStmt = Union[
 ]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Constant(Node):
     """`constant NAME = set;` in a planning domain."""
 
@@ -973,7 +996,7 @@ class Constant(Node):
     value: SetUnion
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Attribute(Node):
     """`attribute NAME(?params) { ... }`: a state variable of a planning domain."""
 
@@ -982,7 +1005,7 @@ class Attribute(Node):
     body: tuple[TStmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Resource(Node):
     """`resource NAME(?params) { ... }`: a shared resource of a planning domain."""
 
@@ -991,7 +1014,7 @@ class Resource(Node):
     body: tuple[TStmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Macro(Node):
     """`macro NAME(params) { ... }`: statements written once and used in tasks."""
 
@@ -1000,7 +1023,7 @@ class Macro(Node):
     body: tuple[TStmt, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Task(Node):
     """`task NAME(?params) (t_start, t_end) { ... }`: an action a plan may hold (IxTeT's chronicle)."""
 
@@ -1015,7 +1038,7 @@ class Task(Node):
 DomainMember = Union[Include, Constant, Attribute, Resource, Macro, Task]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Domain(Node):
     """`domain NAME { ... }`: an IxTeT planning domain (seed 004 annex A)."""
 
@@ -1023,7 +1046,7 @@ class Domain(Node):
     members: tuple[DomainMember, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Problem(Node):
     """`problem NAME for DOMAIN { ... }`: the initial state, goals and deadlines of a planning problem."""
 
@@ -1033,7 +1056,7 @@ class Problem(Node):
     preemption: str | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Fragment(Node):
     """`fragment NAME { ... }`: statements shared by domains and problems (`include NAME;`)."""
 
@@ -1044,7 +1067,7 @@ class Fragment(Node):
 # ---------------------------------------------------------------- ftplan
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class ViewFact(Node):
     """`ATTRIBUTE(args): value` in a correspondence; on FTplan's side the value may be an interval."""
 
@@ -1053,7 +1076,7 @@ class ViewFact(Node):
     value: IxExpr | Interval
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Correspondence(Node):
     """`planner facts <=> FTplan's facts`: how a planner's vocabulary reads FTplan's state."""
 
@@ -1061,7 +1084,7 @@ class Correspondence(Node):
     state_facts: tuple[ViewFact, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Planner(Node):
     """`planner NAME { domain: ...; }` in an ftplan block: one of FTplan's diverse planners."""
 
@@ -1078,7 +1101,7 @@ class Planner(Node):
     view: tuple[Correspondence, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class MissionProblem(Node):
     """`planner: problem;` in a mission: the planner's statement of the mission."""
 
@@ -1086,7 +1109,7 @@ class MissionProblem(Node):
     problem: Ref
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class MissionView(Node):
     """`view planner { ... }` in a mission: correspondences that hold for this mission only."""
 
@@ -1094,7 +1117,7 @@ class MissionView(Node):
     correspondences: tuple[Correspondence, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Mission(Node):
     """`mission NAME { planner: problem; ... }` in an ftplan block: the problem each planner plans."""
 
@@ -1103,7 +1126,7 @@ class Mission(Node):
     views: tuple[MissionView, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AnalyzerCondition(Node):
     """`during|at_start|at_end TASK(args) requires ATTR: value;`: a condition FTplan's plan analyser checks."""
 
@@ -1113,14 +1136,14 @@ class AnalyzerCondition(Node):
     requirement: AttrValue
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AnalyzerNoOverlap(Node):
     """`no_overlap TASK, TASK;`: tasks FTplan's plan analyser forbids to overlap."""
 
     tasks: tuple[str, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class AnalyzerMaxDuration(Node):
     """`max_duration TASK duration;`: a duration FTplan's plan analyser bounds."""
 
@@ -1131,7 +1154,7 @@ class AnalyzerMaxDuration(Node):
 AnalyzerRule = Union[AnalyzerCondition, AnalyzerNoOverlap, AnalyzerMaxDuration]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class FactUpdate(Node):
     """`ATTR(args) := value` in a state update."""
 
@@ -1140,7 +1163,7 @@ class FactUpdate(Node):
     value: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class StateUpdate(Node):
     """`on ended|failed|report TASK(args) => updates;`: how an action's outcome changes FTplan's state."""
 
@@ -1150,7 +1173,7 @@ class StateUpdate(Node):
     updates: tuple[FactUpdate, ...]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class FtPlan(Node):
     """`ftplan NAME { ... }`: the fault-tolerant planning component (seed 004 ch. 3) and its planners."""
 
@@ -1168,7 +1191,7 @@ class FtPlan(Node):
 # ---------------------------------------------------------------- system
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Setting(Node):
     """One `name: value;` entry of a system's `body { }` or `worlds { }`."""
 
@@ -1176,14 +1199,14 @@ class Setting(Node):
     value: PropValue
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Settings(Node):
     """A system's `body { }` or `worlds { }` section."""
 
     entries: tuple[Setting, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class DeviceGrant(Node):
     """`module: device, ...;` in a system's `devices { }`: what the module's codels may drive."""
 
@@ -1191,14 +1214,14 @@ class DeviceGrant(Node):
     devices: tuple[Ref, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class DeviceGrants(Node):
     """A system's `devices { }` section."""
 
     entries: tuple[DeviceGrant, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Binding(Node):
     """`TASK(?a, ?b) => goal G(?a);`: how a planning task is carried out (kind: goal, service or
     request), with the target's arguments made from the task's."""
@@ -1212,7 +1235,7 @@ class Binding(Node):
     report: BindingReport | None = None
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class BindingWhere(Node):
     """`where ATTR(?o, ...) := VALUE`: ?variables bound by the first of FTplan's state changes at
     the action's end that reads so."""
@@ -1222,7 +1245,7 @@ class BindingWhere(Node):
     value: IxExpr
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class BindingReport(Node):
     """`report NAME(module.Poster.field, ...)`: posters read when the action is over, reported to FTplan."""
 
@@ -1230,14 +1253,14 @@ class BindingReport(Node):
     values: tuple[Ref, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Bindings(Node):
     """A system's `bindings { }` section."""
 
     entries: tuple[Binding, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SystemMission(Node):
     """A mission of the robot: the goals its supervisor is given, in one of its worlds."""
 
@@ -1249,7 +1272,7 @@ class SystemMission(Node):
     goals: tuple[Goal, ...] = ()  # `goal: !(...);`, posted together at the start
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class System(Node):
     """`system NAME { ... }`: how a robot runs: its modules, executive, supervisor, body, worlds, missions."""
 
@@ -1271,7 +1294,7 @@ class System(Node):
 Item = Union[Module, Executive, RuleBase, Procedures, Domain, Problem, Fragment, FtPlan, System]
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class SourceFile(Node):
     """One spec file and the blocks it holds."""
 
@@ -1279,7 +1302,7 @@ class SourceFile(Node):
     items: tuple[Item, ...] = ()
 
 
-@dataclass(frozen=True, kw_only=True, eq=False, repr=False)
+@node
 class Program(Node):
     """Every file of one robot, in the order they were given."""
 

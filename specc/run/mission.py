@@ -290,7 +290,8 @@ def check_mission(robot: Robot, mission: MissionSpec, world: str | None, seed: i
     if mission.plan is None:
         if configuration is not None or domains:
             raise RunError(f"{'--config' if configuration is not None else 'a planning domain'}: mission "
-                           f"{mission.name} of robot '{robot.name}' is not planned (FTplan plans in them)")
+                           f"{mission.name} of robot '{robot.name}' is not planned (it has no 'plan:'), and only "
+                           "a planned mission has FTplan's configurations and domains: run it without them")
         return CheckedMission(world_file, ground=prepared_world(robot, mission, seed, world_file, None))
     block = robot.part("ftplan").FTPLANS[robot.system.planning]
     try:

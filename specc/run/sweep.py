@@ -116,17 +116,28 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
     """Run `robot` (compiled into base.generated) on every combination, each run as `base` says
     otherwise (its folder under base.runs). Names are checked before the first run. No missions:
     every mission of the system (with configurations: every planned one); no worlds: each in its own;
-    no configurations: FTplan's default."""
+    no configurations: FTplan's default. A mission without planning named beside configurations
+    runs once, without any."""
     if not seeds:
         raise RunError("no seed to run: give at least one")
-    declared = load_robot(base.generated, base.specs, robot).system.missions if not missions else {}
+    declared = load_robot(base.generated, base.specs, robot).system.missions
+
+    def is_planned(name: str) -> bool:
+        mission = declared.get(name)
+        return mission is None or mission.plan is not None  # an unknown name: plan_run says so
+
     # With configurations of FTplan and no mission named: the planned missions, which they are for.
-    every = missions or tuple(name for name, mission in declared.items()
-                              if not configurations or mission.plan is not None)
-    if configurations and not every:
-        raise RunError(f"--config: robot '{robot}' has no planned mission (a mission with 'plan:') to run it on")
-    requests = [replace(base, mission=m, world=w, configuration=c, seed=s)
-                for c, m, w, s in itertools.product(configurations or (None,), every, worlds or (None,), seeds)]
+    every = missions or tuple(name for name in declared if not configurations or is_planned(name))
+    if configurations and not any(is_planned(name) for name in every):
+        raise RunError(f"--config: {'no mission named' if missions else f'no mission of robot {robot!r}'} is "
+                       "planned (a mission with 'plan:'), and a configuration is FTplan's: run without --config")
+    requests = []
+    for c, m, w, s in itertools.product(configurations or (None,), every, worlds or (None,), seeds):
+        if c is not None and not is_planned(m):
+            if c != configurations[0]:
+                continue
+            c = None  # a mission without planning runs without FTplan: once, whatever the configurations
+        requests.append(replace(base, mission=m, world=w, configuration=c, seed=s))
     if not requests:
         raise RunError("nothing to run: give at least one mission, world and configuration")
     planned = [plan_run(robot, request) for request in requests]  # a typo stops the table before any run

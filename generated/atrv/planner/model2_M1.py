@@ -992,7 +992,7 @@ PROBLEMS = {
             Member(expr=Op('-', (Time('t_end'), Time('t_goal1'))), domain=Interval(2.0, 4.0), line=129),
             Member(expr=Op('-', (Time('t_goal3e'), Time('t_evisi1'))), domain=Interval(2.0, 4.0), line=130),
             Member(expr=Op('-', (Time('t_goal4e'), Time('t_evisi2'))), domain=Interval(2.0, 4.0), line=131),
-            Member(expr=Op('-', (Time('t_end'), Time('t_start'))), domain=Interval(330.0, 900.0), line=174),
+            Member(expr=Op('-', (Time('t_end'), Time('t_start'))), domain=Interval(330.0, 800.0), line=175),
         ),
         preemption='earlyPreemptive',
         source='atrv/missions/M1_model2.spec',

@@ -25,9 +25,10 @@ PREDICATES = (
         domains=(
             None,
             (
-                'OK', 'ERROR', 'TIMEOUT', 'INT', 'REFUSED', 'BAD-INPUT', 'BAD_GOAL', 'POSE_NOT_FOUND',
-                'LASER_FAILURE', 'BLOCKED', 'NO_PROGRESS', 'BAD_POSITION', 'PTU_TIMEOUT', 'PTU_MOVING',
-                'NO_TARGET_IN_VIEW', 'BAD_DURATION', 'NO_VISIBILITY', 'LINK_LOST',
+                'OK', 'ERROR', 'TIMEOUT', 'INT', 'REFUSED', 'BAD-INPUT', 'FINAL_ERROR', 'SERVER_ERROR',
+                'BAD_GOAL', 'POSE_NOT_FOUND', 'LASER_FAILURE', 'BLOCKED', 'NO_PROGRESS', 'BAD_POSITION',
+                'PTU_TIMEOUT', 'PTU_MOVING', 'NO_TARGET_IN_VIEW', 'BAD_DURATION', 'NO_VISIBILITY',
+                'LINK_LOST',
             ),
         ),
     ),

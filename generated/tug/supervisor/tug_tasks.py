@@ -25,8 +25,8 @@ PREDICATES = (
         domains=(
             None,
             (
-                'OK', 'ERROR', 'TIMEOUT', 'INT', 'REFUSED', 'BLOCKED', 'NO_CART', 'ALREADY_HITCHED',
-                'BAD_LOAD', 'BAD-INPUT',
+                'OK', 'ERROR', 'TIMEOUT', 'INT', 'REFUSED', 'BAD-INPUT', 'FINAL_ERROR', 'BLOCKED', 'NO_CART',
+                'ALREADY_HITCHED', 'BAD_LOAD',
             ),
         ),
     ),

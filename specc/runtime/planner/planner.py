@@ -16,8 +16,9 @@ import random
 import re
 import time
 from collections import Counter
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from typing import TypeVar
 
 from specc.runtime.planner import model as pm
 from specc.runtime.planner import waypoints as wp
@@ -31,7 +32,7 @@ from specc.runtime.planner.heuristics import (
 )
 from specc.runtime.planner.numeric import domain_of, exact_duration
 from specc.runtime.planner.plan import Action, GoalOutcome, Link, Plan, PlanResult, Repair
-from specc.runtime.planner.reachable import impossible_goal, reach, valued
+from specc.runtime.planner.reachable import Reach, impossible_goal, reach, valued
 from specc.runtime.planner.search import (
     CONTROLLABILITIES,
     EPS,
@@ -42,6 +43,7 @@ from specc.runtime.planner.search import (
     Bindings,
     Context,
     DeadEnd,
+    Instance,
     Limits,
     Node,
     Term,
@@ -172,10 +174,10 @@ class Planner:
         alone: dict[int, Attempt] = {}  # each goal's search alone: the first of those below, if it comes to them
         reached = reach(self.domain, setup.problem)  # a goal no task can ever reach needs no search to drop
         for goal in goals:
-            impossible = impossible_goal(reached, goal.hold) if reached is not None else None
-            if impossible is None:
-                alone[goal.index] = attempt([goal], self.goal_nodes)
-                impossible = impossible_alone(alone[goal.index], goal, setup.problem)
+            impossible, tried = why_impossible(reached, goal, setup.problem,
+                                               functools.partial(attempt, [goal], self.goal_nodes))
+            if tried is not None:
+                alone[goal.index] = tried
             if impossible is not None:
                 outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, impossible)
             else:
@@ -199,8 +201,8 @@ class Planner:
                     together = "cannot be met" if tried.exhausted else "was not planned"
                     why = (f"{together} together with the goals kept before it ({', '.join(g.text for g in kept)})"
                            if kept else "not met alone either (no goal was kept before it)")
-                    outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False,
-                                                       f"{why}: {explain(tried)}")
+                    why += f": {explain(tried)}{dates_said(goal, setup.problem, tried)}"
+                    outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, why)
         assert best.node is not None
         # Not an improvement (which FTplan's planners leave at 0): a plan that puts an object down
         # only to pick it up again is one no robot should carry out.
@@ -300,9 +302,7 @@ class Planner:
         found = {}
         reached = reach(self.domain, setup.problem)
         for goal in setup.goals:
-            why = impossible_goal(reached, goal.hold) if reached is not None else None
-            if why is None:
-                why = impossible_alone(setup.search([goal], self.goal_nodes), goal, problem)
+            why, _ = why_impossible(reached, goal, problem, functools.partial(setup.search, [goal], self.goal_nodes))
             if why is not None:
                 found[goal.hold.line] = why
         return found
@@ -377,16 +377,45 @@ def _push(stack: list[tuple[Node, Resolver | None, int]], node: Node, choice: li
     return cut
 
 
+def why_impossible(reached: Reach | None, goal: Goal, problem: pm.Problem,
+                   search_alone: Callable[[], Attempt]) -> tuple[str | None, Attempt | None]:
+    """Why no plan can meet `goal`, or None: no task ever reaches its value (`reached`, the
+    relaxed reachability; None when not judged), which needs no search; else the goal's own
+    search (`search_alone`) failed everywhere. And that search, when it was made."""
+    never = impossible_goal(reached, goal.hold) if reached is not None else None
+    if never is not None:
+        return never, None
+    alone = search_alone()
+    return impossible_alone(alone, goal, problem), alone
+
+
 def impossible_alone(alone: Attempt, goal: Goal, problem: pm.Problem) -> str | None:
-    """Why a goal searched for alone is impossible (its whole search space failed), else None;
-    with the problem's constraints on the goal's dates (a deadline), which the search's own words
-    (a contradiction between two timepoints) do not name."""
+    """Why a goal searched for alone is impossible (its whole search space failed), else None."""
     if alone.node is not None or not alone.exhausted:
         return None
+    return f"impossible even alone: {explain(alone)}{dates_said(goal, problem, alone)}"
+
+
+def dates_said(goal: Goal, problem: pm.Problem, attempt: Attempt) -> str:
+    """The problem's constraints on the goal's dates (a deadline), and when the search failed
+    for time (`attempt`'s contradictions between timepoints), the mission's latest end: what the
+    search's own words do not name, and what a goal dropped for time is dropped for."""
     dated = set(pm.assertion_timepoints(goal.hold)) - {problem.start, problem.end}
-    bounds = [f"{_constraint_text(c)} (line {c.line})" for c in problem.constraints
-              if c.line and pm.timepoints_of(c) & dated]
-    return f"impossible even alone: {explain(alone)}" + (f"; the goal's dates: {', '.join(bounds)}" if bounds else "")
+    own = [f"{_constraint_text(c)} (line {c.line})" for c in problem.constraints
+           if c.line and pm.timepoints_of(c) & dated]
+    said = f"; the goal's dates: {', '.join(own)}" if own else ""
+    latest = pm.latest_end(problem)
+    if math.isfinite(latest) and any(TIMED_OUT in why for why in attempt.failures):
+        span = pm.Op("-", (pm.Time(problem.end), pm.Time(problem.start)))
+        lines = sorted({c.line for c in problem.constraints if isinstance(c, pm.Member) and c.expr == span and c.line
+                        and isinstance(c.domain, pm.Interval) and c.domain.high == latest})
+        said += f"; the mission ends by {latest:g} s at the latest" + (
+            f" (line {', '.join(map(str, lines))})" if lines else "")
+    return said
+
+
+# What a dead end says when the plan's dates cannot all hold (search.Node.require).
+TIMED_OUT = "contradicts"
 
 
 def nature_conflict(constraints: list[tuple[pm.Constraint, list[tuple[str, str, float, float]]]]) -> str | None:
@@ -567,6 +596,7 @@ class Setup:
         self.owned = {point: owners for point, owners in used_by.items()
                       if owners <= goal_indexes and point not in (self.origin, problem.end)}
         self.kept_ids: set[str] = set()  # a repair's instances put back from the plan it repairs
+        self._roots: dict[frozenset[int], Node] = {}  # problem_root's, by the indexes of the active goals
         self.context = Context(problem.end, self.origin, now, limits, {r.name: r.capacity for r in domain.resources},
                                producers_of(domain), self.nature_before, controllability,
                                flaws == OLDEST_TASK_FIRST, restoring=restoring_events(domain))
@@ -582,23 +612,24 @@ class Setup:
         # A repair's actions still to carry out, each with the arguments it had; an action that
         # no longer fits (its arguments, duration or window refused by the present) is left out,
         # and so is an order between two of them that no longer can hold.
-        points: dict[str, str] = {}  # the repaired plan's timepoints -> the new instances'
-        for action in repair.actions:
+        def put_back(node: Node, action: Action) -> tuple[Action, Instance] | None:
+            """The action inserted into `node` with its arguments, and its instance (None: its
+            task is gone); DeadEnd when it no longer fits."""
             task = self.domain.task(action.task)
             if task is None:
-                continue
-            trial = node.copy()
-            try:
-                instance = trial.insert(task)
-                changed: list[str] = []
-                for local, value in zip(task.params, action.args, strict=True):
-                    changed += trial.bindings.unify(instance.var(local), value)
-                trial.bound(changed)
-            except DeadEnd:
-                continue
+                return None
+            instance = node.insert(task)
+            changed: list[str] = []
+            for local, value in zip(task.params, action.args, strict=True):
+                changed += node.bindings.unify(instance.var(local), value)
+            node.bound(changed)
+            return action, instance
+
+        node, put = each_that_fits(node, repair.actions, put_back)
+        points: dict[str, str] = {}  # the repaired plan's timepoints -> the new instances'
+        for action, instance in filter(None, put):
             self.kept_ids.add(instance.id)
             points |= {action.start: instance.start, action.end: instance.end}
-            node = trial
         for first, second, low in repair.orderings:
             if first in points and second in points and node.allows(points[first], points[second], low):
                 node.require(points[first], points[second], low)
@@ -610,21 +641,33 @@ class Setup:
         renamed["problem"] = "problem"  # its goals, and the facts that still hold
         described = {f"{old}: {a.text(node.bindings)}": a for old, new in renamed.items()
                      for a in node.assertions if a.owner == new}
-        for link in repair.plan.links:
-            producer, consumer = described.get(link.producer), described.get(link.consumer)
-            if producer is None or consumer is None or consumer.id not in node.open:
-                continue
-            trial = node.copy()
-            try:
-                trial.link(trial.assertions[producer.id], trial.assertions[consumer.id])
-            except DeadEnd:
-                continue
-            node = trial
+        links = [(producer.id, consumer.id) for link in repair.plan.links
+                 if (producer := described.get(link.producer)) is not None
+                 and (consumer := described.get(link.consumer)) is not None]
+
+        def relink(node: Node, link: tuple[int, int]) -> None:
+            producer, consumer = link
+            if consumer in node.open:
+                node.link(node.assertions[producer], node.assertions[consumer])
+
+        node, _ = each_that_fits(node, links, relink)
         return node
 
     def problem_root(self, active: list[Goal]) -> Node:
+        """The partial plan the search starts from: the problem's assertions, its active goals
+        and their constraints. Made once per set of goals (the improvement searches the same
+        goals again and again, under other goal orders), then copied: a search changes its root."""
         if self.nature_conflict is not None:
             raise DeadEnd(self.nature_conflict)
+        key = frozenset(g.index for g in active)
+        made = self._roots.get(key)
+        if made is None:
+            made = self._roots[key] = self._problem_root(active)
+        node = made.copy()
+        node.ctx = self.context  # the goal order of the moment (`reorder`); the rest is the same
+        return node
+
+    def _problem_root(self, active: list[Goal]) -> Node:
         node = Node(self.context)
         problem = self.problem
         active_indexes = {g.index for g in active}
@@ -1180,6 +1223,30 @@ class Resolver:
             node.bindings.keep_apart(*self.terms)
         elif self.kind == "bind":
             node.bound(node.bindings.unify(*self.terms))
+
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+def each_that_fits(node: Node, items: Sequence[T], put: Callable[[Node, T], R]) -> tuple[Node, list[R]]:
+    """A copy of `node` with `put` of each item, leaving out those that raise DeadEnd (each tried
+    on the node the ones before it left), and what `put` gave for those kept. Most often all of
+    them fit: they are put in one copy, the very node one copy per item would give."""
+    try:
+        trial = node.copy()
+        return trial, [put(trial, item) for item in items]
+    except DeadEnd:
+        pass
+    kept = []
+    for item in items:
+        trial = node.copy()
+        try:
+            kept.append(put(trial, item))
+        except DeadEnd:
+            continue
+        node = trial
+    return node, kept
 
 
 def select(node: Node) -> list[Resolver] | None:

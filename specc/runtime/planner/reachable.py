@@ -80,30 +80,49 @@ def reach(domain: pm.PlanningDomain, problem: pm.Problem) -> Reach | None:
     instances = list(itertools.islice(_instances(domain), MOST_ASSIGNMENTS + 1))
     if len(instances) > MOST_ASSIGNMENTS:
         return None
-    waiting = instances
+    waiting = [_Instance(task, chosen, finite, attributes) for task, chosen, finite in instances]
     while True:
-        still: list[tuple[pm.Task, dict[str, Value], dict[str, frozenset[str]]]] = []
+        still: list[_Instance] = []
         grew = False
-        for task, chosen, finite in waiting:
-            mine = [a for a in task.assertions if isinstance(a, (pm.Hold, pm.Event)) and a.attribute in attributes]
-            gives = {k: (a.attribute, _pattern(a, chosen, need=False), _choices(a, finite, chosen, attributes))
-                     for k, a in enumerate(mine) if isinstance(a, pm.Event)}
-            # A need another of the task's own events gives (a communication IDLE from its start,
-            # for the rest of it) is met by the task itself, whatever comes first.
-            own = {k: Reach() for k in range(len(mine))}
-            for k, known in own.items():
-                for j, (subject, pattern, choices) in gives.items():
-                    if j != k:
-                        known.add(subject, pattern, choices)
-            if not all(found.holds(a.attribute, need) or own[k].holds(a.attribute, need)
-                       for k, a in enumerate(mine) for need in (_pattern(a, chosen, need=True),)):
-                still.append((task, chosen, finite))
+        for instance in waiting:
+            if not instance.ready(found):
+                still.append(instance)
                 continue
-            for subject, pattern, choices in gives.values():
+            for subject, pattern, choices in instance.gives.values():
                 grew = found.add(subject, pattern, choices) or grew
         if not grew or not still:
             return found
         waiting = still
+
+
+class _Instance:
+    """A task with some of its parameters chosen: what it needs and gives, worked out once (the
+    reachability asks every round whether its needs are reached yet)."""
+
+    def __init__(self, task: pm.Task, chosen: dict[str, Value], finite: dict[str, frozenset[str]],
+                 attributes: Mapping[str, pm.Attribute]):
+        mine = [a for a in task.assertions if isinstance(a, (pm.Hold, pm.Event)) and a.attribute in attributes]
+        self.gives = {k: (a.attribute, _pattern(a, chosen, need=False), _choices(a, finite, chosen, attributes))
+                      for k, a in enumerate(mine) if isinstance(a, pm.Event)}
+        self.needs = [(k, a.attribute, _pattern(a, chosen, need=True)) for k, a in enumerate(mine)]
+        self._met_by_itself: dict[int, bool] = {}
+
+    def ready(self, found: Reach) -> bool:
+        """Are all its needs reached, in `found` or by the task itself?"""
+        return all(found.holds(attribute, need) or self.met_by_itself(k, attribute, need)
+                   for k, attribute, need in self.needs)
+
+    def met_by_itself(self, k: int, attribute: str, need: Pattern) -> bool:
+        """A need another of the task's own events gives (a communication IDLE from its start,
+        for the rest of it) is met by the task itself, whatever comes first."""
+        met = self._met_by_itself.get(k)
+        if met is None:
+            own = Reach()
+            for j, (subject, pattern, choices) in self.gives.items():
+                if j != k and subject == attribute:
+                    own.add(subject, pattern, choices)
+            met = self._met_by_itself[k] = own.holds(attribute, need)
+        return met
 
 
 def _instances(domain: pm.PlanningDomain) -> Iterator[tuple[pm.Task, dict[str, Value], dict[str, frozenset[str]]]]:

@@ -50,6 +50,7 @@ Comparisons use an absolute tolerance of 1e-6 (`<` and `>` are strict).
 
 from __future__ import annotations
 
+import bisect
 import functools
 import itertools
 import math
@@ -922,8 +923,10 @@ class Validator:
             dated = [(dates[e.time], i, e) for i, e in events if e.time in dates]
             if dated:
                 by_instance[instance] = dated
-        for timeline in by_instance.values():
+        times: dict[object, list[float]] = {}  # each timeline's dates, for bisect
+        for instance, timeline in by_instance.items():
             timeline.sort(key=lambda x: (x[0], x[1]))
+            times[instance] = [entry[0] for entry in timeline]
             for (t1, i, a), (t2, j, b) in itertools.pairwise(timeline):
                 if abs(t2 - t1) < TOLERANCE:
                     add(("simultaneous", i, j), f"{a.owner}: {a.describe()} and {b.owner}'s {b.describe()} "
@@ -931,7 +934,7 @@ class Validator:
             for t, i, e in timeline:
                 if not e.needs_support:
                     continue
-                prior = last_before(timeline, t - TOLERANCE)
+                prior = last_before(timeline, times[instance], t - TOLERANCE)
                 if prior is None:
                     add(("support", i), f"{e.owner}: {e.describe()} at {date_text(t)} is not supported "
                                         f"(nothing sets {instance_text(e.instance)} before)")
@@ -944,16 +947,16 @@ class Validator:
             if h.start not in dates or h.end not in dates:
                 continue
             t1, t2 = dates[h.start], dates[h.end]
-            timeline = by_instance.get(h.key, [])
+            timeline, moments = by_instance.get(h.key, []), times.get(h.key, [])
             if t1 > t2 + TOLERANCE:
                 add(("hold-order", k), f"{h.owner}: {h.describe()} ends at {date_text(t2)}, before it starts "
                                        f"at {date_text(t1)}")
-            for t, _, e in timeline:
-                if t1 + TOLERANCE < t < t2 - TOLERANCE:
-                    add(("hold-broken", k, e.owner), f"{h.owner}: {h.describe()} over [{date_text(t1)}, "
-                                                     f"{date_text(t2)}] is broken by {e.owner}'s {e.describe()} "
-                                                     f"at {date_text(t)}")
-            prior = last_before(timeline, t1 + TOLERANCE)
+            inside = timeline[bisect.bisect_right(moments, t1 + TOLERANCE):bisect.bisect_left(moments, t2 - TOLERANCE)]
+            for t, _, e in inside:  # strictly between the hold's ends, give or take TOLERANCE
+                add(("hold-broken", k, e.owner), f"{h.owner}: {h.describe()} over [{date_text(t1)}, "
+                                                 f"{date_text(t2)}] is broken by {e.owner}'s {e.describe()} "
+                                                 f"at {date_text(t)}")
+            prior = last_before(timeline, moments, t1 + TOLERANCE)
             value = prior[2].after if prior is not None else None
             if value is not None and h.value is not None and same(value, h.value):
                 continue  # met: the findings' texts below are only built when one is added
@@ -992,11 +995,8 @@ class Validator:
                                            f"at {date_text(instant)}, more than its capacity {text(limit)}")
 
 
-def last_before(timeline: list[tuple[float, int, GroundEvent]], date: float) -> tuple[float, int, GroundEvent] | None:
-    """The latest event at or before `date` (the timeline is sorted)."""
-    found = None
-    for entry in timeline:
-        if entry[0] > date:
-            break
-        found = entry
-    return found
+def last_before(timeline: list[tuple[float, int, GroundEvent]], dates: list[float],
+                date: float) -> tuple[float, int, GroundEvent] | None:
+    """The latest event at or before `date` (the timeline is sorted; `dates` are its dates)."""
+    index = bisect.bisect_right(dates, date)
+    return timeline[index - 1] if index else None
