@@ -400,6 +400,13 @@ def verify(paths: PathsArg,
             raise typer.Exit(CANNOT_VERIFY) from None
     for line in describe(result):
         out.print(line, markup=False)
+    unfollowed = sorted({d.code for d in loaded.diagnostics if d.code in ("undeclared-send", "computed-send")})
+    if unfollowed:
+        # What holds was proved of the codels as `sends:` declares them: the warnings above say
+        # that some send what it does not declare (or a name computed at run time).
+        out.print(f"assumed: the codels send only what their requests' `sends:` declare, which the warnings above "
+                  f"({', '.join(unfollowed)}) say they do not: what holds is proved of the declared sends only; "
+                  "declare every request a codel sends", markup=False)
     out.print(f"{result.states} states, {result.transitions} transitions, at most {requests} outstanding "
               f"request(s), in {time.perf_counter() - started:.1f} s", markup=False)
     if result.limited:

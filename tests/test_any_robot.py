@@ -560,6 +560,33 @@ def watch(sdi):
 '''
 
 
+# A permanent codel that, once, sends the module's own Goto behind the executive's back: the module
+# interrupts the GOTO the executive runs, which the executive never asked for (its ERROR state).
+MEDDLING_TASK = (FAULTY_TASK[0], FAULTY_TASK[0] + "  exec_task Watch { period: 100 ms; codel permanent: meddle; }\n")
+MEDDLING_CODEL = '''
+
+MEDDLED = [0]
+
+
+def meddle(sdi):
+    MEDDLED[0] += 1
+    if MEDDLED[0] == 20:
+        sdi.send_request("drive.Goto", x=1.0, y=1.0)
+'''
+
+
+def test_the_executive_s_error_state_is_an_incident_of_the_run(tmp_path: Path) -> None:
+    """The ERROR state is trouble the robot lives on with, as a codel that raised: an alarm in
+    the log, and an incident of the report (it was an alarm only, and the run said "0 incidents")."""
+    robot = write_robot(tmp_path, SPEC.replace(*MEDDLING_TASK), CODELS + MEDDLING_CODEL)
+    result = specc(tmp_path, "run", robot, "--folder", tmp_path / "run", "--no-pictures")
+    events = read_events(tmp_path / "run" / "events.jsonl")
+    assert [e for e in events if e["kind"] == "alarm" and e["what"] == "executive-error"], result.stdout
+    report = json.loads((tmp_path / "run" / "report.json").read_text())
+    assert any("the executive entered its ERROR state" in text for text in report["incidents"])
+    assert report["measures"]["incidents"] == len(report["incidents"]) >= 1
+
+
 def test_a_permanent_codel_that_raises_is_in_the_log_the_report_and_the_summary(tmp_path: Path) -> None:
     """The robot goes on (a permanent codel is retried every period); the run says which module
     and codel raised, where a person and a program look."""

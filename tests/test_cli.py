@@ -750,3 +750,38 @@ def test_long_work_in_a_log_says_it_is_alive_at_most_once_a_heartbeat(monkeypatc
     assert capsys.readouterr().err == "... 3 checked of 10: checking warehouse's mutants\n"
     with cli.ProgressDisplay(quiet=True) as silent:
         assert silent is None
+
+
+def test_verify_says_what_it_assumed_when_codels_send_what_sends_does_not_declare(tmp_path: Path) -> None:
+    """PICK's codel sends gripper.Close without `sends:` saying so (check warns): the controller
+    cannot keep OPEN apart from it, and verify proves its properties of the declared sends. It
+    says that its 'holds' rests on them."""
+    (tmp_path / "shop_codels.py").write_text(
+        "def pick(sdi, request):\n    sdi.send_request('gripper.Close')\n    return 'exec'\n\n"
+        "def work(sdi, request):\n    return 'end'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text("""
+module arm {
+  codels: "shop_codels";
+  request Pick { type: exec; task: T; codel start: pick; codel exec: work; }
+  exec_task T { period: 100 ms; }
+}
+module gripper {
+  codels: "shop_codels";
+  request Close { type: exec; task: T; incompatible_with: Open; codel exec: work; }
+  request Open { type: exec; task: T; incompatible_with: Close; codel exec: work; }
+  exec_task T { period: 100 ms; }
+}
+executive e {
+  service PICK { request: arm.Pick; }
+  service OPEN { request: gripper.Open; }
+}
+""")
+    result = specc("verify", str(spec), "--requests", "1")
+    assert "[undeclared-send]" in result.stderr
+    assumed = [line for line in result.stdout.splitlines() if line.startswith("assumed: ")]
+    assert len(assumed) == 1 and "(undeclared-send)" in assumed[0], result.stdout
+    # Declared, the send is followed (and PICK kept apart from OPEN): nothing is assumed.
+    spec.write_text(spec.read_text().replace("codel start: pick;", "sends: gripper.Close; codel start: pick;"))
+    declared = specc("verify", str(spec), "--requests", "1")
+    assert declared.returncode == 0 and "assumed: " not in declared.stdout, declared.stdout + declared.stderr

@@ -183,7 +183,96 @@ def test_a_reaction_loop_outside_time_is_a_finding_not_a_verifier_that_never_end
     result = run([spec], "e", 2)
     assert result.complete and "settles" in result.violations
     violation = result.violations["settles"]
-    assert "went on for 10,000 decisions" in violation.message and "ptu: Sweep goes ZOMBIE" in violation.trace
+    # Each restart sends the module a request: their count stops the event first.
+    assert "sent 1,000 requests to the modules (the last: ptu.Sweep) with no time passing" in violation.message
+    assert "ptu: Sweep goes ZOMBIE" in violation.trace
+
+
+REQUESTED_AGAIN = """
+module cam {
+  codels: "cam_codels";
+  request Snap { type: exec; task: Grab; codel exec: grab; }
+  exec_task Grab { period: 100 ms; }
+}
+executive e {
+  service SNAP { request: cam.Snap; }
+  reflex again on reply cam.Snap => request cam.Snap;
+}
+"""
+
+
+def test_a_reflex_requesting_a_frozen_module_again_is_a_finding_and_the_executive_does_not_hang(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same loop through a module request, which takes no decision: the frozen module
+    refuses each request at once. The verifier used to run that event for ever; it counts the
+    requests now, and `settles` is refuted. The executive itself, on a robot, ends in its ERROR
+    state after CYCLES_PER_INSTANT cycles: in it no reflex fires, where it used to go on at that
+    instant for ever."""
+    from specc.analysis import verify as v
+    from specc.runtime import executive as rx
+
+    (tmp_path / "cam_codels.py").write_text("def grab(sdi, request):\n    return 'exec'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text(REQUESTED_AGAIN)
+    program = load([spec]).program
+    assert program is not None
+    executive = next(i for i in program.items if isinstance(i, m.Executive))
+    result = v.verify(program, executive, 1, limit=60)
+    assert "settles" in result.violations, result.violations
+    violation = result.violations["settles"]
+    assert "sent 1,000 requests to the modules (the last: cam.Snap)" in violation.message
+    assert "cam: Snap goes ZOMBIE" in violation.trace
+
+    # The runtime alone: a frozen module, the reflex, a request; no cap of the verifier's.
+    monkeypatch.setattr(v, "REQUESTS_PER_EVENT", 10**9)
+    monkeypatch.setattr(rx, "CYCLES_PER_INSTANT", 2_000)
+    world = v.explorer_for(program, executive, 1).initial()
+    frozen = world.registry.modules["cam"]
+    frozen.zombies.add(999)
+    world.executive.request("SNAP", 1)
+    assert world.executive.error is not None and "2,000 cycles" in world.executive.error
+    assert frozen.registry.submitted < 2_100  # it stopped soon after the limit
+
+
+CHAIN = """
+module arm {
+  codels: "chain_codels";
+  request Pick { type: exec; task: T; sends: gripper.Close; codel start: pick; codel exec: work; }
+  exec_task T { period: 100 ms; }
+}
+module gripper {
+  codels: "chain_codels";
+  request Close { type: exec; task: T; sends: camera.Snap; codel start: close; codel exec: work; }
+  exec_task T { period: 100 ms; }
+}
+module camera {
+  codels: "chain_codels";
+  request Snap { type: exec; task: T; incompatible_with: Snap; codel exec: work; }
+  exec_task T { period: 100 ms; }
+}
+executive e {
+  service PICK { request: arm.Pick; }
+  service SNAP { request: camera.Snap; }
+}
+"""
+
+
+def test_a_request_sent_by_a_codel_ends_with_its_sender_and_sends_nothing_after(tmp_path: Path) -> None:
+    """PICK's codel sends gripper.Close, whose codel sends camera.Snap, which would interrupt
+    SNAP behind the executive's back: the controller keeps PICK and SNAP apart (sends are
+    followed through). The runtime interrupts a request's children when it ends, so Close never
+    sends once Pick is over; the model let it ("Pick ends; Close sends camera.Snap; Snap is
+    interrupted") and refuted no-error for a robot on which that cannot happen."""
+    (tmp_path / "chain_codels.py").write_text(
+        "def pick(sdi, request):\n    sdi.send_request('gripper.Close')\n    return 'exec'\n\n"
+        "def close(sdi, request):\n    sdi.send_request('camera.Snap')\n    return 'exec'\n\n"
+        "def work(sdi, request):\n    return 'end'\n")
+    spec = tmp_path / "robot.spec"
+    spec.write_text(CHAIN)
+    result = run([spec], "e", 2)
+    assert result.ok, describe(result)
+    # Close is sent, and sends, while Pick runs: those states are there.
+    assert result.states > 100
 
 
 def test_a_refusing_rule_is_answered_refused_and_keeps_every_property(tmp_path: Path) -> None:

@@ -63,6 +63,10 @@ PROPERTIES = {
 # few (the request, the starts asked again, a reflex or two); a reflex restarting on every reply a
 # service its frozen module answers at once takes them without end, and so would the robot.
 DECISIONS_PER_EVENT = 10_000
+# Requests the executive may send the modules while handling one event: a few (a service's, an
+# abort, a reflex's); a reflex requesting again on every reply what a frozen module refuses at once
+# sends them without end, and takes no decision for DECISIONS_PER_EVENT to count.
+REQUESTS_PER_EVENT = 1_000
 # Requests to validate codels one event may make: each may be accepted or refused, and the
 # explorer replays the event for every sequence, so a loop through them is cut here, not at
 # DECISIONS_PER_EVENT.
@@ -117,6 +121,9 @@ class ModelActivity:
     cause: str = "ABORT"
     sent: frozenset[str] = frozenset()  # the requests (`sends:`) its codels have sent already
     sent_by_codel: bool = False  # it is itself such a request: it counts as an outstanding one
+    # The requests it sent that are still there, (module, id): its children, which the module
+    # interrupts first when it ends or is interrupted (specc.runtime.functional.Module.finish).
+    children: list[tuple[str, int]] = field(default_factory=list)
 
 
 class Choices:
@@ -180,6 +187,12 @@ class ModelModule:
         return Reply(rqst_id, self.name, request, status, Report(code), None, final)
 
     def submit(self, request: str, input_: Any, sink: Callable[[Reply], None], parent: Any = None) -> int:
+        self.registry.submitted += 1
+        if self.registry.submitted > REQUESTS_PER_EVENT:
+            raise Unsettled(f"the executive's handling of this event sent {REQUESTS_PER_EVENT:,} requests to the "
+                            f"modules (the last: {self.name}.{request}) with no time passing: a reaction loop, as "
+                            "a reflex starting or requesting again, on every reply, what a frozen module refuses "
+                            "at once")
         rqst_id = self.registry.new_id()
         spec = self.requests.get(request)
         if spec is None:
@@ -242,6 +255,7 @@ class ModelModule:
             self.finish(activity, Status.INTERRUPTED, cause)
         elif activity.state == "EXEC":
             activity.state = "INTER"
+            self.interrupt_children(activity)
         elif activity.state == "ZOMBIE":
             del self.activities[activity.id]
             self.zombies.discard(activity.id)
@@ -255,7 +269,19 @@ class ModelModule:
         activity.state = "EXEC"
         self.emit(activity.sink, self.reply(activity.id, activity.spec.name, Status.WAITING, "final", final=False))
 
+    def interrupt_children(self, activity: ModelActivity) -> None:
+        """The runtime interrupts a parent's running children when it ends or is interrupted: a
+        child does not go on, and send, once its parent is over. (Its final reply, which the
+        runtime holds until the children have ended, is not held here: the executive may hear
+        it a little sooner than on the robot.)"""
+        for module, ident in activity.children:
+            receiver = self.registry.modules.get(module)
+            child = receiver.activities.get(ident) if receiver is not None else None
+            if receiver is not None and child is not None and child.state in ("INIT", "EXEC"):
+                receiver.interrupt(child, "ABORT")
+
     def finish(self, activity: ModelActivity, status: Status, code: str) -> None:
+        self.interrupt_children(activity)
         if status is Status.ZOMBIE and code != "MODULE_FROZEN":
             activity.state = "ZOMBIE"
             self.zombies.add(activity.id)
@@ -276,6 +302,7 @@ class ModelModule:
             ident = receiver.submit(request, None, _ignore)
             if ident in receiver.activities:
                 receiver.activities[ident].sent_by_codel = True
+                activity.children.append((module, ident))
 
     def endings(self, activity: ModelActivity) -> list[tuple[str, Callable[[], None]]]:
         """What the activity itself may do next."""
@@ -323,6 +350,7 @@ class ModelRegistry:
     def __init__(self, modules: Mapping[str, Mapping[str, RequestSpec]], codes: tuple[str, ...] = ()):
         self.kernel = ModelKernel()
         self._ids = itertools.count(1)
+        self.submitted = 0  # requests sent to its modules: a world is made for one event (see Unsettled)
         self.choices = Choices()
         self.modules = ModelModules(lambda name: ModelModule(name, modules[name], self, codes), modules)
 
@@ -447,15 +475,20 @@ class Explorer:
             activity, which = _timer_parts(timer)
             if isinstance(activity, rx.Activity) and activity.id in ranks:
                 timers.setdefault(ranks[activity.id], []).append(which)
+        def by_owner(name: str, module: ModelModule) -> list[ModelActivity]:
+            return sorted(module.activities.values(), key=lambda a: (owners.get((name, a.id), len(ordered)), a.id))
+
+        listed = [(name, by_owner(name, module)) for name, module in sorted(world.registry.modules.items())
+                  if module.activities]
+        place = {(name, a.id): i for name, entries in listed for i, a in enumerate(entries)}
         modules = []
-        for name, module in sorted(world.registry.modules.items()):
-            if not module.activities:
-                continue
-            entries = sorted(module.activities.values(), key=lambda a: (owners.get((name, a.id), len(ordered)), a.id))
-            index = {a.id: i for i, a in enumerate(entries)}
+        for name, entries in listed:
             modules.append((name, tuple((owners.get((name, a.id), -1), a.spec.name, a.state, a.cause,
-                                         tuple(sorted(index[w] for w in a.waiting_for if w in index)),
-                                         tuple(sorted(a.sent)), a.sent_by_codel) for a in entries)))
+                                         tuple(sorted(place[name, w] for w in a.waiting_for if (name, w) in place)),
+                                         tuple(sorted(a.sent)), a.sent_by_codel,
+                                         tuple(sorted((child[0], place[child]) for child in a.children
+                                                      if child in place)))
+                                        for a in entries)))
         activities = tuple((a.service.name, a.state, a.holds_group, a.answered, a.abort_sent,
                             tuple(sorted(timers.get(rank, ()))))
                            for rank, a in enumerate(ordered))
@@ -476,10 +509,11 @@ class Explorer:
                     0.0, functools.partial(executive._post, executive._on_timeout, activity, which)))
             executive.activities[activity.id] = activity
             made.append(activity)
+        built_in: dict[str, list[ModelActivity]] = {}
         for name, entries in modules:
             module = registry.modules[name]
-            built = []
-            for owner, request, state, cause, _, sent, sent_by_codel in entries:
+            built = built_in[name] = []
+            for owner, request, state, cause, _, sent, sent_by_codel, _ in entries:
                 owned = made[owner] if owner >= 0 else None
                 sink = (functools.partial(executive._post, executive._on_reply, owned) if owned is not None
                         else executive.reflex_replies.append)
@@ -491,8 +525,11 @@ class Explorer:
                 if owned is not None:
                     owned.module_id = entry.id
                 built.append(entry)
-            for entry, (_, _, _, _, waiting, _, _) in zip(built, entries, strict=True):
+            for entry, (_, _, _, _, waiting, _, _, _) in zip(built, entries, strict=True):
                 entry.waiting_for = {built[i].id for i in waiting}
+        for name, entries in modules:  # the children, once every module's entries are there
+            for entry, (*_, children) in zip(built_in[name], entries, strict=True):
+                entry.children = [(module, built_in[module][i].id) for module, i in children]
         for activity in made:
             if activity.module_id is None and activity.state is not rx.Phase.WAIT:
                 activity.module_id = registry.new_id()  # its module has forgotten it

@@ -156,24 +156,35 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
 RUNTIME_CODES = frozenset({"ABORT", "INTERRUPTED", "BAD_INPUT", "CODEL_ERROR", "NO_EXEC_TASK", "UNDECLARED_STATE",
                            "UNKNOWN_ACTIVITY", "UNKNOWN_ID", "UNKNOWN_MODULE", "UNKNOWN_REQUEST", "ZOMBIE",
                            "MODULE_FROZEN"})
+# ... and those of a request whose codels send requests: a child's error, a child not started.
+CHILD_CODES = frozenset({"CHILD_ERROR", "CHILD_NOT_ACTIVATED"})
 
 
 def check_reflex_loops(ctx: Context, reflexes: tuple[m.Reflex, ...], services: Mapping[str, m.Service]) -> None:
-    """A warning for reflexes that start, on any intermediate or final reply of a service (no
-    condition on its report), that service again, directly or through others: each start brings
-    the reply that starts the next, for as long as the executive runs."""
+    """A warning for reflexes that, on any intermediate or final reply of a service or of a
+    module request (no condition on its report), start that service or request it again,
+    directly or through others: each brings the reply that brings the next, for as long as the
+    executive runs (at one instant when the module refuses at once, frozen by a ZOMBIE). A
+    service's replies are its request's too, which a reflex on `module.request` hears."""
+    def replies_of(verb: str, target: str) -> list[str]:
+        """What an action makes reply: a service started, and its module request; a request."""
+        if verb == "start" and target in services:
+            ran = services[target].request
+            return [target] + ([ran.text] if ran is not None else [])
+        return [target] if verb == "request" else []
+
     starts: dict[str, list[tuple[str, m.Reflex]]] = {}
     for reflex in reflexes:
-        if reflex.comparison is None and reflex.trigger in ("interm", "reply") and reflex.source.text in services:
+        if reflex.comparison is None and reflex.trigger in ("interm", "reply"):
             for action in reflex.actions:
-                if action.verb == "start" and action.target.text in services:
-                    starts.setdefault(reflex.source.text, []).append((action.target.text, reflex))
+                for target in replies_of(action.verb, action.target.text):
+                    starts.setdefault(reflex.source.text, []).append((target, reflex))
     warned: set[int] = set()
     for first in sorted(starts):
         path: list[tuple[str, m.Reflex]] = []
 
-        def follow(service: str, seen: frozenset[str]) -> list[tuple[str, m.Reflex]] | None:
-            for target, reflex in starts.get(service, ()):
+        def follow(source: str, seen: frozenset[str]) -> list[tuple[str, m.Reflex]] | None:
+            for target, reflex in starts.get(source, ()):
                 path.append((target, reflex))
                 if target == first:
                     return list(path)
@@ -190,8 +201,8 @@ def check_reflex_loops(ctx: Context, reflexes: tuple[m.Reflex, ...], services: M
         warned.update(id(reflex) for _, reflex in loop)
         chain = " -> ".join([first] + [target for target, _ in loop])
         ctx.warn("reflex-loop", f"these reflexes start {first} again on every reply it gives ({chain}): once "
-                 "started, it never stops being restarted; give the reflex a condition on the reply "
-                 "(`== FAILED`) or start another service", loop[0][1].span)
+                 "started, it never stops being restarted (at one instant when its module refuses at once); give "
+                 "the reflex a condition on the reply (`== FAILED`) or start another service", loop[0][1].span)
 
 
 def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Service]) -> None:
@@ -210,7 +221,7 @@ def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Servic
         value = comparison.value.text if isinstance(comparison.value, m.Ref) else None
         module = ctx.symbols.module_of(request)
         replies = {"OK"} | {f.text for f in request.fail} | RUNTIME_CODES | set(
-            ctx.symbols.requests_of(module) if module is not None else ())
+            ctx.symbols.requests_of(module) if module is not None else ()) | (CHILD_CODES if request.sends else set())
         if value is not None and value not in replies:
             # A reflex reads the module's report (OK, a fail message, the runtime's codes, the request
             # that interrupted it), not the result the executive gives the task level (INT, TIMEOUT...).

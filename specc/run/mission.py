@@ -709,7 +709,8 @@ class Recorder:
         if message.kind == "WARNING":
             self.log.emit(now, "warning", service=message.service, id=message.id, type=str(message.result),
                           detail=message.detail)
-            if message.service == "EXECUTIVE":
+            if message.service == "EXECUTIVE":  # its general ERROR state: trouble the robot lives on with
+                self.incidents.append(f"{now:.3f} the executive entered its ERROR state: {message.detail}")
                 self.log.emit(now, "alarm", what="executive-error", detail=message.detail)
             return
         result = message.result if isinstance(message.result, int | float | str) else str(message.result)

@@ -629,6 +629,11 @@ class Executive:
 
     # ------------------------------------------------------------ reflexes (§3.5)
     def _reflexes(self, trigger: str, source: str, reply: Reply) -> None:
+        if self.error is not None:
+            # §3.4.2: in the ERROR state every request is refused, the executive's own too. A
+            # reflex requesting again what a frozen module refuses at once would otherwise go
+            # on without end at one instant, past the cycle limit that brought the ERROR.
+            return
         for reflex in self.spec.reflexes:
             if reflex.matches(trigger, source, reply.report.code):
                 for listener in self.reflex_listeners:
