@@ -640,3 +640,28 @@ def test_an_answer_domain_without_ok_is_refused_not_a_deadlock(tmp_path: Path) -
         check(text, "!(CHECK)", tmp_path)
     assert any("service SPRAY answers OK when it works" in d.message for d in raised.value.diagnostics)
     assert "answer-without-ok" in {d.code for d in raised.value.diagnostics}
+
+
+def test_a_protocol_that_never_hears_a_zombie_s_warning_waits_for_ever(tmp_path: Path) -> None:
+    """A service gone ZOMBIE gets no REPLY until the procedures interrupt it (§3.4.1): its
+    (WARNING ...) comes instead. The net answered ZOMBIE as if the REPLY came by itself, and
+    missed the wait for ever a run shows; a protocol waiting for the WARNING too (Fig 4.3's
+    `choose`, then the interruption) gets it, and has no such finding."""
+    zombie = PROBED.replace("NO_SAMPLE, HEAVY", "NO_SAMPLE, ZOMBIE, HEAVY")
+    report = check(probed(tmp_path, zombie), "!(CHECK)", tmp_path, failing=["SPRAY"])
+    said = finding(report, "zombie-unanswered")
+    assert said.startswith("service SPRAY may go ZOMBIE") and "KA Exec never waits for the WARNING" in said
+    # A service that works never goes ZOMBIE: only `--fail` brings it.
+    assert "zombie-unanswered" not in check(probed(tmp_path, zombie), "!(CHECK)", tmp_path).kinds()
+    heard = zombie.replace(
+        "  predicate event REPLY(id: int, result: RESULTS);",
+        "  predicate event REPLY(id: int, result: RESULTS);\n"
+        "  predicate event WARNING(service: SERVICES, id: int, type: {ZOMBIE});\n"
+        "  action INTERRUPT(id: int) = \"field_codels.interrupt\";\n"
+        "  ka Interrupt { invocation: !(INTERRUPT $ID); action: (INTERRUPT $ID); }").replace(
+        "body { !(SEND $SERVICE $ID); ^(REPLY $ID $RESULT); }",
+        "body { !(SEND $SERVICE $ID); choose { branch { ^(REPLY $ID $RESULT); } "
+        "branch { ^(WARNING $SERVICE $ID ZOMBIE); !(INTERRUPT $ID); ^(REPLY $ID $RESULT); } } }")
+    heard = probed(tmp_path, heard)
+    (tmp_path / "field_codels.py").write_text(VERDICT + "\n\ndef interrupt(ctx, ident):\n    pass\n", encoding="utf-8")
+    assert "zombie-unanswered" not in check(heard, "!(CHECK)", tmp_path, failing=["SPRAY"]).kinds()

@@ -376,3 +376,6 @@ def test_a_goal_still_running_at_the_horizon_says_what_it_waited_on() -> None:
               {"kind": "activity", "id": 2, "service": "OPEN-DRAWER", "from": "EXEC", "to": "ZOMBIE", "t": 14.0}]
     assert waiting_on(events) == "; waiting on OPEN-DRAWER (id 2) in ZOMBIE since 14.0 s"
     assert waiting_on(events[:3]) == ""
+    # A request the controller never let start stays in WAIT, its first phase, which only its
+    # `request` event shows.
+    assert waiting_on(events[:4]) == "; waiting on OPEN-DRAWER (id 2) in WAIT since 9.5 s"

@@ -138,6 +138,10 @@ def test_a_rule_keeping_a_service_waiting_starves_it_unless_it_has_a_start_timeo
     assert starving.violations["no-starvation"].trace == ["task: RQST EXEC BACK"]
     timed = run(robot(tmp_path, rule, back="timeout { start: 1 s; }"), "shop", 1)
     assert timed.ok
+    # Every property holds, and BACK never runs (each request of it times out in WAIT): said.
+    assert timed.never_started == ("BACK",)
+    assert any(line.startswith("never started, in any state explored: BACK") for line in describe(timed))
+    assert run(robot(tmp_path, ""), "shop", 1).never_started == ()
 
 
 def test_a_rule_the_controller_cannot_follow_puts_the_executive_in_error(tmp_path: Path) -> None:

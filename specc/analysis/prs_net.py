@@ -1163,7 +1163,8 @@ class Translator:
         else:
             error = f"{ka.name}.L{line}.OUT-OF-DOMAIN"
             self.result.errors[error] = ("out-of-domain", f"{ka.name}:{line}: a value leaves its domain: give it a "
-                                         "wider domain or keep it in range")
+                                         "wider domain or keep it in range (a counter that passes every bound "
+                                         "is a loop that may not end: its trace shows how it gets there)")
             self.result.where[error] = Where(ka.name, line, "value out of its domain")
             self.emit.fire(f"{origin} [out of domain]", origin, [(source.place, source.colour(env))],
                            [(error, petri.BLACK)])
@@ -1395,7 +1396,7 @@ class Translator:
                 else:
                     self.emit.fire(f"{origin}: no KA", origin, [(f"{head}.POST", colour)], [(f"{head}.FAIL", colour)])
                     out["FAIL"][colour] = None
-            self._executive_server(servers[0], served, out)
+            self._executive_server(servers, served, out)
             return out
         for colour in posted:
             applicable = self._applicable(kas, colour)
@@ -1464,12 +1465,13 @@ class Translator:
                                            [(node.place, node.colour(final)), parked],
                                            [(f"{head}.TRY", colour + (mask | bit,))])
 
-    def _executive_server(self, ka: rp.KA, posted: list[tuple[Any, ...]],
+    def _executive_server(self, servers: list[rp.KA], posted: list[tuple[Any, ...]],
                           out: dict[str, dict[tuple[Any, ...], None]]) -> None:
         """The services of §5.4.1: a group place per service group (colour: the running service
         or IDLE); a service starts when its group is IDLE and no group runs a service it
         conflicts with, then answers. A net has no time: interrupting is modelled as waiting."""
         assert self.executive is not None
+        ka = servers[0]  # the protocol's head and arity are theirs all
         head = ka.trigger.head
         results = self.db.argument_values(head, len(ka.trigger.args) - 1)
         if not results or not any(p.name == head for p in self.node_ast.predicates):
@@ -1527,10 +1529,29 @@ class Translator:
                              f"({', '.join(map(str, results))}) lacks: add OK to it", "answer-without-ok")
                 continue
             self.result.environment.add(f"{origin} answers")
+            # Does the protocol serving it hear a ZOMBIE's warning (seed 000 Fig 4.3 does, and
+            # interrupts the service)?
+            serving = self._applicable(servers, colour) or servers
+            handles_zombies = any(isinstance(s, rp.Step) and s.goal.op == "^" and s.goal.expr.head == "WARNING"
+                                  for k in serving for s in _statements(k.body or ()))
             for result in answers:
                 answer = colour[:-1] + (result,)
                 release = [(service.group, name)] if service.group else []
                 back = [(service.group, IDLE)] if service.group else []
+                if result == "ZOMBIE" and not handles_zombies:
+                    # A ZOMBIE's REPLY comes only once the procedures interrupt it (§3.4.1),
+                    # after its (WARNING ...), which this protocol never waits for.
+                    error = f"{head}.{name}.ZOMBIE-UNANSWERED"
+                    self.result.errors[error] = (
+                        "zombie-unanswered", f"service {name} may go ZOMBIE: the executive then sends (WARNING {name} "
+                        f"id ZOMBIE) and no REPLY until the procedures interrupt it, and KA {serving[0].name} never "
+                        "waits for the WARNING: its caller waits for ever; wait for it beside the REPLY (`choose`) "
+                        "and send the interruption")
+                    self.result.where[error] = Where(serving[0].name, serving[0].line,
+                                                     f"{name} ZOMBIE, never interrupted")
+                    self.emit.fire(f"{origin} goes ZOMBIE", origin, [(f"{head}.RUN", colour), *release],
+                                   [(error, petri.BLACK), *back])
+                    continue
                 self.emit.fire(f"{origin} answers", origin, [(f"{head}.RUN", colour), *release],
                                [(f"{head}.SUCC", answer), *back])
                 out["SUCC"][answer] = None

@@ -6,6 +6,9 @@ Findings:
   where every posted goal has succeeded or failed is the expected end, §4.5);
 - unbounded: a place that grows without bound (unbounded recursion, §4.5);
 - out-of-domain: a value leaves its finite domain (the net would need more colours);
+- zombie-unanswered: with `--fail`, a service may go ZOMBIE, and the request protocol never waits
+  for its (WARNING ...): no REPLY comes until the procedures interrupt it, so its caller waits
+  for ever;
 - never-succeeds: a statement is reached but its arc can never be crossed (a dead transition);
 - changes-nothing: a retraction that only ever runs with an unbound argument (it retracts nothing);
 - unreachable: statements of an invoked KA that can never run; never-invoked: a KA never started;

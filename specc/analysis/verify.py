@@ -423,6 +423,9 @@ class Verification:
     limited: bool = False  # the state limit stopped the exploration
     unexplored: tuple[tuple[str, ...], ...] = ()  # the parts the state limit kept from being explored
     cut: tuple[str, ...] = ()  # events not replayed for every sequence of choices (SEQUENCES_PER_EVENT)
+    # Exec services that entered EXEC in no state of a complete exploration: each request of them
+    # ends before it runs (refused, timed out, kept waiting), which no property forbids.
+    never_started: tuple[str, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -452,6 +455,7 @@ class Explorer:
         self.arcs = arcs
         # (running, started): a service entered EXEC while the other was in EXEC, in some state explored.
         self.together: set[tuple[str, str]] = set()
+        self.started: set[str] = set()  # the services that entered EXEC in some state explored
         self.requests = requests
         # The report codes reflexes look for: module activities may end with them too.
         self.codes = tuple(sorted({str(r.value) for r in self.spec.reflexes if r.op is not None} - {"OK"}))
@@ -461,7 +465,7 @@ class Explorer:
         registry = ModelRegistry(self.modules, self.codes)
         executive = rx.Executive(self.spec, self.decide, registry)  # type: ignore[arg-type]
         world = World(executive, registry)
-        executive.observers.append(functools.partial(_check_exclusion, world, self.arcs, self.together))
+        executive.observers.append(functools.partial(_check_exclusion, world, self.arcs, self.together, self.started))
         return world
 
     def key(self, world: World) -> Key:
@@ -852,10 +856,11 @@ def _timer_label(timer: ModelTimer) -> str:
     return which
 
 
-def _check_exclusion(world: World, arcs: set[tuple[str, str]], together: set[tuple[str, str]],
+def _check_exclusion(world: World, arcs: set[tuple[str, str]], together: set[tuple[str, str]], started: set[str],
                      activity: rx.Activity, source: rx.Phase, target: rx.Phase) -> None:
     if target is not rx.Phase.EXEC:
         return
+    started.add(activity.service.name)
     for other in world.executive.activities.values():
         if other is activity or other.state is not rx.Phase.EXEC:
             continue
@@ -1009,7 +1014,9 @@ def verify(program: m.Program, executive: m.Executive, requests: int = 2, limit:
                            if source != target and (target, source) not in arcs
                            and source not in graph.control and target not in graph.control
                            and (source, target) in explorer.together))
-    return dataclasses.replace(result, one_way=one_way)
+    never = tuple(name for name, service in explorer.spec.services.items()
+                  if not service.control and name not in explorer.started) if result.complete else ()
+    return dataclasses.replace(result, one_way=one_way, never_started=never)
 
 
 def describe(result: Verification) -> Iterator[str]:
@@ -1037,6 +1044,9 @@ def describe(result: Verification) -> Iterator[str]:
         yield (f"conflicts declared one way only, which the states explored show running together (exclusion "
                f"reads them as written): {said}; for two services never to run together, give each a conflict "
                "with the other")
+    if result.never_started:
+        yield (f"never started, in any state explored: {', '.join(result.never_started)} (every request of it ends "
+               "before it runs: refused, timed out or kept waiting); a service no request can run is worth a look")
     if result.limited:
         skipped = (f"; parts not explored at all: {' | '.join(', '.join(part) for part in result.unexplored)}"
                    if result.unexplored else "")

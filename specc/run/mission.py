@@ -557,6 +557,8 @@ def waiting_on(events: Iterable[Mapping[str, Any]]) -> str:
     for e in events:
         if e["kind"] == "request":
             asked[e["id"]] = str(e.get("service") or e.get("request"))
+            if e.get("service"):  # an executive service's activity starts in WAIT (the log's `request`)
+                phases[e["id"]] = ("WAIT", float(e["t"]))
         elif e["kind"] == "reply":
             asked.pop(e["id"], None)
         elif e["kind"] == "activity":

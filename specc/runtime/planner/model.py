@@ -393,11 +393,16 @@ def timepoints_of(e: Expr | Constraint) -> set[str]:
     return set()
 
 
+def end_bounds(problem: Problem) -> list[Member]:
+    """The problem's own bounds on `t_end - t_start`: how long the mission may last."""
+    span = Op("-", (Time(problem.end), Time(problem.start)))
+    return [c for c in problem.constraints
+            if isinstance(c, Member) and c.expr == span and isinstance(c.domain, Interval)]
+
+
 def latest_end(problem: Problem) -> float:
     """The latest end its own bounds on `t_end - t_start` allow the mission (inf: none)."""
-    span = Op("-", (Time(problem.end), Time(problem.start)))
-    return min((c.domain.high for c in problem.constraints
-                if isinstance(c, Member) and c.expr == span and isinstance(c.domain, Interval)), default=INF)
+    return min((c.domain.high for c in end_bounds(problem) if isinstance(c.domain, Interval)), default=INF)
 
 
 def without_latest_end(problem: Problem) -> Problem:

@@ -406,9 +406,8 @@ def dates_said(goal: Goal, problem: pm.Problem, attempt: Attempt) -> str:
     said = f"; the goal's dates: {', '.join(own)}" if own else ""
     latest = pm.latest_end(problem)
     if math.isfinite(latest) and any(TIMED_OUT in why for why in attempt.failures):
-        span = pm.Op("-", (pm.Time(problem.end), pm.Time(problem.start)))
-        lines = sorted({c.line for c in problem.constraints if isinstance(c, pm.Member) and c.expr == span and c.line
-                        and isinstance(c.domain, pm.Interval) and c.domain.high == latest})
+        lines = sorted({c.line for c in pm.end_bounds(problem)
+                        if c.line and isinstance(c.domain, pm.Interval) and c.domain.high == latest})
         said += f"; the mission ends by {latest:g} s at the latest" + (
             f" (line {', '.join(map(str, lines))})" if lines else "")
     return said
