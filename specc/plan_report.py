@@ -33,11 +33,12 @@ class Outcome:
     def useful(self) -> bool:
         """Is there a plan, meeting some goal when the problem has any? A plan dropping every goal
         does nothing: the problem is unsolvable as it stands; nor does one with no action that
-        drops goals (those it keeps held without it)."""
+        drops a goal for itself (those it keeps held without it). One with no action that drops
+        goals only because they exclude the goals it keeps is the planner's answer."""
         goals, plan = self.result.goals, self.result.plan
         if plan is None:
             return False
-        if not plan.actions and any(not g.kept for g in goals):
+        if not plan.actions and any(not g.kept and not g.for_others for g in goals):
             return False
         return not goals or any(g.kept for g in goals)
 

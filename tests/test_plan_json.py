@@ -148,3 +148,37 @@ def test_the_planner_option_plans_as_that_ftplan_planner_does_in_a_run(tmp_path:
     assert misspelt.returncode == 2 and "no FTplan planner 'carefull' (did you mean 'careful'?)" in misspelt.stderr
     elsewhere = plan("--problem", "shuttle", "--planner", "careful")
     assert elsewhere.returncode == 2 and "plans in domain 'warehouse_slow'" in elsewhere.stderr
+
+
+def test_a_plan_of_no_action_that_drops_a_goal_only_for_one_it_keeps_is_a_plan(tmp_path: Path) -> None:
+    """Staying HOME (true from the start, priority 2) and being at A at the end (priority 1)
+    exclude each other: the best plan keeps the first with no action and drops the second, for
+    the first only. That is the planner's answer (exit 0), unlike a plan of no action that drops
+    a goal for itself (impossible, or not planned alone: exit 1)."""
+    spec = tmp_path / "hops.spec"
+    spec.write_text("""
+domain hops {
+  attribute AT() { ?value in {HOME, A}; }
+  task HOP(?from, ?to) (t_start, t_end) {
+    ?from in {HOME, A};
+    ?to in {HOME, A};
+    ?from != ?to;
+    event(AT(): (?from, ?to), t_end);
+    contingent (t_end - t_start) in [5, 10];
+  } nonPreemptive
+}
+problem both for hops {
+  timepoint th, ta;
+  explained event(AT(): (A, HOME), t_start);
+  hold(AT(): HOME, (th, t_end)) goal(2, 0);
+  hold(AT(): A, (ta, t_end)) goal(1, 0);
+  (t_end - t_start) in [0, 100];
+}
+""")
+    result = subprocess.run([sys.executable, "-m", "specc.cli", "plan", str(spec), "--problem", "both", "--json", "-"],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout + result.stderr
+    document = json.loads(result.stdout)
+    assert document["plan"]["actions"] == []
+    assert [(g["kept"], "together with the goals kept before it" in g["reason"]) for g in document["goals"]] == [
+        (True, False), (False, True)]

@@ -312,7 +312,7 @@ def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
     assert_clean_failure(specc("table", HILARE, "--config", "Robot1"), 2, "--config: no mission of robot 'hilare' "
                          "is planned (a mission with 'plan:'), and a configuration is FTplan's: run without --config")
     assert_clean_failure(specc("table", HILARE, "--mission", "hunt", "--config", "Robot1"), 2,
-                         "--config: no mission named is planned")
+                         "--config: none of the missions named (hunt) is planned")
 
 
 def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:

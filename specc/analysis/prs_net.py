@@ -1422,6 +1422,21 @@ class Translator:
                         out[outcome][answer] = None
         return out
 
+    def _reached_from(self, kas: list[rp.KA]) -> list[rp.KA]:
+        """The KAs, and those the goals of their bodies invoke, and so on (by the goals' heads)."""
+        reached = {k.name: k for k in kas}
+        waiting = list(kas)
+        while waiting:
+            ka = waiting.pop()
+            for statement in _statements(ka.body or ()):
+                if isinstance(statement, rp.Step) and statement.goal.op == "!":
+                    for other in self.library.kas:
+                        if other.goal_invoked and other.trigger.head == statement.goal.expr.head \
+                                and other.name not in reached:
+                            reached[other.name] = other
+                            waiting.append(other)
+        return list(reached.values())
+
     def _applicable(self, kas: list[rp.KA], colour: tuple[Any, ...]) -> list[rp.KA]:
         return [k for k in kas
                 if len(k.trigger.args) == len(colour) and unify_into(k.trigger.args, colour, {}) is not None]
@@ -1529,11 +1544,11 @@ class Translator:
                              f"({', '.join(map(str, results))}) lacks: add OK to it", "answer-without-ok")
                 continue
             self.result.environment.add(f"{origin} answers")
-            # Does the protocol serving it hear a ZOMBIE's warning (seed 000 Fig 4.3 does, and
-            # interrupts the service)?
+            # Does the protocol hear a ZOMBIE's warning (seed 000 Fig 4.3 does, and interrupts
+            # the service)? Its KA may hand the wait to the KAs of its subgoals.
             serving = self._applicable(servers, colour) or servers
             handles_zombies = any(isinstance(s, rp.Step) and s.goal.op == "^" and s.goal.expr.head == "WARNING"
-                                  for k in serving for s in _statements(k.body or ()))
+                                  for k in self._reached_from(serving) for s in _statements(k.body or ()))
             for result in answers:
                 answer = colour[:-1] + (result,)
                 release = [(service.group, name)] if service.group else []

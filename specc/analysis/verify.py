@@ -315,8 +315,12 @@ class ModelModule:
                     ("fails", functools.partial(self.finish, activity, Status.FINAL_ERROR, "FAILED")),
                     ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         if activity.state == "INTER":
+            # Its `inter` codel runs, and may send what the request sends (its children then).
+            sends = [(f"sends {target}", functools.partial(self.send, activity, target))
+                     for target in activity.spec.sends if target not in activity.sent] if (
+                "inter" in activity.spec.codels) else []
             return [("is interrupted", functools.partial(self.finish, activity, Status.INTERRUPTED, activity.cause)),
-                    ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
+                    *sends, ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         return []
 
 
@@ -490,8 +494,8 @@ class Explorer:
             modules.append((name, tuple((owners.get((name, a.id), -1), a.spec.name, a.state, a.cause,
                                          tuple(sorted(place[name, w] for w in a.waiting_for if (name, w) in place)),
                                          tuple(sorted(a.sent)), a.sent_by_codel,
-                                         tuple(sorted((child[0], place[child]) for child in a.children
-                                                      if child in place)))
+                                         # in the order they were sent: the order they are interrupted in
+                                         tuple((child[0], place[child]) for child in a.children if child in place))
                                         for a in entries)))
         activities = tuple((a.service.name, a.state, a.holds_group, a.answered, a.abort_sent,
                             tuple(sorted(timers.get(rank, ()))))
@@ -604,6 +608,7 @@ class Explorer:
         # A pass only asks again for the starts of WAIT activities: with none, it changes nothing.
         if (self.check_passes and not self.passes_matter and executive.error is None
                 and any(a.state is rx.Phase.WAIT for a in executive.activities.values())):
+            self.decisions = world.registry.submitted = 0  # the pass is an event of its own
             try:
                 executive._post(_nothing)  # a cycle with no event
             except Unsettled:  # the pass itself loops: every cycle counts, as when it changes a state
@@ -991,6 +996,7 @@ def explorer_for(program: m.Program, executive: m.Executive, requests: int = 2) 
     spec = executive_spec(program, controller)
     modules = {name: {r.name: RequestSpec(r.name, r.kind or "exec",
                                           validate=r.validate.text if r.validate is not None else None,
+                                          codels={c.state: c.function for c in r.codels},
                                           fail=tuple(x.text for x in r.fail),
                                           incompatible=tuple(x.text for x in r.incompatible_with),
                                           sends=tuple(x.text for x in r.sends))

@@ -141,13 +141,13 @@ def check_diversity(ctx: Context, mission: m.Mission, planners: dict[str, m.Plan
     declared = {name: p.domain.text for name, p in planners.items() if p.domain is not None}
     for planner, (domain, entry) in planned_in.items():
         own = declared.get(planner)
-        others = sorted(other for other, (there, _) in planned_in.items()
-                        if other != planner and there == domain and declared.get(other) not in (None, own))
+        others = sorted(other for other, (there, _) in planned_in.items() if other != planner and declared.get(
+            other) not in (None, own) and domain in (there, declared.get(other)))
         if own is None or domain == own or not others:
             continue
         ctx.warn("planners-share-domain", f"planner '{planner}' (domain '{own}') plans mission '{mission.name}' in "
-                 f"domain '{domain}', as planner '{others[0]}' does: problem '{entry.problem.text}' is for "
-                 f"'{domain}', so the two plan on one model and are not diverse here; name a problem for "
+                 f"domain '{domain}', planner '{others[0]}''s: problem '{entry.problem.text}' is for '{domain}', so "
+                 f"'{planner}' plans on that planner's model and the two are not diverse here; name a problem for "
                  f"'{own}'", entry.problem.span)
 
 

@@ -60,7 +60,8 @@ class Node:
     # the repr fields by name; each field set once, by __init__, and nothing set or deleted after.
     def __setattr__(self, name: str, value: Any) -> None:
         if name in self.__dict__ or name not in self.__dataclass_fields__:
-            raise FrozenInstanceError(f"cannot assign to field {name!r}")
+            what = "field" if name in self.__dataclass_fields__ else "attribute"
+            raise FrozenInstanceError(f"cannot assign to {what} {name!r}")
         object.__setattr__(self, name, value)
 
     def __delattr__(self, name: str) -> None:

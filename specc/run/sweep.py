@@ -129,8 +129,9 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
     # With configurations of FTplan and no mission named: the planned missions, which they are for.
     every = missions or tuple(name for name in declared if not configurations or is_planned(name))
     if configurations and not any(is_planned(name) for name in every):
-        raise RunError(f"--config: {'no mission named' if missions else f'no mission of robot {robot!r}'} is "
-                       "planned (a mission with 'plan:'), and a configuration is FTplan's: run without --config")
+        which = f"none of the missions named ({', '.join(every)})" if missions else f"no mission of robot {robot!r}"
+        raise RunError(f"--config: {which} is planned (a mission with 'plan:'), and a configuration is FTplan's: "
+                       "run without --config")
     requests = []
     for c, m, w, s in itertools.product(configurations or (None,), every, worlds or (None,), seeds):
         if c is not None and not is_planned(m):

@@ -254,6 +254,7 @@ class Executive:
         self._in_modules = 0.0
         self._inbox: deque[tuple[Callable[..., None], tuple[Any, ...]]] = deque()
         self._busy = False
+        self._looping = False  # the cycle limit stopped a reaction loop at this instant: reflexes are off
         self._internal_ids = itertools.count(-1, -1)
         self._highest_id = 0  # of the ids task-level clients gave their requests (see `fresh_id`)
         missing = sorted({s.module for s in spec.services.values() if s.module not in registry.modules})
@@ -337,6 +338,7 @@ class Executive:
                     self._fatal(f"{CYCLES_PER_INSTANT:,} cycles at {self.kernel.now:g} s with no time passing: a "
                                 "reaction loop (a reflex starting a service again on every reply its module gives "
                                 "at once?); `specc verify` shows how (its `settles` property)")
+                    self._looping = True
                 started = time.perf_counter()
                 self._in_modules = 0.0
                 handler, args = self._inbox.popleft()
@@ -345,7 +347,7 @@ class Executive:
                 if self.cycle_durations is not None:
                     self.cycle_durations.append(time.perf_counter() - started - self._in_modules)
         finally:
-            self._busy = False
+            self._busy = self._looping = False
 
     def _retry_waiting(self) -> None:
         """§3.3.3: a WAIT activity asks again for its start at every cycle."""
@@ -629,10 +631,10 @@ class Executive:
 
     # ------------------------------------------------------------ reflexes (§3.5)
     def _reflexes(self, trigger: str, source: str, reply: Reply) -> None:
-        if self.error is not None:
-            # §3.4.2: in the ERROR state every request is refused, the executive's own too. A
-            # reflex requesting again what a frozen module refuses at once would otherwise go
-            # on without end at one instant, past the cycle limit that brought the ERROR.
+        if self._looping:
+            # The cycle limit caught a reaction loop at this instant (a reflex requesting again
+            # what a frozen module refuses at once): no reflex fires until the instant is over,
+            # or it would go on without end past the ERROR the limit brought.
             return
         for reflex in self.spec.reflexes:
             if reflex.matches(trigger, source, reply.report.code):

@@ -48,6 +48,8 @@ class GoalOutcome:
     line: int
     kept: bool
     reason: str = ""  # why it was dropped
+    # Dropped for the goals kept before it (not planned together with them), not for itself.
+    for_others: bool = False
 
 
 @dataclass(frozen=True)

@@ -202,7 +202,8 @@ class Planner:
                     why = (f"{together} together with the goals kept before it ({', '.join(g.text for g in kept)})"
                            if kept else "not met alone either (no goal was kept before it)")
                     why += f": {explain(tried)}{dates_said(goal, setup.problem, tried)}"
-                    outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, why)
+                    outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, why,
+                                                       for_others=bool(kept))  # planned alone, or tried
         assert best.node is not None
         # Not an improvement (which FTplan's planners leave at 0): a plan that puts an object down
         # only to pick it up again is one no robot should carry out.
