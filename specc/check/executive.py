@@ -200,7 +200,7 @@ def check_reflex_loops(ctx: Context, reflexes: tuple[m.Reflex, ...], services: M
             continue
         warned.update(id(reflex) for _, reflex in loop)
         chain = " -> ".join([first] + [target for target, _ in loop])
-        ctx.warn("reflex-loop", f"these reflexes start {first} again on every reply it gives ({chain}): once "
+        ctx.warn("reflex-loop", f"these reflexes ask for {first} again on every reply it gives ({chain}): once "
                  "started, it never stops being restarted (at one instant when its module refuses at once); give "
                  "the reflex a condition on the reply (`== FAILED`) or start another service", loop[0][1].span)
 

@@ -170,7 +170,10 @@ def check_request(ctx: Context, module: m.Module, request: m.Request, requests: 
         ctx.report("missing-property", f"request '{request.name}' needs 'type: control;' or 'type: exec;'",
                    request.span)
     for other in request.incompatible_with:
-        if len(other.parts) > 1:
+        if len(other.parts) > 1 and other.parts[0] == module.name:
+            ctx.report("undefined-request", f"incompatible_with names requests of module '{module.name}' by their "
+                       f"own names: write '{'.'.join(other.parts[1:])}', not '{other.text}'", other.span)
+        elif len(other.parts) > 1:
             # A module only knows its own requests; two modules' requests kept apart is the
             # executive's business.
             ctx.report("undefined-request", f"incompatible_with names requests of module '{module.name}' only, not "

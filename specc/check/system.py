@@ -91,7 +91,9 @@ def check_reply_domain(ctx: Context, procedures: m.Procedures, executive: m.Exec
             if code not in allowed:
                 missing.setdefault(code, []).append(service.name)
     if missing:
-        said = ", ".join(f"{code} ({', '.join(services)})" for code, services in sorted(missing.items()))
+        every = sorted(s.name for s in executive.services if s.name in named and ctx.symbols.service_request(s))
+        said = ", ".join(f"{code} ({'every service they name' if sorted(services) == every else ', '.join(services)})"
+                         for code, services in sorted(missing.items()))
         ctx.warn("incomplete-reply-domain", f"REPLY's result domain lacks result(s) the services the procedures "
                  f"name may answer: {said}; a reply carrying one reaches the procedures outside the domain "
                  "`specc verify --goal` assumes (a run notes an incident): add them to it", reply.params[1].span)
