@@ -605,6 +605,7 @@ class Translator:
         self.diagnostics: list[Diagnostic] = []
         self.pending: list[PendingReceive] = []
         self.posted: dict[str, dict[tuple[Any, ...], None]] = {}  # goal -> colours posted
+        self._heard: dict[tuple[str, ...], bool] = {}  # _hears_warnings, by the protocol's KAs
         self.translated: dict[str, None] = {}
         self.var_domains: dict[str, dict[str, tuple[Any, ...]]] = {}
         self.result = Translation(petri.Net(procedures.name), [])
@@ -1422,6 +1423,17 @@ class Translator:
                         out[outcome][answer] = None
         return out
 
+    def _hears_warnings(self, serving: tuple[str, ...]) -> bool:
+        """Does the request protocol (these KAs, and those their subgoals reach) wait for a
+        `(WARNING ...)` anywhere? Worked out once per protocol, not once per service."""
+        heard = self._heard.get(serving)
+        if heard is None:
+            kas = [k for k in self.library.kas if k.name in serving]
+            heard = self._heard[serving] = any(
+                isinstance(s, rp.Step) and s.goal.op == "^" and s.goal.expr.head == "WARNING"
+                for k in self._reached_from(kas) for s in _statements(k.body or ()))
+        return heard
+
     def _reached_from(self, kas: list[rp.KA]) -> list[rp.KA]:
         """The KAs, and those the goals of their bodies invoke, and so on (by the goals' heads)."""
         reached = {k.name: k for k in kas}
@@ -1547,8 +1559,7 @@ class Translator:
             # Does the protocol hear a ZOMBIE's warning (seed 000 Fig 4.3 does, and interrupts
             # the service)? Its KA may hand the wait to the KAs of its subgoals.
             serving = self._applicable(servers, colour) or servers
-            handles_zombies = any(isinstance(s, rp.Step) and s.goal.op == "^" and s.goal.expr.head == "WARNING"
-                                  for k in self._reached_from(serving) for s in _statements(k.body or ()))
+            handles_zombies = self._hears_warnings(tuple(k.name for k in serving))
             for result in answers:
                 answer = colour[:-1] + (result,)
                 release = [(service.group, name)] if service.group else []

@@ -306,21 +306,19 @@ class ModelModule:
 
     def endings(self, activity: ModelActivity) -> list[tuple[str, Callable[[], None]]]:
         """What the activity itself may do next."""
+        # What its codels may still send: while it runs, and while its `inter` codel runs.
+        sends = [(f"sends {target}", functools.partial(self.send, activity, target))
+                 for target in activity.spec.sends if target not in activity.sent]
         if activity.state == "EXEC":
             reported = [(f"ends with {code}", functools.partial(self.finish, activity, Status.END, code))
                         for code in self.codes]
-            sends = [(f"sends {target}", functools.partial(self.send, activity, target))
-                     for target in activity.spec.sends if target not in activity.sent]
             return [("ends", functools.partial(self.finish, activity, Status.END, "OK")), *reported, *sends,
                     ("fails", functools.partial(self.finish, activity, Status.FINAL_ERROR, "FAILED")),
                     ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         if activity.state == "INTER":
-            # Its `inter` codel runs, and may send what the request sends (its children then).
-            sends = [(f"sends {target}", functools.partial(self.send, activity, target))
-                     for target in activity.spec.sends if target not in activity.sent] if (
-                "inter" in activity.spec.codels) else []
             return [("is interrupted", functools.partial(self.finish, activity, Status.INTERRUPTED, activity.cause)),
-                    *sends, ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
+                    *(sends if "inter" in activity.spec.codels else []),
+                    ("goes ZOMBIE", functools.partial(self.finish, activity, Status.ZOMBIE, "ZOMBIE"))]
         return []
 
 

@@ -79,10 +79,12 @@ def check_reply_domain(ctx: Context, procedures: m.Procedures, executive: m.Exec
     named = {a.binding.service for a in procedures.actions if isinstance(a.binding, m.ServiceBinding)}
     named |= {v for n in walk(procedures) if isinstance(n, m.SymbolSet) for v in n.values}
     missing: dict[str, list[str]] = {}
+    every: list[str] = []  # the services named that run a request
     for service in executive.services:
         request = ctx.symbols.service_request(service) if service.name in named else None
         if request is None:
             continue
+        every.append(service.name)
         # Its fail codes, and the module's status when a codel breaks: one that raises (or a
         # validate codel refusing) ends the request FINAL_ERROR, a child's error SERVER_ERROR.
         runs_codels = request.kind != "control" or request.validate is not None
@@ -91,8 +93,7 @@ def check_reply_domain(ctx: Context, procedures: m.Procedures, executive: m.Exec
             if code not in allowed:
                 missing.setdefault(code, []).append(service.name)
     if missing:
-        every = sorted(s.name for s in executive.services if s.name in named and ctx.symbols.service_request(s))
-        said = ", ".join(f"{code} ({'every service they name' if sorted(services) == every else ', '.join(services)})"
+        said = ", ".join(f"{code} ({'every service they name' if services == every else ', '.join(services)})"
                          for code, services in sorted(missing.items()))
         ctx.warn("incomplete-reply-domain", f"REPLY's result domain lacks result(s) the services the procedures "
                  f"name may answer: {said}; a reply carrying one reaches the procedures outside the domain "
