@@ -66,6 +66,16 @@ def a_folder(value: Path | None) -> Path | None:
     return value
 
 
+def runs_folder(value: Path) -> Path:
+    """`--runs` of `run` and `table` is a folder: a bare number that names none yet is a count
+    meant for another option (`specc campaign --runs 3`), which would make a folder '3'."""
+    value = a_folder(value) or value
+    if str(value).isdigit() and not value.exists():
+        raise typer.BadParameter(f"'{value}' would be a new folder named {value}: --runs is where the run folders "
+                                 f"go (for {value} seeds of every combination: `specc table --seeds {value}`)")
+    return value
+
+
 def refuse_unwritable(path: Path | None, what: str, option: str, example: str, picture: bool = False) -> None:
     """Exit at once, before any planning or drawing, when the file `path` cannot be written
     (`specc.run.writable_file`; '-' is the standard output)."""
@@ -86,15 +96,24 @@ def refuse_unwritable(path: Path | None, what: str, option: str, example: str, p
         raise typer.Exit(BAD_INPUT) from None
 
 
+# Errors of the command line's paths, not of the specs: the command could not do its work (exit 2).
+INPUT_CODES = frozenset({"missing-file", "no-spec-files"})
+
+
 def report(loaded: Loaded) -> int:
-    """Print every diagnostic; the exit code is 1 when any is an error."""
+    """Print every diagnostic; the exit code: 2 when a path given is missing or holds no spec, 1
+    when any diagnostic is an error, else 0."""
     for diagnostic in loaded.diagnostics:
         err.print(render(diagnostic, loaded.sources), markup=False)
     errors = len(loaded.errors)
     warnings = len(loaded.diagnostics) - errors
     if errors or warnings:
         err.print(f"{errors} error(s), {warnings} warning(s)", markup=False)
-    return 1 if errors else 0
+    return exit_code(loaded)
+
+
+def exit_code(loaded: Loaded) -> int:
+    return 2 if any(d.code in INPUT_CODES for d in loaded.errors) else 1 if loaded.errors else 0
 
 
 @app.command()
@@ -105,7 +124,7 @@ def explain(code: Annotated[Optional[str], typer.Argument(help="A diagnostic's c
 
     Example: specc explain missing-semicolon
     """
-    from specc.codes import CODES
+    from specc.codes import CODES, FIXES
 
     shown = code.strip("[]") if code is not None else None
     if shown is not None and shown not in CODES:
@@ -114,7 +133,7 @@ def explain(code: Annotated[Optional[str], typer.Argument(help="A diagnostic's c
         raise typer.Exit(2)
     for name in [shown] if shown is not None else sorted(CODES):
         entry = CODES[name]
-        out.print(f"{name}: {entry.summary}\n    e.g. {entry.example}", markup=False)
+        out.print(f"{name}: {entry.summary}\n    e.g. {entry.example}\n    fix: {FIXES[name]}", markup=False)
 
 
 @app.command()
@@ -139,10 +158,10 @@ def check(paths: PathsArg,
                     "warnings": len(loaded.diagnostics) - errors,
                     "diagnostics": [d.as_data() for d in loaded.diagnostics]}
         sys.stdout.write(json.dumps(document, indent=2) + "\n")
-        raise typer.Exit(1 if errors or (strict and loaded.diagnostics) else 0)
+        raise typer.Exit(exit_code(loaded) or (1 if strict and loaded.diagnostics else 0))
     code = report(loaded)
     if strict and loaded.diagnostics:
-        raise typer.Exit(1)
+        raise typer.Exit(code or 1)
     if code == 0 and not quiet:
         count = len(loaded.sources)
         items = len(loaded.program.items) if loaded.program else 0
@@ -215,8 +234,9 @@ def fmt(paths: PathsArg,
     from specc.syntax.printer import format_source
 
     loaded = load(paths, check=False)
-    if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+    code = report(loaded)
+    if code or loaded.program is None:
+        raise typer.Exit(code or 1)
     changed = []
     unwritable = []
     for source in loaded.program.files:
@@ -724,8 +744,9 @@ def rules_report(paths: PathsArg,
     from specc.analysis.kheops import describe, tally, worst_first
 
     loaded = load(paths)
-    if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+    code = report(loaded)
+    if code or loaded.program is None:
+        raise typer.Exit(code or 1)
     from specc.analysis.controller import executive_controller
 
     items = [i for i in loaded.program.items if isinstance(i, (m.RuleBase, m.Executive))]
@@ -789,8 +810,9 @@ def skeleton(paths: PathsArg) -> None:
     from specc.backends import skeleton as stubs
 
     loaded = load(paths, check=False)
-    if report(loaded) or loaded.program is None:
-        raise typer.Exit(1)
+    code = report(loaded)
+    if code or loaded.program is None:
+        raise typer.Exit(code or 1)
     # New codel modules go to the robot's folder, where `specc run` imports them from: the nearest
     # folder above a spec (or its own) holding the system block; with no system block yet (step 1
     # of docs/your-robot.md), the folder the command was given; beside the spec otherwise.
@@ -857,7 +879,7 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
         seed: Annotated[int, typer.Option(min=0, help="Draws the run's randomness: one seed, one event log.")] = 0,
         generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to (compiled "
                                                 "first when stale).")] = Path("generated"),
-        runs: Annotated[Path, typer.Option(help="Where run folders go.")] = Path("runs"),
+        runs: Annotated[Path, typer.Option(callback=runs_folder, help="Where run folders go.")] = Path("runs"),
         folder: Annotated[Optional[Path], typer.Option("--folder", "-o", callback=a_folder,
                                                        help="The run folder (default: "
                                                        "RUNS/<robot>-<mission>-<world>[-<config>]-s<seed>; with "
@@ -1036,7 +1058,8 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
           seeds: Annotated[int, typer.Option(min=1, help="Seeds 0..N-1 for every combination.")] = 1,
           generated: Annotated[Path, typer.Option("--generated", "-g", help="Where the specs compile to.")]
           = Path("generated"),
-          runs: Annotated[Path, typer.Option(help="Where the run folders go.")] = Path("runs"),
+          runs: Annotated[Path, typer.Option(callback=runs_folder, help="Where the run folders go.")]
+          = Path("runs"),
           output: Annotated[Optional[Path], typer.Option("--output", "-o", help="The table (Markdown; JSON "
                                                          "beside it). Default: RUNS/<robot>-table.md")] = None,
           pictures: Annotated[bool, typer.Option(help="Draw every run's pictures.")] = False,
@@ -1302,7 +1325,8 @@ def campaign(
         path = store or Path("campaigns") / f"{robot}-{domain}-{mutants}.sqlite"
         with ResultStore(path) as results:
             job = Campaign(plan, results, engine, selection.domains, selection.records)
-            job.start()
+            for note in job.start():
+                err.print(f"note: {note}", markup=False)
             err.print(f"results in {path} ({results.count()} already there); on {engine.describe()}", markup=False)
             try:
                 with CampaignProgress(quiet) as step:
@@ -1315,6 +1339,12 @@ def campaign(
         kept = sum(1 for v in verdicts.values() if v.verdict == "kept")
         out.print(f"{len(report.outcomes)} experiments; {kept} of {len(verdicts)} mutants kept", markup=False)
         _print_report(report, output or path.parent, path.stem)
+        missing = sum(max(0, c.expected - c.done) for c in report.coverage)
+        if missing:  # experiments that timed out: a script must not take the campaign for finished
+            err.print(f"the campaign is not finished: {missing} experiment(s) timed out (--timeout {timeout:g} s); "
+                      "the same command runs them again (with a larger --timeout if they keep timing out)",
+                      markup=False)
+            raise typer.Exit(1)
     except RunError as error:
         raise _run_error(error, 2) from None
 

@@ -47,6 +47,10 @@ def load(paths: list[Path], *, check: bool = True) -> Loaded:
         loaded.comments[shown] = result.comments
         if result.source is not None:
             sources.append(result.source)
+            if not result.source.items:  # a file emptied, or one of comments only: nothing of it is read
+                loaded.diagnostics.append(warning("empty-file", f"'{shown}' holds no block (module, executive, "
+                                                  "rules...): nothing in it is checked or compiled; write one or "
+                                                  "remove the file", Span(shown, 1, 1, 1, 1)))
     parsed_all = len(sources) == len(files)
     if sources:
         loaded.program = m.Program(files=tuple(sources))

@@ -70,9 +70,37 @@ class FunctionShape:
     posters: tuple[tuple[str, int], ...] = ()  # the names it reads posters by (`x.read_poster("m.P")`), with lines
     sends: tuple[tuple[str, int], ...] = ()  # the requests it sends by name (`x.send_request("m.R")`), with lines
     computed_sends: tuple[int, ...] = ()  # the lines sending a request whose name is computed (`"m." + r`)
+    # What the name holds when it is no function (`step = "exec"`: "a str"): nothing calls it.
+    not_callable: str = ""
 
     def accepts(self, count: int) -> bool:
-        return self.least <= count and (self.most is None or count <= self.most)
+        return not self.not_callable and self.least <= count and (self.most is None or count <= self.most)
+
+
+# Assigned values that are no function, and how to say what they are.
+_NOT_CALLABLE = {ast.List: "a list", ast.Tuple: "a tuple", ast.Dict: "a dict", ast.Set: "a set",
+                 ast.JoinedStr: "a str", ast.ListComp: "a list", ast.DictComp: "a dict", ast.SetComp: "a set"}
+
+
+def assigned_shape(value: ast.expr, line: int) -> FunctionShape | None:
+    """`name = value` at a module's top level: a lambda's shape, what a literal is (no function),
+    or None when only running it would tell (another function's name, a call's result)."""
+    if isinstance(value, ast.Lambda):
+        least, most = _arity(value.args)
+        return FunctionShape(line, least, most, tuple((v, line) for v in _strings_returned(value.body)))
+    if isinstance(value, ast.Constant):
+        return FunctionShape(line, 0, 0, not_callable=f"a {type(value.value).__name__}")
+    kind = _NOT_CALLABLE.get(type(value))
+    return FunctionShape(line, 0, 0, not_callable=kind) if kind is not None else None
+
+
+def _arity(arguments: ast.arguments) -> tuple[int, int | None]:
+    """The positional arguments a function needs and accepts (None: any number; -1: none works,
+    a keyword-only argument has no default)."""
+    positional = len(arguments.posonlyargs) + len(arguments.args)
+    if any(default is None for default in arguments.kw_defaults):
+        return positional - len(arguments.defaults), -1
+    return positional - len(arguments.defaults), None if arguments.vararg is not None else positional
 
 
 def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | None:
@@ -80,12 +108,7 @@ def shape_of(node: ast.FunctionDef | ast.AsyncFunctionDef) -> FunctionShape | No
     if node.decorator_list:
         return None
     arguments = node.args
-    positional = len(arguments.posonlyargs) + len(arguments.args)
-    required_keywords = any(default is None for default in arguments.kw_defaults)
-    least = positional - len(arguments.defaults)
-    most = None if arguments.vararg is not None else positional
-    if required_keywords:  # a keyword-only argument without default: no positional call works
-        most = -1
+    least, most = _arity(arguments)
     returns: list[tuple[str, int]] = []
     named: dict[str, list[tuple[str, int]]] = {"read_poster": [], "send_request": []}
     computed: list[int] = []
@@ -197,7 +220,8 @@ def _read_names(data: bytes, filename: str) -> dict[str, FunctionShape | _Import
         elif isinstance(node, ast.Import):
             names.update(((alias.asname or alias.name).split(".")[0], None) for alias in node.names)
         elif isinstance(node, ast.Assign):
-            names.update((t.id, None) for t in node.targets if isinstance(t, ast.Name))
+            names.update((t.id, assigned_shape(node.value, node.lineno)) for t in node.targets
+                         if isinstance(t, ast.Name))
     return names
 
 

@@ -81,7 +81,8 @@ def test_a_killed_campaign_resumes_without_losing_or_repeating_a_result(tmp_path
     assert partial.returncode == 0, partial.stderr
     assert f"{len(before)} experiments in {store}" in partial.stdout and "not finished" in partial.stdout
     assert rows(store) == before
-    assert "**not finished: Robot1" in (tmp_path / "partial" / "small.md").read_text()
+    partial_report = (tmp_path / "partial" / "small.md").read_text()
+    assert "**not finished: Robot1" in partial_report and "; not judged yet (the first configuration" in partial_report
     resumed = specc("campaign", ATRV, *SMALL, "--store", store, "-q")
     assert resumed.returncode == 0, resumed.stderr
     assert f"results in {store} ({len(before)} already there)" in resumed.stderr
@@ -99,6 +100,7 @@ def test_a_killed_campaign_resumes_without_losing_or_repeating_a_result(tmp_path
         assert all(o.status == "done" for o in results.outcomes())
     report = (tmp_path / "small.md").read_text()
     assert "kept (F*)" in report and "## Means over sets of activities" in report
+    assert "goals counted as FTplan believed them" not in report  # the rover judges its goals in the world
     assert is_png(tmp_path / "small.png")
     # Once complete, the same command runs nothing again and rewrites the same report.
     again = specc("campaign", ATRV, *SMALL, "--store", store, "-q")
@@ -114,8 +116,13 @@ def test_a_store_refuses_to_mix_two_campaigns(tmp_path: Path) -> None:
         with pytest.raises(RunError, match="holds another campaign \\(mutants: model1-0001 stored, model1-0002 "
                                            "asked; runs: 3 stored, 1 asked\\)"):
             store.describe(first | {"mutants": ["model1-0002"], "runs": 1})
-        # More configurations after those it has: the same campaign, compared further.
-        store.describe(first | {"configurations": ["Robot1", "Robot1/2"]})
+        # More configurations after those it has: the same campaign, compared further (said).
+        assert store.describe(first | {"configurations": ["Robot1", "Robot1/2"]}) == [
+            f"the campaign in '{tmp_path / 'c.sqlite'}' grows by 1 configurations: Robot1/2"]
+        assert store.description()["configurations"] == ["Robot1", "Robot1/2"]
+        # The command it was first run with still resumes it (said), and the store keeps what it grew to.
+        assert store.describe(first) == [f"'{tmp_path / 'c.sqlite'}' holds 2 configurations (it grew by a later "
+                                         "command), 1 of them asked: theirs are resumed, the report covers all 2"]
         assert store.description()["configurations"] == ["Robot1", "Robot1/2"]
         with pytest.raises(RunError, match="configurations: Robot1, Robot1/2 stored, Robot1/2 asked"):
             store.describe(first | {"configurations": ["Robot1/2"]})
@@ -229,6 +236,38 @@ def test_the_report_compares_the_configurations_with_and_without_faults(tmp_path
     assert [p.name for p in written] == ["campaign.md", "campaign.json", "campaign.png"] and is_png(written[2])
 
 
+def test_the_chart_s_title_fits_one_panel_as_two(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without a world set apart the chart has one panel, 720 pixels wide: its title was cut at
+    both ends (a trial's report)."""
+    import matplotlib.figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from specc.campaign.report import draw
+
+    with ResultStore(tmp_path / "c.sqlite") as store:
+        store.describe({"robot": "atrv", "domain": "model1", "configurations": ["Robot1", "Robot1/2"],
+                        "mutants": ["model1-0001"], "missions": ["M1"], "worlds": ["W1"], "runs": 1})
+        store.add_mutants([MutantRecord("model1-0001", "numeric", "model1.spec:1:1: numeric 1 -> 2 in MOVE", "")])
+        store.judge([("model1-0001", KEPT, "")])
+        for configuration in ("Robot1", "Robot1/2"):
+            record_m1(store, configuration, ORIGINAL, "W1", True)
+            record_m1(store, configuration, "model1-0001", "W1", configuration == "Robot1/2")
+        report = build_report(store)
+    for apart in ([], ["W1"]):
+        drawn: list[matplotlib.figure.Figure] = []
+        save = matplotlib.figure.Figure.savefig
+        with monkeypatch.context() as patch:
+            patch.setattr(matplotlib.figure.Figure, "savefig",
+                          lambda self, *args, **kwargs: (drawn.append(self), save(self, *args, **kwargs))[1])
+            draw(replace(report, description={**report.description, "set_apart": apart}), tmp_path / "chart.png")
+        figure = drawn[0]
+        renderer = FigureCanvasAgg(figure).get_renderer()
+        title = figure._suptitle
+        assert title is not None and len(figure.axes) == 1 + len(apart)
+        box, whole = title.get_window_extent(renderer), figure.bbox
+        assert whole.x0 <= box.x0 and box.x1 <= whole.x1, (box, whole)
+
+
 def test_the_configurations_are_compared_on_the_experiments_each_finished(tmp_path: Path) -> None:
     """Robot1/2 crashed on the kept mutant in W4: that activity leaves both configurations'
     means (else Robot1's failure there would count and Robot1/2's would not, a gain from a
@@ -320,6 +359,20 @@ def test_a_small_campaign_on_the_tug(tmp_path: Path) -> None:
     report = (tmp_path / "tug.md").read_text()
     assert "faults injected into warehouse of tug" in report and "σ̄_CART_AT" in report
     assert "T̄ the physical activity time" in report  # the columns are said, for a reader of the report alone
+    # The tug judges no goal in the world: the report says its goals are what FTplan believed.
+    assert original.measures["judged_by_robot"] is False and "**goals counted as FTplan believed them:**" in report
+
+
+def test_a_campaign_with_experiments_timed_out_exits_1_and_says_so(tmp_path: Path) -> None:
+    """A script must be able to tell a finished campaign from one whose experiments timed out
+    (an experiment of the rover's takes seconds: one second is too short for most)."""
+    store = tmp_path / "short.sqlite"
+    result = specc("campaign", ATRV, *SMALL, "--configs", "Robot1", "--timeout", "1", "--store", store, "-q")
+    with ResultStore(store) as results:
+        timed_out = sum(o.status == "timeout" for o in results.outcomes())
+    assert timed_out, "every experiment ended within a second: this test needs a longer one"
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert f"the campaign is not finished: {timed_out} experiment(s) timed out (--timeout 1 s)" in result.stderr
 
 
 def test_a_damaged_or_foreign_store_is_one_clear_message_and_loses_no_verdict(tmp_path: Path) -> None:

@@ -78,3 +78,13 @@ def test_a_binding_s_constant_is_checked_against_its_own_module_s_enum(tmp_path:
         spec.write_text(text.replace("LIFT() => request drive.Lift(HIGH);", f"LIFT() => request drive.Pace({value});"))
         found = [d for d in load([spec]).diagnostics if d.code == "bad-argument-type" and "drive.Pace" in d.message]
         assert bool(found) == wrong, [d.message for d in found]
+
+
+def test_the_sdi_names_check_keeps_for_specc_are_the_runtime_s() -> None:
+    """`reserved-name` for an internal data field that would hide what a codel reaches through its
+    SDI: the check lists those names itself (importing the runtime would slow every check)."""
+    from specc.check.modules import SDI_ATTRIBUTES
+    from specc.runtime.functional import InternalData
+
+    assert SDI_ATTRIBUTES == {name for name in vars(InternalData) if not name.startswith("_")}
+

@@ -98,7 +98,7 @@ def test_a_misspelt_keyword_is_named_even_where_the_parser_no_longer_expects_it(
                                   ["fmt", "no/such/file.spec"]])
 def test_missing_inputs_are_clear_errors(args: list[str]) -> None:
     result = specc(*args)
-    assert result.returncode == 1
+    assert result.returncode == 2  # the command could not do its work (docs/reference.md §11), no verdict
     assert "no such file or folder" in result.stderr and "[missing-file]" in result.stderr
     assert "Traceback" not in result.stderr
 
@@ -361,7 +361,7 @@ def test_symbolic_link_loops_are_clear_errors(tmp_path: Path) -> None:
     (robot / "again").symlink_to(robot)
     result = specc("check", "loop", "robot", cwd=tmp_path)
     assert "'loop' is a broken or looping symbolic link [missing-file]" in result.stderr
-    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert result.returncode == 2 and "Traceback" not in result.stderr
     assert specc("check", "robot", cwd=tmp_path).stdout.startswith("ok: 1 file(s)")
 
 
@@ -646,6 +646,30 @@ def test_an_operator_written_a_character_short_is_named() -> None:
     (found,) = parse_text(text, "q.spec").diagnostics
     assert found.code == "unexpected-token" and "unexpected '=' (did you mean '==>'?)" in found.message
 
+
+
+def test_a_misspelt_keyword_read_as_a_property_s_name_is_named() -> None:
+    """`requst Goto {` fails at 'Goto' (a property `requst: ...` was the parser's reading): the
+    word before it is the misspelt keyword."""
+    from specc.syntax.parser import parse_text
+
+    text = "module m {\n  number: 1;\n  requst Goto { type: control; }\n}\n"
+    (found,) = parse_text(text, "m.spec").diagnostics
+    assert (found.span.line, found.span.column) == (3, 10)
+    assert "unexpected 'Goto' after 'requst' (did you mean 'request'?)" in found.message
+    (plain,) = parse_text(text.replace("requst", "pigeon"), "m.spec").diagnostics  # close to no keyword
+    assert "did you mean" not in plain.message
+
+
+def test_a_word_processor_s_quote_or_sign_is_named_with_the_character_to_write() -> None:
+    from specc.syntax.parser import parse_text
+
+    (quote,) = parse_text('module m {\n  codels: \u201cm_codels\u201d;\n}\n', "m.spec").diagnostics
+    assert quote.code == "unexpected-character" and (quote.span.line, quote.span.column) == (2, 11)
+    assert "unexpected character '\u201c' here (a word processor's character: write '\"')" in quote.message
+    rule = 'rules r {\n  inputs x: [0, 9];\n  outputs o: {"a"};\n  q: x \u2264 5 ==> restrict o == "a";\n}\n'
+    (sign,) = parse_text(rule, "r.spec").diagnostics
+    assert "(a word processor's character: write '<=')" in sign.message
 
 
 def test_a_negative_number_where_none_has_a_meaning_is_said_so() -> None:

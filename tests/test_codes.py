@@ -74,7 +74,13 @@ def test_a_folder_without_specs_and_a_skeleton_that_cannot_be_written_say_so_wit
         tmp_path: Path) -> None:
     empty = subprocess.run([sys.executable, "-m", "specc.cli", "check", str(tmp_path)], capture_output=True,
                            text=True, timeout=60)
-    assert empty.returncode == 1 and "[no-spec-files]" in empty.stdout + empty.stderr
+    assert empty.returncode == 2 and "[no-spec-files]" in empty.stdout + empty.stderr
+    (tmp_path / "notes.spec").write_text("// a robot to come\n", encoding="utf-8")  # a file of comments only
+    comments = subprocess.run([sys.executable, "-m", "specc.cli", "check", str(tmp_path)], capture_output=True,
+                              text=True, timeout=60)
+    assert comments.returncode == 0 and "notes.spec:1:1: warning: " in comments.stderr
+    assert "holds no block (module, executive, rules...)" in comments.stderr and "[empty-file]" in comments.stderr
+    (tmp_path / "notes.spec").unlink()
     (tmp_path / "m.spec").write_text('module m { number: 1; codels: "m_codels"; request Go { type: control; '
                                      "validate: check; } }\n", encoding="utf-8")
     (tmp_path / "m_codels.py").mkdir()  # where the stubs would go: a folder, not a file
@@ -83,6 +89,16 @@ def test_a_folder_without_specs_and_a_skeleton_that_cannot_be_written_say_so_wit
     shown = stubs.stdout + stubs.stderr
     assert stubs.returncode != 0 and "[skeleton-failed]" in shown and "Traceback" not in shown, shown
     assert "m.spec:1:1: error: " in shown  # where the spec names the module the stubs were for
+
+
+def test_every_code_says_how_to_fix_it() -> None:
+    from specc.codes import FIXES
+
+    assert list(FIXES) == list(CODES)  # one each, in the table's order
+    assert all(fix.strip() and fix.endswith(".") for fix in FIXES.values())
+    shown = subprocess.run([sys.executable, "-m", "specc.cli", "explain", "macro-cycle"], capture_output=True,
+                           text=True, timeout=60)
+    assert shown.returncode == 0 and f"    fix: {FIXES['macro-cycle']}" in shown.stdout
 
 
 # Codes no test produces yet: this list only shrinks.

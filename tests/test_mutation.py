@@ -218,6 +218,39 @@ def test_a_mutant_parses_back_into_the_mutated_model(data: st.DataObject) -> Non
     assert parsed.source != target.source
 
 
+def test_a_mutant_s_diff_is_against_the_file_as_its_author_wrote_it(tmp_path: Path) -> None:
+    """A file not laid out as `specc fmt` would (`[2,10]`, a comment, a blank line): each mutant's
+    diff is a patch of that file, at its lines, which gives the mutated model back. The preemption,
+    written after the task's block, is shown against the printed file, and says so."""
+    written = TINY.replace("[2, 10]", "[2,10]").replace("    ?to in SIDES;\n",
+                                                       "    ?to in SIDES;   // where it ends\n\n")
+    (tmp_path / "tiny.spec").write_text(written, encoding="utf-8")
+    mutants = enumerate_mutants(tmp_path, "tiny", random_values=0)
+    lines = written.splitlines()
+    shown = 0
+    for x in mutants:
+        header = x.diff.splitlines()[0]
+        if x.kind == "operator" and "preemption" in x.description:
+            assert header.endswith("(original, as specc fmt prints it)")
+            continue
+        assert header.endswith("tiny.spec (original)"), x.description
+        patched = list(lines)
+        for hunk in x.diff.split("\n@@ ")[1:]:
+            start = int(hunk.split()[0].lstrip("-").split(",")[0])
+            body = [line for line in hunk.splitlines()[1:] if line[:1] in " -+"]
+            old = [line[1:] for line in body if line[:1] in " -"]
+            new = [line[1:] for line in body if line[:1] in " +"]
+            assert patched[start - 1:start - 1 + len(old)] == old, x.description  # the author's own lines
+            patched[start - 1:start - 1 + len(old)] = new
+        parsed = parse_text("\n".join(patched) + "\n", "tiny.spec").source
+        assert parsed == parse_text(x.text, "tiny.spec").source, x.description
+        shown += 1
+    assert shown == len(mutants) - 2  # two other preemptions
+    # Line 23 of the file written (22 as printed: the blank line added), where the description says too.
+    ten = next(x for x in mutants if x.description.startswith("tiny.spec:23:") and "10 -> 5" in x.description)
+    assert "-    contingent (t_end - t_start) in [2,10];\n+    contingent (t_end - t_start) in [2,5];" in ten.diff
+
+
 # ---------------------------------------------------------------- filtering
 
 

@@ -121,6 +121,20 @@ def test_an_order_nature_keeps_only_sometimes_describes_nature_and_is_planned(tm
     assert validate(domain, problem, result.plan) == []
 
 
+def test_two_goals_holding_one_attribute_at_two_values_at_once_are_said_to_clash(tmp_path: Path) -> None:
+    """No budget plans both: the second is dropped at once, naming the first, instead of a search
+    that runs out and says "a larger search budget may find one"."""
+    both = "hold(DONE(): YES, (t_g, t_end)) goal(2, 0);\n  hold(DONE(): NO, (t_g, t_end)) goal(1, 0);"
+    text = WINDOW_SPEC.replace("hold(DONE(): YES, (t_g, t_end)) goal(1, 0);", both)
+    domain, problem = from_text(text, tmp_path)
+    result = Planner(domain).plan(problem)
+    kept, dropped = result.goals
+    assert kept.kept and not dropped.kept and dropped.for_others  # each alone has a plan
+    assert dropped.reason.startswith("cannot be met together with DONE() = YES (line ")
+    assert "both hold DONE() from t_g to t_end, with other values" in dropped.reason
+    assert result.plan is not None and not validate(domain, problem, result.plan, dropped_lines={dropped.line})
+
+
 def test_a_symbol_given_to_a_numeric_attribute_is_refused_with_a_reason(tmp_path: Path) -> None:
     domain, problem = from_text(WINDOW_SPEC, tmp_path)
     wrong = replace(problem, assertions=tuple(

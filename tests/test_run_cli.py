@@ -313,6 +313,10 @@ def test_bad_options_of_the_table_are_one_line(tmp_path: Path) -> None:
                          "is planned (a mission with 'plan:'), and a configuration is FTplan's: run without --config")
     assert_clean_failure(specc("table", HILARE, "--mission", "hunt", "--config", "Robot1"), 2,
                          "--config: none of the missions named (hunt) is planned")
+    # `--runs 3` is a count to `specc campaign`, a folder here: not a folder named 3 made silently.
+    counted = specc("table", HILARE, "--seeds", "1", "--runs", "3")
+    assert counted.returncode == 2 and "--runs is where the run folders go" in counted.stderr
+    assert "`specc table --seeds 3`" in counted.stderr and not (ROOT / "3").exists()
 
 
 def test_replay_of_a_missing_or_broken_run_is_one_line(tmp_path: Path) -> None:

@@ -561,6 +561,36 @@ def test_a_loop_that_never_waits_is_abandoned_and_time_goes_on(monkeypatch: pyte
     assert "a loop that never waits" in said
 
 
+def test_a_recursion_without_end_ends_its_intention_and_one_with_an_end_runs_to_it() -> None:
+    """A KA posting its own goal before anything stops it nests KAs without end (Python's stack
+    gave out, and the run crashed): at MOST_NESTED_KAS the intention is abandoned, saying so. A
+    recursion that ends runs as deep as it needs below that."""
+    from specc.runtime.supervisor import MOST_NESTED_KAS
+
+    endless = supervisor(ka("Spot", "!(SPOT $X)", step("!(SPOT $X)", 19), line=17), ka("Ping", "!(PING)", step(
+        "!(PONG)", 3)), ka("Pong", "!(PONG)", step("!(PING)", 5)))
+    for posted, chain in (("!(SPOT 4)", "Spot -> Spot for (SPOT 4)"), ("!(PING)", "Pong -> Ping for (PING)")):
+        failed = done(endless, posted)
+        assert failed.status == "failed"
+        assert failed.lines()[-1].startswith(f"top:0: abandoned: KAs nested {MOST_NESTED_KAS} deep (... ")
+        assert f"{chain}): a KA posting its own goal, or KAs posting each other's" in failed.lines()[-1]
+    counting = supervisor(ka("Down", "!(DOWN $N)", If(goal("?(> $N 0)"), (step("!(DOWN (- $N 1))"),),
+                                                     (step("=>(BOTTOM)"),)), line=30))
+    assert done(counting, f"!(DOWN {MOST_NESTED_KAS - 1})").status == "succeeded"  # that many KAs nested
+    assert done(counting, f"!(DOWN {MOST_NESTED_KAS})").status == "failed"  # one more
+
+
+def test_a_recursion_deeper_than_python_s_stack_ends_its_intention_too(monkeypatch: pytest.MonkeyPatch) -> None:
+    from specc.runtime import supervisor as rp
+
+    monkeypatch.setattr(rp, "MOST_NESTED_KAS", 100_000)  # each KA nests statements: Python's stack ends first
+    counting = supervisor(ka("Down", "!(DOWN $N)", If(goal("?(> $N 0)"), (step("!(DOWN (- $N 1))"),),
+                                                     (step("=>(BOTTOM)"),)), line=30))
+    failed = done(counting, "!(DOWN 5000)")
+    assert failed.status == "failed" and "KAs nested too deep for Python's stack" in failed.lines()[-1]
+    assert done(counting, "!(DOWN 3)").status == "succeeded"  # the supervisor goes on
+
+
 def test_a_failed_goal_says_why_each_applicable_ka_failed() -> None:
     s = supervisor(ka("Count", "!(COUNT)", Assign(Var("@N"), parse_term("(+ @N 1)"), 71), line=70),
                    ka("Other", "!(COUNT)", Fail(81), line=80))

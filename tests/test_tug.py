@@ -44,6 +44,10 @@ def test_a_planned_mission_shows_each_action_s_goal_service_and_module_request(t
     folder = tmp_path / "tug-shuttle-crowded-Robot1-2-s0"
     report = json.loads((folder / "report.json").read_text())
     assert report["outcome"] == "succeeded" and report["measures"]["planned_goals_met"] == 2
+    # The summary says FTplan's figures as seed 004 does (σ, κ, R), and whose judgement the goals are.
+    summary = (folder / "summary.txt").read_text()
+    assert "goals met: CART_AT 1/1 (sigma_CART_AT 100 %), AT 1/1 (sigma_AT 100 %)" in summary
+    assert "(each goal as FTplan's ledger counted it" in summary and "planned_goals_met:" not in summary
     events = read_events(folder / "events.jsonl")
     chains = []
     for start in (e for e in events if e["kind"] == "action" and e["status"] == "started"):

@@ -157,8 +157,20 @@ class DecisionView:
         if otherwise is not None:
             lines += otherwise
         else:
-            lines.append(f"{pad}{INDENT}raise ValueError(f\"{node.attribute}={{v!r}} is outside its domain\")")
+            # The domain as a literal of its own (repr), outside the f-string: its values are the spec's text.
+            lines.append(f"{pad}{INDENT}raise ValueError(f\"{node.attribute}={{v!r}} is outside its domain, \" + "
+                         f"{domain_text(attribute)!r})")
         return lines
+
+
+def domain_text(attribute: k.Attribute) -> str:
+    """An input's declared domain as its error says it: `[0, 100]`, or `one of 'on', 'off'`."""
+    values = attribute.values
+    pieces = [v for v in values if isinstance(v, k.Piece)]
+    if pieces and len(pieces) == len(values):
+        first, last = min(pieces, key=lambda p: p.low), max(pieces, key=lambda p: p.high)
+        return str(k.Piece(first.low, last.high, first.low_closed, last.high_closed))
+    return "one of " + ", ".join(repr(v) for v in values)
 
 
 def children(node: k.Node) -> list[k.Node]:

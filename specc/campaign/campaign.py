@@ -106,10 +106,12 @@ class Campaign:
     domains: dict[str, pm.PlanningDomain]  # mutant id -> its planning domain
     records: list[MutantRecord] = field(default_factory=list)
 
-    def start(self) -> None:
-        """Record what the campaign is, or check the store holds this very campaign."""
-        self.store.describe(self.plan.description(list(self.domains)))
+    def start(self) -> list[str]:
+        """Record what the campaign is, or check the store holds this very campaign (or one it
+        grows, or one grown from it): returns what to say of the store."""
+        notes = self.store.describe(self.plan.description(list(self.domains)))
         self.store.add_mutants(self.records)
+        return notes
 
     def experiments(self, kept: Sequence[str]) -> list[Experiment]:
         """The whole campaign when the later configurations run the mutants `kept`: the first

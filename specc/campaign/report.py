@@ -108,6 +108,10 @@ class CampaignReport:
     def failed(self) -> list[Outcome]:
         return [o for o in self.outcomes if o.status != "done"]
 
+    def measured(self) -> list[Measures]:
+        """The measures of the experiments that ran to their end."""
+        return [Measures.from_json(o.measures) for o in self.outcomes if o.status == "done" and o.measures]
+
 
 def build_report(store: ResultStore) -> CampaignReport:
     description = store.description()
@@ -119,11 +123,14 @@ def build_report(store: ResultStore) -> CampaignReport:
     # The configurations are compared on the same mutants and activities: an experiment one of
     # them did not finish (a timeout, a crash) leaves that activity out of every one's means,
     # instead of a failure left out of one side only.
+    # A configuration that has run nothing yet (a campaign interrupted before it) is left out of
+    # the pairing: the others' means stand, and it has none.
     finished: dict[tuple[str, str, str, int], set[str]] = {}
     for o, _ in measures:
         finished.setdefault(_paired(o), set()).add(o.experiment.configuration)
+    started = set(configurations) & {o.experiment.configuration for o, _ in measures}
     unpaired = {key for key, done_by in finished.items() if key[0] in kept | {ORIGINAL}
-                and not done_by >= set(configurations)}
+                and not done_by >= started}
     measures = [(o, m) for o, m in measures if _paired(o) not in unpaired]
     world_sets = world_subsets(description)
     means = []
@@ -206,18 +213,27 @@ def _nu(means: Iterable[Mean], configuration: str, faults: str, worlds: str) -> 
 def markdown(report: CampaignReport) -> str:
     d = report.description
     lines = [f"# Campaign: faults injected into {d.get('domain')} of {d.get('robot')}", ""]
-    counts = {v: len(report.with_verdict(v)) for v in (KEPT, NEVER_PLANS, EQUIVALENT)}
+    counts = {v: len(report.with_verdict(v)) for v in (KEPT, NEVER_PLANS, EQUIVALENT, UNJUDGED)}
     lines += [f"- missions {', '.join(d.get('missions', []))} x worlds {', '.join(d.get('worlds', []))} x "
               f"{d.get('runs')} run(s); configurations {', '.join(d.get('configurations', []))}",
               f"- mutants drawn: {len(report.mutants)}; kept (F*): {counts[KEPT]}; never plan: "
-              f"{counts[NEVER_PLANS]}; equivalent to the original: {counts[EQUIVALENT]}",
+              f"{counts[NEVER_PLANS]}; equivalent to the original: {counts[EQUIVALENT]}"
+              + (f"; not judged yet (the first configuration has not run all of their experiments): "
+                 f"{counts[UNJUDGED]}" if counts[UNJUDGED] else ""),
               f"- experiments: {len(report.outcomes)} ({len(report.failed)} crashed or timed out): "
               + "; ".join(f"{c.configuration} {c.done:,} of {c.expected:,}" for c in report.coverage)]
+    if any(not m.judged_by_robot for m in report.measured()):
+        lines.append("- **goals counted as FTplan believed them:** the robot's extension judges no goal in the "
+                     "world (a `measure` hook, docs/your-robot.md §8), so a goal counts as met when FTplan's "
+                     "ledger says so. A mutant that corrupts FTplan's model of the world (a wrong effect) can "
+                     "make it believe a goal met that the robot missed: σ and ν then count it met. Judge the "
+                     "goals on what the log shows happened to trust them under faults")
     unfinished = [c.configuration for c in report.coverage if not c.complete]
     if unfinished:
         timed_out = sum(o.status == "timeout" for o in report.outcomes)
         lines.append(f"- **not finished: {', '.join(unfinished)}.** The means cover the experiments every "
-                     "configuration has run so far; the same command resumes the campaign"
+                     "configuration started has run so far (one not started has none); the same command resumes "
+                     "the campaign"
                      + (f" and runs again the {timed_out} that timed out (a larger --timeout if they keep doing so)"
                         if timed_out else ""))
     elif report.unpaired:
@@ -333,7 +349,8 @@ def draw(report: CampaignReport, path: Path) -> Path:
     columns = min(4, len(series))
     handles, labels = axes[0].get_legend_handles_labels()
     figure.legend(handles, labels, loc="lower center", ncol=columns, fontsize=8, frameon=False)
-    figure.suptitle("Goals met and missions succeeded, without faults (∅) and with injected faults (F*)")
+    # Wrapped to the figure: one panel (no world set apart) is too narrow for it on one line.
+    figure.suptitle("Goals met and missions succeeded, without faults (∅) and with injected faults (F*)", wrap=True)
     figure.tight_layout(rect=(0, 0.02 + 0.06 * -(-len(series) // columns), 1, 1))
     figure.savefig(path, dpi=120)
     plt.close(figure)

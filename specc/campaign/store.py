@@ -109,18 +109,31 @@ class ResultStore:
         self.db.close()
 
     # ------------------------------------------------------------ what the campaign is
-    def describe(self, description: dict[str, Any]) -> None:
+    def describe(self, description: dict[str, Any]) -> list[str]:
         """Record the campaign's description, or check that the store already holds this one (a
         resumed campaign): RunError naming what differs otherwise. A list under one of GROWING
         may hold more than the stored one if it holds all of it (more configurations compared after
         the same first one, which judges the mutants; more mutants drawn, as a larger draw_kept
-        sample holds the smaller one): the stored description grows."""
+        sample holds the smaller one): the stored description grows. It may hold part of a stored
+        one that grew so (the command the campaign was first run with): the store stays as it is.
+        Returns what to tell the user of either."""
         stored = self.description()
+        notes: list[str] = []
         if stored:
             differs = sorted(k for k in set(stored) | set(description) if stored.get(k) != description.get(k))
             grows = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))
                      or k in REPORT_ONLY]
-            if set(differs) - set(grows):
+            part = [k for k in differs if k in GROWING and _grows(k, description.get(k), stored.get(k))]
+            for k in grows:
+                if k in GROWING:
+                    added = [item for item in description[k] if item not in stored[k]]
+                    notes.append(f"the campaign in '{self.path}' grows by {len(added)} {k}: {_shown(added)}")
+            for k in part:
+                notes.append(f"'{self.path}' holds {len(stored[k])} {k} (it grew by a later command), "
+                             f"{len(description[k])} of them asked: theirs are resumed, the report covers all "
+                             f"{len(stored[k])}")
+                description = {**description, k: stored[k]}
+            if set(differs) - set(grows) - set(part):
                 said = "; ".join(f"{k}: {_shown(stored.get(k))} stored, {_shown(description.get(k))} asked"
                                  for k in differs)
                 files = (" (files: the robot's specs, codels and worlds, or specc itself, changed since: a "
@@ -130,10 +143,11 @@ class ResultStore:
             with self.db:
                 self.db.executemany("UPDATE campaign SET value = ? WHERE name = ?",
                                     [(json.dumps(description[k]), k) for k in grows])
-            return
+            return notes
         with self.db:
             self.db.executemany("INSERT INTO campaign VALUES (?, ?)",
                                 [(name, json.dumps(value)) for name, value in description.items()])
+        return notes
 
     def description(self) -> dict[str, Any]:
         return {name: self._json(value, f"the campaign's '{name}'")

@@ -133,6 +133,11 @@ def check_call(ctx: Context, name: str, shape: FunctionShape | None, call: tuple
     """The function can be called as the runtime calls it (read from its `def`, never run)."""
     if shape is None or shape.accepts(len(call)):
         return
+    if shape.not_callable:
+        ctx.report("bad-codel-signature", f"'{name}' ({place(shape, where, shape.line)}) is {shape.not_callable}, "
+                   f"not a function: the runtime calls it as {name}({', '.join(call)}); define it with "
+                   f"`def {name}({', '.join(call)}):`", span)
+        return
     if shape.most is not None and shape.most < 0:
         takes = "a keyword-only argument without default"
     elif shape.most is None:

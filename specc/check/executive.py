@@ -86,6 +86,10 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
                 if arg.name not in inputs:
                     ctx.unknown("undefined-input", "input", arg.name, inputs, arg.span,
                                 f" of request '{service.request.text}'")
+            typed_inputs = {i.name: i for i in request.inputs} if request is not None else {}
+            for arg in service.args:
+                if arg.name in typed_inputs:
+                    check_constant_input(ctx, arg, typed_inputs[arg.name], service.request)
             constants = {a.name for a in service.args}
             for taken in service.takes if request is not None else ():
                 if taken.text not in inputs:
@@ -124,7 +128,8 @@ def check_executive(ctx: Context, executive: m.Executive) -> None:
         ctx.duplicates(service.conflicts, "conflict with service", key="service")
         for conflict in service.conflicts:
             if conflict.service not in services:
-                ctx.unknown("undefined-service", "service", conflict.service, services, conflict.span)
+                ctx.unknown("undefined-service", "service", conflict.service, services, conflict.span,
+                            elsewhere(ctx, conflict.service, executive, "its conflicts name its own services"))
                 continue
             target = ctx.symbols.service_request(services[conflict.service])
             if target is not None and target.kind == "control":  # the incompatibility graph leaves it out
@@ -205,6 +210,13 @@ def check_reflex_loops(ctx: Context, reflexes: tuple[m.Reflex, ...], services: M
                  "the reflex a condition on the reply (`== FAILED`) or start another service", loop[0][1].span)
 
 
+def elsewhere(ctx: Context, service: str, executive: m.Executive, rule: str) -> str:
+    """' in executive 'e' (it is executive 'other''s: ...)' for a service another executive has."""
+    owners = [e.name for e in ctx.items(m.Executive) if e is not executive and any(s.name == service
+                                                                                 for s in e.services)]
+    return f" in executive '{executive.name}' (it is executive '{owners[0]}''s: {rule})" if owners else ""
+
+
 def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Service]) -> None:
     source = reflex.source
     request: m.Request | None = None
@@ -246,3 +258,44 @@ def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Servic
             ctx.report("reflex-needs-input", f"a reflex starts '{target.text}' without input, but it takes {taken} "
                        "from the task level: it would always end BAD-INPUT; give the service `args { }` instead "
                        "of `takes:`, or let the task level ask for it", target.span)
+
+
+NUMERIC_INPUTS = frozenset({"double", "float"})
+WHOLE_INPUTS = frozenset({"int", "long", "char"})
+TEXT_INPUTS = frozenset({"string"})
+
+
+def module_enums(ctx: Context, module_name: str) -> dict[str, set[str]]:
+    """The enums of a module, by name, with their values: a request's input names its own
+    module's (two modules may each have an enum of one name)."""
+    return {e.name: set(e.values) for module in ctx.items(m.Module) if module.name == module_name
+            for e in module.enums}
+
+
+def refused_values(kind: str, values: list[str | float], enums: Mapping[str, set[str]]) -> list[str | float]:
+    """The values (numbers, or words: symbols) an input of type `kind` refuses at run time: a word
+    for a number, a fraction for a whole number, a word no member of its enum. Text and
+    structures refuse nothing here: the runtime reads what it is given."""
+    if kind in NUMERIC_INPUTS:
+        return [v for v in values if isinstance(v, str)]
+    if kind in WHOLE_INPUTS:
+        return [v for v in values if isinstance(v, str) or not float(v).is_integer()]
+    if kind in enums:
+        return [v for v in values if v not in enums[kind]]
+    return []
+
+
+def check_constant_input(ctx: Context, arg: m.Argument, typed: m.TypedName, request: m.Ref) -> None:
+    """A service's constant input (`args { rate: 0.5; }`) of the type its request declares: the
+    request would refuse it at every call (BAD_INPUT), which the task level sees as an ERROR."""
+    value = arg.value
+    if typed.type.size is not None or not isinstance(value, (m.Number, m.Ref)) or (
+            isinstance(value, m.Ref) and len(value.parts) > 1):
+        return
+    shown: str | float = value.value if isinstance(value, m.Number) else value.text
+    enums = module_enums(ctx, request.parts[0])
+    if refused_values(typed.type.name, [shown], enums):
+        allowed = f" ({', '.join(sorted(enums[typed.type.name]))})" if typed.type.name in enums else ""
+        ctx.report("bad-argument-type", f"{shown} cannot be input '{typed.name}' of {request.text}, of type "
+                   f"{typed.type.name}{allowed}{did_you_mean(str(shown), enums.get(typed.type.name, ()))}: the "
+                   "request would refuse it at every call", value.span)

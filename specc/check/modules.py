@@ -40,6 +40,14 @@ ACTIVITY_ATTRIBUTES = frozenset({"id", "spec", "module", "input", "output", "sta
                                  "fail_report", "task", "live_children"})
 
 
+# Elements of one array type (`double[N]`): a list of this many is built in tens of milliseconds,
+# and copied at each poster update; a typo's extra zeros would exhaust the memory.
+MOST_ARRAY_ELEMENTS = 1_000_000
+# What a codel reaches through its SDI besides the module's data (`sdi.hardware`, `sdi.read_poster`):
+# an internal data field of one of these names would hide it. The public names of
+# specc.runtime.functional.InternalData (tests/test_cases.py holds them equal; not imported here:
+# every `specc check` would load the runtime's modules).
+SDI_ATTRIBUTES = frozenset({"hardware", "read_poster", "write_poster", "send_request"})
 # What the generated module imports or defines at top level beside the spec's types.
 MODULE_NAMES = frozenset({"annotations", "enum", "dataclass", "field", "Any", "rt", "SPEC", "create", "client"})
 # Names an Enum refuses, or keeps out of its members: `mro`, and the _sunder_ and __dunder__ ones.
@@ -72,6 +80,9 @@ def check_names(ctx: Context, module: m.Module) -> None:
         elif what == "input or output" and name in ACTIVITY_ATTRIBUTES:
             ctx.report("reserved-name", f"{what} '{name}' would be hidden by the activity's own '{name}' "
                        "when a codel reads request.{name}; rename it", span)
+        elif what == "internal data field" and name in SDI_ATTRIBUTES:
+            ctx.report("reserved-name", f"{what} '{name}' would hide the SDI's own '{name}' (codels reach "
+                       f"sdi.{name}: {', '.join(sorted(SDI_ATTRIBUTES))} are specc's); rename it", span)
         elif what == "request" and name in accessors:
             ctx.report("reserved-name", f"request '{name}' would be hidden by the client's accessor of poster "
                        f"'{name.removeprefix('poster_')}'; rename it", span)
@@ -128,6 +139,11 @@ def check_module(ctx: Context, module: m.Module) -> None:
     def check_type(t: m.TypeRef) -> None:
         if t.name not in types:
             ctx.unknown("undefined-type", "type", t.name, types, t.span, f" in module '{module.name}'")
+        if t.size is not None and t.size > MOST_ARRAY_ELEMENTS:
+            ctx.report("array-too-large", f"{t.name}[{t.size:,}]: an array holds at most {MOST_ARRAY_ELEMENTS:,} "
+                       "elements (specc builds it as a Python list when the module starts, and again for every "
+                       "request or poster copy); keep large data (maps, images) outside the SDI, in the codels' "
+                       "own objects", t.span)
 
     for struct in module.structs:
         ctx.duplicates(struct.fields, "field")

@@ -14,6 +14,7 @@ from typing import Any
 
 from specc.check.context import Context
 from specc.check.expressions import UnknownFunction, lowered
+from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
 from specc.model.visitor import Visitor, walk
 from specc.runtime.planner import model as pm
@@ -383,8 +384,12 @@ class ScopeChecker(Visitor):
             elif isinstance(node, m.IxCall) and len(node.args) < 2 and node.function != "abs":
                 self.ctx.report("arity-mismatch", f"{node.function} takes two arguments or more", node.span)
             if isinstance(node, m.IxVar) and node.name not in scope.variables:
-                self.ctx.report("undeclared-variable",
-                                f"variable '{node.name}' is not declared; add 'variable {node.name};'", node.span)
+                close = did_you_mean(node.name, scope.variables)
+                declared = sorted(scope.variables)
+                fix = (f"add 'variable {node.name};'{close}" if close else
+                       f"add 'variable {node.name};', or use one of {', '.join(declared)}"
+                       if 0 < len(declared) <= 6 else f"add 'variable {node.name};'")
+                self.ctx.report("undeclared-variable", f"variable '{node.name}' is not declared; {fix}", node.span)
             elif isinstance(node, m.IxName):
                 self.named.add(node.name)
                 known = scope.timepoints | scope.macro_params | self.symbols
@@ -410,12 +415,36 @@ def constant_value(e: m.IxExpr) -> float | None:
     return None
 
 
+def check_macro_cycles(ctx: Context, macros: dict[str, m.Macro]) -> None:
+    """A macro is inlined where it is called: one that calls itself, directly or through other
+    macros, would be inlined without end. Said at the call that closes the cycle."""
+    calls = {name: [c for statement in macro.body for c in walk(statement)
+                    if isinstance(c, m.MacroCall) and c.name in macros] for name, macro in macros.items()}
+
+    def visit(name: str, chain: tuple[str, ...]) -> None:
+        for call in calls[name]:
+            if call.name == chain[0]:
+                if chain[0] == min(chain):  # said once, from the cycle's first macro by name
+                    what = "itself" if len(chain) == 1 else (
+                        f"'{call.name}', which leads back to it ({' -> '.join(chain + (call.name,))})")
+                    ctx.report("macro-cycle", f"macro '{name}' calls {what}: a macro is written out where it "
+                               "is called, so this never ends; write the statements out instead of the call",
+                               call.span)
+            elif call.name not in chain:
+                visit(call.name, chain + (call.name,))
+
+    for name in macros:
+        visit(name, (name,))
+
+
 def check_members(ctx: Context, tables_: DomainTables) -> None:
+    check_macro_cycles(ctx, tables_.macros)
     checker = ScopeChecker(ctx, tables_)
     for member in tables_.members:
         if isinstance(member, m.Task):
             scope = checker.scope_for("task", member.body, member.params, (member.start, member.end))
             checker.statements(member.body, scope)
+            check_task_network(ctx, member, scope.timepoints)
         elif isinstance(member, m.Macro):
             scope = checker.scope_for("macro", member.body, macro_params=member.params)
             scope.timepoints.update(member.params)
@@ -494,7 +523,7 @@ def temporal_bounds(statements: Iterable[Any], timepoints: set[str]) -> list[Bou
         try:
             if isinstance(s, m.InConstraint) and isinstance(s.domain, m.Interval):
                 low, high = constant_value(s.domain.low), constant_value(s.domain.high)
-                if low is not None and high is not None:
+                if low is not None and high is not None and low <= high:  # else `empty-interval` says it
                     expr = lowered(s.expr, timepoints)
                     constraint = pm.Member(expr, pm.Interval(low, high))
                     text = f"{pm.describe(expr)} in [{low:g}, {high:g}]"
@@ -552,11 +581,25 @@ def negative_cycle(bounds: list[Bound]) -> list[Bound] | None:
             return cycle[::-1]
 
 
+def check_task_network(ctx: Context, task: m.Task, timepoints: set[str]) -> None:
+    """A task's own temporal constraints (its durations, contingent or not, the delays between its
+    timepoints) must be able to hold together: else no instance of it is ever in a plan, which
+    only planning would show ("duration would lie in [100, 30]")."""
+    written = [b for b in temporal_bounds(task.body, timepoints) if b.span is not None]
+    written.append(Bound(task.end, task.start, 0.0, f"{task.start} <= {task.end} (a task ends after it starts)"))
+    report_cycle(ctx, negative_cycle(written), f"task '{task.name}'", task.span)
+
+
 def check_temporal_network(ctx: Context, problem: m.Problem, statements: list[Any], timepoints: set[str]) -> None:
     """The problem's temporal constraints must be able to hold together: when they cannot, the
     planner has no plan to give, whatever its domain (and nature's instants promise dates no
     realisation keeps: a plan would be judged against no nature at all)."""
-    cycle = negative_cycle(temporal_bounds(statements, timepoints))
+    report_cycle(ctx, negative_cycle(temporal_bounds(statements, timepoints)), f"problem '{problem.name}'",
+                 problem.span)
+
+
+def report_cycle(ctx: Context, cycle: list[Bound] | None, owner: str, owner_span: m.Span) -> None:
+    """`contradictory-constraints` at the first constraint written of `cycle`, noting the others."""
     if cycle is None:
         return
     said: list[str] = []
@@ -567,7 +610,7 @@ def check_temporal_network(ctx: Context, problem: m.Problem, statements: list[An
     written = sorted({id(b.span): b.span for b in cycle if b.span is not None}.values(),
                      key=lambda span: (span.file, span.line, span.column))
     listed = said[0] if len(said) == 1 else f"{', '.join(said[:-1])} and {said[-1]}"
-    span = written[0] if written else problem.span
-    ctx.report("contradictory-constraints", f"the temporal constraints of problem '{problem.name}' cannot all hold: "
+    span = written[0] if written else owner_span
+    ctx.report("contradictory-constraints", f"the temporal constraints of {owner} cannot all hold: "
                f"{listed}; loosen or remove one of them", span,
                *((other, "and this constraint") for other in written[1:]))

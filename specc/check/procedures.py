@@ -207,6 +207,15 @@ def check_concluded_once(ctx: Context, ka: m.KA) -> None:
                 ctx.warn("unbound-variable", f"'{var.name}' has no value when {goal.op}({goal.body.head} ...) "
                            f"runs: nothing else in KA '{ka.name}' names it; bind it first (a test `?(...)` or a "
                            "goal's result) or write the value", var.span)
+    # `?(= $RR2 OK)` for `?(= $R2 OK)`: the misspelt variable has no value, the test gives it one
+    # and holds, whatever the reply was: a check of a result that checks nothing.
+    others = sorted(name for name, count in named.items() if count > 1)
+    for goal in (n for n in walk(ka.body) if isinstance(n, m.Goal) and n.op == "?" and n.body.head == "="):
+        for arg in goal.body.args:
+            if isinstance(arg, m.LogicVar) and named[arg.name] == 1:
+                ctx.warn("always-true-test", f"'{arg.name}' is named nowhere else in KA '{ka.name}', so "
+                         f"?(= ...) gives it the value and always holds{did_you_mean(arg.name, others)}: compare "
+                         "a variable bound before (a reply's result, the invocation's), or a value", arg.span)
 
 
 def _variables(node: m.Node | None) -> list[m.LogicVar | m.ProgramVar]:

@@ -14,7 +14,7 @@ import math
 from specc.check.context import Context
 from specc.diagnostics import did_you_mean
 from specc.model import nodes as m
-from specc.model.visitor import Visitor
+from specc.model.visitor import Visitor, walk
 
 BOOL_WORDS = ("true", "false")  # what a bool is compared with by mistake
 ARITHMETIC = {"+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
@@ -51,6 +51,9 @@ class RuleVisitor(Visitor):
         self.inits = {i.name for i in base.inits}
         self.loop_vars: list[str] = []
         self.restricted: set[str] = set()
+        # Attributes a `do` sets from their own value (`level = level + 1`), and those something else sets.
+        self.set_from_itself: dict[str, m.DoAssign] = {}
+        self.set_otherwise: set[str] = set()
         self.tested: set[str] = set()
         self.first_read: dict[str, m.AttrRef] = {}  # where each attribute is first tested
         self.first_set: dict[str, m.AttrRef] = {}  # where each attribute is first deduced
@@ -82,8 +85,17 @@ class RuleVisitor(Visitor):
         self.in_action = False
 
     def visit_DoAssign(self, node: m.DoAssign) -> None:
+        if any(isinstance(n, m.AttrRef) and n.name == node.target and not n.previous for n in walk(node.value)):
+            self.set_from_itself.setdefault(node.target, node)  # `level = level + 1`
+        else:
+            self.set_otherwise.add(node.target)
         self.restricted.add(node.target)
         self.check_not_input(node.target, node.span)
+        declared = self.declared.get(node.target)
+        if declared is not None and declared.role == "outputs":
+            self.ctx.report("assigned-output", f"'{node.target}' is an output: a decision's outputs are what its "
+                            f"rules restrict (`restrict {node.target} == ...`), and `do` computes a value the rules "
+                            f"test (an intermediate); decide would give '{node.target}' unrestricted", node.span)
         self.in_action = False
         self.visit(node.value)
         self.in_action = True
@@ -210,6 +222,7 @@ class RuleVisitor(Visitor):
             return
         for name in names:
             if self.in_action:
+                self.set_otherwise.add(name)
                 self.restricted.add(name)
                 self.first_set.setdefault(name, attr)
                 self.check_not_input(name, attr.span)
@@ -269,6 +282,49 @@ def check_never_set(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> Non
         ctx.report("undefined-attribute", f"'{name}' is tested, but it is no input, has no init and no rule sets "
                    f"it: the rule can never fire (a misspelt input or constant?){did_you_mean(name, known)}",
                    ref.span)
+    for name, assign in visitor.set_from_itself.items():
+        if name not in inputs and name not in visitor.set_otherwise:
+            ctx.report("undefined-attribute", f"'{name} = ...' reads '{name}' itself, which has no value then: no "
+                       "input gives it and nothing else sets it; compute it from inputs and constants, or from a "
+                       "previous cycle's value (`@x`, with its `init`)", assign.span)
+
+
+def check_rules_never_fire(ctx: Context, base: m.RuleBase, visitor: RuleVisitor) -> None:
+    """Rules that test attributes only rules which need them first can set (`c1: mood == "a" ==>
+    restrict state == "b"; c2: state == "b" ==> restrict mood == "a";`): neither ever fires.
+    What can have a value grows from the inputs through the rules that may fire, to a fixpoint;
+    a rule written per element (`r[i]`, `foreach`) counts as firing."""
+    def named(node: m.Node | None) -> set[str]:
+        return {n.name for n in (walk(node) if node is not None else ()) if isinstance(n, m.AttrRef)
+                and not n.previous and n.index is None and n.name not in visitor.constants}
+
+    def sets(rule: m.Rule) -> set[str]:
+        return {n.target if isinstance(n, m.DoAssign) else n.name for action in rule.actions for n in walk(action)
+                if isinstance(n, m.DoAssign) or (isinstance(n, m.AttrRef) and isinstance(action, m.Restrict))}
+
+    plain = [r for r in base.rules if isinstance(r, m.Rule) and r.index is None and r.kind == "when"]
+    valued = {a.name for a in base.attributes if a.role == "inputs"}
+    for rule in base.rules:
+        if rule not in plain:  # an else rule, a rule written per element: taken to fire
+            valued |= set().union(*(sets(r) for r in (rule.rules if isinstance(rule, m.RuleForeach) else (rule,))))
+    waiting = [(rule, named(rule.condition)) for rule in plain]
+    grew = True
+    while grew:
+        grew = False
+        for rule, reads in waiting:
+            if reads <= valued and not sets(rule) <= valued:
+                valued |= sets(rule)
+                grew = True
+    deduced = {name for rule in plain for name in sets(rule)}
+    for rule, reads in waiting:
+        missing = sorted(reads - valued)
+        if missing and set(missing) <= deduced & visitor.set_otherwise:  # else `undefined-attribute` says it
+            setters = sorted(r.name for r in plain if sets(r) & set(missing))
+            said = " and ".join(f"'{name}'" for name in missing)
+            one = len(missing) == 1
+            ctx.warn("rule-never-fires", f"rule '{rule.name}' can never fire: {said} {'gets' if one else 'get'} a "
+                     f"value only from rules that need {'it' if one else 'them'} first ({', '.join(setters)}); "
+                     "start the chain from an input", rule.span)
 
 
 def conjuncts(condition: m.Node) -> list[m.Node]:
@@ -314,6 +370,7 @@ def check(ctx: Context) -> None:
         if base.name not in completed:  # an executive's own rules read the controller's attributes
             check_never_set(ctx, base, visitor)
             check_set_never_read(ctx, base, visitor)
+            check_rules_never_fire(ctx, base, visitor)
         check_never_read(ctx, base, visitor)
         for attr in base.attributes:
             domain = attr.domain

@@ -11,7 +11,15 @@ from dataclasses import dataclass
 
 from specc.check.codels import check_call, python_functions
 from specc.check.context import Context
-from specc.check.executive import resolve_poster, resolve_request
+from specc.check.executive import (
+    NUMERIC_INPUTS,
+    TEXT_INPUTS,
+    WHOLE_INPUTS,
+    module_enums,
+    refused_values,
+    resolve_poster,
+    resolve_request,
+)
 from specc.check.ftplan import check_attribute, check_bound, check_task, check_terms, planned_tasks, planner_tables
 from specc.check.planning import DomainTables
 from specc.check.procedures import Domains
@@ -24,9 +32,6 @@ from specc.runtime.sim.world import WorldError, load_world
 
 # The PRS domains a request input of each type accepts (seed 000 §4.2: the task level passes
 # numbers and symbols; records are the functional level's business).
-NUMERIC_INPUTS = frozenset({"double", "float"})
-WHOLE_INPUTS = frozenset({"int", "long", "char"})
-TEXT_INPUTS = frozenset({"string"})
 NUMERIC_DOMAINS = frozenset({"int", "float", "number"})
 TEXT_DOMAINS = frozenset({"string", "symbol"})
 # The hooks a system's extension module may define, and how the runner calls them
@@ -416,15 +421,7 @@ def check_constant_inputs(ctx: Context, binding: m.Binding, inputs: list[m.Typed
         else:
             continue
         kind = typed.type.name
-        refused: list[str | float]
-        if kind in NUMERIC_INPUTS:
-            refused = [v for v in values if isinstance(v, str)]
-        elif kind in WHOLE_INPUTS:
-            refused = [v for v in values if isinstance(v, str) or not float(v).is_integer()]
-        elif kind in enums:
-            refused = [v for v in values if v not in enums[kind]]
-        else:
-            continue  # text or a structure: the runtime reads what it is given
+        refused = refused_values(kind, values, enums)
         if refused:
             allowed = f" ({', '.join(sorted(enums[kind]))})" if kind in enums else ""
             shown = said.format(", ".join(str(v) for v in refused))
@@ -701,13 +698,6 @@ def _service_name(arg: m.SArg) -> str | None:
     """The service a request's first argument names: a name, or a string (the service's name too,
     once compiled: `"AVOID-ON"`); None for a variable or a number."""
     return arg.text if isinstance(arg, m.Ref) else arg.value if isinstance(arg, m.String) else None
-
-
-def module_enums(ctx: Context, module_name: str) -> dict[str, set[str]]:
-    """The enums of a module, by name, with their values: a request's input names its own
-    module's (two modules may each have an enum of one name)."""
-    return {e.name: set(e.values) for module in ctx.items(m.Module) if module.name == module_name
-            for e in module.enums}
 
 
 def request_inputs(ctx: Context, service: m.Service) -> dict[str, m.TypedName]:

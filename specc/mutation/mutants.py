@@ -22,12 +22,12 @@ from specc.diagnostics import Diagnostic
 from specc.model import nodes as m
 from specc.model.span import Span
 from specc.mutation.edits import CLASSES, Edit, MutationClass, domain_edits
-from specc.mutation.tree import replace_at
+from specc.mutation.tree import node_at, replace_at
 from specc.pipeline import Loaded, load
 from specc.runtime.planner import model as pm
 from specc.syntax.parsed import Comment
 from specc.syntax.parser import parse_text
-from specc.syntax.printer import format_source, print_source
+from specc.syntax.printer import domain_value, format_source, ixexpr, print_source, tstmt
 
 Robot = Union[Path, Sequence[Path], Loaded, m.Program]
 Reason = Literal["identical", "duplicate", "invalid", "equivalent"]
@@ -307,10 +307,58 @@ def mutant(target: MutationTarget, edit: Edit, mutant_id: str) -> Mutant:
     source = replace_at(target.source, edit.path, edit.new)
     text = target.print(source)
     path = target.source.path
-    diff = "".join(difflib.unified_diff(target.original_text.splitlines(keepends=True),
-                                        text.splitlines(keepends=True), f"{path} (original)",
-                                        f"{path} ({mutant_id})"))
+    # The diff against the file as its author wrote it (its own lines and layout, a patch that
+    # applies to it), when the edit can be written into it in place; else against the file as
+    # `specc fmt` prints it, said so.
+    written = _written_in_place(target, edit)
+    before, after, label = ((target.written, written, "original") if written is not None
+                            else (target.original_text, text, "original, as specc fmt prints it"))
+    diff = "".join(difflib.unified_diff(before.splitlines(keepends=True), after.splitlines(keepends=True),
+                                        f"{path} ({label})", f"{path} ({mutant_id})"))
     return Mutant(mutant_id, edit.kind, edit.describe(), path, text, diff, edit.span, target)
+
+
+def _node_text(node: m.Node) -> str | None:
+    """How the printer writes a mutated node alone (None for one it writes only within its block)."""
+    try:
+        if isinstance(node, m.Interval):
+            return domain_value(node)
+        if isinstance(node, (m.Number, m.Infinity, m.IxVar, m.IxName, m.IxCall, m.IxUnary, m.IxBinary)):
+            return ixexpr(node)
+        return tstmt(node)
+    except TypeError:
+        return None
+
+
+def _written_in_place(target: MutationTarget, edit: Edit) -> str | None:
+    """The file as written with the edit made where its node is written: the new node's text in
+    place of the old one's, or the old one's lines removed. None when the text there is not the
+    old node's as the printer writes it, spaces aside (a comment inside it), or the node is one
+    the printer writes only within its block."""
+    written, span = target.written, edit.span
+    if not written or span.file != target.source.path:
+        return None
+    old = _node_text(node_at(target.source, edit.path))
+    new = _node_text(edit.new) if edit.new is not None else ""
+    if old is None or new is None:
+        return None
+    starts = [0]
+    for line in written.split("\n"):
+        starts.append(starts[-1] + len(line) + 1)
+    if span.end_line >= len(starts):
+        return None
+    start, end = starts[span.line - 1] + span.column - 1, starts[span.end_line - 1] + span.end_column - 1
+    there = written[start:end]
+    if "".join(there.split()).rstrip(";") != "".join(old.split()).rstrip(";"):
+        return None
+    if edit.new is None:  # the statement's lines go when it is all they hold
+        line_start, line_end = written.rfind("\n", 0, start) + 1, written.find("\n", end)
+        line_end = len(written) if line_end < 0 else line_end
+        rest = written[end:line_end].strip()
+        if not written[line_start:start].strip() and rest in ("", ";"):
+            return written[:line_start] + written[line_end + 1:]
+        return written[:start] + written[end + (1 if rest.startswith(";") else 0):]
+    return written[:start] + (new if there.endswith(";") else new.rstrip(";")) + written[end:]
 
 
 # ---------------------------------------------------------------- filtering

@@ -27,6 +27,15 @@ def nodes_with_paths(node: m.Node, path: Path = ()) -> Iterator[tuple[Path, m.No
         yield from nodes_with_paths(child, path + ((name, index),))
 
 
+def node_at(root: m.Node, path: Path) -> m.Node:
+    """The node at `path` below `root`."""
+    node: Any = root
+    for name, index in path:
+        node = getattr(node, name) if index is None else getattr(node, name)[index]
+    assert isinstance(node, m.Node)
+    return node
+
+
 def replace_at(root: N, path: Path, new: m.Node | None) -> N:
     """`root` with the node at `path` replaced by `new`; None removes it from its tuple."""
     if not path:

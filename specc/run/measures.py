@@ -88,6 +88,9 @@ class Measures:
     believed: GoalCount  # every goal, as FTplan's ledger counted them
     repairs: int = 0  # plan repairs asked after an action failure (not replannings: seed 004 §4.2.1.2)
     repaired: int = 0  # of them, those whose plan was carried out
+    # The goals were judged by the robot's own judgement of the world (its extension's `measure`),
+    # not as FTplan's ledger believed them: a fault in FTplan's model cannot count a goal met.
+    judged_by_robot: bool = False
 
     def count(self, kind: str) -> GoalCount:
         """The goals of `kind` (none asked when the run had none)."""
@@ -136,7 +139,8 @@ class Measures:
                        replannings=int(data["replannings"]), activity_time=float(data["activity_time"]),
                        distance=float(data["distance"]), mission_time=float(data["mission_time"]),
                        planner_failures=int(data["planner_failures"]), believed=believed,
-                       repairs=int(data.get("repairs", 0)), repaired=int(data.get("repaired", 0)))
+                       repairs=int(data.get("repairs", 0)), repaired=int(data.get("repaired", 0)),
+                       judged_by_robot=bool(data.get("judged_by_robot", False)))
         except (KeyError, TypeError, ValueError, AttributeError) as error:
             raise RunError(f"not the measures of seed 004 §4.1.4 ({type(error).__name__}: {error})") from None
 
@@ -215,7 +219,8 @@ def planned_measures(events: Sequence[Mapping[str, Any]], judge: Judgement = bel
         distance=float(figures.get("distance", 0.0)), mission_time=float(figures["t"]),
         planner_failures=int(figures.get("planner_failures", 0)),
         believed=GoalCount(len(goals), sum(g.believed for g in goals)),
-        repairs=int(figures.get("repairs", 0)), repaired=int(figures.get("repaired", 0)))
+        repairs=int(figures.get("repairs", 0)), repaired=int(figures.get("repaired", 0)),
+        judged_by_robot=judge is not believed)
 
 
 def _rank(kind: str, kinds: Sequence[str]) -> int:

@@ -247,12 +247,24 @@ class MissionRun:
     def _measure_lines(self) -> list[str]:
         """The run's figures: seed 004 §4.1.4's as its notation reads when the extension measured
         them; else each figure that is a number or a word."""
-        from specc.run.measures import Measures
+        from specc.run.measures import Measures, planned_measures
 
         if Measures.readable(self.extension_measures):
             return ["  " + line for line in Measures.from_json(self.extension_measures).summary().splitlines()]
-        return [f"  {name}: {value}" for name, value in self.extension_measures.items()
-                if isinstance(value, int | float | str) and value != ""]
+        lines, shown = [], dict(self.extension_measures)
+        if self.events and "planned_goals" in self.events[0]:  # FTplan's figures, read as seed 004 §4.1.4's
+            measured = planned_measures(self.events)
+            lines = ["  " + line for line in measured.summary().splitlines()]
+            lines.append("  (each goal as FTplan's ledger counted it: the robot's extension judges none itself)")
+            shown = {name: value for name, value in shown.items() if name not in PLANNED_FIGURES}
+        return lines + [f"  {name}: {value}" for name, value in shown.items()
+                        if isinstance(value, int | float | str) and value != ""]
+
+
+# What a planned run reports of FTplan (`run_mission`), which its measures' summary says in seed
+# 004's notation.
+PLANNED_FIGURES = frozenset({"planned_goals_met", "planned_goals", "planned_goals_met_each", "plannings",
+                             "replannings", "repairs", "repaired", "planner_failures", "planning_failure"})
 
 
 @dataclass(frozen=True)

@@ -497,6 +497,9 @@ class Module:
         self.observers: list[Callable[[Module, Activity, State, State], None]] = []
         self.reply_listeners: list[ReplySink] = []  # see every reply the module sends (reflexes, logs)
         self._functions: dict[str, Callable[..., Any]] = {}
+        # Permanent codels raising on every cycle: codel -> (the first raise's date, raises in a row).
+        # A robot lives on with one for hours; its incidents say the first, then the count (`_raised`).
+        self._raising: dict[str, tuple[float, int]] = {}
         # A poster's activity is a request, or a codel (of a request or an exec task) whose cycles update it.
         self._auto_posters: dict[str, list[Poster[Any]]] = {}
         for poster_spec in spec.posters:
@@ -524,8 +527,9 @@ class Module:
             found = getattr(self.codels, name, None)
             if not callable(found):
                 given = getattr(self.codels, "__name__", None) if isinstance(self.codels, ModuleType) else None
-                raise CodelMissing(f"codel '{name}' is not defined in " + (
-                    given or f"the codels given to module '{self.name}' ({type(self.codels).__name__})"))
+                where = given or f"the codels given to module '{self.name}' ({type(self.codels).__name__})"
+                raise CodelMissing(f"codel '{name}' is not defined in {where}" if found is None else
+                                   f"codel '{name}' of {where} is a {type(found).__name__}, not a function")
             if self._enum_fields:
                 found = functools.partial(self._enum_checked, found)
             self._functions[name] = found
@@ -565,6 +569,8 @@ class Module:
             self.refuse(self.reply(rqst_id, request, Status.CS_ERROR, Report(
                 "UNKNOWN_REQUEST", f"module '{self.name}' has no request '{request}'")), sink, parent)
             return rqst_id
+        if spec.input_type is not None and isinstance(input_, spec.input_type):
+            as_declared(input_)  # `client.setMode("FAST")`: an enum's name is its member, as in a codel's writes
         problem = check_record(input_, spec.input_type)
         if problem:
             self.refuse(self.reply(rqst_id, request, Status.FINAL_ERROR, Report("BAD_INPUT", problem)), sink,
@@ -793,7 +799,8 @@ class Module:
             name = text[len(missing):-1]
             fields = [f.name for f in dataclasses.fields(self.sdi)]
             return (f"AttributeError: module {self.name}'s SDI has no field '{name}'{did_you_mean(name, fields)} "
-                    f"(its fields: {', '.join(fields) or 'none'}; declare it in the module's internal_data)")
+                    f"(its fields: {', '.join(fields) or 'none'}; declare it in the module's internal_data)"
+                    f"{where_raised(exc)}")
         return f"{type(exc).__name__}: {text}{where_raised(exc)}"
 
     def call_with_parent(self, activity: Activity, function: Callable[..., Any], *args: Any) -> Any:
@@ -810,10 +817,27 @@ class Module:
         try:
             self.function(name)(self.sdi)
         except CODE_ERRORS as exc:
-            self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: {kind} codel '{name}' "
-                                           f"raised {self.explain(exc)}")
+            self._raised(name, kind, self.explain(exc))
             return False
+        streak = self._raising.pop(name, None)
+        if streak is not None and streak[1] > 1:
+            self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: {kind} codel '{name}' ran again "
+                                           f"after raising {streak[1]:,} times in a row since {streak[0]:.3f} s")
         return True
+
+    def _raised(self, name: str, kind: str, said: str) -> None:
+        """An incident for the first raise of a streak, then one at its 10th, 100th, 1,000th... raise:
+        a codel raising on every cycle of a long run fills no log."""
+        now = self.kernel.now
+        first, count = self._raising.get(name, (now, 0))
+        count += 1
+        self._raising[name] = (first, count)
+        if count == 1:
+            self.registry.incidents.append(f"{now:.3f} {self.name}: {kind} codel '{name}' raised {said}")
+        elif _power_of_ten(count):
+            self.registry.incidents.append(f"{now:.3f} {self.name}: {kind} codel '{name}' has raised {count:,} times "
+                                           f"in a row since {first:.3f} s (said again at 10, 100, 1,000... "
+                                           f"times), the last: {said}")
 
     # -- endings
     def end(self, activity: Activity, report: Report) -> None:
@@ -943,6 +967,12 @@ class ControlRecord:
         return ""
 
 
+def _power_of_ten(count: int) -> bool:
+    while count % 10 == 0:
+        count //= 10
+    return count == 1
+
+
 def child_failed(parent: Activity, reply: Reply, activated: bool) -> None:
     """A child's error ends its running parent: SERVER_ERROR when the child ran, FINAL_ERROR
     (Table 2.1: "non activation d'activité fille") when it never started; both chain the reply."""
@@ -1043,6 +1073,10 @@ def check_value(value: Any, kind: Any, size: int | None) -> str:
         if isinstance(value, bool) and bool not in allowed:
             return f"expected {kind}, got bool"
         return "" if isinstance(value, allowed) else f"expected {kind}, got {type(value).__name__}"
+    if isinstance(kind, type) and issubclass(kind, enum.Enum) and not isinstance(value, kind):
+        names = [member.name for member in kind]
+        return (f"{value!r} is not a {kind.__name__} ({', '.join(names)})"
+                f"{did_you_mean(str(value), names)}")
     return check_record(value, kind)
 
 

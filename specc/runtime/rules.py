@@ -6,6 +6,8 @@ import math
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any, NamedTuple
 
+from specc.runtime.hints import did_you_mean
+
 
 class Decision(NamedTuple):
     """The outcome of one deduction cycle: the outputs (None when undetermined) and what went wrong."""
@@ -35,6 +37,24 @@ Calls = Callable[[str, tuple[Any, ...]], object]
 
 def no_calls(function: str, args: tuple[Any, ...]) -> None:
     """The default for `do {f(...)}` actions: nothing to call."""
+
+
+class MissingInput(KeyError):
+    """A decision asked for an input its caller did not give (a KeyError, said in words)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+def check_inputs(names: Iterable[str], inputs: Mapping[str, Any], error: KeyError) -> None:
+    """After a decision raised `error`: MissingInput naming the input it needed and the caller
+    left out (with the closest key given, a misspelt one), if that is the cause; else nothing."""
+    needed = error.args[0] if error.args else None
+    known = list(names)
+    if needed in known and needed not in inputs:
+        unknown = [str(k) for k in inputs if k not in known]
+        raise MissingInput(f"the decision needs input '{needed}'{did_you_mean(str(needed), unknown)}; its inputs: "
+                           f"{', '.join(known)}") from None
 
 
 def check_numbers(numeric: Iterable[str], inputs: Mapping[str, Any], error: TypeError) -> None:

@@ -316,6 +316,10 @@ TRACE_LENGTH = 10_000  # trace entries kept per intention
 # Steps one intention may run at one kernel instant: a KA's goal takes one step, and a task
 # reacting to an event takes tens; a loop that never waits takes them without end.
 STEPS_PER_INSTANT = 100_000
+# KAs one thread may run nested in one another (a KA's subgoal's KA, and so on): a recursion of
+# procedures ends long before (a count to ten, a list walked); a KA posting its own goal before
+# anything stops it, or two posting each other's, nests without end.
+MOST_NESTED_KAS = 100
 
 
 class TraceEntry(NamedTuple):
@@ -369,6 +373,11 @@ class _Blocked(NamedTuple):
 
 _Body = Generator[_Blocked | None, None, bool]
 _Pursuit = Generator[_Blocked | None, None, str | None]  # returns why the goal failed, None on success
+
+
+class _NestedTooDeep(Exception):
+    """MOST_NESTED_KAS reached: not a KA's failure, which another KA might mend, but an endless
+    recursion; it ends the intention (`_advance`)."""
 
 
 class _GuardBroken(Exception):
@@ -623,6 +632,13 @@ class Supervisor:
                 signal = thread.body.throw(broken)
             else:
                 signal = next(thread.body)
+        except _NestedTooDeep as deep:
+            self.abandon(thread.intention, str(deep))
+            return
+        except RecursionError:  # fewer KAs, each nesting statements deeply: the same endless recursion
+            self.abandon(thread.intention, "KAs nested too deep for Python's stack: a KA posting its own goal, "
+                                           "or KAs posting each other's, with nothing to end it")
+            return
         except StopIteration as stop:
             if thread.repair is not None:
                 self._repaired(thread, stop.value)
@@ -686,6 +702,11 @@ class Supervisor:
         return failure is None
 
     def _run_ka(self, thread: _Thread, ka: KA, env: dict[str, Any], why: str) -> _Body:
+        if len(thread.frames) >= MOST_NESTED_KAS:
+            last = [f.name for f in thread.frames[-4:]]
+            raise _NestedTooDeep(f"KAs nested {MOST_NESTED_KAS} deep (... {' -> '.join(last)} -> {ka.name} for {why}): "
+                                 "a KA posting its own goal, or KAs posting each other's, with nothing to end it; "
+                                 "test first what ends the recursion (an `if`, a context), or post another goal")
         frame = _Frame(ka, env, thread.intention)
         thread.frames.append(frame)
         self._record(frame, ka.line, f"started for {why}")

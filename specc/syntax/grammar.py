@@ -124,8 +124,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
             char = f"U+{ord(char):04X}"
         span = Span(path, line, column, line, column + 1)
         expected = describe_expected(exc.allowed or set(), keyword_texts())
+        ascii_form = TYPOGRAPHIC.get(char)
+        hint = f" (a word processor's character: write '{ascii_form}')" if ascii_form else ""
         return error("unexpected-character",
-                     f"unexpected character '{char}' here; expected {expected}", span)
+                     f"unexpected character '{char}' here{hint}; expected {expected}", span)
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
     unit = _unit_typo(text, position)
@@ -156,6 +158,10 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
 
 
 UNITS = ("us", "ms", "s", "min")
+# Characters an editor or a document puts for the ASCII ones the language reads.
+TYPOGRAPHIC = {"\u201c": '"', "\u201d": '"', "\u201e": '"', "\u00ab": '"', "\u00bb": '"', "\u2018": "'",
+               "\u2019": "'", "\u2264": "<=", "\u2265": ">=", "\u2260": "!=", "\u2192": "=>",
+               "\u21d2": "=>", "\u2212": "-", "\u2013": "-", "\u2014": "-", "\u00d7": "*", "\u2026": "..."}
 
 
 def _meant(exc: UnexpectedToken, text: str, position: int, written: str, is_name: bool) -> str:
@@ -175,6 +181,17 @@ def _meant(exc: UnexpectedToken, text: str, position: int, written: str, is_name
     for candidate, replaced in dict.fromkeys(tried):
         if _parses_past(text[:position] + candidate + text[position + replaced:], position + len(candidate)):
             return f" (did you mean '{candidate}'?)"
+    if is_name:  # `requst Goto {`: the misspelt keyword is the word before, read as a property's name
+        before = text[:position].rstrip(" \t")
+        start = len(before)
+        while start > 0 and (before[start - 1].isalnum() or before[start - 1] == "_"):
+            start -= 1
+        previous = before[start:]
+        words = [k for k in texts.values() if k.isidentifier() and len(k) > 2]
+        if previous.isidentifier() and previous not in words:
+            for candidate in difflib.get_close_matches(previous, words, n=3):
+                if _parses_past(text[:start] + candidate + text[len(before):], start + len(candidate) + 1):
+                    return f" after '{previous}' (did you mean '{candidate}'?)"
     return ""
 
 

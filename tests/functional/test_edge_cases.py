@@ -190,6 +190,21 @@ def test_a_codel_setting_an_enum_field_to_no_value_of_its_enum_is_a_codel_error(
     assert robot.alpha.sdi.mode == "BUSY"
 
 
+def test_a_client_may_give_an_enum_input_by_its_name_and_a_misspelt_one_is_refused(robot: Robot) -> None:
+    # The typed client's `SetMode("BUSY")`, as a codel's `sdi.mode = "BUSY"`: the module takes the
+    # name for its member; a misspelt name is BAD_INPUT naming the values, before any codel runs.
+    typed = robot.package.alpha.client(robot.alpha)
+    reply = typed.final(typed.SetMode("BUSY"))
+    mode = robot.alpha.sdi.mode
+    assert reply.status is Status.END and mode is type(mode).BUSY
+    refused = typed.final(typed.SetMode("IDEL"))
+    assert refused.status is Status.FINAL_ERROR and refused.report.code == "BAD_INPUT"
+    assert refused.report.detail == "mode: 'IDEL' is not a Mode (IDLE, BUSY) (did you mean 'IDLE'?)"
+    assert robot.alpha.sdi.mode is mode
+    record = robot.package.alpha.SetModeInput(mode="IDLE")  # a record built by hand, through the plain client
+    assert robot.client().call("SetMode", record).status is Status.END and robot.alpha.sdi.mode == "IDLE"
+
+
 def test_an_output_of_the_wrong_type_is_the_codel_s_error_and_whole_numbers_of_doubles_become_floats(
         robot: Robot) -> None:
     """`request.trace = 7` into a string output: the activity ends with CODEL_ERROR naming the
@@ -297,6 +312,9 @@ def test_a_codel_writing_a_field_the_sdi_does_not_declare_is_a_codel_error_namin
     reply = with_codels(robot, get_value=get_value).client().call("Get")
     assert (reply.status, reply.report.code) == (Status.FINAL_ERROR, "CODEL_ERROR")
     assert "module alpha's SDI has no field 'valeu' (did you mean 'value'?" in reply.report.detail
+    line = get_value.__code__.co_firstlineno + 1  # where the codel wrote it
+    assert reply.report.detail.endswith(f"internal_data) (tests/functional/test_edge_cases.py:{line})"), \
+        reply.report.detail
 
 
 def test_a_request_sent_by_a_validate_codel_is_nobody_s_child(robot: Robot) -> None:
@@ -357,6 +375,16 @@ def test_a_permanent_codel_that_raises_leaves_its_poster_s_date_alone(robot: Rob
     assert any("permanent codel 'perm' raised" in i for i in registry.incidents)
     after = registry.read_poster("alpha.Status")
     assert after is not None and after.date == before.date  # not published as fresh
+    # Raising on every cycle (20 ms) for 2.5 s: the first raise, then the 10th and the 100th, then
+    # the recovery with the count; not an incident a cycle.
+    registry.kernel.run_for(2.4)
+    unplugged = False
+    registry.kernel.run_for(0.1)
+    said = [i.partition(" alpha: permanent codel 'perm' ")[2] for i in registry.incidents]
+    assert [text.split(" in a row")[0] for text in said] == [
+        "raised RuntimeError: sensor unplugged" + said[0].partition("sensor unplugged")[2],
+        "has raised 10 times", "has raised 100 times", "ran again after raising 125 times"]
+    assert said[1].endswith("the last: " + said[0].removeprefix("raised "))
 
 
 def test_modules_created_twice_on_one_registry_are_refused(robot: Robot) -> None:

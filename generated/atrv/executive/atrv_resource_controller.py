@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -74,7 +75,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_0
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -84,9 +85,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_3
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@GOTOstate={v!r} is outside its domain")
+                raise ValueError(f"@GOTOstate={v!r} is outside its domain, " + "one of 'GOTO', 'IDLE'")
         elif v == 'STOP-NAV':
             v = a['event']
             if v == 'START':
@@ -97,13 +98,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_4
                 else:
-                    raise ValueError(f"@GOTOstate={v!r} is outside its domain")
+                    raise ValueError(f"@GOTOstate={v!r} is outside its domain, " + "one of 'GOTO', 'IDLE'")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                 return _LEAF_5
             elif v == 'END':
                 return _LEAF_4
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'STOP-WHEELS':
             v = a['event']
             if v in ('START', 'END'):
@@ -111,7 +112,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                 return _LEAF_5
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'PTU-MOVE':
             v = a.get('@PTU_MOVEstate', 'IDLE')
             if v == 'PTU-MOVE':
@@ -126,7 +127,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_6
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -136,9 +137,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_9
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain")
+                raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain, " + "one of 'PTU-MOVE', 'IDLE'")
         elif v == 'PTU-INIT':
             v = a['event']
             if v == 'START':
@@ -149,13 +150,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_4
                 else:
-                    raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain")
+                    raise ValueError(f"@PTU_MOVEstate={v!r} is outside its domain, " + "one of 'PTU-MOVE', 'IDLE'")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                 return _LEAF_5
             elif v == 'END':
                 return _LEAF_4
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'PICTURE':
             v = a.get('@PICTUREstate', 'IDLE')
             if v == 'PICTURE':
@@ -170,7 +171,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_10
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -180,9 +181,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_13
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@PICTUREstate={v!r} is outside its domain")
+                raise ValueError(f"@PICTUREstate={v!r} is outside its domain, " + "one of 'PICTURE', 'IDLE'")
         elif v == 'COMMUNICATE':
             v = a.get('@COMMUNICATEstate', 'IDLE')
             if v == 'COMMUNICATE':
@@ -197,7 +198,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_14
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -207,11 +208,14 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_17
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@COMMUNICATEstate={v!r} is outside its domain")
+                raise ValueError(f"@COMMUNICATEstate={v!r} is outside its domain, " + "one of 'COMMUNICATE', 'IDLE'")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain, " + "one of 'GOTO', 'STOP-NAV', 'STOP-WHEELS', 'PTU-MOVE', 'PTU-INIT', 'PICTURE', 'COMMUNICATE'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise

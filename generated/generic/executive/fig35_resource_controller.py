@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -97,7 +98,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_4
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -107,9 +108,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_5
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@Bstate={v!r} is outside its domain")
+                raise ValueError(f"@Bstate={v!r} is outside its domain, " + "one of 'B', 'IDLE'")
         elif v == 'C':
             v = a['event']
             if v == 'START':
@@ -121,11 +122,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     calls('sendAbortRequest', (a.get('@DEFstate', 'IDLE'),))
                     return _LEAF_6
                 else:
-                    raise ValueError(f"@DEFstate={v!r} is outside its domain")
+                    raise ValueError(f"@DEFstate={v!r} is outside its domain, " + "one of 'D', 'E', 'F', 'IDLE'")
             elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'D':
             v = a.get('@DEFstate', 'IDLE')
             if v == 'D':
@@ -139,7 +140,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_10
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'E':
                 return _node_1(a, calls)
             elif v == 'F':
@@ -153,9 +154,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_15
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@DEFstate={v!r} is outside its domain")
+                raise ValueError(f"@DEFstate={v!r} is outside its domain, " + "one of 'D', 'E', 'F', 'IDLE'")
         elif v == 'E':
             v = a.get('@DEFstate', 'IDLE')
             if v == 'D':
@@ -171,7 +172,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_16
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'F':
                 return _node_3(a, calls)
             elif v == 'IDLE':
@@ -183,9 +184,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_15
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@DEFstate={v!r} is outside its domain")
+                raise ValueError(f"@DEFstate={v!r} is outside its domain, " + "one of 'D', 'E', 'F', 'IDLE'")
         elif v == 'F':
             v = a.get('@DEFstate', 'IDLE')
             if v == 'D':
@@ -203,7 +204,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_17
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -213,9 +214,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_15
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@DEFstate={v!r} is outside its domain")
+                raise ValueError(f"@DEFstate={v!r} is outside its domain, " + "one of 'D', 'E', 'F', 'IDLE'")
         elif v == 'G':
             v = a.get('@Gstate', 'IDLE')
             if v == 'G':
@@ -229,7 +230,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_18
                     else:
-                        raise ValueError(f"@HIstate={v!r} is outside its domain")
+                        raise ValueError(f"@HIstate={v!r} is outside its domain, " + "one of 'H', 'I', 'IDLE'")
                 elif v == 'INTERM':
                     return _LEAF_19
                 elif v == 'END':
@@ -237,7 +238,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_21
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -247,15 +248,15 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_20
                     else:
-                        raise ValueError(f"@HIstate={v!r} is outside its domain")
+                        raise ValueError(f"@HIstate={v!r} is outside its domain, " + "one of 'H', 'I', 'IDLE'")
                 elif v == 'INTERM':
                     return _LEAF_21
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_23
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@Gstate={v!r} is outside its domain")
+                raise ValueError(f"@Gstate={v!r} is outside its domain, " + "one of 'G', 'IDLE'")
         elif v == 'H':
             v = a.get('@HIstate', 'IDLE')
             if v == 'H':
@@ -271,7 +272,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_27
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'I':
                 v = a['event']
                 if v == 'START':
@@ -281,7 +282,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_29
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -291,9 +292,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_30
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@HIstate={v!r} is outside its domain")
+                raise ValueError(f"@HIstate={v!r} is outside its domain, " + "one of 'H', 'I', 'IDLE'")
         elif v == 'I':
             v = a.get('@HIstate', 'IDLE')
             if v == 'H':
@@ -309,11 +310,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_24
                     else:
-                        raise ValueError(f"@Jstate={v!r} is outside its domain")
+                        raise ValueError(f"@Jstate={v!r} is outside its domain, " + "one of 'J', 'IDLE'")
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_25
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'I':
                 v = a['event']
                 if v == 'START':
@@ -327,7 +328,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_28
                     else:
-                        raise ValueError(f"@Jstate={v!r} is outside its domain")
+                        raise ValueError(f"@Jstate={v!r} is outside its domain, " + "one of 'J', 'IDLE'")
                 elif v == 'INTERM':
                     return _LEAF_29
                 elif v == 'END':
@@ -335,7 +336,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_31
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -347,15 +348,15 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_26
                     else:
-                        raise ValueError(f"@Jstate={v!r} is outside its domain")
+                        raise ValueError(f"@Jstate={v!r} is outside its domain, " + "one of 'J', 'IDLE'")
                 elif v == 'INTERM':
                     return _LEAF_31
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_30
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@HIstate={v!r} is outside its domain")
+                raise ValueError(f"@HIstate={v!r} is outside its domain, " + "one of 'H', 'I', 'IDLE'")
         elif v == 'J':
             v = a.get('@Jstate', 'IDLE')
             if v == 'J':
@@ -371,7 +372,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_36
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -381,13 +382,16 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_37
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@Jstate={v!r} is outside its domain")
+                raise ValueError(f"@Jstate={v!r} is outside its domain, " + "one of 'J', 'IDLE'")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'D', 'E', 'F', 'G', 'H', 'I', 'J'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise
 
 
@@ -404,7 +408,7 @@ def _node_1(a: Any, calls: Calls) -> Decision:
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
         return _LEAF_12
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_2(a: Any, calls: Calls) -> Decision:
@@ -420,7 +424,7 @@ def _node_3(a: Any, calls: Calls) -> Decision:
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
         return _LEAF_14
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_4(a: Any, calls: Calls) -> Decision:
@@ -436,7 +440,7 @@ def _node_5(a: Any, calls: Calls) -> Decision:
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
         return _LEAF_8
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_6(a: Any, calls: Calls) -> Decision:

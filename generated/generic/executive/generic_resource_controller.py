@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -98,7 +99,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_0
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'B':
                 v = a['event']
                 if v == 'START':
@@ -106,7 +107,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_4
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'C':
                 return _node_2(a, calls)
             elif v == 'IDLE':
@@ -118,9 +119,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_7
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'B':
             v = a.get('@ABCstate', 'IDLE')
             if v == 'A':
@@ -130,7 +131,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_1
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'B':
                 v = a['event']
                 if v == 'START':
@@ -142,7 +143,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_3
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'C':
                 return _node_2(a, calls)
             elif v == 'IDLE':
@@ -154,9 +155,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_7
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'C':
             v = a.get('@ABCstate', 'IDLE')
             if v == 'A':
@@ -166,7 +167,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_1
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'B':
                 v = a['event']
                 if v == 'START':
@@ -174,7 +175,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_4
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'C':
                 v = a['event']
                 if v == 'START':
@@ -186,7 +187,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_5
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -196,9 +197,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_7
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'D':
             v = a.get('@ABCstate', 'IDLE')
             if v == 'A':
@@ -210,7 +211,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
             elif v == 'IDLE':
                 return _LEAF_2
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'E':
             v = a['event']
             if v == 'START':
@@ -228,7 +229,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_11
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'B':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -240,7 +241,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_15
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'C':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -252,7 +253,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_19
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -264,9 +265,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_23
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ABCstate', 'IDLE')
                 if v == 'A':
@@ -280,7 +281,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_39
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'B':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -292,7 +293,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_40
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'C':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -304,7 +305,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_41
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -316,13 +317,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_42
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_4(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'F':
             v = a['event']
             if v == 'START':
@@ -340,7 +341,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_12
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'B':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -352,7 +353,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_16
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'C':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -364,7 +365,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_20
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -376,9 +377,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_24
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ABCstate', 'IDLE')
                 if v == 'A':
@@ -392,7 +393,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_39
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'B':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -404,7 +405,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_40
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'C':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -416,7 +417,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_41
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -428,13 +429,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_42
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_5(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'G':
             v = a['event']
             if v == 'START':
@@ -452,7 +453,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_13
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'B':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -464,7 +465,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_17
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'C':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -476,7 +477,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_21
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -488,9 +489,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_25
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ABCstate', 'IDLE')
                 if v == 'A':
@@ -504,7 +505,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_39
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'B':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -516,7 +517,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_40
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'C':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -528,7 +529,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_41
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@EFGstate', 'IDLE')
                     if v == 'E':
@@ -540,13 +541,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_42
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_6(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'H':
             v = a.get('@ABCstate', 'IDLE')
             if v == 'A':
@@ -558,13 +559,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_0
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                     return _LEAF_1
                 elif v == 'END':
                     return _LEAF_0
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'B':
                 v = a['event']
                 if v == 'START':
@@ -574,13 +575,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_3
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                     return _LEAF_4
                 elif v == 'END':
                     return _LEAF_3
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'C':
                 v = a['event']
                 if v == 'START':
@@ -590,17 +591,17 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_5
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                     return _LEAF_6
                 elif v == 'END':
                     return _LEAF_5
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 return _node_10(a, calls)
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'I':
             v = a.get('@ABCstate', 'IDLE')
             if v == 'A':
@@ -612,7 +613,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_0
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'B':
                 v = a['event']
                 if v == 'START':
@@ -622,7 +623,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_3
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'C':
                 v = a['event']
                 if v == 'START':
@@ -632,11 +633,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_5
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 return _node_10(a, calls)
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'J':
             v = a.get('@ABCstate', 'IDLE')
             if v == 'A':
@@ -650,7 +651,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_0
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'B':
                 v = a['event']
                 if v == 'START':
@@ -662,7 +663,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_3
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'C':
                 v = a['event']
                 if v == 'START':
@@ -674,15 +675,18 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_5
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 return _node_10(a, calls)
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'D', 'E', 'F', 'G', 'H', 'I', 'J'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise
 
 
@@ -704,7 +708,7 @@ def _node_2(a: Any, calls: Calls) -> Decision:
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
         return _LEAF_6
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_3(a: Any, calls: Calls) -> Decision:
@@ -723,7 +727,7 @@ def _node_3(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_14
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'B':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -738,7 +742,7 @@ def _node_3(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_18
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'C':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -753,7 +757,7 @@ def _node_3(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_22
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'IDLE':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -768,9 +772,9 @@ def _node_3(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_26
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
 
 
 def _node_4(a: Any, calls: Calls) -> Decision:
@@ -786,7 +790,7 @@ def _node_4(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_39
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'B':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -798,7 +802,7 @@ def _node_4(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_40
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'C':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -810,7 +814,7 @@ def _node_4(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_41
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'IDLE':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -822,9 +826,9 @@ def _node_4(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_42
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
 
 
 def _node_5(a: Any, calls: Calls) -> Decision:
@@ -840,7 +844,7 @@ def _node_5(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_39
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'B':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -852,7 +856,7 @@ def _node_5(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_40
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'C':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -864,7 +868,7 @@ def _node_5(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_41
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'IDLE':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -876,9 +880,9 @@ def _node_5(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_42
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
 
 
 def _node_6(a: Any, calls: Calls) -> Decision:
@@ -894,7 +898,7 @@ def _node_6(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_39
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'B':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -906,7 +910,7 @@ def _node_6(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_40
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'C':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -918,7 +922,7 @@ def _node_6(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_41
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v == 'IDLE':
         v = a.get('@EFGstate', 'IDLE')
         if v == 'E':
@@ -930,9 +934,9 @@ def _node_6(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_42
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     else:
-        raise ValueError(f"@ABCstate={v!r} is outside its domain")
+        raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
 
 
 def _node_7(a: Any, calls: Calls) -> Decision:
@@ -959,13 +963,13 @@ def _node_10(a: Any, calls: Calls) -> Decision:
         elif v == 'IDLE':
             return _LEAF_2
         else:
-            raise ValueError(f"@EFGstate={v!r} is outside its domain")
+            raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
     elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
         return _LEAF_7
     elif v == 'END':
         return _LEAF_2
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_11(a: Any, calls: Calls) -> Decision:

@@ -26,6 +26,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -67,7 +68,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 else:
                     return _LEAF_4
             else:
-                raise ValueError(f"pres1={v!r} is outside its domain")
+                raise ValueError(f"pres1={v!r} is outside its domain, " + ']-inf, inf[')
         elif 4.0 <= v and v < 20.0:
             return _node_0(a, calls)
         elif 20.0 <= v:
@@ -91,11 +92,14 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 else:
                     return _LEAF_4
             else:
-                raise ValueError(f"temp={v!r} is outside its domain")
+                raise ValueError(f"temp={v!r} is outside its domain, " + ']-inf, inf[')
         else:
-            raise ValueError(f"deltaP={v!r} is outside its domain")
+            raise ValueError(f"deltaP={v!r} is outside its domain, " + ']-inf, inf[')
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise
 
 
@@ -119,7 +123,7 @@ def _node_0(a: Any, calls: Calls) -> Decision:
                         elif 10.0 <= v:
                             return _LEAF_2
                         else:
-                            raise ValueError(f"difP={v!r} is outside its domain")
+                            raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
                     elif v == 'low':
                         v = a['difP']
                         if (v < 0.0) or (0.0 <= v and v < 10.0):
@@ -127,7 +131,7 @@ def _node_0(a: Any, calls: Calls) -> Decision:
                         elif 10.0 <= v:
                             return _LEAF_2
                         else:
-                            raise ValueError(f"difP={v!r} is outside its domain")
+                            raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
                     else:
                         v = a['difP']
                         if (v < 0.0) or (0.0 <= v and v < 10.0):
@@ -135,13 +139,13 @@ def _node_0(a: Any, calls: Calls) -> Decision:
                         elif 10.0 <= v:
                             return _LEAF_2
                         else:
-                            raise ValueError(f"difP={v!r} is outside its domain")
+                            raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
                 else:
                     return _LEAF_4
             elif 40.0 <= v:
                 return _node_1(a, calls)
             else:
-                raise ValueError(f"pres2={v!r} is outside its domain")
+                raise ValueError(f"pres2={v!r} is outside its domain, " + ']-inf, inf[')
         else:
             v = a['pres2']
             if v < 40.0:
@@ -156,13 +160,13 @@ def _node_0(a: Any, calls: Calls) -> Decision:
                     elif 10.0 <= v:
                         return _LEAF_2
                     else:
-                        raise ValueError(f"difP={v!r} is outside its domain")
+                        raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
                 else:
                     return _LEAF_4
             elif 40.0 <= v:
                 return _node_3(a, calls)
             else:
-                raise ValueError(f"pres2={v!r} is outside its domain")
+                raise ValueError(f"pres2={v!r} is outside its domain, " + ']-inf, inf[')
     elif 286.0 <= v:
         v = a['valve']
         if v == 'open':
@@ -172,7 +176,7 @@ def _node_0(a: Any, calls: Calls) -> Decision:
             elif 40.0 <= v:
                 return _node_1(a, calls)
             else:
-                raise ValueError(f"pres2={v!r} is outside its domain")
+                raise ValueError(f"pres2={v!r} is outside its domain, " + ']-inf, inf[')
         else:
             v = a['pres2']
             if v < 40.0:
@@ -180,9 +184,9 @@ def _node_0(a: Any, calls: Calls) -> Decision:
             elif 40.0 <= v:
                 return _node_3(a, calls)
             else:
-                raise ValueError(f"pres2={v!r} is outside its domain")
+                raise ValueError(f"pres2={v!r} is outside its domain, " + ']-inf, inf[')
     else:
-        raise ValueError(f"temp={v!r} is outside its domain")
+        raise ValueError(f"temp={v!r} is outside its domain, " + ']-inf, inf[')
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:
@@ -197,7 +201,7 @@ def _node_1(a: Any, calls: Calls) -> Decision:
         elif 10.0 <= v:
             return _LEAF_2
         else:
-            raise ValueError(f"difP={v!r} is outside its domain")
+            raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
     else:
         return _LEAF_4
 
@@ -224,7 +228,7 @@ def _node_3(a: Any, calls: Calls) -> Decision:
         elif (0.0 <= v and v < 10.0) or (10.0 <= v):
             return _LEAF_2
         else:
-            raise ValueError(f"difP={v!r} is outside its domain")
+            raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
     else:
         return _LEAF_4
 
@@ -241,6 +245,6 @@ def _node_4(a: Any, calls: Calls) -> Decision:
         elif 10.0 <= v:
             return _LEAF_2
         else:
-            raise ValueError(f"difP={v!r} is outside its domain")
+            raise ValueError(f"difP={v!r} is outside its domain, " + ']-inf, inf[')
     else:
         return _LEAF_4

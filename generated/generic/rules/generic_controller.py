@@ -34,6 +34,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -66,7 +67,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif v in ('B', 'C', 'IDLE'):
                 return _node_1(a, calls)
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'B':
             v = a.get('@ABCstate', 'IDLE')
             if v in ('A', 'C'):
@@ -82,9 +83,9 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_2
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'C':
             v = a.get('@ABCstate', 'IDLE')
             if v in ('A', 'B'):
@@ -98,7 +99,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'END':
                     return _LEAF_1
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -108,9 +109,9 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_2
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
         elif v == 'D':
             v = a['event']
             if v in ('START', 'INTERM', 'END'):
@@ -118,7 +119,7 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif v in ('ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v in ('E', 'F', 'G'):
             return _node_3(a, calls)
         elif v == 'H':
@@ -130,13 +131,13 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_5
                 else:
-                    raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                    raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
             elif v == 'INTERM':
                 return _LEAF_2
             elif v in ('END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'I':
             v = a['event']
             if v == 'START':
@@ -150,15 +151,15 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_0
                     else:
-                        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+                        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v == 'INTERM':
                 return _LEAF_2
             elif v in ('END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'J':
             v = a['event']
             if v == 'START':
@@ -168,17 +169,20 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_0
                 else:
-                    raise ValueError(f"@ABCstate={v!r} is outside its domain")
+                    raise ValueError(f"@ABCstate={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'IDLE'")
             elif v == 'INTERM':
                 return _LEAF_2
             elif v in ('END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain, " + "one of 'A', 'B', 'C', 'D', 'E', 'F', 'G', 'H', 'I', 'J'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise
 
 
@@ -189,7 +193,7 @@ def _node_0(a: Any, calls: Calls) -> Decision:
     elif v == 'END':
         return _LEAF_1
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:
@@ -199,7 +203,7 @@ def _node_1(a: Any, calls: Calls) -> Decision:
     elif v in ('END', 'ABORT', 'ZOMBIE'):
         return _LEAF_2
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_2(a: Any, calls: Calls) -> Decision:
@@ -211,7 +215,7 @@ def _node_2(a: Any, calls: Calls) -> Decision:
     elif v in ('END', 'ABORT', 'ZOMBIE'):
         return _LEAF_2
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_3(a: Any, calls: Calls) -> Decision:
@@ -225,9 +229,9 @@ def _node_3(a: Any, calls: Calls) -> Decision:
         elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
             return _LEAF_0
         else:
-            raise ValueError(f"event={v!r} is outside its domain")
+            raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
     else:
-        raise ValueError(f"@EFGstate={v!r} is outside its domain")
+        raise ValueError(f"@EFGstate={v!r} is outside its domain, " + "one of 'E', 'F', 'G', 'IDLE'")
 
 
 def _node_4(a: Any, calls: Calls) -> Decision:
@@ -239,7 +243,7 @@ def _node_4(a: Any, calls: Calls) -> Decision:
     elif v in ('END', 'ABORT', 'ZOMBIE'):
         return _LEAF_0
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_5(a: Any, calls: Calls) -> Decision:

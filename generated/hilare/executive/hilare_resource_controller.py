@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -108,7 +109,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_5
                 else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate', 'IDLE')
                 if v == 'READ-MODEL':
@@ -120,7 +121,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_2
                 else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate', 'IDLE')
                 if v == 'READ-MODEL':
@@ -132,11 +133,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_9
                 else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_3(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'INIT-MODEL':
             v = a['event']
             if v == 'START':
@@ -146,13 +147,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_0
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                 return _LEAF_1
             elif v == 'END':
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'READ-OBST':
             v = a['event']
             if v == 'START':
@@ -165,7 +166,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_12
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@READ_OBST_SEARCH_OBJstate', 'IDLE')
                 if v == 'READ-OBST':
@@ -175,7 +176,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_10
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@READ_OBST_SEARCH_OBJstate', 'IDLE')
                 if v == 'READ-OBST':
@@ -185,11 +186,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_15
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_6(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'EXEC-TRAJ-GOAL':
             v = a['event']
             if v == 'START':
@@ -201,7 +202,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'CALC-TRAJ-OBJ':
                         return _LEAF_16
                     else:
-                        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
                 elif v == 'EXEC-TRAJ-OBJ':
                     return _LEAF_18
                 elif v == 'IDLE':
@@ -211,9 +212,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'CALC-TRAJ-OBJ':
                         return _LEAF_19
                     else:
-                        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@ExecTrajState', 'IDLE')
                 if v == 'EXEC-TRAJ-GOAL':
@@ -223,7 +224,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_17
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ExecTrajState', 'IDLE')
                 if v == 'EXEC-TRAJ-GOAL':
@@ -233,11 +234,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_23
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_10(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'EXEC-TRAJ-OBJ':
             v = a['event']
             if v == 'START':
@@ -250,7 +251,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_20
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@ExecTrajState', 'IDLE')
                 if v == 'EXEC-TRAJ-GOAL':
@@ -260,7 +261,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_24
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ExecTrajState', 'IDLE')
                 if v == 'EXEC-TRAJ-GOAL':
@@ -270,11 +271,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_23
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_11(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'CALC-TRAJ-GOAL':
             v = a.get('@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate', 'IDLE')
             if v == 'READ-MODEL':
@@ -284,7 +285,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_6
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'CALC-TRAJ-GOAL':
                 v = a['event']
                 if v == 'START':
@@ -296,7 +297,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_3
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'CALC-TRAJ-OBJ':
                 v = a['event']
                 if v == 'START':
@@ -304,7 +305,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_8
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -314,9 +315,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_9
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
         elif v == 'CALC-TRAJ-OBJ':
             v = a['event']
             if v == 'START':
@@ -333,7 +334,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                         return _node_1(a, calls)
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 elif v == 'CALC-TRAJ-OBJ':
                     v = a.get('@ExecTrajState', 'IDLE')
                     if v == 'EXEC-TRAJ-GOAL':
@@ -344,7 +345,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                         return _node_2(a, calls)
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@ExecTrajState', 'IDLE')
                     if v == 'EXEC-TRAJ-GOAL':
@@ -354,9 +355,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                         return _LEAF_5
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate', 'IDLE')
                 if v == 'READ-MODEL':
@@ -368,7 +369,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_4
                 else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate', 'IDLE')
                 if v == 'READ-MODEL':
@@ -380,11 +381,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_9
                 else:
-                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_12(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'ARM-OBJ':
             v = a['event']
             if v == 'START':
@@ -398,7 +399,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                         return _node_13(a, calls)
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 elif v == 'ARM-BACK':
                     v = a.get('@ExecTrajState', 'IDLE')
                     if v == 'EXEC-TRAJ-GOAL':
@@ -408,7 +409,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                         return _node_14(a, calls)
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@ExecTrajState', 'IDLE')
                     if v == 'EXEC-TRAJ-GOAL':
@@ -418,9 +419,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                         return _LEAF_32
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 else:
-                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@ARM_OBJ_ARM_BACKstate', 'IDLE')
                 if v == 'ARM-OBJ':
@@ -430,7 +431,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_28
                 else:
-                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ARM_OBJ_ARM_BACKstate', 'IDLE')
                 if v == 'ARM-OBJ':
@@ -440,11 +441,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_35
                 else:
-                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_15(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'ARM-BACK':
             v = a['event']
             if v == 'START':
@@ -456,7 +457,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_32
                 else:
-                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@ARM_OBJ_ARM_BACKstate', 'IDLE')
                 if v == 'ARM-OBJ':
@@ -466,7 +467,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_30
                 else:
-                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
             elif v == 'END':
                 v = a.get('@ARM_OBJ_ARM_BACKstate', 'IDLE')
                 if v == 'ARM-OBJ':
@@ -476,11 +477,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_35
                 else:
-                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+                    raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_16(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'TAKE-IMAGE':
             v = a['event']
             if v == 'START':
@@ -490,13 +491,13 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'SEARCH-OBJ':
                     return _LEAF_36
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                 return _LEAF_1
             elif v == 'END':
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'SEARCH-OBJ':
             v = a['event']
             if v == 'START':
@@ -508,7 +509,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_12
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@READ_OBST_SEARCH_OBJstate', 'IDLE')
                 if v == 'READ-OBST':
@@ -518,7 +519,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_11
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@READ_OBST_SEARCH_OBJstate', 'IDLE')
                 if v == 'READ-OBST':
@@ -528,11 +529,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_15
                 else:
-                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_17(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'CALC-GOAL':
             v = a['event']
             if v == 'START':
@@ -544,7 +545,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'EXEC-TRAJ-OBJ':
                         return _LEAF_39
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 elif v == 'IDLE':
                     v = a.get('@ExecTrajState', 'IDLE')
                     if v in ('EXEC-TRAJ-GOAL', 'IDLE'):
@@ -552,9 +553,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'EXEC-TRAJ-OBJ':
                         return _LEAF_41
                     else:
-                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
                 else:
-                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain, " + "one of 'CALC-GOAL', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@CALC_GOALstate', 'IDLE')
                 if v == 'CALC-GOAL':
@@ -562,7 +563,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_38
                 else:
-                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain, " + "one of 'CALC-GOAL', 'IDLE'")
             elif v == 'END':
                 v = a.get('@CALC_GOALstate', 'IDLE')
                 if v == 'CALC-GOAL':
@@ -570,11 +571,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_43
                 else:
-                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+                    raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain, " + "one of 'CALC-GOAL', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_19(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         elif v == 'CALC-OBJ':
             v = a['event']
             if v == 'START':
@@ -588,11 +589,11 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                     elif v == 'IDLE':
                         return _LEAF_45
                     else:
-                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")
                 elif v in ('EXEC-TRAJ-OBJ', 'IDLE'):
                     return _node_20(a, calls)
                 else:
-                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+                    raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
             elif v == 'INTERM':
                 v = a.get('@CALC_OBJstate', 'IDLE')
                 if v == 'CALC-OBJ':
@@ -600,7 +601,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_46
                 else:
-                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")
             elif v == 'END':
                 v = a.get('@CALC_OBJstate', 'IDLE')
                 if v == 'CALC-OBJ':
@@ -608,15 +609,18 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v == 'IDLE':
                     return _LEAF_49
                 else:
-                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+                    raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")
             elif v in ('ABORT', 'ZOMBIE'):
                 return _node_21(a, calls)
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain, " + "one of 'AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'READ-MODEL', 'INIT-MODEL', 'READ-OBST', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'ARM-OBJ', 'ARM-BACK', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'TAKE-IMAGE', 'SEARCH-OBJ', 'GET-NEAR-OBJ', 'CALC-GOAL', 'CALC-OBJ'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise
 
 
@@ -627,7 +631,7 @@ def _node_0(a: Any, calls: Calls) -> Decision:
     elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
         return _LEAF_1
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:
@@ -651,7 +655,7 @@ def _node_3(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_9
     else:
-        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
 
 
 def _node_4(a: Any, calls: Calls) -> Decision:
@@ -673,7 +677,7 @@ def _node_6(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_15
     else:
-        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
 
 
 def _node_7(a: Any, calls: Calls) -> Decision:
@@ -687,9 +691,9 @@ def _node_7(a: Any, calls: Calls) -> Decision:
         elif v in ('ARM-BACK', 'IDLE'):
             return _node_8(a, calls)
         else:
-            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
     else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")
 
 
 def _node_8(a: Any, calls: Calls) -> Decision:
@@ -708,9 +712,9 @@ def _node_9(a: Any, calls: Calls) -> Decision:
         elif v in ('ARM-BACK', 'IDLE'):
             return _LEAF_20
         else:
-            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+            raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
     else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")
 
 
 def _node_10(a: Any, calls: Calls) -> Decision:
@@ -722,7 +726,7 @@ def _node_10(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_23
     else:
-        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
 
 
 def _node_11(a: Any, calls: Calls) -> Decision:
@@ -734,7 +738,7 @@ def _node_11(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_23
     else:
-        raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+        raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'IDLE'")
 
 
 def _node_12(a: Any, calls: Calls) -> Decision:
@@ -748,7 +752,7 @@ def _node_12(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_9
     else:
-        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@READ_MODEL_CALC_TRAJ_GOAL_CALC_TRAJ_OBJstate={v!r} is outside its domain, " + "one of 'READ-MODEL', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'IDLE'")
 
 
 def _node_13(a: Any, calls: Calls) -> Decision:
@@ -770,7 +774,7 @@ def _node_15(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_35
     else:
-        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
 
 
 def _node_16(a: Any, calls: Calls) -> Decision:
@@ -782,7 +786,7 @@ def _node_16(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_35
     else:
-        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain")
+        raise ValueError(f"@ARM_OBJ_ARM_BACKstate={v!r} is outside its domain, " + "one of 'ARM-OBJ', 'ARM-BACK', 'IDLE'")
 
 
 def _node_17(a: Any, calls: Calls) -> Decision:
@@ -794,7 +798,7 @@ def _node_17(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_15
     else:
-        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@READ_OBST_SEARCH_OBJstate={v!r} is outside its domain, " + "one of 'READ-OBST', 'SEARCH-OBJ', 'IDLE'")
 
 
 def _node_18(a: Any, calls: Calls) -> Decision:
@@ -809,7 +813,7 @@ def _node_19(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_43
     else:
-        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_GOALstate={v!r} is outside its domain, " + "one of 'CALC-GOAL', 'IDLE'")
 
 
 def _node_20(a: Any, calls: Calls) -> Decision:
@@ -820,7 +824,7 @@ def _node_20(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_47
     else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")
 
 
 def _node_21(a: Any, calls: Calls) -> Decision:
@@ -830,4 +834,4 @@ def _node_21(a: Any, calls: Calls) -> Decision:
     elif v == 'IDLE':
         return _LEAF_49
     else:
-        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain")
+        raise ValueError(f"@CALC_OBJstate={v!r} is outside its domain, " + "one of 'CALC-OBJ', 'IDLE'")

@@ -17,6 +17,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -56,13 +57,16 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
                     calls('sendAbortRequest', ('EXEC-TRAJ-GOAL',))
                     return _LEAF_2
                 else:
-                    raise ValueError(f"service={v!r} is outside its domain")
+                    raise ValueError(f"service={v!r} is outside its domain, " + "one of 'AVOID-ON', 'SET-DYNAMIC', 'AUTOBOX-OFF', 'SET-BOX', 'READ-MODEL', 'INIT-MODEL', 'READ-OBST', 'EXEC-TRAJ-GOAL', 'EXEC-TRAJ-OBJ', 'CALC-TRAJ-GOAL', 'CALC-TRAJ-OBJ', 'ARM-OBJ', 'ARM-BACK', 'OPEN-GRIP', 'CLOSE-GRIP', 'TURN-CAMERA', 'TAKE-IMAGE', 'SEARCH-OBJ', 'GET-NEAR-OBJ', 'CALC-GOAL', 'CALC-OBJ'")
             elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                 return _LEAF_0
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         else:
-            raise ValueError(f"@ExecTrajState={v!r} is outside its domain")
+            raise ValueError(f"@ExecTrajState={v!r} is outside its domain, " + "one of 'EXEC-TRAJ-OBJ', 'EXEC-TRAJ-GOAL', 'IDLE'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise

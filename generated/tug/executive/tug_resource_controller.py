@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -69,7 +70,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_0
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'HITCH':
                 v = a['event']
                 if v == 'START':
@@ -77,7 +78,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_4
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'UNHITCH':
                 v = a['event']
                 if v == 'START':
@@ -85,7 +86,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_6
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -95,9 +96,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_7
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain, " + "one of 'GOTO', 'HITCH', 'UNHITCH', 'IDLE'")
         elif v == 'HITCH':
             v = a.get('@GOTO_HITCH_UNHITCHstate', 'IDLE')
             if v == 'GOTO':
@@ -113,7 +114,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_9
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'UNHITCH':
                 v = a['event']
                 if v == 'START':
@@ -121,7 +122,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_6
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -131,9 +132,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_7
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain, " + "one of 'GOTO', 'HITCH', 'UNHITCH', 'IDLE'")
         elif v == 'UNHITCH':
             v = a.get('@GOTO_HITCH_UNHITCHstate', 'IDLE')
             if v == 'GOTO':
@@ -145,7 +146,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_4
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'UNHITCH':
                 v = a['event']
                 if v == 'START':
@@ -157,7 +158,7 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('ABORT', 'ZOMBIE'):
                     return _LEAF_10
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             elif v == 'IDLE':
                 v = a['event']
                 if v == 'START':
@@ -167,9 +168,9 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
                 elif v in ('END', 'ABORT', 'ZOMBIE'):
                     return _LEAF_7
                 else:
-                    raise ValueError(f"event={v!r} is outside its domain")
+                    raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
             else:
-                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain")
+                raise ValueError(f"@GOTO_HITCH_UNHITCHstate={v!r} is outside its domain, " + "one of 'GOTO', 'HITCH', 'UNHITCH', 'IDLE'")
         elif v == 'SET-LOAD':
             v = a['event']
             if v in ('START', 'END'):
@@ -177,11 +178,14 @@ def _decide(inputs: Mapping[str, Any], calls: Calls) -> Decision:
             elif v in ('INTERM', 'ABORT', 'ZOMBIE'):
                 return _LEAF_12
             else:
-                raise ValueError(f"event={v!r} is outside its domain")
+                raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
         else:
-            raise ValueError(f"service={v!r} is outside its domain")
+            raise ValueError(f"service={v!r} is outside its domain, " + "one of 'GOTO', 'HITCH', 'UNHITCH', 'SET-LOAD'")
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise
 
 
@@ -192,7 +196,7 @@ def _node_0(a: Any, calls: Calls) -> Decision:
     elif v in ('INTERM', 'END', 'ABORT', 'ZOMBIE'):
         return _LEAF_1
     else:
-        raise ValueError(f"event={v!r} is outside its domain")
+        raise ValueError(f"event={v!r} is outside its domain, " + "one of 'START', 'INTERM', 'END', 'ABORT', 'ZOMBIE'")
 
 
 def _node_1(a: Any, calls: Calls) -> Decision:

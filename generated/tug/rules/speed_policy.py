@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import Any
 
 from specc.runtime.rules import Calls, Decision, no_calls
+from specc.runtime.rules import check_inputs as _check_inputs
 from specc.runtime.rules import check_numbers as _check_numbers
 from specc.runtime.rules import divide as _divide
 
@@ -44,9 +45,12 @@ def decide(inputs: Mapping[str, Any], calls: Calls = no_calls) -> Decision:
             elif 100.0 <= v and v <= 1000.0:
                 return _LEAF_1
             else:
-                raise ValueError(f"load={v!r} is outside its domain")
+                raise ValueError(f"load={v!r} is outside its domain, " + '[0, 1000]')
         else:
-            raise ValueError(f"clearance={v!r} is outside its domain")
+            raise ValueError(f"clearance={v!r} is outside its domain, " + '[0, 30]')
     except TypeError as error:  # a numeric input given a string or None: say which
         _check_numbers(NUMERIC_INPUTS, inputs, error)
+        raise
+    except KeyError as error:  # an input left out (or misspelt): say which
+        _check_inputs(INPUTS, inputs, error)
         raise

@@ -97,6 +97,16 @@ class Goal:
         return f"{a.attribute}{args} = {value} (line {a.line}, priority {self.priority:g})"
 
 
+def holds_apart(first: Goal, second: Goal) -> bool:
+    """Two goals holding one attribute (the same constant arguments) at other constant values over
+    the same interval: no plan meets both."""
+    a, b = first.hold, second.hold
+    constant = (pm.Num, pm.Sym)
+    return (isinstance(a, pm.Hold) and isinstance(b, pm.Hold) and (a.attribute, a.args, a.start, a.end)
+            == (b.attribute, b.args, b.start, b.end) and a.value != b.value
+            and all(isinstance(x, constant) for x in (*a.args, a.value, b.value)))
+
+
 @dataclass
 class Attempt:
     """One search: the plan found (or none), the partial plans expanded, whether every branch was
@@ -190,6 +200,16 @@ class Planner:
             # Highest priority first; within a priority, in the order the problem lists them.
             best = base
             for goal in sorted(candidates, key=lambda g: (-g.priority, g.index)):
+                clash = next((k for k in kept if holds_apart(k, goal)), None)
+                if clash is not None:  # no search tells it better, nor a larger budget
+                    h = goal.hold
+                    assert isinstance(h, pm.Hold)
+                    why = (f"cannot be met together with {clash.text}: both hold {h.attribute}"
+                           f"({', '.join(pm.describe(x) for x in h.args)}) from {h.start} to {h.end}, with "
+                           "other values, and an attribute has one value at a time")
+                    outcomes[goal.index] = GoalOutcome(goal.text, goal.priority, goal.hold.line, False, why,
+                                                       for_others=True)
+                    continue
                 # The first goal alone was searched already, with the same budget: the same search.
                 tried = alone[goal.index] if not kept else attempt(kept + [goal], self.goal_nodes)
                 if tried.node is not None:

@@ -36,6 +36,11 @@ def set_value(sdi, request):
     return "end"
 
 
+def set_mode(sdi, request):
+    sdi.mode = request.mode
+    return "end"
+
+
 def accept(sdi, request):
     return "end"
 

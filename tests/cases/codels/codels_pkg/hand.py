@@ -35,3 +35,8 @@ def watch(sdi, request):  # an exec task's codel is called with (sdi)
 
 def release(sdi, request):
     return "ether"
+
+
+loosen = "exec"  # a codel state where the function should be: no function at all
+relax = lambda sdi: "ether"  # noqa: E731 - called with (sdi, request)
+settle = lambda sdi, request: "etehr"  # noqa: E731 - a lambda's returned string is checked too
