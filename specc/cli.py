@@ -72,7 +72,8 @@ def runs_folder(value: Path) -> Path:
     value = a_folder(value) or value
     if str(value).isdigit() and not value.exists():
         raise typer.BadParameter(f"'{value}' would be a new folder named {value}: --runs is where the run folders "
-                                 f"go (for {value} seeds of every combination: `specc table --seeds {value}`)")
+                                 f"go (for {value} seeds of every combination: `specc table --seeds {value}`; a "
+                                 "folder named by digits: give its absolute path)")
     return value
 
 
@@ -97,7 +98,7 @@ def refuse_unwritable(path: Path | None, what: str, option: str, example: str, p
 
 
 # Errors of the command line's paths, not of the specs: the command could not do its work (exit 2).
-INPUT_CODES = frozenset({"missing-file", "no-spec-files"})
+INPUT_CODES = frozenset({"missing-file", "no-spec-files", "unreadable-file", "unreadable-folder"})
 
 
 def report(loaded: Loaded) -> int:
@@ -895,6 +896,9 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
                                                        "stuck in a loop): its report says so.")] = 3600.0,
         pictures: Annotated[bool, typer.Option(help="Draw the map and timeline now (else: specc replay "
                                                     "RUN).")] = True,
+        mutant: Annotated[Optional[str], typer.Option(help="Plan with this mutant of a planning model in its "
+                                                           "place, e.g. model1-0131 (`specc mutants` lists them; "
+                                                           "a campaign's report names them).")] = None,
         quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False) -> None:
     """Run a mission end to end (modules on the simulated robot, executive, supervisor, FTplan and its
     planners) and write a run folder: events.jsonl, report.json, summary.txt, map.png, timeline.png.
@@ -905,13 +909,27 @@ def run(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot's
     Example: specc run examples/tug --goal '!(FETCH B C)' --seed 3
 
     Example: specc run examples/tug --mission shuttle --world crowded --config Robot2
+
+    Example: specc run examples/tug --mission shuttle --config Robot1 --mutant warehouse-0042
     """
     from specc.run import RunError
-    from specc.run.session import RunCrashed, RunRequest, run_in_folder
+    from specc.run.session import InjectedModel, RunCrashed, RunRequest, run_in_folder
 
+    injected = None
+    if mutant is not None:
+        from specc.mutation import MutationError, find_mutant, mutant_domain
+
+        try:
+            found, aside = find_mutant(specs, mutant)
+            injected = InjectedModel(found.id, found.description, mutant_domain(found))
+        except MutationError as error:
+            raise _run_error(RunError(f"--mutant {mutant}: {error}"), 2) from None
+        if aside is not None:  # a campaign sets it aside before running it: say why this run is no news
+            err.print(f"note: mutant {mutant} is set aside by a campaign ({aside.reason}: {aside.detail})",
+                      markup=False)
     request = RunRequest(specs, mission=mission, world=world, configuration=config, seed=seed, generated=generated,
                          runs=runs, folder=folder, timing=timing, horizon=horizon,
-                         goals=tuple(goal or ()), pictures=pictures, wall_limit=wall_limit)
+                         goals=tuple(goal or ()), pictures=pictures, wall_limit=wall_limit, mutant=injected)
     try:
         with ProgressDisplay(quiet) as progress:
             outcome = run_in_folder(request, progress, compiled_note=lambda text: err.print(text, markup=False))
@@ -1094,7 +1112,10 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
             result = sweep(robot, base, missions=tuple(dict.fromkeys(mission or ())),
                            worlds=tuple(dict.fromkeys(world or ())), configurations=tuple(dict.fromkeys(config or ())),
                            seeds=range(seeds), step=step)
-        written = write_table(result, output or runs / f"{robot}-table.md")
+        table_path = output or runs / f"{robot}-table.md"
+        if result.interrupted:  # beside the table of a whole sweep, which it must not replace
+            table_path = table_path.with_name(f"{table_path.stem}-interrupted{table_path.suffix}")
+        written = write_table(result, table_path)
     except RunCrashed as crash:  # stopped by a signal: the runs so far keep their folders
         raise _run_error(crash, crash.exit_code) from None
     except RunError as error:
@@ -1117,6 +1138,10 @@ def table(specs: Annotated[Path, typer.Argument(metavar="ROBOT", help="The robot
         out.print(f"{failure.outcome}: {failure.name}: {brief_why(failure.why)}", markup=False)
     for path in written:
         out.print(f"wrote {path}", markup=False)
+    if result.interrupted:
+        err.print(f"interrupted after {len(result.outcomes)} of {result.planned} run(s): the table is of those "
+                  "(the run stopped has its folder too)", markup=False)
+        raise typer.Exit(130)
 
 
 @app.command(name="mutants")
@@ -1282,7 +1307,7 @@ def campaign(
     """
     from specc.campaign.campaign import Campaign, CampaignPlan, campaign_defaults, check_names, select_mutants
     from specc.campaign.engines import DaskEngine, LocalEngine
-    from specc.campaign.experiments import Setting
+    from specc.campaign.experiments import ORIGINAL, Setting
     from specc.campaign.report import build_report
     from specc.campaign.store import ResultStore
     from specc.mutation import default_workers
@@ -1339,9 +1364,13 @@ def campaign(
         kept = sum(1 for v in verdicts.values() if v.verdict == "kept")
         out.print(f"{len(report.outcomes)} experiments; {kept} of {len(verdicts)} mutants kept", markup=False)
         _print_report(report, output or path.parent, path.stem)
-        missing = sum(max(0, c.expected - c.done) for c in report.coverage)
-        if missing:  # experiments that timed out: a script must not take the campaign for finished
-            err.print(f"the campaign is not finished: {missing} experiment(s) timed out (--timeout {timeout:g} s); "
+        # This command's experiments that timed out (a wall-clock limit): a script must not take the
+        # campaign for finished. Those of configurations or mutants a later command added are theirs.
+        timed_out = sum(1 for o in report.outcomes if o.status == "timeout"
+                        and o.experiment.configuration in plan.configurations
+                        and (o.experiment.mutant == ORIGINAL or o.experiment.mutant in selection.domains))
+        if timed_out:
+            err.print(f"the campaign is not finished: {timed_out} experiment(s) timed out (--timeout {timeout:g} s); "
                       "the same command runs them again (with a larger --timeout if they keep timing out)",
                       markup=False)
             raise typer.Exit(1)

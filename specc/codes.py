@@ -163,7 +163,7 @@ CODES: dict[str, Code] = {
     "bad-binding": Code("an action or predicate bound to what is not a Python module.function (or a service)",
                         'action LOG(t: string) = "log";'),
     "unbound-variable": Code("a variable with no value where one is needed", "goal: !(GO $X 2);"),
-    "array-too-large": Code("an array type of more than a million elements", "hist: double[1000000000];"),
+    "array-too-large": Code("an array type of more than ten million elements", "hist: double[1000000000];"),
     "assigned-output": Code("a rule's `do` assigns a declared output: outputs are what rules restrict",
                             "outputs speed: [0, 2]; r: far ==> do {speed = 1.5};"),
     "always-true-test": Code("a test ?(= $V x) of a variable named nowhere else in the KA: it binds it and always "
@@ -514,7 +514,7 @@ FIXES: dict[str, str] = {
         "Bind the variable before it is used (a test `?(...)`, an invocation or a goal's result), or write a "
         "constant value in its place."),
     "array-too-large": (
-        "Shrink the array to at most a million elements; keep large data (maps, images) in the codels' own "
+        "Shrink the array to at most ten million elements; keep large data (maps, images) in the codels' own "
         "objects, outside the SDI."),
     "assigned-output": (
         "Set the output with `restrict out == ...` instead of `do {out = ...}`; use `do` only for "

@@ -124,6 +124,10 @@ def test_a_store_refuses_to_mix_two_campaigns(tmp_path: Path) -> None:
         assert store.describe(first) == [f"'{tmp_path / 'c.sqlite'}' holds 2 configurations (it grew by a later "
                                          "command), 1 of them asked: theirs are resumed, the report covers all 2"]
         assert store.description()["configurations"] == ["Robot1", "Robot1/2"]
+        # Part of it asked and something else changed: refused, saying what was asked.
+        with pytest.raises(RunError, match="configurations: Robot1, Robot1/2 stored, Robot1 asked; runs: 3 stored, "
+                                           "1 asked"):
+            store.describe(first | {"runs": 1})
         with pytest.raises(RunError, match="configurations: Robot1, Robot1/2 stored, Robot1/2 asked"):
             store.describe(first | {"configurations": ["Robot1/2"]})
         # More mutants drawn (a larger sample holds the smaller one), never fewer.
@@ -361,6 +365,9 @@ def test_a_small_campaign_on_the_tug(tmp_path: Path) -> None:
     assert "T̄ the physical activity time" in report  # the columns are said, for a reader of the report alone
     # The tug judges no goal in the world: the report says its goals are what FTplan believed.
     assert original.measures["judged_by_robot"] is False and "**goals counted as FTplan believed them:**" in report
+    assert dict(original.measures["detected"]) == {"watchdog": 0, "analyzer": 0, "action failure": 0, "goal check": 0}
+    assert "## Detections per experiment, by mechanism (FTplan's log; seed 004 §3.1.1)" in report
+    assert "| configuration | faults | worlds | watchdog | analyzer | action failure | goal check |" in report
 
 
 def test_a_campaign_with_experiments_timed_out_exits_1_and_says_so(tmp_path: Path) -> None:

@@ -87,4 +87,3 @@ def test_the_sdi_names_check_keeps_for_specc_are_the_runtime_s() -> None:
     from specc.runtime.functional import InternalData
 
     assert SDI_ATTRIBUTES == {name for name in vars(InternalData) if not name.startswith("_")}
-

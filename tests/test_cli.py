@@ -221,11 +221,11 @@ def test_unreadable_file_and_folder_are_gcc_style_errors(tmp_path: Path) -> None
     try:
         for command in ("check", "fmt", "compile"):
             result = specc_unprivileged(command, "hidden.spec", cwd=tmp_path)
-            assert result.returncode == 1, result.stderr
+            assert result.returncode == 2, result.stderr  # could not do its work (docs/reference.md §11)
             assert "hidden.spec:1:1: error: cannot read" in result.stderr and "[unreadable-file]" in result.stderr
         # A folder that cannot be listed is not silently skipped.
         result = specc_unprivileged("check", "robot", cwd=tmp_path)
-        assert result.returncode == 1 and "[unreadable-folder]" in result.stderr, result.stderr
+        assert result.returncode == 2 and "[unreadable-folder]" in result.stderr, result.stderr
     finally:
         (robot / "locked").chmod(0o755)
     assert "Traceback" not in result.stderr
@@ -243,7 +243,7 @@ def test_an_unreadable_codel_module_is_unreadable_not_a_syntax_error(tmp_path: P
         result = specc_unprivileged("check", "drive.spec", cwd=tmp_path)
     finally:
         codels.chmod(0o644)
-    assert result.returncode == 1 and "[unreadable-file]" in result.stderr, result.stderr
+    assert result.returncode == 2 and "[unreadable-file]" in result.stderr, result.stderr
     assert "cannot read Python module 'bot_codels.drive' (bot_codels/drive.py)" in result.stderr
     assert "[python-syntax-error]" not in result.stderr and str(tmp_path) not in result.stderr
 
@@ -670,6 +670,28 @@ def test_a_word_processor_s_quote_or_sign_is_named_with_the_character_to_write()
     rule = 'rules r {\n  inputs x: [0, 9];\n  outputs o: {"a"};\n  q: x \u2264 5 ==> restrict o == "a";\n}\n'
     (sign,) = parse_text(rule, "r.spec").diagnostics
     assert "(a word processor's character: write '<=')" in sign.message
+
+
+def test_a_brace_missing_or_one_too_many_above_the_error_is_suspected_from_the_indentation() -> None:
+    """The parser fails at the next block, lines below the mistake: the braces open there, against
+    the line's indentation, point back at it."""
+    from specc.syntax.parser import parse_text
+
+    module = ("module m {\n  number: 1;\n  request Go {\n    type: exec;\n    task: T;\n  }\n"
+              "  exec_task T { period: 10 ms; }\n}\n")
+    (missing,) = parse_text(module.replace("    task: T;\n  }\n", "    task: T;\n\n"), "m.spec").diagnostics
+    assert (missing.span.line, missing.code) == (7, "unexpected-token")
+    assert missing.message.endswith("; is a '}' missing above? the '{' of line 3 is still open here")
+    (extra,) = parse_text(module.replace("    task: T;\n  }\n", "    task: T;\n  }}\n"), "m.spec").diagnostics
+    assert extra.span.line == 7 and extra.message.endswith("; is the '}' of line 6 one too many? It closed the '{' "
+                                                           "of line 1")
+    (inline,) = parse_text("module m {\n  request Go { type control; }\n}\n", "m.spec").diagnostics
+    assert "'}'" not in inline.message  # a mistake inside a block written on one line: no brace to blame
+    # A value missing before the '}' (the brace is the unexpected token), a file written flush left:
+    # no guess at braces where adding or removing one would not mend the file.
+    (value,) = parse_text("module m {\n  request Go {\n    type:\n  }\n}\n", "m.spec").diagnostics
+    (flush,) = parse_text('module m {\nnumber: 1;\ncodels "m_codels";\n}\n', "m.spec").diagnostics
+    assert "is a '}' missing" not in value.message + flush.message and "too many" not in value.message + flush.message
 
 
 def test_a_negative_number_where_none_has_a_meaning_is_said_so() -> None:

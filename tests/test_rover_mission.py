@@ -294,6 +294,10 @@ def test_a_trapped_robot_fails_its_moves_cleanly_and_the_mission_ends(robot: Rob
     measures = measures_of(done)
     assert done.outcome == "failed" and not measures.success
     assert measures.count("p").met < measures.count("p").asked
+    # Each failed move is a detection by action failure (seed 004 §3.1.1), counted from FTplan's log.
+    detected = dict(measures.detected)
+    assert list(detected) == ["watchdog", "analyzer", "action failure", "goal check"]
+    assert detected["action failure"] == len(failed) and detected["analyzer"] == 0  # every plan valid
     assert done.events[-1]["kind"] == "mission-end" and done.events[-1]["outcome"] == "failed"
     x, y = final_position(done.events)
     assert math.hypot(x - 5.0, y - 5.0) > 2.0

@@ -267,6 +267,32 @@ def test_the_table_of_measures_comes_from_one_command(tmp_path: Path) -> None:
     assert all((Path(run["folder"]) / "events.jsonl").is_file() for run in data["runs"])
 
 
+def test_a_table_stopped_by_a_signal_keeps_the_table_of_the_runs_before(tmp_path: Path,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C in the second of three runs: the first run's row is the table (said so), not nothing."""
+    import specc.run.sweep as sweeping
+    from specc.run.package import ensure_compiled
+
+    real = sweeping.run_planned
+    runs: list[object] = []
+
+    def stopped_at_the_second(run: object) -> object:
+        runs.append(run)
+        if len(runs) == 2:  # as the signal handler ends a run: RunCrashed, exit code 130
+            raise RunCrashed("stopped by SIGINT", real(run), 130)  # type: ignore[arg-type]
+        return real(run)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sweeping, "run_planned", stopped_at_the_second)
+    tug = EXAMPLES / "tug"
+    robot = ensure_compiled(tug, tmp_path / "generated").robot
+    base = RunRequest(tug, generated=tmp_path / "generated", runs=tmp_path / "runs", pictures=False)
+    result = sweeping.sweep(robot, base, missions=("deliver",), seeds=range(3))
+    assert (result.planned, len(result.outcomes), result.interrupted) == (3, 1, True)
+    assert result.missions[0].seeds == 1
+    assert "Interrupted after 1 of 3 run(s): the means above are over those." in result.markdown()
+    assert (result.to_json()["planned"], result.to_json()["interrupted"]) == (3, True)
+
+
 def test_a_failed_mission_says_each_reason_once_and_its_summary_cuts_it_short() -> None:
     """FTplan gives every goal it abandons at once the same reason, every planner's diagnostics:
     said once for the goals it stands for, cut short in the summary's line and the table's

@@ -568,12 +568,16 @@ def test_a_recursion_without_end_ends_its_intention_and_one_with_an_end_runs_to_
     from specc.runtime.supervisor import MOST_NESTED_KAS
 
     endless = supervisor(ka("Spot", "!(SPOT $X)", step("!(SPOT $X)", 19), line=17), ka("Ping", "!(PING)", step(
-        "!(PONG)", 3)), ka("Pong", "!(PONG)", step("!(PING)", 5)))
-    for posted, chain in (("!(SPOT 4)", "Spot -> Spot for (SPOT 4)"), ("!(PING)", "Pong -> Ping for (PING)")):
+        "!(PONG)", 3)), ka("Pong", "!(PONG)", step("!(PING)", 5)),
+        # through a parallel branch: each branch is a thread of its own, its KAs nested in its parent's
+        ka("Fork", "!(FORK)", Parallel(((step("!(FORK)", 41),), (step("=>(FORKED)", 42),)), 40), line=39))
+    for posted, chain in (("!(SPOT 4)", "Spot -> Spot for (SPOT 4)"), ("!(PING)", "Pong -> Ping for (PING)"),
+                          ("!(FORK)", "Fork for (FORK)")):
         failed = done(endless, posted)
-        assert failed.status == "failed"
+        assert failed.status == "failed", posted
         assert failed.lines()[-1].startswith(f"top:0: abandoned: KAs nested {MOST_NESTED_KAS} deep (... ")
-        assert f"{chain}): a KA posting its own goal, or KAs posting each other's" in failed.lines()[-1]
+        assert f"{chain}), the most the supervisor runs (MOST_NESTED_KAS): most often a KA posting its own goal, " \
+            "or KAs posting each other's" in failed.lines()[-1]
     counting = supervisor(ka("Down", "!(DOWN $N)", If(goal("?(> $N 0)"), (step("!(DOWN (- $N 1))"),),
                                                      (step("=>(BOTTOM)"),)), line=30))
     assert done(counting, f"!(DOWN {MOST_NESTED_KAS - 1})").status == "succeeded"  # that many KAs nested

@@ -313,3 +313,29 @@ def test_the_task_level_s_inputs_of_the_wrong_count_or_type_are_answered_bad_inp
     assert [(m.id, m.result) for m in replies] == [(1, "BAD-INPUT"), (2, "BAD-INPUT")]
     assert replies[0].detail == "GOTO takes x, y from the task level; 1 given"
     assert replies[1].detail == "GOTO's input x: expected float, got str"
+    # A bare value, not a tuple: the caller's mistake, said with the service's inputs.
+    with pytest.raises(TypeError, match=r"inputs of SET-LOAD: give a tuple of values in the order the service takes "
+                                        r"them \(load\), e.g. \(1,\), not int 1"):
+        executive.request("SET-LOAD", 3, inputs=1)  # type: ignore[arg-type]
+
+
+def test_a_run_with_a_mutant_of_the_planning_model_says_which(tmp_path: Path) -> None:
+    """`specc run --mutant ID` reruns one experiment of a campaign: FTplan plans in the mutant,
+    the report and the summary name it, and a wrong id or an unplanned mission is one line."""
+    result = specc("run", TUG, "--mission", "shuttle", "--config", "Robot1", "--mutant", "warehouse-0124",
+                   "--runs", tmp_path, "-q", "--no-pictures")
+    folder = tmp_path / "tug-shuttle-hall-Robot1-s0-warehouse-0124"
+    report = json.loads((folder / "report.json").read_text())
+    assert report["mutant"] == {"id": "warehouse-0124",
+                                "description": "planning.spec:38:29: value TUG -> DOCK of CART_AT (after) in HITCH"}
+    assert (folder / "summary.txt").read_text().startswith("with mutant warehouse-0124: planning.spec:38:29: ")
+    # The mutant is what FTplan plans in: HITCH no longer puts the cart on the tug, and the cart's
+    # goal is left aside (the original model meets it: tests above).
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert report["outcome"] == "failed" and "CART_AT(CART1) = C" in report["why"]
+    wrong = specc("run", TUG, "--mission", "shuttle", "--mutant", "warehouse-9999", "--runs", tmp_path)
+    assert wrong.returncode == 2 and "--mutant warehouse-9999: no such mutant (the mutants of 'warehouse' are " \
+        "warehouse-0001 to warehouse-" in wrong.stderr
+    unplanned = specc("run", TUG, "--mission", "deliver", "--mutant", "warehouse-0001", "--runs", tmp_path)
+    assert unplanned.returncode == 2 and "mission deliver of robot 'tug' is not planned" in unplanned.stderr
+

@@ -221,7 +221,9 @@ def check_names(plan: CampaignPlan) -> list[str]:
                         f"configuration {configuration}: planners {', '.join(sharing)} all plan in '{plan.domain}', "
                         "so each mutant reaches them all (a fault common to them): their diversity is measured "
                         "against model faults only with a model of their own each (seed 004 §3.1; §4.1.2.2: "
-                        "Modele1 and Modele2)")
+                        "Modele1 and Modele2). With one model written once, give the other planner a copy of the "
+                        "domain under another name (its own problems for it), and the mutants reach one planner "
+                        "only")
     return list(notes.values())
 
 

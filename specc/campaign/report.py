@@ -128,7 +128,7 @@ def build_report(store: ResultStore) -> CampaignReport:
     finished: dict[tuple[str, str, str, int], set[str]] = {}
     for o, _ in measures:
         finished.setdefault(_paired(o), set()).add(o.experiment.configuration)
-    started = set(configurations) & {o.experiment.configuration for o, _ in measures}
+    started = set(configurations) & {o.experiment.configuration for o in outcomes}  # crashed ones too
     unpaired = {key for key, done_by in finished.items() if key[0] in kept | {ORIGINAL}
                 and not done_by >= started}
     measures = [(o, m) for o, m in measures if _paired(o) not in unpaired]
@@ -255,7 +255,9 @@ def markdown(report: CampaignReport) -> str:
         lines += [f"- for reference, seed 004's own campaign (§4.2.2.3, W* \\ W4, its rover and missions): "
                   f"+{seed_abs * 100:.0f} points of mission success, failures cut by {seed_rel:.0%} relative: "
                   f"its Robot1 succeeded in about {1 - seed_failed:.0%} of missions under faults, its Robot1/2 in "
-                  f"about {1 - seed_failed + seed_abs:.0%}, still below fault-free", ""]
+                  f"about {1 - seed_failed + seed_abs:.0%}, still below fault-free. Its FTplan had no plan "
+                  "analyzer, and its IxTeT repaired plans before replanning: configurations named "
+                  "`-noanalyzer` (and `-repair`) are the seed's (docs/campaign.md)", ""]
     shown = quotients(report)
     header = [label for _, label in shown] + ["κ̄", "R̄", "T̄ (s)", "D̄ (m)"]
     lines += ["## Means over sets of activities", "",
@@ -274,6 +276,22 @@ def markdown(report: CampaignReport) -> str:
               "the robot then simply stays); R̄ the replannings per mission; T̄ the physical activity time, how "
               "long at least one action ran (neither planning nor waiting counts, so a recovery's cost shows in "
               "R̄ and in each result's `mission_time`, not here); D̄ the distance travelled."]
+    mechanisms = list(dict.fromkeys(name for mean in report.means if mean.means is not None
+                                    for name, _ in mean.means.detected))
+    if mechanisms:
+        lines += ["", "## Detections per experiment, by mechanism (FTplan's log; seed 004 §3.1.1)", "",
+                  "| configuration | faults | worlds | " + " | ".join(mechanisms) + " |",
+                  "| --- | --- | --- | " + " | ".join("---" for _ in mechanisms) + " |"]
+        for mean in report.means:
+            if mean.means is None:
+                continue
+            detected: dict[str, float] = dict(mean.means.detected)
+            lines.append(f"| {mean.configuration} | {mean.faults} | {mean.worlds} | "
+                         + " | ".join(f"{detected.get(name, 0.0):.2f}" for name in mechanisms) + " |")
+        lines += ["", "Each a mean count per experiment: the watchdog on planning time, the plan analyzer "
+                  "(`-noanalyzer` configurations have none), an action's failure reported by the executive, the "
+                  "check of the goals once a plan has ended. A fault detected is followed by a replanning (R̄) or "
+                  "ends the mission (κ̄)."]
     configurations = list(d.get("configurations", []))
     lines += ["", "## Kept mutants (F*): mission success ν̄ over every activity", "",
               "| mutant | class | mutation | " + " | ".join(configurations) + " |",

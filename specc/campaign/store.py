@@ -121,9 +121,20 @@ class ResultStore:
         notes: list[str] = []
         if stored:
             differs = sorted(k for k in set(stored) | set(description) if stored.get(k) != description.get(k))
-            grows = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))
-                     or k in REPORT_ONLY]
-            part = [k for k in differs if k in GROWING and _grows(k, description.get(k), stored.get(k))]
+            # A list of the same items (configurations in another order after the same first): the same.
+            same = [k for k in differs if k in GROWING and _grows(k, stored.get(k), description.get(k))
+                    and _grows(k, description.get(k), stored.get(k))]
+            grows = [k for k in differs if k not in same and (k in REPORT_ONLY or k in GROWING
+                                                              and _grows(k, stored.get(k), description.get(k)))]
+            part = [k for k in differs if k not in same and k in GROWING
+                    and _grows(k, description.get(k), stored.get(k))]
+            if set(differs) - set(same) - set(grows) - set(part):
+                said = "; ".join(f"{k}: {_shown(stored.get(k))} stored, {_shown(description.get(k))} asked"
+                                 for k in differs)
+                files = (" (files: the robot's specs, codels and worlds, or specc itself, changed since: a "
+                         "campaign's results all come from one robot and one specc)") if "files" in differs else ""
+                raise RunError(f"'{self.path}' holds another campaign ({said}){files}: give another --store, or "
+                               "the options it was run (or last grown) with to resume it")
             for k in grows:
                 if k in GROWING:
                     added = [item for item in description[k] if item not in stored[k]]
@@ -132,14 +143,6 @@ class ResultStore:
                 notes.append(f"'{self.path}' holds {len(stored[k])} {k} (it grew by a later command), "
                              f"{len(description[k])} of them asked: theirs are resumed, the report covers all "
                              f"{len(stored[k])}")
-                description = {**description, k: stored[k]}
-            if set(differs) - set(grows) - set(part):
-                said = "; ".join(f"{k}: {_shown(stored.get(k))} stored, {_shown(description.get(k))} asked"
-                                 for k in differs)
-                files = (" (files: the robot's specs, codels and worlds, or specc itself, changed since: a "
-                         "campaign's results all come from one robot and one specc)") if "files" in differs else ""
-                raise RunError(f"'{self.path}' holds another campaign ({said}){files}: give another --store, or "
-                               "the options it was run (or last grown) with to resume it")
             with self.db:
                 self.db.executemany("UPDATE campaign SET value = ? WHERE name = ?",
                                     [(json.dumps(description[k]), k) for k in grows])

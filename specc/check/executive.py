@@ -214,7 +214,7 @@ def elsewhere(ctx: Context, service: str, executive: m.Executive, rule: str) -> 
     """' in executive 'e' (it is executive 'other''s: ...)' for a service another executive has."""
     owners = [e.name for e in ctx.items(m.Executive) if e is not executive and any(s.name == service
                                                                                  for s in e.services)]
-    return f" in executive '{executive.name}' (it is executive '{owners[0]}''s: {rule})" if owners else ""
+    return f" in executive '{executive.name}' (it is a service of executive '{owners[0]}': {rule})" if owners else ""
 
 
 def check_reflex(ctx: Context, reflex: m.Reflex, services: Mapping[str, m.Service]) -> None:

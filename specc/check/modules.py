@@ -40,9 +40,10 @@ ACTIVITY_ATTRIBUTES = frozenset({"id", "spec", "module", "input", "output", "sta
                                  "fail_report", "task", "live_children"})
 
 
-# Elements of one array type (`double[N]`): a list of this many is built in tens of milliseconds,
-# and copied at each poster update; a typo's extra zeros would exhaust the memory.
-MOST_ARRAY_ELEMENTS = 1_000_000
+# Elements of one array type (`double[N]`): a list of ten million is 80 MB of references, built
+# when the module starts and copied at each poster update (a 1024 x 1024 grid is a tenth of it); a
+# typo's extra zeros would exhaust the memory.
+MOST_ARRAY_ELEMENTS = 10_000_000
 # What a codel reaches through its SDI besides the module's data (`sdi.hardware`, `sdi.read_poster`):
 # an internal data field of one of these names would hide it. The public names of
 # specc.runtime.functional.InternalData (tests/test_cases.py holds them equal; not imported here:

@@ -93,9 +93,11 @@ class RuleVisitor(Visitor):
         self.check_not_input(node.target, node.span)
         declared = self.declared.get(node.target)
         if declared is not None and declared.role == "outputs":
-            self.ctx.report("assigned-output", f"'{node.target}' is an output: a decision's outputs are what its "
-                            f"rules restrict (`restrict {node.target} == ...`), and `do` computes a value the rules "
-                            f"test (an intermediate); decide would give '{node.target}' unrestricted", node.span)
+            self.ctx.report("assigned-output", f"'{node.target}' is an output: a decision's outputs take the values "
+                            f"its rules restrict them to (`restrict {node.target} == 5`, or `oneof [...]`), and `do` "
+                            "computes a value for the rules' own tests (an intermediate): decide would give "
+                            f"'{node.target}' unrestricted. A value computed from the inputs (`battery / 10`) is no "
+                            "output of a propositional rule base: let the caller compute it", node.span)
         self.in_action = False
         self.visit(node.value)
         self.in_action = True
@@ -298,6 +300,18 @@ def check_rules_never_fire(ctx: Context, base: m.RuleBase, visitor: RuleVisitor)
         return {n.name for n in (walk(node) if node is not None else ()) if isinstance(n, m.AttrRef)
                 and not n.previous and n.index is None and n.name not in visitor.constants}
 
+    def needs(node: m.Node | None) -> list[frozenset[str]]:
+        """The sets of attributes a condition reads, any one of which may let it hold once they all
+        have values: `a | b` holds with either side's, `a, b` needs both sides'."""
+        if isinstance(node, m.KOr):
+            return [alternative for operand in node.operands for alternative in needs(operand)]
+        if isinstance(node, m.KAnd):
+            found = [frozenset[str]()]
+            for operand in node.operands:
+                found = [a | b for a in found for b in needs(operand)][:ALTERNATIVES]
+            return found
+        return [frozenset(named(node))]
+
     def sets(rule: m.Rule) -> set[str]:
         return {n.target if isinstance(n, m.DoAssign) else n.name for action in rule.actions for n in walk(action)
                 if isinstance(n, m.DoAssign) or (isinstance(n, m.AttrRef) and isinstance(action, m.Restrict))}
@@ -307,17 +321,20 @@ def check_rules_never_fire(ctx: Context, base: m.RuleBase, visitor: RuleVisitor)
     for rule in base.rules:
         if rule not in plain:  # an else rule, a rule written per element: taken to fire
             valued |= set().union(*(sets(r) for r in (rule.rules if isinstance(rule, m.RuleForeach) else (rule,))))
-    waiting = [(rule, named(rule.condition)) for rule in plain]
+    waiting = [(rule, needs(rule.condition)) for rule in plain]
     grew = True
     while grew:
         grew = False
-        for rule, reads in waiting:
-            if reads <= valued and not sets(rule) <= valued:
+        for rule, alternatives in waiting:
+            if any(reads <= valued for reads in alternatives) and not sets(rule) <= valued:
                 valued |= sets(rule)
                 grew = True
     deduced = {name for rule in plain for name in sets(rule)}
-    for rule, reads in waiting:
-        missing = sorted(reads - valued)
+    for rule, alternatives in waiting:
+        if any(reads <= valued for reads in alternatives):
+            continue
+        fewest = min((reads - valued for reads in alternatives), key=len)
+        missing = sorted(fewest)
         if missing and set(missing) <= deduced & visitor.set_otherwise:  # else `undefined-attribute` says it
             setters = sorted(r.name for r in plain if sets(r) & set(missing))
             said = " and ".join(f"'{name}'" for name in missing)
@@ -325,6 +342,11 @@ def check_rules_never_fire(ctx: Context, base: m.RuleBase, visitor: RuleVisitor)
             ctx.warn("rule-never-fires", f"rule '{rule.name}' can never fire: {said} {'gets' if one else 'get'} a "
                      f"value only from rules that need {'it' if one else 'them'} first ({', '.join(setters)}); "
                      "start the chain from an input", rule.span)
+
+
+# Alternatives a condition's `|` under `,` may multiply into, kept: past them a rule counts as one
+# that may fire (a warning is only given when sure).
+ALTERNATIVES = 64
 
 
 def conjuncts(condition: m.Node) -> list[m.Node]:

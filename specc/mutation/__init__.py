@@ -25,6 +25,7 @@ from specc.mutation.mutants import (
     default_workers,
     draw_kept,
     enumerate_mutants,
+    find_mutant,
     keep_valid,
     mutant_domain,
     mutation_target,
@@ -32,6 +33,6 @@ from specc.mutation.mutants import (
 
 __all__ = [
     "CLASSES", "ClassCounts", "Edit", "Mutant", "MutantSet", "MutationClass", "MutationError", "MutationTarget",
-    "Rejection", "default_workers", "draw_kept", "enumerate_mutants", "keep_valid", "mutant_domain",
+    "Rejection", "default_workers", "draw_kept", "enumerate_mutants", "find_mutant", "keep_valid", "mutant_domain",
     "mutation_target",
 ]

@@ -355,7 +355,9 @@ def _written_in_place(target: MutationTarget, edit: Edit) -> str | None:
         line_start, line_end = written.rfind("\n", 0, start) + 1, written.find("\n", end)
         line_end = len(written) if line_end < 0 else line_end
         rest = written[end:line_end].strip()
-        if not written[line_start:start].strip() and rest in ("", ";"):
+        after = rest.removeprefix(";").strip()
+        # Alone on its line, with or without a comment of its own after it: the line goes.
+        if not written[line_start:start].strip() and (not after or after.startswith("//")):
             return written[:line_start] + written[line_end + 1:]
         return written[:start] + written[end + (1 if rest.startswith(";") else 0):]
     return written[:start] + (new if there.endswith(";") else new.rstrip(";")) + written[end:]
@@ -494,6 +496,24 @@ def without_lines(value: Any) -> Any:
 
 
 # ---------------------------------------------------------------- campaigns
+
+
+def find_mutant(robot: Robot, mutant_id: str) -> tuple[Mutant, Rejection | None]:
+    """The mutant `mutant_id` (`<domain>-NNNN`, as `specc mutants` and a campaign name it) of the
+    robot, and why keep_valid sets it aside if it does (identical, a duplicate, equivalent: it
+    runs as the original or another mutant); MutationError when there is none, or it does not
+    pass `specc check` (a campaign never runs those)."""
+    domain = mutant_id.rpartition("-")[0]
+    mutants = enumerate_mutants(robot, domain)
+    found = next((x for x in mutants if x.id == mutant_id), None)
+    if found is None:
+        raise MutationError(f"no such mutant (the mutants of '{domain}' are {mutants[0].id} to "
+                            f"{mutants[-1].id}: `specc mutants` lists them)")
+    rejected = keep_valid([found]).rejected
+    if rejected and rejected[0].reason == "invalid":
+        raise MutationError(f"mutant {mutant_id} does not pass specc check ({rejected[0].detail}): a campaign "
+                            "never runs it")
+    return found, rejected[0] if rejected else None
 
 
 def mutant_domain(mutant: Mutant) -> pm.PlanningDomain:

@@ -91,6 +91,8 @@ class Measures:
     # The goals were judged by the robot's own judgement of the world (its extension's `measure`),
     # not as FTplan's ledger believed them: a fault in FTplan's model cannot count a goal met.
     judged_by_robot: bool = False
+    # FTplan's detections by mechanism (seed 004 §3.1.1), counted from its log: (mechanism, count).
+    detected: tuple[tuple[str, int], ...] = ()
 
     def count(self, kind: str) -> GoalCount:
         """The goals of `kind` (none asked when the run had none)."""
@@ -140,7 +142,8 @@ class Measures:
                        distance=float(data["distance"]), mission_time=float(data["mission_time"]),
                        planner_failures=int(data["planner_failures"]), believed=believed,
                        repairs=int(data.get("repairs", 0)), repaired=int(data.get("repaired", 0)),
-                       judged_by_robot=bool(data.get("judged_by_robot", False)))
+                       judged_by_robot=bool(data.get("judged_by_robot", False)),
+                       detected=tuple((str(name), int(count)) for name, count in data.get("detected", ())))
         except (KeyError, TypeError, ValueError, AttributeError) as error:
             raise RunError(f"not the measures of seed 004 §4.1.4 ({type(error).__name__}: {error})") from None
 
@@ -220,7 +223,15 @@ def planned_measures(events: Sequence[Mapping[str, Any]], judge: Judgement = bel
         planner_failures=int(figures.get("planner_failures", 0)),
         believed=GoalCount(len(goals), sum(g.believed for g in goals)),
         repairs=int(figures.get("repairs", 0)), repaired=int(figures.get("repaired", 0)),
-        judged_by_robot=judge is not believed)
+        judged_by_robot=judge is not believed,
+        detected=tuple((mechanism, sum(1 for e in events if e["kind"] == "ftplan" and e.get("event") == event))
+                       for event, mechanism in DETECTIONS))
+
+
+# FTplan's events that are a detection (seed 004 §3.1.1), and the mechanism each is: the watchdog on
+# planning, the plan analyzer, an action's failure, the on-line check of the goals.
+DETECTIONS = (("watchdog", "watchdog"), ("invalid-plan", "analyzer"), ("action-failed", "action failure"),
+              ("goals-open", "goal check"))
 
 
 def _rank(kind: str, kinds: Sequence[str]) -> int:
@@ -269,6 +280,7 @@ class MeanMeasures:
     replannings: float  # R-bar
     activity_time: float  # T-bar, s
     distance: float  # D-bar, m
+    detected: tuple[tuple[str, float], ...] = ()  # detections per run, by mechanism (FTplan's log)
 
     def sigma_of(self, kind: str) -> float:
         """sigma-bar of `kind` (1: no run asked for any)."""
@@ -283,7 +295,8 @@ class MeanMeasures:
 
     def to_json(self) -> dict[str, Any]:
         data: dict[str, Any] = {k: round(v, 6) if isinstance(v, float) else v for k, v in asdict(self).items()
-                                if k != "sigma"}
+                                if k not in ("sigma", "detected")}
+        data["detected"] = {mechanism: round(value, 6) for mechanism, value in self.detected}
         for kind, value in self.sigma:
             data[f"sigma_{kind}"] = round(value, 6)
             data[f"phi_{kind}"] = round(1.0 - value, 6)
@@ -311,7 +324,9 @@ def aggregate(measures: Sequence[Measures]) -> MeanMeasures:
         sigma=tuple((kind, mean(m.count(kind).sigma for m in measures)) for kind in kinds),
         nu=mean(m.nu for m in measures), kappa=mean(m.kappa for m in measures),
         replannings=mean(m.replannings for m in measures),
-        activity_time=mean(m.activity_time for m in measures), distance=mean(m.distance for m in measures))
+        activity_time=mean(m.activity_time for m in measures), distance=mean(m.distance for m in measures),
+        detected=tuple((mechanism, mean(dict(m.detected).get(mechanism, 0) for m in measures))
+                       for mechanism in dict.fromkeys(name for m in measures for name, _ in m.detected)))
 
 
 def measure_table(measures: Iterable[Measures], by: Sequence[str] = GROUPS) -> list[MeanMeasures]:

@@ -116,6 +116,17 @@ class RunRequest:
     goals: tuple[str, ...] = ()  # PRS goals to post instead of a mission's (`--goal '!(...)'`)
     wall_limit: float | None = DEFAULT_WALL_LIMIT  # s of wall time before the run is stopped (None: no limit)
     pictures: bool = True  # draw them now (`specc replay RUN` draws them later from the log)
+    mutant: InjectedModel | None = None  # a mutant of a planning domain in place of that domain
+
+
+@dataclass(frozen=True)
+class InjectedModel:
+    """A mutant of a planning model (`specc.mutation`) a run plans in, in place of the model of
+    its name: what `specc run --mutant` reruns of a campaign."""
+
+    id: str  # "model1-0131"
+    description: str  # where and what was mutated
+    domain: Any  # specc.runtime.planner.model.PlanningDomain
 
 
 @dataclass
@@ -195,6 +206,7 @@ def plan_run(robot: str, request: RunRequest) -> PlannedRun:
         said = re.sub(r"[^A-Za-z0-9_.-]+", "-", " ".join(request.goals)).strip("-")[:GOALS_IN_NAME]
         digest = hashlib.sha256("\0".join(request.goals).encode()).hexdigest()[:6]
         variant = f"-{said}-{digest}{variant}"
+    variant += f"-{request.mutant.id}" if request.mutant is not None else ""
     name = folder_name(robot, *plan.name_parts, request.seed)
     return PlannedRun(robot, request, plan, request.runs / (name + variant))
 
@@ -291,8 +303,9 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         mission = robot.mission(missions[0])
     else:
         mission = robot.mission(request.mission)
+    injected = request.mutant
     checked = check_mission(robot, mission, request.world, request.seed, request.horizon, request.configuration,
-                            request.timing)
+                            request.timing, {injected.domain.name: injected.domain} if injected is not None else None)
     if checked.planning is None and request.timing != "model":
         raise RunError(f"timing '{request.timing}': FTplan's planning charge; mission {mission.name} is not planned")
     world = request.world or mission.world
@@ -313,9 +326,14 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
         report = {"outcome": "succeeded" if result.outcome == "succeeded" else result.outcome, "why": why,
                   "simulated_time": round(result.simulated_time, 3), "goals": [list(g) for g in result.goals],
                   "measures": result.measures(), "incidents": list(result.incidents)}
-        return report, result.summary()
+        summary = result.summary()
+        if injected is not None:
+            report["mutant"] = {"id": injected.id, "description": injected.description}
+            summary = f"with mutant {injected.id}: {injected.description}\n{summary}"
+        return report, summary
 
     return _Plan((mission.name, world_name, configuration), run)
+
 
 
 def _checked_goal(robot: Any, text: str, specs: Path) -> str:

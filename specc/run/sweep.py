@@ -66,6 +66,11 @@ class SweepResult:
     outcomes: list[RunOutcome] = field(default_factory=list)
     rows: list[MeanMeasures] = field(default_factory=list)  # seed 004's means, when the runs measured them
     missions: list[MissionRow] = field(default_factory=list)
+    planned: int = 0  # the runs asked for: more than the outcomes when the table was interrupted
+
+    @property
+    def interrupted(self) -> bool:
+        return len(self.outcomes) < self.planned
 
     @property
     def failures(self) -> list[Failure]:
@@ -79,6 +84,9 @@ class SweepResult:
             headings, cells = self.mission_cells()
             text = ("| " + " | ".join(headings) + " |\n" + "| --- " * len(headings) + "|\n"
                     + "".join(("| " + " | ".join(row) + " |").replace("|  |", "| |") + "\n" for row in cells))
+        if self.interrupted:
+            text += (f"\nInterrupted after {len(self.outcomes)} of {self.planned} run(s): the means above are over "
+                     "those.\n")
         crashed = sum(o.report.get("outcome") == "crashed" for o in self.outcomes)
         if crashed:
             text += f"\n{crashed} run(s) crashed: they have no measures, so the means above leave them out.\n"
@@ -97,13 +105,16 @@ class SweepResult:
             # planned_goals columns), and columns of zeros would read as goals failed.
             figures = [name for name in figures if name not in POSTED_GOALS]
         headings = ["mission", "world", "configuration", "seeds", "succeeded", "success rate", "time (s)", *figures]
+        # A planned mission beside missions of posted goals posts none: "-", not goals failed.
         cells = [[row.mission, row.world, row.configuration or "-", str(row.seeds), str(row.succeeded),
                   f"{100 * row.success_rate:.0f} %", mean_time_text(row.simulated_time, ".1f"),
-                  *(f"{row.means[n]:.4g}" if n in row.means else "" for n in figures)] for row in self.missions]
+                  *("-" if n in POSTED_GOALS and not row.means.get("goals") else
+                    f"{row.means[n]:.4g}" if n in row.means else "" for n in figures)] for row in self.missions]
         return headings, cells
 
     def to_json(self) -> dict[str, Any]:
-        return {"robot": self.robot, "runs": [dict(o.report, folder=str(o.folder)) for o in self.outcomes],
+        return {"robot": self.robot, "planned": self.planned, "interrupted": self.interrupted,
+                "runs": [dict(o.report, folder=str(o.folder)) for o in self.outcomes],
                 "rows": [row.to_json() for row in self.rows],
                 "missions": [row.to_json() for row in self.missions]}
 
@@ -142,7 +153,7 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
     if not requests:
         raise RunError("nothing to run: give at least one mission, world and configuration")
     planned = [plan_run(robot, request) for request in requests]  # a typo stops the table before any run
-    result = SweepResult(robot)
+    result = SweepResult(robot, planned=len(planned))
     with planner_processes_kept():  # the runs' planners start warm, one after another
         for done, run in enumerate(planned):
             if step is not None:
@@ -150,10 +161,10 @@ def sweep(robot: str, base: RunRequest, *, missions: Sequence[str] = (), worlds:
             try:
                 result.outcomes.append(run_planned(run))
             except RunCrashed as crash:  # one broken run is a failure of the table, not the end of it
+                if crash.exit_code == 130:  # but a signal (Ctrl-C) stops the table: the runs before it make it
+                    break
                 result.outcomes.append(crash.outcome)
-                if crash.exit_code == 130:  # but a signal (Ctrl-C) stops the table: its runs so far are kept
-                    raise
-    if step is not None:
+    if step is not None and not result.interrupted:
         step(len(requests), len(requests), "")
     result.missions = mission_rows(result.outcomes)
     measured = [o.report.get("measures") for o in result.outcomes if o.report.get("outcome") != "crashed"]

@@ -274,8 +274,13 @@ class Executive:
         TypeError, before anything is sent, when `inputs` is not a tuple or list of values in the
         order the service `takes` them."""
         if not isinstance(inputs, (tuple, list)):
-            raise TypeError(f"inputs of {service}: give a tuple of values in the order the service takes them, e.g. "
-                            f"(3.0, 4.0), not {type(inputs).__name__} {inputs!r}")
+            spec = self.spec.services.get(service)
+            takes = spec.takes if spec is not None else ()
+            example = ("()" if not takes else f"({inputs!r},)" if len(takes) == 1
+                       else "(" + ", ".join(f"{k + 1}.0" for k in range(len(takes))) + ")")
+            order = f" ({', '.join(takes)})" if takes else ""
+            raise TypeError(f"inputs of {service}: give a tuple of values in the order the service takes them{order}, "
+                            f"e.g. {example}, not {type(inputs).__name__} {inputs!r}")
         ident = next(self._internal_ids) if ident is None else ident
         self._highest_id = max(self._highest_id, ident)
         self._post(self._on_request, service, ident, tuple(inputs))

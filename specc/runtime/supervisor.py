@@ -375,6 +375,17 @@ _Body = Generator[_Blocked | None, None, bool]
 _Pursuit = Generator[_Blocked | None, None, str | None]  # returns why the goal failed, None on success
 
 
+def _nesting(thread: _Thread) -> int:
+    """The KAs running nested where `thread` runs: its own, and those of the threads whose
+    parallel branches it is (each waits at its join with its KAs still running)."""
+    depth = 0
+    current: _Thread | None = thread
+    while current is not None:
+        depth += len(current.frames)
+        current = current.parent
+    return depth
+
+
 class _NestedTooDeep(Exception):
     """MOST_NESTED_KAS reached: not a KA's failure, which another KA might mend, but an endless
     recursion; it ends the intention (`_advance`)."""
@@ -702,11 +713,12 @@ class Supervisor:
         return failure is None
 
     def _run_ka(self, thread: _Thread, ka: KA, env: dict[str, Any], why: str) -> _Body:
-        if len(thread.frames) >= MOST_NESTED_KAS:
+        if _nesting(thread) >= MOST_NESTED_KAS:
             last = [f.name for f in thread.frames[-4:]]
-            raise _NestedTooDeep(f"KAs nested {MOST_NESTED_KAS} deep (... {' -> '.join(last)} -> {ka.name} for {why}): "
-                                 "a KA posting its own goal, or KAs posting each other's, with nothing to end it; "
-                                 "test first what ends the recursion (an `if`, a context), or post another goal")
+            raise _NestedTooDeep(f"KAs nested {MOST_NESTED_KAS} deep (... {' -> '.join(last)} -> {ka.name} for {why}), "
+                                 "the most the supervisor runs (MOST_NESTED_KAS): most often a KA posting its own "
+                                 "goal, or KAs posting each other's, with nothing to end it; test first what ends "
+                                 "the recursion (an `if`, a context), or post another goal")
         frame = _Frame(ka, env, thread.intention)
         thread.frames.append(frame)
         self._record(frame, ka.line, f"started for {why}")

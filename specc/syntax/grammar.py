@@ -154,7 +154,8 @@ def syntax_error(exc: UnexpectedInput, text: str, path: str) -> Diagnostic:
         # `wheel_base: -0.5;`: a property's value is a count, a length or a duration, never below 0.
         # (In a list, `[-5, 0]` or `{-1, 0}`, a negative value may mean something: no such hint.)
         close = " (a negative number has no meaning here: this value must be 0 or more)"
-    return error("unexpected-token", f"unexpected {describe_token(token)}{close}; expected {expected}", span)
+    braces = "" if close else _brace_hint(text, position)  # one guess at a time: a word misspelt first
+    return error("unexpected-token", f"unexpected {describe_token(token)}{close}; expected {expected}{braces}", span)
 
 
 UNITS = ("us", "ms", "s", "min")
@@ -243,8 +244,46 @@ def _end_of_previous_line(text: str, position: int) -> int | None:
 
 def _unclosed_brace(text: str) -> tuple[int, int] | None:
     """(line, column) of the last `{` no `}` closes, strings and comments aside."""
+    openers, _ = _braces(text, len(text))
+    return _line_column(text, openers[-1]) if openers else None
+
+
+def _brace_hint(text: str, position: int) -> str:
+    """Where the braces before `position` disagree with the indentation of its line: a `{` still
+    open although the line is no deeper than the line that opened it (a `}` missing above), or
+    none open although the line is indented (a `}` too many above); else ''."""
+    if text.startswith("}", position):  # the brace itself is what came too early: nothing above to blame
+        return ""
+    openers, closed = _braces(text, position)
+    line_start = text.rfind("\n", 0, position) + 1
+    indent = _indentation(text, line_start)
+    # Each guess is kept only when the file, so mended, parses past the error: a layout of one's own
+    # (every line flush left) is no mistake.
+    if openers and openers[-1] < line_start and indent <= _indentation(text, text.rfind("\n", 0, openers[-1]) + 1) \
+            and _parses_past(text[:line_start] + "}\n" + text[line_start:], position + 2):
+        line = _line_column(text, openers[-1])[0]
+        return f"; is a '}}' missing above? the '{{' of line {line} is still open here"
+    if not openers and indent > 0 and closed is not None \
+            and _parses_past(text[:closed[0]] + text[closed[0] + 1:], position - 1):
+        closer, opener = closed
+        return (f"; is the '}}' of line {_line_column(text, closer)[0]} one too many? It closed the '{{' of line "
+                f"{_line_column(text, opener)[0]}")
+    return ""
+
+
+def _indentation(text: str, line_start: int) -> int:
+    end = line_start
+    while end < len(text) and text[end] in " \t":
+        end += 1
+    return len(text[line_start:end].expandtabs(4))
+
+
+def _braces(text: str, stop: int) -> tuple[list[int], tuple[int, int] | None]:
+    """The positions of the `{` still open at `stop`, and the last `}` before it with the `{` it
+    closed, strings and comments aside."""
     openers: list[int] = []
-    k, n = 0, len(text)
+    closed: tuple[int, int] | None = None
+    k, n = 0, stop
     while k < n:
         c = text[k]
         if c == '"':
@@ -258,9 +297,9 @@ def _unclosed_brace(text: str) -> tuple[int, int] | None:
         elif c == "{":
             openers.append(k)
         elif c == "}" and openers:
-            openers.pop()
+            closed = (k, openers.pop())
         k += 1
-    return _line_column(text, openers[-1]) if openers else None
+    return openers, closed
 
 
 def _line_column(text: str, position: int) -> tuple[int, int]:

@@ -396,7 +396,8 @@ def test_executive_inputs_that_are_no_tuple_are_refused_before_anything_is_sent(
     from specc.runtime import executive as rx
 
     sent: list[Any] = []
-    executive = types.SimpleNamespace(_post=lambda *args: sent.append(args), _internal_ids=iter([-1]))
+    executive = types.SimpleNamespace(_post=lambda *args: sent.append(args), _internal_ids=iter([-1]),
+                                      spec=types.SimpleNamespace(services={}))
     with pytest.raises(TypeError, match=r"inputs of GOTO: give a tuple .* not dict \{'x': 3.0\}"):
         rx.Executive.request(executive, "GOTO", inputs={"x": 3.0})  # type: ignore[arg-type]
     assert not sent
