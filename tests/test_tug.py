@@ -338,4 +338,3 @@ def test_a_run_with_a_mutant_of_the_planning_model_says_which(tmp_path: Path) ->
         "warehouse-0001 to warehouse-" in wrong.stderr
     unplanned = specc("run", TUG, "--mission", "deliver", "--mutant", "warehouse-0001", "--runs", tmp_path)
     assert unplanned.returncode == 2 and "mission deliver of robot 'tug' is not planned" in unplanned.stderr
-

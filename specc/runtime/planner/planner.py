@@ -120,6 +120,19 @@ class Attempt:
 
 
 
+def forget_caches() -> None:
+    """Drop what the plannings of this process worked out and keep for the next ones (tasks'
+    durations and constraints by binding, the validator's checks): a planning after it does a
+    first planning's work. A comparison of one planning with another planner's (`make bench`)
+    starts from here."""
+    from specc.runtime.planner import numeric, search, validate
+
+    for table in (numeric._READERS, numeric._DURATIONS, numeric._TASK_CONSTRAINTS, search._TASK_CONSTRAINTS):
+        table.clear()
+    numeric.exact_duration.cache_clear()
+    validate.check_task.cache_clear()
+
+
 class Planner:
     def __init__(self, domain: pm.PlanningDomain, *, nodes: int = 300, goal_nodes: int = 300,
                  exact: bool = True, limits: Limits | None = None, controllability: str = STRONG,
