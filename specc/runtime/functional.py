@@ -435,7 +435,7 @@ class TaskRunner:
 
     def initialise(self) -> None:
         if not self.initialised and self.spec.init is not None:
-            if self.module.call_permanent(self.spec.init, "init"):
+            if self.module.call_permanent(self.spec.init, "init", self.spec.name):
                 self.module.cycle_done(self.spec.init)
         self.initialised = True
 
@@ -461,7 +461,7 @@ class TaskRunner:
             self.initialise()
         permanent = self.spec.permanent
         if permanent is not None:
-            if module.call_permanent(permanent):
+            if module.call_permanent(permanent, task=self.spec.name):
                 module.cycle_done(permanent)
         if self.activities:
             for activity in list(self.activities):
@@ -497,9 +497,10 @@ class Module:
         self.observers: list[Callable[[Module, Activity, State, State], None]] = []
         self.reply_listeners: list[ReplySink] = []  # see every reply the module sends (reflexes, logs)
         self._functions: dict[str, Callable[..., Any]] = {}
-        # Permanent codels raising on every cycle: codel -> (the first raise's date, raises in a row).
-        # A robot lives on with one for hours; its incidents say the first, then the count (`_raised`).
-        self._raising: dict[str, tuple[float, int]] = {}
+        # Permanent codels raising on every cycle, by (exec task, codel): the first raise's date and the
+        # raises in a row. A robot lives on with one for hours; its incidents say the first, then the
+        # count (`_raised`).
+        self._raising: dict[tuple[str, str], tuple[float, int]] = {}
         # A poster's activity is a request, or a codel (of a request or an exec task) whose cycles update it.
         self._auto_posters: dict[str, list[Poster[Any]]] = {}
         for poster_spec in spec.posters:
@@ -811,27 +812,27 @@ class Module:
         finally:
             self.registry.current = previous
 
-    def call_permanent(self, name: str, kind: str = "permanent") -> bool:
+    def call_permanent(self, name: str, kind: str = "permanent", task: str = "") -> bool:
         """Run a permanent (or init) codel; False when it raised (an incident): then the posters
         named after it keep their last date, so that no reader takes stale data for fresh."""
         try:
             self.function(name)(self.sdi)
         except CODE_ERRORS as exc:
-            self._raised(name, kind, self.explain(exc))
+            self._raised(name, kind, self.explain(exc), task)
             return False
-        streak = self._raising.pop(name, None)
+        streak = self._raising.pop((task, name), None)
         if streak is not None and streak[1] > 1:
             self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: {kind} codel '{name}' ran again "
                                            f"after raising {streak[1]:,} times in a row since {streak[0]:.3f} s")
         return True
 
-    def _raised(self, name: str, kind: str, said: str) -> None:
+    def _raised(self, name: str, kind: str, said: str, task: str = "") -> None:
         """An incident for the first raise of a streak, then one at its 10th, 100th, 1,000th... raise:
         a codel raising on every cycle of a long run fills no log."""
         now = self.kernel.now
-        first, count = self._raising.get(name, (now, 0))
+        first, count = self._raising.get((task, name), (now, 0))
         count += 1
-        self._raising[name] = (first, count)
+        self._raising[task, name] = (first, count)
         if count == 1:
             self.registry.incidents.append(f"{now:.3f} {self.name}: {kind} codel '{name}' raised {said}")
         elif _power_of_ten(count):
