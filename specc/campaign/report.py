@@ -100,6 +100,7 @@ class CampaignReport:
     # Activities (a mutant, or the original, in a mission, world and seed) left out of the means
     # because some configuration did not finish them: the means compare the same experiments.
     unpaired: int = 0
+    ledger_judged: bool = False  # some experiment's goals were counted as FTplan's ledger believed them
 
     def with_verdict(self, verdict: str) -> list[MutantRecord]:
         return [m for m in self.mutants if m.verdict == verdict]
@@ -108,9 +109,6 @@ class CampaignReport:
     def failed(self) -> list[Outcome]:
         return [o for o in self.outcomes if o.status != "done"]
 
-    def measured(self) -> list[Measures]:
-        """The measures of the experiments that ran to their end."""
-        return [Measures.from_json(o.measures) for o in self.outcomes if o.status == "done" and o.measures]
 
 
 def build_report(store: ResultStore) -> CampaignReport:
@@ -120,6 +118,7 @@ def build_report(store: ResultStore) -> CampaignReport:
     configurations: list[str] = list(description.get("configurations", []))
     kept = {m.id for m in mutants if m.verdict == KEPT}
     measures = [(o, Measures.from_json(o.measures)) for o in outcomes if o.status == "done" and o.measures]
+    ledger_judged = any(not m.judged_by_robot for _, m in measures)
     # The configurations are compared on the same mutants and activities: an experiment one of
     # them did not finish (a timeout, a crash) leaves that activity out of every one's means,
     # instead of a failure left out of one side only.
@@ -157,7 +156,8 @@ def build_report(store: ResultStore) -> CampaignReport:
             if all(v is not None for v in faulty + free):
                 headlines.append(Headline(label, first, second, faulty, free))  # type: ignore[arg-type]
     return CampaignReport(description, mutants, outcomes, tuple(means), tuple(per_mutant), tuple(headlines),
-                          coverage(description, mutants, outcomes), len(unpaired))
+                          coverage(description, mutants, outcomes), len(unpaired),
+                          ledger_judged)
 
 
 def _paired(o: Outcome) -> tuple[str, str, str, int]:
@@ -222,7 +222,7 @@ def markdown(report: CampaignReport) -> str:
                  f"{counts[UNJUDGED]}" if counts[UNJUDGED] else ""),
               f"- experiments: {len(report.outcomes)} ({len(report.failed)} crashed or timed out): "
               + "; ".join(f"{c.configuration} {c.done:,} of {c.expected:,}" for c in report.coverage)]
-    if any(not m.judged_by_robot for m in report.measured()):
+    if report.ledger_judged:
         lines.append("- **goals counted as FTplan believed them:** the robot's extension judges no goal in the "
                      "world (a `measure` hook, docs/your-robot.md §8), so a goal counts as met when FTplan's "
                      "ledger says so. A mutant that corrupts FTplan's model of the world (a wrong effect) can "

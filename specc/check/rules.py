@@ -321,22 +321,22 @@ def check_rules_never_fire(ctx: Context, base: m.RuleBase, visitor: RuleVisitor)
     for rule in base.rules:
         if rule not in plain:  # an else rule, a rule written per element: taken to fire
             valued |= set().union(*(sets(r) for r in (rule.rules if isinstance(rule, m.RuleForeach) else (rule,))))
-    waiting = [(rule, needs(rule.condition)) for rule in plain]
+    waiting = [(rule, needs(rule.condition), sets(rule)) for rule in plain]
     grew = True
     while grew:
         grew = False
-        for rule, alternatives in waiting:
-            if any(reads <= valued for reads in alternatives) and not sets(rule) <= valued:
-                valued |= sets(rule)
+        for _, alternatives, targets in waiting:
+            if any(reads <= valued for reads in alternatives) and not targets <= valued:
+                valued |= targets
                 grew = True
-    deduced = {name for rule in plain for name in sets(rule)}
-    for rule, alternatives in waiting:
+    deduced = {name for _, _, targets in waiting for name in targets}
+    for rule, alternatives, _ in waiting:
         if any(reads <= valued for reads in alternatives):
             continue
         fewest = min((reads - valued for reads in alternatives), key=len)
         missing = sorted(fewest)
         if missing and set(missing) <= deduced & visitor.set_otherwise:  # else `undefined-attribute` says it
-            setters = sorted(r.name for r in plain if sets(r) & set(missing))
+            setters = sorted(r.name for r, _, targets in waiting if targets & set(missing))
             said = " and ".join(f"'{name}'" for name in missing)
             one = len(missing) == 1
             ctx.warn("rule-never-fires", f"rule '{rule.name}' can never fire: {said} {'gets' if one else 'get'} a "

@@ -65,6 +65,14 @@ class MutationTarget:
         return format_source(source, self.written, list(self.comments))
 
     @cached_property
+    def line_starts(self) -> list[int]:
+        """Where each line of the file as written starts (and one past its end): a mutant's span in it."""
+        starts = [0]
+        for line in self.written.split("\n"):
+            starts.append(starts[-1] + len(line) + 1)
+        return starts
+
+    @cached_property
     def original_text(self) -> str:
         """The domain's file printed (the file itself when `specc fmt` leaves it as it is)."""
         return self.print(self.source)
@@ -342,9 +350,7 @@ def _written_in_place(target: MutationTarget, edit: Edit) -> str | None:
     new = _node_text(edit.new) if edit.new is not None else ""
     if old is None or new is None:
         return None
-    starts = [0]
-    for line in written.split("\n"):
-        starts.append(starts[-1] + len(line) + 1)
+    starts = target.line_starts
     if span.end_line >= len(starts):
         return None
     start, end = starts[span.line - 1] + span.column - 1, starts[span.end_line - 1] + span.end_column - 1

@@ -335,7 +335,6 @@ def _plan_system(robot: Any, request: RunRequest) -> _Plan:
     return _Plan((mission.name, world_name, configuration), run)
 
 
-
 def _checked_goal(robot: Any, text: str, specs: Path) -> str:
     """A goal given on the command line: PRS syntax, for a goal some KA of the supervisor is invoked by."""
     from specc.runtime.procedures import parse_goal

@@ -570,8 +570,6 @@ class Module:
             self.refuse(self.reply(rqst_id, request, Status.CS_ERROR, Report(
                 "UNKNOWN_REQUEST", f"module '{self.name}' has no request '{request}'")), sink, parent)
             return rqst_id
-        if spec.input_type is not None and isinstance(input_, spec.input_type):
-            as_declared(input_)  # `client.setMode("FAST")`: an enum's name is its member, as in a codel's writes
         problem = check_record(input_, spec.input_type)
         if problem:
             self.refuse(self.reply(rqst_id, request, Status.FINAL_ERROR, Report("BAD_INPUT", problem)), sink,
@@ -820,7 +818,7 @@ class Module:
         except CODE_ERRORS as exc:
             self._raised(name, kind, self.explain(exc), task)
             return False
-        streak = self._raising.pop((task, name), None)
+        streak = self._raising.pop((task, name), None) if self._raising else None  # a dict lookup less a cycle
         if streak is not None and streak[1] > 1:
             self.registry.incidents.append(f"{self.kernel.now:.3f} {self.name}: {kind} codel '{name}' ran again "
                                            f"after raising {streak[1]:,} times in a row since {streak[0]:.3f} s")
@@ -1177,6 +1175,8 @@ class ModuleClient:
     def send(self, request: str, input_: Any = None, *, interm_timeout: float | None = None,
              final_timeout: float | None = None) -> int:
         """modFuncRqstSend: the request's id; its replies arrive through the kernel."""
+        if input_ is not None:  # `client.setMode("FAST")`: an enum's name is its member, as in a codel's writes
+            as_declared(input_)  # (the executive's and codels' requests are built so already)
         exchange = _Exchange(request)
         receive = self._receiver(exchange)
         rqst_id = self.module.submit(request, input_, receive)
